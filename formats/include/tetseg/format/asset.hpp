@@ -1,0 +1,85 @@
+#pragma once
+/// \file
+/// The tetseg asset: everything the runtime needs to cull and query self-collisions of one
+/// deformable tetrahedral object, and nothing it does not. Plain structs, written by the
+/// preprocessor (`tetseg build`) and read by the runtime. The byte layout is in docs/format.md.
+///
+/// All indices are 0-based. "Node" always means a node of the tetrahedral mesh: the runtime
+/// receives positions of all nodes each step, so surface triangles and detector points refer
+/// to tet-mesh node ids.
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace tetseg::format {
+
+/// Asset format version. Major must match to load; an asset with an older or equal minor
+/// version loads, a newer minor does not.
+inline constexpr std::uint16_t kVersionMajor = 1;
+inline constexpr std::uint16_t kVersionMinor = 0;
+
+/// Documented limits, checked on load (docs/format.md). They bound memory for hostile input.
+inline constexpr std::uint32_t kMaxNodes = 1u << 26;          ///< 67,108,864 tet-mesh nodes
+inline constexpr std::uint32_t kMaxTriangles = 1u << 25;      ///< 33,554,432 surface triangles
+inline constexpr std::uint32_t kMaxClusters = 1u << 20;       ///< 1,048,576 clusters
+inline constexpr std::uint32_t kMaxBoundaryLoops = 1u << 20;  ///< segment-boundary loops
+inline constexpr std::uint32_t kMaxStringBytes = 1u << 16;    ///< one provenance string
+inline constexpr std::uint32_t kMaxProvenanceOptions = 1024;  ///< provenance key/value pairs
+
+using Triangle = std::array<std::uint32_t, 3>;  ///< tet-mesh node ids, wound outward
+
+/// One node of a cluster's bounding-volume hierarchy. Node indices are local to the cluster
+/// (0 = root). A leaf has `count > 0` and covers `Cluster` triangles
+/// `[first, first + count)` of the cluster's triangle list (local positions, BVH leaf order).
+/// An inner node has `count == 0` and children `first` and `second`, both with a larger index
+/// than the node itself, so iterating nodes in reverse order refits bottom-up.
+struct BvhNode {
+  std::uint32_t first = 0;   ///< leaf: first local triangle; inner: left child
+  std::uint32_t second = 0;  ///< leaf: unused (0); inner: right child
+  std::uint32_t count = 0;   ///< leaf: triangle count (> 0); inner: 0
+};
+
+/// A cluster: a connected patch of the surface bounded by segment boundaries, culled with
+/// radial views from its detector node.
+struct Cluster {
+  std::uint32_t detector_node = 0;        ///< interior tet-mesh node (not on the surface)
+  float rest_positive_fraction = 0.0f;    ///< in [0,1]: share of triangles positive at rest
+  std::uint32_t triangle_offset = 0;      ///< into Asset::cluster_triangles
+  std::uint32_t triangle_count = 0;       ///< > 0
+  std::uint32_t bvh_offset = 0;           ///< into Asset::bvh_nodes
+  std::uint32_t bvh_count = 0;            ///< > 0; 2 * leaves - 1
+};
+
+/// A segment boundary: a closed edge loop of surface nodes (consecutive nodes share a surface
+/// edge, and the last connects back to the first).
+struct BoundaryLoop {
+  std::uint32_t node_offset = 0;  ///< into Asset::boundary_nodes
+  std::uint32_t node_count = 0;   ///< >= 3
+};
+
+/// Where an asset came from: enough to rebuild it byte for byte.
+struct Provenance {
+  std::string tool_version;  ///< e.g. "tetseg 0.1.0"
+  std::string source;        ///< input file name (no directories)
+  std::vector<std::pair<std::string, std::string>> options;  ///< sorted by key
+};
+
+/// The whole asset. Clusters are stored contiguously: cluster c owns
+/// `cluster_triangles[clusters[c].triangle_offset ..+ triangle_count]` (surface triangle ids,
+/// in BVH leaf order) and `bvh_nodes[clusters[c].bvh_offset ..+ bvh_count]`.
+struct Asset {
+  std::uint32_t node_count = 0;                 ///< tet-mesh nodes the runtime expects per step
+  std::vector<Triangle> triangles;              ///< surface triangles, outward winding
+  std::vector<std::uint32_t> triangle_cluster;  ///< per triangle: its cluster id
+  std::vector<Cluster> clusters;
+  std::vector<std::uint32_t> cluster_triangles;  ///< surface triangle ids grouped by cluster
+  std::vector<BvhNode> bvh_nodes;                ///< all clusters' BVH nodes, grouped
+  std::vector<BoundaryLoop> boundaries;
+  std::vector<std::uint32_t> boundary_nodes;  ///< loops' node ids, grouped
+  Provenance provenance;
+};
+
+}  // namespace tetseg::format

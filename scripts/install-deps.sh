@@ -1,0 +1,29 @@
+#!/usr/bin/env bash
+# Installs every build and test dependency of tetseg from Debian 12 packages.
+# Run as root (or with sudo). Safe to run again: already-installed packages are skipped.
+set -euo pipefail
+
+packages=(
+  build-essential cmake ninja-build ccache pkg-config
+  libcgal-dev libcgal-demo libgmp-dev libmpfr-dev libboost-dev   # preprocess (CGAL, GPL)
+  libeigen3-dev libassimp-dev libomp-dev                           # preprocess
+  libcereal-dev                                                    # asset payload (header-only)
+  libcli11-dev                                                     # command-line tools
+  catch2                                                           # tests
+  clang libclang-rt-14-dev                                         # libFuzzer target
+  python3                                                          # test helpers
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if ((${#missing[@]})); then
+  SUDO=""
+  [ "$(id -u)" -ne 0 ] && SUDO="sudo"
+  echo "install-deps: installing ${missing[*]}"
+  $SUDO apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+else
+  echo "install-deps: all ${#packages[@]} packages present"
+fi

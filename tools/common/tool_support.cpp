@@ -1,0 +1,75 @@
+#include "tool_support.hpp"
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <iostream>
+#include <cctype>
+
+#include <unistd.h>
+
+namespace tetseg::tools {
+
+void print_error(const std::string& tool, const std::string& file, const std::string& message) {
+  std::cerr << tool << ": error: ";
+  if (!file.empty()) std::cerr << file << ": ";
+  std::cerr << message << '\n';
+}
+
+void write_file_atomic(const std::string& path, const void* bytes, std::size_t size) {
+  const std::string temp = path + ".tmp" + std::to_string(::getpid());
+  std::FILE* file = std::fopen(temp.c_str(), "wb");
+  if (!file) throw ToolError(kExitOutputFailed, path, std::string("cannot write: ") + std::strerror(errno));
+  const bool written = size == 0 || std::fwrite(bytes, 1, size, file) == size;
+  const bool flushed = std::fflush(file) == 0;
+  const bool closed = std::fclose(file) == 0;
+  if (!written || !flushed || !closed) {
+    const int saved = errno;
+    std::remove(temp.c_str());
+    throw ToolError(kExitOutputFailed, path, std::string("write failed: ") + std::strerror(saved));
+  }
+  if (std::rename(temp.c_str(), path.c_str()) != 0) {
+    const int saved = errno;
+    std::remove(temp.c_str());
+    throw ToolError(kExitOutputFailed, path, std::string("cannot rename into place: ") + std::strerror(saved));
+  }
+}
+
+std::string base_name(const std::string& path) {
+  const auto slash = path.find_last_of('/');
+  return slash == std::string::npos ? path : path.substr(slash + 1);
+}
+
+std::string extension_of(const std::string& path) {
+  const std::string name = base_name(path);
+  const auto dot = name.find_last_of('.');
+  if (dot == std::string::npos || dot == 0) return {};
+  std::string ext = name.substr(dot);
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext;
+}
+
+std::string json_escape(const std::string& text) {
+  std::string out;
+  out.reserve(text.size());
+  for (unsigned char c : text) {
+    switch (c) {
+      case '"': out += "\\\""; break;
+      case '\\': out += "\\\\"; break;
+      case '\n': out += "\\n"; break;
+      case '\t': out += "\\t"; break;
+      case '\r': out += "\\r"; break;
+      default:
+        if (c < 0x20) {
+          char buf[8];
+          std::snprintf(buf, sizeof buf, "\\u%04x", c);
+          out += buf;
+        } else {
+          out += static_cast<char>(c);
+        }
+    }
+  }
+  return out;
+}
+
+}  // namespace tetseg::tools

@@ -1,0 +1,57 @@
+#pragma once
+/// \file
+/// What every tetseg command-line tool shares: exit codes, error reporting, atomic output.
+
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace tetseg::tools {
+
+/// Exit codes of every tetseg tool (docs/cli.md).
+enum ExitCode : int {
+  kExitOk = 0,
+  kExitProcessingFailed = 1,
+  kExitUsage = 2,
+  kExitBadInput = 3,
+  kExitOutputFailed = 4,
+};
+
+/// An error that ends the tool with `code` after printing `<tool>: error: <file>: <message>`.
+class ToolError : public std::runtime_error {
+ public:
+  ToolError(int code, std::string file, const std::string& message)
+      : std::runtime_error(message), m_code(code), m_file(std::move(file)) {}
+  int code() const noexcept { return m_code; }
+  const std::string& file() const noexcept { return m_file; }
+
+ private:
+  int m_code;
+  std::string m_file;
+};
+
+/// Prints `<tool>: error: <file>: <message>` (or without the file when empty) to stderr.
+void print_error(const std::string& tool, const std::string& file, const std::string& message);
+
+/// Writes `bytes` to `path` through a temporary file in the same directory and a rename, so
+/// readers never see a partial file. Throws ToolError(kExitOutputFailed) on failure and leaves
+/// no temporary file behind.
+void write_file_atomic(const std::string& path, const void* bytes, std::size_t size);
+inline void write_file_atomic(const std::string& path, const std::string& text) {
+  write_file_atomic(path, text.data(), text.size());
+}
+inline void write_file_atomic(const std::string& path, const std::vector<std::uint8_t>& bytes) {
+  write_file_atomic(path, bytes.data(), bytes.size());
+}
+
+/// File name without directories ("a/b/c.mesh" -> "c.mesh").
+std::string base_name(const std::string& path);
+
+/// Lower-case extension with the dot (".mesh"), or "" when there is none.
+std::string extension_of(const std::string& path);
+
+/// Escapes a string for a JSON string literal (without the surrounding quotes).
+std::string json_escape(const std::string& text);
+
+}  // namespace tetseg::tools
