@@ -72,6 +72,10 @@ struct Provenance {
 /// in BVH leaf order) and `bvh_nodes[clusters[c].bvh_offset ..+ bvh_count]`.
 struct Asset {
   std::uint32_t node_count = 0;                 ///< tet-mesh nodes the runtime expects per step
+  /// Rest positions of all nodes (length units of the input), or empty when stripped
+  /// (`tetseg build --no-rest-positions`). Used for the `bvh` mode's initial topology, the
+  /// rest-intersection check and by tools that draw the asset; never required per frame.
+  std::vector<std::array<double, 3>> rest_positions;
   std::vector<Triangle> triangles;              ///< surface triangles, outward winding
   std::vector<std::uint32_t> triangle_cluster;  ///< per triangle: its cluster id
   std::vector<Cluster> clusters;

@@ -1,0 +1,73 @@
+#pragma once
+/// \file
+/// From equalised charge density to clusters, segment boundaries, detector nodes and per-cluster
+/// BVH topology (Wong & Yeh, section IV-B/C). Decisions on the points the paper leaves open:
+/// docs/segmentation.md.
+
+#include <cstdint>
+#include <vector>
+
+#include "tetseg/format/asset.hpp"
+#include "tetseg/preprocess/charge.hpp"
+#include "tetseg/preprocess/mesh.hpp"
+
+namespace tetseg::preprocess {
+
+enum class DetectorStrategy {
+  kNearestCentroid,  ///< the paper: interior node nearest the cluster centroid
+  kVisibility,       ///< among nearby interior nodes, the one seeing most triangles positive
+};
+
+struct SegmentationOptions {
+  double alpha = 0.1;           ///< triangles with equalised density < alpha are marked
+  double beta_divisor = 400.0;  ///< segments larger than N / beta_divisor triangles are grown
+  Equalization equalization = Equalization::kHistogram;
+  double growth_bound = 0.25;   ///< a segment never grows beyond this fraction of the surface
+  std::uint32_t min_cluster_triangles = 0;  ///< 0 = derived (docs/segmentation.md)
+  DetectorStrategy detector = DetectorStrategy::kVisibility;
+};
+
+struct SegmentationCounts {
+  std::uint32_t segments_found = 0;
+  std::uint32_t segments_grown = 0;
+  std::uint32_t segments_shrunk = 0;
+  std::uint32_t boundaries = 0;
+  std::uint32_t clusters = 0;
+  std::uint32_t clusters_merged = 0;
+};
+
+struct Segmentation {
+  std::vector<std::uint32_t> triangle_cluster;           ///< per surface triangle
+  std::uint32_t cluster_count = 0;
+  std::vector<std::vector<std::uint32_t>> boundary_loops;  ///< closed loops of node ids
+  SegmentationCounts counts;
+};
+
+/// Segments the surface using the equalised density (one value per surface triangle).
+/// Deterministic. Every triangle ends in exactly one cluster.
+Segmentation segment_surface(const std::vector<Vec3>& nodes, const Surface& surface,
+                             const std::vector<double>& equalized,
+                             const SegmentationOptions& options);
+
+struct Detector {
+  std::uint32_t node = 0;               ///< interior tet-mesh node id
+  float rest_positive_fraction = 0.0f;  ///< share of the cluster's triangles positive at rest
+};
+
+/// One detector per cluster (cluster ids 0..cluster_count-1). Requires at least one interior
+/// node; throws InputError otherwise.
+std::vector<Detector> choose_detectors(const std::vector<Vec3>& nodes, const Surface& surface,
+                                       const std::vector<std::uint32_t>& triangle_cluster,
+                                       std::uint32_t cluster_count, DetectorStrategy strategy);
+
+struct ClusterBvh {
+  std::vector<std::uint32_t> triangles;  ///< the cluster's surface triangle ids, leaf order
+  std::vector<format::BvhNode> nodes;    ///< local indices, root 0, children after parents
+};
+
+/// Builds the BVH topology of one cluster from rest positions (deterministic median split on
+/// the longest axis of the centroid box; one triangle per leaf).
+ClusterBvh build_cluster_bvh(const std::vector<Vec3>& nodes, const std::vector<Tri>& triangles,
+                             std::vector<std::uint32_t> cluster_triangle_ids);
+
+}  // namespace tetseg::preprocess
