@@ -1,0 +1,62 @@
+#pragma once
+/// \file
+/// The whole preprocessing pipeline: tet mesh -> surface -> charge -> segmentation -> detector
+/// nodes -> BVH topology -> asset. What `tetseg build` runs.
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "tetseg/format/asset.hpp"
+#include "tetseg/preprocess/charge.hpp"
+#include "tetseg/preprocess/mesh.hpp"
+#include "tetseg/preprocess/segmentation.hpp"
+
+namespace tetseg::preprocess {
+
+/// How the surface is cut into clusters.
+enum class ClusterMethod {
+  kSingle,  ///< one cluster (no charge, no segmentation)
+  kCharge,  ///< the paper: charge density, segment boundaries, clusters
+};
+
+struct BuildOptions {
+  ClusterMethod clusters = ClusterMethod::kCharge;
+  ChargeOptions charge;
+  SegmentationOptions segmentation;
+  bool keep_rest_positions = true;  ///< store rest positions in the asset (docs/format.md)
+};
+
+/// One finished stage: its name, wall time and a short human summary.
+struct StageReport {
+  std::string name;
+  double seconds = 0.0;
+  std::string summary;
+};
+
+/// Counts and times of one build, for `--report`.
+struct BuildReport {
+  std::vector<StageReport> stages;
+  std::uint32_t nodes = 0;
+  std::uint32_t tets = 0;
+  std::uint32_t surface_triangles = 0;
+  std::uint32_t interior_nodes = 0;
+  std::uint32_t clusters = 0;
+  std::uint32_t boundaries = 0;
+  SegmentationCounts segmentation;
+  ChargeResult charge;  ///< density left empty; solver figures only
+  std::vector<float> rest_positive_fraction;  ///< per cluster
+};
+
+/// Options as the key/value pairs recorded in the asset's provenance (sorted by key).
+std::vector<std::pair<std::string, std::string>> provenance_options(const BuildOptions& options);
+
+/// Runs every stage on a tet mesh read from `source` (used in messages and provenance: only
+/// its file name is stored). Validates the mesh first (InputError on defects). Calls
+/// `on_stage` after each stage when given. Deterministic: equal input gives an equal asset.
+format::Asset build_asset(const TetMesh& mesh, const std::string& source,
+                          const BuildOptions& options, BuildReport& report,
+                          const std::function<void(const StageReport&)>& on_stage = {});
+
+}  // namespace tetseg::preprocess

@@ -1,0 +1,206 @@
+#include "tetseg/preprocess/pipeline.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <numeric>
+#include <sstream>
+
+#include "tetseg/format/asset_io.hpp"
+#include "tetseg/preprocess/surface.hpp"
+
+namespace tetseg::preprocess {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+std::string format_number(double value) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof buffer, "%.17g", value);
+  return buffer;
+}
+
+const char* solver_name(ChargeSolver solver) {
+  switch (solver) {
+    case ChargeSolver::kAuto: return "auto";
+    case ChargeSolver::kDirect: return "direct";
+    case ChargeSolver::kGmres: return "gmres";
+    case ChargeSolver::kFast: return "fast";
+  }
+  return "auto";
+}
+
+const char* equalization_name(Equalization method) {
+  switch (method) {
+    case Equalization::kHistogram: return "histogram";
+    case Equalization::kRank: return "rank";
+    case Equalization::kLogHistogram: return "log-histogram";
+  }
+  return "histogram";
+}
+
+const char* detector_name(DetectorStrategy strategy) {
+  return strategy == DetectorStrategy::kNearestCentroid ? "nearest-centroid" : "visibility";
+}
+
+std::string base_name(const std::string& path) {
+  const auto slash = path.find_last_of('/');
+  return slash == std::string::npos ? path : path.substr(slash + 1);
+}
+
+// Times one stage and reports it.
+class StageTimer {
+ public:
+  StageTimer(BuildReport& report, const std::function<void(const StageReport&)>& on_stage)
+      : m_report(report), m_on_stage(on_stage) {}
+  template <typename F>
+  auto run(const char* name, F&& work) {
+    const auto start = Clock::now();
+    StageReport stage;
+    stage.name = name;
+    auto result = work(stage.summary);
+    stage.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+    m_report.stages.push_back(stage);
+    if (m_on_stage) m_on_stage(stage);
+    return result;
+  }
+
+ private:
+  BuildReport& m_report;
+  const std::function<void(const StageReport&)>& m_on_stage;
+};
+
+}  // namespace
+
+std::vector<std::pair<std::string, std::string>> provenance_options(const BuildOptions& options) {
+  const SegmentationOptions& seg = options.segmentation;
+  std::vector<std::pair<std::string, std::string>> out = {
+      {"clusters", options.clusters == ClusterMethod::kSingle ? "single" : "charge"},
+      {"charge.solver", solver_name(options.charge.solver)},
+      {"charge.tolerance", format_number(options.charge.tolerance)},
+      {"segmentation.alpha", format_number(seg.alpha)},
+      {"segmentation.beta_divisor", format_number(seg.beta_divisor)},
+      {"segmentation.equalization", equalization_name(seg.equalization)},
+      {"segmentation.growth_bound", format_number(seg.growth_bound)},
+      {"segmentation.min_cluster_triangles", std::to_string(seg.min_cluster_triangles)},
+      {"segmentation.detector", detector_name(seg.detector)},
+      {"rest_positions", options.keep_rest_positions ? "yes" : "no"},
+  };
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+format::Asset build_asset(const TetMesh& mesh, const std::string& source,
+                          const BuildOptions& options, BuildReport& report,
+                          const std::function<void(const StageReport&)>& on_stage) {
+  StageTimer timer(report, on_stage);
+  report.nodes = static_cast<std::uint32_t>(mesh.nodes.size());
+  report.tets = static_cast<std::uint32_t>(mesh.tets.size());
+
+  const Surface surface = timer.run("surface", [&](std::string& summary) {
+    Surface s = extract_surface(mesh);
+    validate_tet_mesh(mesh, s, source);
+    summary = std::to_string(s.triangles.size()) + " triangles, " +
+              std::to_string(s.interior_nodes.size()) + " interior nodes";
+    return s;
+  });
+  report.surface_triangles = static_cast<std::uint32_t>(surface.triangles.size());
+  report.interior_nodes = static_cast<std::uint32_t>(surface.interior_nodes.size());
+  if (surface.interior_nodes.empty()) {
+    throw InputError(source, "tet mesh has no interior node to serve as a detector point "
+                             "(refine the mesh or tetrahedralise with a smaller cell size)");
+  }
+
+  Segmentation segmentation;
+  if (options.clusters == ClusterMethod::kSingle) {
+    segmentation.triangle_cluster.assign(surface.triangles.size(), 0);
+    segmentation.cluster_count = 1;
+    segmentation.counts.clusters = 1;
+  } else {
+    ChargeResult charge = timer.run("charge", [&](std::string& summary) {
+      ChargeResult r = compute_charge(mesh.nodes, surface.triangles, options.charge, source);
+      std::ostringstream text;
+      text << r.solver << ", " << r.iterations << " iterations, residual " << r.residual
+           << ", capacitance " << r.capacitance;
+      summary = text.str();
+      return r;
+    });
+    const std::vector<double> equalized = timer.run("equalize", [&](std::string& summary) {
+      summary = equalization_name(options.segmentation.equalization);
+      return equalize(charge.density, options.segmentation.equalization);
+    });
+    charge.density.clear();
+    report.charge = std::move(charge);
+    segmentation = timer.run("segmentation", [&](std::string& summary) {
+      Segmentation s = segment_surface(mesh.nodes, surface, equalized, options.segmentation);
+      summary = std::to_string(s.counts.segments_found) + " segments, " +
+                std::to_string(s.boundary_loops.size()) + " boundaries, " +
+                std::to_string(s.cluster_count) + " clusters";
+      return s;
+    });
+  }
+  report.segmentation = segmentation.counts;
+  report.clusters = segmentation.cluster_count;
+  report.boundaries = static_cast<std::uint32_t>(segmentation.boundary_loops.size());
+
+  const std::vector<Detector> detectors = timer.run("detectors", [&](std::string& summary) {
+    std::vector<Detector> d =
+        choose_detectors(mesh.nodes, surface, segmentation.triangle_cluster,
+                         segmentation.cluster_count, options.segmentation.detector);
+    double worst = 1.0;
+    for (const Detector& detector : d) worst = std::min<double>(worst, detector.rest_positive_fraction);
+    std::ostringstream text;
+    text << d.size() << " detector nodes, lowest rest visibility " << worst;
+    summary = text.str();
+    return d;
+  });
+
+  format::Asset asset;
+  asset.node_count = static_cast<std::uint32_t>(mesh.nodes.size());
+  asset.triangles = surface.triangles;
+  asset.triangle_cluster = segmentation.triangle_cluster;
+  timer.run("bvh", [&](std::string& summary) {
+    std::vector<std::vector<std::uint32_t>> members(segmentation.cluster_count);
+    for (std::uint32_t t = 0; t < segmentation.triangle_cluster.size(); ++t) {
+      members[segmentation.triangle_cluster[t]].push_back(t);
+    }
+    for (std::uint32_t c = 0; c < segmentation.cluster_count; ++c) {
+      ClusterBvh bvh = build_cluster_bvh(mesh.nodes, surface.triangles, members[c]);
+      format::Cluster cluster;
+      cluster.detector_node = detectors[c].node;
+      cluster.rest_positive_fraction = detectors[c].rest_positive_fraction;
+      cluster.triangle_offset = static_cast<std::uint32_t>(asset.cluster_triangles.size());
+      cluster.triangle_count = static_cast<std::uint32_t>(bvh.triangles.size());
+      cluster.bvh_offset = static_cast<std::uint32_t>(asset.bvh_nodes.size());
+      cluster.bvh_count = static_cast<std::uint32_t>(bvh.nodes.size());
+      asset.cluster_triangles.insert(asset.cluster_triangles.end(), bvh.triangles.begin(),
+                                     bvh.triangles.end());
+      asset.bvh_nodes.insert(asset.bvh_nodes.end(), bvh.nodes.begin(), bvh.nodes.end());
+      asset.clusters.push_back(cluster);
+    }
+    summary = std::to_string(asset.bvh_nodes.size()) + " nodes";
+    return 0;
+  });
+  for (const auto& loop : segmentation.boundary_loops) {
+    format::BoundaryLoop boundary;
+    boundary.node_offset = static_cast<std::uint32_t>(asset.boundary_nodes.size());
+    boundary.node_count = static_cast<std::uint32_t>(loop.size());
+    asset.boundary_nodes.insert(asset.boundary_nodes.end(), loop.begin(), loop.end());
+    asset.boundaries.push_back(boundary);
+  }
+  if (options.keep_rest_positions) asset.rest_positions = mesh.nodes;
+  asset.provenance.tool_version = std::string("tetseg ") + TETSEG_VERSION_STRING;
+  asset.provenance.source = base_name(source);
+  asset.provenance.options = provenance_options(options);
+  for (const Detector& detector : detectors) {
+    report.rest_positive_fraction.push_back(detector.rest_positive_fraction);
+  }
+
+  std::string detail;
+  if (format::validate(asset, &detail) != format::Status::kOk) {
+    throw std::runtime_error("internal error: built asset does not validate: " + detail);
+  }
+  return asset;
+}
+
+}  // namespace tetseg::preprocess

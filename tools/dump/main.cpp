@@ -1,0 +1,148 @@
+// tetseg-dump: inspects an asset. Links the runtime only.
+
+#include <algorithm>
+#include <cstdio>
+#include <iostream>
+#include <map>
+#include <sstream>
+#include <unordered_map>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "tetseg/runtime/asset.hpp"
+#include "tool_support.hpp"
+
+namespace {
+
+using tetseg::format::Asset;
+
+/// Per cluster: edges of its triangles whose other triangle lies in another cluster.
+std::vector<std::uint32_t> boundary_edges_per_cluster(const Asset& asset) {
+  std::unordered_map<std::uint64_t, std::uint32_t> first_triangle;
+  std::vector<std::uint32_t> counts(asset.clusters.size(), 0);
+  first_triangle.reserve(asset.triangles.size() * 3);
+  for (std::uint32_t t = 0; t < asset.triangles.size(); ++t) {
+    const auto& tri = asset.triangles[t];
+    for (int k = 0; k < 3; ++k) {
+      const std::uint32_t a = std::min(tri[k], tri[(k + 1) % 3]);
+      const std::uint32_t b = std::max(tri[k], tri[(k + 1) % 3]);
+      const std::uint64_t key = (std::uint64_t{a} << 32) | b;
+      const auto [it, inserted] = first_triangle.emplace(key, t);
+      if (inserted) continue;
+      const std::uint32_t ca = asset.triangle_cluster[it->second];
+      const std::uint32_t cb = asset.triangle_cluster[t];
+      if (ca != cb) {
+        ++counts[ca];
+        ++counts[cb];
+      }
+    }
+  }
+  return counts;
+}
+
+std::string version_string() {
+  return std::to_string(tetseg::format::kVersionMajor) + "." +
+         std::to_string(tetseg::format::kVersionMinor);
+}
+
+void print_summary(const std::string& path, const Asset& asset) {
+  const auto edges = boundary_edges_per_cluster(asset);
+  std::printf("%s: tetseg asset, format %s\n", path.c_str(), version_string().c_str());
+  std::printf("  nodes               %u%s\n", asset.node_count,
+              asset.rest_positions.empty() ? " (no rest positions)" : "");
+  std::printf("  surface triangles   %zu\n", asset.triangles.size());
+  std::printf("  clusters            %zu\n", asset.clusters.size());
+  std::printf("  segment boundaries  %zu (%zu boundary nodes)\n", asset.boundaries.size(),
+              asset.boundary_nodes.size());
+  std::printf("  bvh nodes           %zu\n", asset.bvh_nodes.size());
+  std::printf("  provenance          %s, source %s\n", asset.provenance.tool_version.c_str(),
+              asset.provenance.source.c_str());
+  for (const auto& [key, value] : asset.provenance.options) {
+    std::printf("    %-36s %s\n", key.c_str(), value.c_str());
+  }
+  std::printf("  %-8s %10s %14s %18s %15s\n", "cluster", "triangles", "detector_node",
+              "rest_positive", "boundary_edges");
+  for (std::size_t c = 0; c < asset.clusters.size(); ++c) {
+    const auto& cluster = asset.clusters[c];
+    std::printf("  %-8zu %10u %14u %18.4f %15u\n", c, cluster.triangle_count,
+                cluster.detector_node, cluster.rest_positive_fraction, edges[c]);
+  }
+}
+
+void print_json(const Asset& asset) {
+  using tetseg::tools::json_escape;
+  const auto edges = boundary_edges_per_cluster(asset);
+  std::ostringstream out;
+  out.precision(9);
+  out << "{\n  \"format_version\": \"" << version_string() << "\",\n";
+  out << "  \"nodes\": " << asset.node_count << ",\n";
+  out << "  \"rest_positions\": " << (asset.rest_positions.empty() ? "false" : "true") << ",\n";
+  out << "  \"surface_triangles\": " << asset.triangles.size() << ",\n";
+  out << "  \"bvh_nodes\": " << asset.bvh_nodes.size() << ",\n";
+  out << "  \"clusters\": [";
+  for (std::size_t c = 0; c < asset.clusters.size(); ++c) {
+    const auto& cluster = asset.clusters[c];
+    out << (c ? ",\n    " : "\n    ") << "{\"triangles\": " << cluster.triangle_count
+        << ", \"detector_node\": " << cluster.detector_node
+        << ", \"rest_positive_fraction\": " << cluster.rest_positive_fraction
+        << ", \"boundary_edges\": " << edges[c] << ", \"bvh_nodes\": " << cluster.bvh_count << "}";
+  }
+  out << "\n  ],\n  \"segment_boundaries\": [";
+  for (std::size_t b = 0; b < asset.boundaries.size(); ++b) {
+    const auto& loop = asset.boundaries[b];
+    out << (b ? ", " : "") << "{\"nodes\": [";
+    for (std::uint32_t i = 0; i < loop.node_count; ++i) {
+      out << (i ? ", " : "") << asset.boundary_nodes[loop.node_offset + i];
+    }
+    out << "]}";
+  }
+  out << "],\n  \"provenance\": {\"tool_version\": \"" << json_escape(asset.provenance.tool_version)
+      << "\", \"source\": \"" << json_escape(asset.provenance.source) << "\", \"options\": {";
+  for (std::size_t i = 0; i < asset.provenance.options.size(); ++i) {
+    const auto& [key, value] = asset.provenance.options[i];
+    out << (i ? ", " : "") << '"' << json_escape(key) << "\": \"" << json_escape(value) << '"';
+  }
+  out << "}}\n}\n";
+  std::cout << out.str();
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using namespace tetseg::tools;
+  CLI::App app{"tetseg-dump " TETSEG_VERSION ": inspect a tetseg asset", "tetseg-dump"};
+  app.set_version_flag("--version", "tetseg-dump " TETSEG_VERSION);
+  std::string path;
+  bool json = false;
+  app.add_option("asset", path, "Asset file written by `tetseg build`")->required();
+  app.add_flag("--json", json, "Print JSON instead of the human summary");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);
+    return code == 0 ? kExitOk : kExitUsage;
+  }
+  try {
+    tetseg::Asset asset;
+    std::string detail;
+    const tetseg::Status status = tetseg::load_asset_file(path, asset, &detail);
+    if (status != tetseg::Status::kOk) {
+      print_error("tetseg-dump", path,
+                  std::string(tetseg::to_string(status)) + (detail.empty() ? "" : ": " + detail));
+      return kExitBadInput;
+    }
+    if (json) {
+      print_json(asset.data());
+    } else {
+      print_summary(path, asset.data());
+    }
+    return kExitOk;
+  } catch (const ToolError& e) {
+    print_error("tetseg-dump", e.file(), e.what());
+    return e.code();
+  } catch (const std::exception& e) {
+    print_error("tetseg-dump", path, e.what());
+    return kExitProcessingFailed;
+  }
+}

@@ -1,0 +1,214 @@
+// `tetseg build`: the whole pipeline from a mesh file to an asset.
+
+#include <chrono>
+#include <cstdio>
+#include <iostream>
+#include <map>
+#include <memory>
+#include <sstream>
+
+#include "commands.hpp"
+#include "tetseg/format/asset_io.hpp"
+#include "tetseg/preprocess/io.hpp"
+#include "tetseg/preprocess/meshing.hpp"
+#include "tetseg/preprocess/pipeline.hpp"
+#include "tetseg/preprocess/surface.hpp"
+#include "tool_support.hpp"
+
+namespace tetseg::tools {
+namespace {
+
+using namespace tetseg::preprocess;
+
+struct BuildArgs {
+  std::string input;
+  std::string output;
+  std::string report_path;
+  BuildOptions options;
+  MeshingOptions meshing;
+  bool no_rest_positions = false;
+  bool quiet = false;
+};
+
+void print_stage(const StageReport& stage, bool quiet) {
+  if (quiet) return;
+  std::fprintf(stderr, "tetseg: %-13s %8.3f s  %s\n", stage.name.c_str(), stage.seconds,
+               stage.summary.c_str());
+}
+
+std::string report_json(const BuildArgs& args, const BuildReport& report,
+                        const format::Asset& asset, std::size_t asset_bytes, double total) {
+  std::ostringstream out;
+  out.precision(9);
+  out << "{\n  \"input\": \"" << json_escape(args.input) << "\",\n";
+  out << "  \"output\": \"" << json_escape(args.output) << "\",\n";
+  out << "  \"asset_bytes\": " << asset_bytes << ",\n";
+  out << "  \"seconds\": {";
+  for (std::size_t i = 0; i < report.stages.size(); ++i) {
+    out << (i ? ", " : "") << '"' << report.stages[i].name << "\": " << report.stages[i].seconds;
+  }
+  out << ", \"total\": " << total << "},\n";
+  out << "  \"counts\": {\"nodes\": " << report.nodes << ", \"tets\": " << report.tets
+      << ", \"surface_triangles\": " << report.surface_triangles
+      << ", \"interior_nodes\": " << report.interior_nodes << ", \"clusters\": " << report.clusters
+      << ", \"boundaries\": " << report.boundaries << "},\n";
+  const SegmentationCounts& seg = report.segmentation;
+  out << "  \"segmentation\": {\"segments_found\": " << seg.segments_found
+      << ", \"segments_grown\": " << seg.segments_grown
+      << ", \"segments_shrunk\": " << seg.segments_shrunk << ", \"boundaries\": " << seg.boundaries
+      << ", \"clusters\": " << seg.clusters << ", \"clusters_merged\": " << seg.clusters_merged
+      << "},\n";
+  if (!report.charge.solver.empty()) {
+    const ChargeResult& c = report.charge;
+    out << "  \"charge\": {\"solver\": \"" << c.solver << "\", \"iterations\": " << c.iterations
+        << ", \"residual\": " << c.residual << ", \"capacitance\": " << c.capacitance
+        << ", \"assembly_seconds\": " << c.assembly_seconds
+        << ", \"solve_seconds\": " << c.solve_seconds << "},\n";
+  }
+  out << "  \"clusters\": [";
+  for (std::size_t c = 0; c < asset.clusters.size(); ++c) {
+    out << (c ? ",\n    " : "\n    ") << "{\"triangles\": " << asset.clusters[c].triangle_count
+        << ", \"detector_node\": " << asset.clusters[c].detector_node
+        << ", \"rest_positive_fraction\": " << asset.clusters[c].rest_positive_fraction << "}";
+  }
+  out << "\n  ],\n  \"options\": {";
+  for (std::size_t i = 0; i < asset.provenance.options.size(); ++i) {
+    const auto& [key, value] = asset.provenance.options[i];
+    out << (i ? ", " : "") << '"' << json_escape(key) << "\": \"" << json_escape(value) << '"';
+  }
+  out << "}\n}\n";
+  return out.str();
+}
+
+void run_build(const BuildArgs& args) {
+  using Clock = std::chrono::steady_clock;
+  const auto start = Clock::now();
+  BuildReport report;
+  auto on_stage = [&](const StageReport& stage) { print_stage(stage, args.quiet); };
+  auto timed = [&](const char* name, auto&& work) {
+    const auto t0 = Clock::now();
+    StageReport stage;
+    stage.name = name;
+    auto result = work(stage.summary);
+    stage.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+    report.stages.push_back(stage);
+    on_stage(stage);
+    return result;
+  };
+
+  TetMesh mesh;
+  if (is_tet_mesh_path(args.input)) {
+    mesh = timed("read", [&](std::string& summary) {
+      TetMesh m = read_tet_mesh(args.input);
+      summary = std::to_string(m.nodes.size()) + " nodes, " + std::to_string(m.tets.size()) + " tets";
+      return m;
+    });
+  } else {
+    const TriangleMesh surface = timed("read", [&](std::string& summary) {
+      TriangleMesh s = read_triangle_mesh(args.input);
+      validate_closed_surface(s, args.input);
+      summary = std::to_string(s.vertices.size()) + " vertices, " +
+                std::to_string(s.triangles.size()) + " triangles (surface)";
+      return s;
+    });
+    mesh = timed("tetrahedralize", [&](std::string& summary) {
+      TetMesh m = tetrahedralize(surface, args.meshing, args.input);
+      summary = std::to_string(m.nodes.size()) + " nodes, " + std::to_string(m.tets.size()) + " tets";
+      return m;
+    });
+  }
+
+  BuildOptions options = args.options;
+  options.keep_rest_positions = !args.no_rest_positions;
+  const format::Asset asset = build_asset(mesh, args.input, options, report, on_stage);
+  const std::vector<std::uint8_t> bytes = timed("write", [&](std::string& summary) {
+    std::vector<std::uint8_t> b = format::write_asset(asset);
+    write_file_atomic(args.output, b);
+    summary = args.output + " (" + std::to_string(b.size()) + " bytes)";
+    return b;
+  });
+  const double total = std::chrono::duration<double>(Clock::now() - start).count();
+  if (!args.report_path.empty()) {
+    write_file_atomic(args.report_path, report_json(args, report, asset, bytes.size(), total));
+  }
+  if (!args.quiet) std::fprintf(stderr, "tetseg: done in %.3f s\n", total);
+}
+
+}  // namespace
+
+void add_build_command(CLI::App& root) {
+  auto args = std::make_shared<BuildArgs>();
+  CLI::App* cmd = root.add_subcommand(
+      "build", "Run the whole pipeline on a tet mesh (or a closed surface, tetrahedralised first) "
+               "and write the runtime asset");
+  cmd->add_option("input", args->input,
+                  "Tet mesh (.mesh, .node/.ele, .msh) or closed surface (.obj, .ply, .stl, .off, ...)")
+      ->required();
+  cmd->add_option("-o,--output", args->output, "Asset file to write (.tetseg)")->required();
+  cmd->add_option("--report", args->report_path, "Write a JSON report: per-stage seconds, counts");
+
+  const std::map<std::string, ClusterMethod> cluster_methods{{"single", ClusterMethod::kSingle},
+                                                             {"charge", ClusterMethod::kCharge}};
+  cmd->add_option("--clusters", args->options.clusters,
+                  "single: one cluster; charge: the paper's charge-based segmentation")
+      ->transform(CLI::CheckedTransformer(cluster_methods, CLI::ignore_case))
+      ->default_str("charge");
+
+  SegmentationOptions& seg = args->options.segmentation;
+  cmd->add_option("--alpha", seg.alpha, "Equalised density below which triangles are marked")
+      ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str();
+  cmd->add_option("--beta-divisor", seg.beta_divisor,
+                  "Segments larger than N/beta-divisor triangles are grown")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  const std::map<std::string, Equalization> equalizations{
+      {"histogram", Equalization::kHistogram},
+      {"rank", Equalization::kRank},
+      {"log-histogram", Equalization::kLogHistogram}};
+  cmd->add_option("--equalization", seg.equalization,
+                  "histogram (the paper, 256 bins), rank (exact) or log-histogram")
+      ->transform(CLI::CheckedTransformer(equalizations, CLI::ignore_case))
+      ->default_str("histogram");
+  cmd->add_option("--growth-bound", seg.growth_bound,
+                  "A segment never grows beyond this fraction of the surface")
+      ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str();
+  cmd->add_option("--min-cluster-triangles", seg.min_cluster_triangles,
+                  "Clusters smaller than this are merged into a neighbour (0: derived)")
+      ->capture_default_str();
+  const std::map<std::string, DetectorStrategy> detectors{
+      {"nearest-centroid", DetectorStrategy::kNearestCentroid},
+      {"visibility", DetectorStrategy::kVisibility}};
+  cmd->add_option("--detector", seg.detector,
+                  "nearest-centroid (the paper) or visibility (most triangles positive at rest)")
+      ->transform(CLI::CheckedTransformer(detectors, CLI::ignore_case))
+      ->default_str("visibility");
+
+  const std::map<std::string, ChargeSolver> solvers{{"auto", ChargeSolver::kAuto},
+                                                    {"direct", ChargeSolver::kDirect},
+                                                    {"gmres", ChargeSolver::kGmres},
+                                                    {"fast", ChargeSolver::kFast}};
+  cmd->add_option("--solver", args->options.charge.solver, "Charge solver: auto, direct, gmres, fast")
+      ->transform(CLI::CheckedTransformer(solvers, CLI::ignore_case))
+      ->default_str("auto");
+  cmd->add_option("--tolerance", args->options.charge.tolerance,
+                  "Relative residual of the iterative charge solvers")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+
+  cmd->add_option("--cell-size", args->meshing.cell_size,
+                  "Surface input only: target tet edge length (0: derived, docs/cli.md)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  cmd->add_option("--facet-distance", args->meshing.facet_distance,
+                  "Surface input only: max surface approximation error (0: derived)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  cmd->add_flag("--no-rest-positions", args->no_rest_positions,
+                "Do not store rest positions in the asset (smaller; tools cannot draw it)");
+  cmd->add_flag("-q,--quiet", args->quiet, "No stage lines");
+  cmd->callback([args] { run_build(*args); });
+}
+
+}  // namespace tetseg::tools
