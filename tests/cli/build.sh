@@ -1,0 +1,73 @@
+#!/usr/bin/env bash
+# End to end: tetseg generate -> build -> tetseg-dump; exit codes, messages, determinism,
+# atomic output.
+set -euo pipefail
+bin=${TETSEG_BIN_DIR:?}
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+cd "$work"
+
+fail() { echo "FAIL: $*" >&2; exit 1; }
+expect_exit() {  # expect_exit CODE PATTERN -- command...
+  local code=$1 pattern=$2; shift 3
+  set +e; "$@" >out.txt 2>err.txt; local got=$?; set -e
+  [ "$got" -eq "$code" ] || { cat err.txt >&2; fail "'$*' exited $got, expected $code"; }
+  grep -q -- "$pattern" err.txt out.txt || { cat err.txt >&2; fail "'$*' did not print '$pattern'"; }
+}
+
+expect_exit 0 "Usage" -- "$bin/tetseg" --help
+expect_exit 0 "tetseg 0.1" -- "$bin/tetseg" --version
+expect_exit 2 "" -- "$bin/tetseg"
+expect_exit 2 "" -- "$bin/tetseg" build
+expect_exit 2 "" -- "$bin/tetseg" build x.mesh -o y.tetseg --alpha 7
+expect_exit 3 "tetseg: error: missing.mesh: " -- "$bin/tetseg" build missing.mesh -o a.tetseg
+[ ! -e a.tetseg ] || fail "a failed build left an asset"
+expect_exit 0 "Usage" -- "$bin/tetseg-dump" --help
+expect_exit 3 "tetseg-dump: error: missing.tetseg: " -- "$bin/tetseg-dump" missing.tetseg
+
+"$bin/tetseg" generate sphere -o sphere.mesh --size 0.5 2>gen.txt
+for clusters in single charge; do
+  "$bin/tetseg" build sphere.mesh -o "$clusters.tetseg" --clusters "$clusters" \
+    --report "$clusters.json" 2>build.txt
+  for stage in surface detectors bvh write; do
+    grep -q "tetseg: $stage" build.txt || fail "no stage line for $stage"
+  done
+  "$bin/tetseg-dump" "$clusters.tetseg" --json >dump.json
+  python3 - "$clusters" dump.json "$clusters.json" <<'PY'
+import json, sys
+mode, dump, report = sys.argv[1], json.load(open(sys.argv[2])), json.load(open(sys.argv[3]))
+assert dump["format_version"].startswith("1."), dump["format_version"]
+assert dump["nodes"] == report["counts"]["nodes"] > 0
+assert dump["surface_triangles"] == report["counts"]["surface_triangles"] > 0
+assert sum(c["triangles"] for c in dump["clusters"]) == dump["surface_triangles"]
+assert all(0.0 <= c["rest_positive_fraction"] <= 1.0 for c in dump["clusters"])
+assert dump["provenance"]["source"] == "sphere.mesh"
+assert dump["provenance"]["options"]["clusters"] == mode
+assert all(k in report["seconds"] for k in ("surface", "detectors", "bvh", "write", "total"))
+if mode == "single":
+    assert len(dump["clusters"]) == 1
+    # The only cluster of a sphere sees every triangle positive from its detector node.
+    assert dump["clusters"][0]["rest_positive_fraction"] == 1.0
+PY
+done
+
+# Same input and options give byte-identical assets.
+"$bin/tetseg" build sphere.mesh -o again.tetseg --clusters single -q
+cmp single.tetseg again.tetseg || fail "assets differ between two identical runs"
+
+# Output that cannot be written: exit 4, nothing left behind.
+expect_exit 4 "tetseg: error: nodir/x.tetseg: " -- "$bin/tetseg" build sphere.mesh -o nodir/x.tetseg --clusters single
+[ -z "$(ls -A . | grep -v -e '\.txt$' -e '\.json$' -e '\.mesh$' -e '\.tetseg$' || true)" ] || fail "temporary files left: $(ls)"
+
+# A corrupt asset is rejected with the loader's status, never a crash.
+size=$(stat -c %s single.tetseg)
+head -c $((size / 2)) single.tetseg >truncated.tetseg
+expect_exit 3 "truncated.tetseg: " -- "$bin/tetseg-dump" truncated.tetseg
+python3 - single.tetseg flipped.tetseg <<'PY'
+import sys
+data = bytearray(open(sys.argv[1], "rb").read())
+data[len(data) - 5] ^= 0x40
+open(sys.argv[2], "wb").write(data)
+PY
+expect_exit 3 "checksum" -- "$bin/tetseg-dump" flipped.tetseg
+echo "build.sh: all checks passed"
