@@ -16,6 +16,7 @@ configure_package_config_file(${PROJECT_SOURCE_DIR}/cmake/tetsegConfig.cmake.in
 write_basic_package_version_file(${PROJECT_BINARY_DIR}/tetsegConfigVersion.cmake
                                  VERSION ${PROJECT_VERSION} COMPATIBILITY SameMinorVersion)
 install(FILES ${PROJECT_BINARY_DIR}/tetsegConfig.cmake ${PROJECT_BINARY_DIR}/tetsegConfigVersion.cmake
+              ${PROJECT_SOURCE_DIR}/cmake/TetsegAsset.cmake
         DESTINATION ${TETSEG_CMAKE_DIR})
 foreach(tool tetseg tetseg-dump tetseg-ccd tetseg-run)
   if(TARGET ${tool})
