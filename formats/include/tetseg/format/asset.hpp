@@ -22,12 +22,14 @@ inline constexpr std::uint16_t kVersionMajor = 1;
 inline constexpr std::uint16_t kVersionMinor = 0;
 
 /// Documented limits, checked on load (docs/format.md). They bound memory for hostile input.
-inline constexpr std::uint32_t kMaxNodes = 1u << 26;          ///< 67,108,864 tet-mesh nodes
-inline constexpr std::uint32_t kMaxTriangles = 1u << 25;      ///< 33,554,432 surface triangles
-inline constexpr std::uint32_t kMaxClusters = 1u << 20;       ///< 1,048,576 clusters
-inline constexpr std::uint32_t kMaxBoundaryLoops = 1u << 20;  ///< segment-boundary loops
-inline constexpr std::uint32_t kMaxStringBytes = 1u << 16;    ///< one provenance string
-inline constexpr std::uint32_t kMaxProvenanceOptions = 1024;  ///< provenance key/value pairs
+inline constexpr std::uint32_t kMaxNodes = 1u << 26;              ///< 67,108,864 tet-mesh nodes
+inline constexpr std::uint32_t kMaxTriangles = 1u << 25;          ///< 33,554,432 surface triangles
+inline constexpr std::uint32_t kMaxClusters = 1u << 20;           ///< 1,048,576 clusters
+inline constexpr std::uint32_t kMaxBoundaryLoops = 1u << 20;      ///< segment-boundary loops
+inline constexpr std::uint32_t kMaxStringBytes = 1u << 16;        ///< one provenance string
+inline constexpr std::uint32_t kMaxProvenanceOptions = 1024;      ///< provenance key/value pairs
+inline constexpr std::uint32_t kMaxBvhNodes = 2 * kMaxTriangles;  ///< all clusters' BVH nodes
+inline constexpr std::uint32_t kMaxBoundaryNodes = 3 * kMaxTriangles;  ///< all loops' node ids
 
 using Triangle = std::array<std::uint32_t, 3>;  ///< tet-mesh node ids, wound outward
 
@@ -45,12 +47,12 @@ struct BvhNode {
 /// A cluster: a connected patch of the surface bounded by segment boundaries, culled with
 /// radial views from its detector node.
 struct Cluster {
-  std::uint32_t detector_node = 0;        ///< interior tet-mesh node (not on the surface)
-  float rest_positive_fraction = 0.0f;    ///< in [0,1]: share of triangles positive at rest
-  std::uint32_t triangle_offset = 0;      ///< into Asset::cluster_triangles
-  std::uint32_t triangle_count = 0;       ///< > 0
-  std::uint32_t bvh_offset = 0;           ///< into Asset::bvh_nodes
-  std::uint32_t bvh_count = 0;            ///< > 0; 2 * leaves - 1
+  std::uint32_t detector_node = 0;      ///< interior tet-mesh node (not on the surface)
+  float rest_positive_fraction = 0.0f;  ///< in [0,1]: share of triangles positive at rest
+  std::uint32_t triangle_offset = 0;    ///< into Asset::cluster_triangles
+  std::uint32_t triangle_count = 0;     ///< > 0
+  std::uint32_t bvh_offset = 0;         ///< into Asset::bvh_nodes
+  std::uint32_t bvh_count = 0;          ///< > 0; 2 * leaves - 1
 };
 
 /// A segment boundary: a closed edge loop of surface nodes (consecutive nodes share a surface
@@ -62,8 +64,8 @@ struct BoundaryLoop {
 
 /// Where an asset came from: enough to rebuild it byte for byte.
 struct Provenance {
-  std::string tool_version;  ///< e.g. "tetseg 0.1.0"
-  std::string source;        ///< input file name (no directories)
+  std::string tool_version;                                  ///< e.g. "tetseg 0.1.0"
+  std::string source;                                        ///< input file name (no directories)
   std::vector<std::pair<std::string, std::string>> options;  ///< sorted by key
 };
 
@@ -71,7 +73,7 @@ struct Provenance {
 /// `cluster_triangles[clusters[c].triangle_offset ..+ triangle_count]` (surface triangle ids,
 /// in BVH leaf order) and `bvh_nodes[clusters[c].bvh_offset ..+ bvh_count]`.
 struct Asset {
-  std::uint32_t node_count = 0;                 ///< tet-mesh nodes the runtime expects per step
+  std::uint32_t node_count = 0;  ///< tet-mesh nodes the runtime expects per step
   /// Rest positions of all nodes (length units of the input), or empty when stripped
   /// (`tetseg build --no-rest-positions`). Used for the `bvh` mode's initial topology, the
   /// rest-intersection check and by tools that draw the asset; never required per frame.

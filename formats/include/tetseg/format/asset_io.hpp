@@ -13,6 +13,9 @@
 
 namespace tetseg::format {
 
+/// Bytes of the fixed envelope ahead of the payload; its byte table is in docs/format.md.
+inline constexpr std::size_t kEnvelopeBytes = 36;
+
 /// Result of reading an asset. Checks run in this order and stop at the first failure.
 enum class Status : std::uint8_t {
   kOk = 0,

@@ -1,0 +1,287 @@
+// Semantic validation of a decoded asset (docs/format.md, "Validation rules"). Every
+// allocation here is bounded by the sizes of vectors that already exist, never by a scalar
+// read from the file (node_count in particular is never used to size anything).
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "tetseg/format/asset_io.hpp"
+
+namespace tetseg::format {
+namespace {
+
+struct Invalid {
+  std::string message;
+};
+
+[[noreturn]] void fail(std::string message) {
+  throw Invalid{std::move(message)};
+}
+
+std::string at(const char* what, std::size_t i) {
+  return std::string(what) + "[" + std::to_string(i) + "]";
+}
+
+std::uint64_t edge_key(std::uint32_t a, std::uint32_t b) {
+  if (a > b) std::swap(a, b);
+  return (std::uint64_t(a) << 32) | b;
+}
+
+void check_limits(const Asset& a) {
+  auto limit = [](const char* what, std::size_t n, std::uint64_t max) {
+    if (n > max) {
+      fail(std::string(what) + " has " + std::to_string(n) + " entries, the limit is " +
+           std::to_string(max));
+    }
+  };
+  limit("node_count", a.node_count, kMaxNodes);
+  limit("rest_positions", a.rest_positions.size(), kMaxNodes);
+  limit("triangles", a.triangles.size(), kMaxTriangles);
+  limit("triangle_cluster", a.triangle_cluster.size(), kMaxTriangles);
+  limit("clusters", a.clusters.size(), kMaxClusters);
+  limit("cluster_triangles", a.cluster_triangles.size(), kMaxTriangles);
+  limit("bvh_nodes", a.bvh_nodes.size(), kMaxBvhNodes);
+  limit("boundaries", a.boundaries.size(), kMaxBoundaryLoops);
+  limit("boundary_nodes", a.boundary_nodes.size(), kMaxBoundaryNodes);
+  limit("provenance.tool_version", a.provenance.tool_version.size(), kMaxStringBytes);
+  limit("provenance.source", a.provenance.source.size(), kMaxStringBytes);
+  limit("provenance.options", a.provenance.options.size(), kMaxProvenanceOptions);
+  for (std::size_t i = 0; i < a.provenance.options.size(); ++i) {
+    limit("provenance option key", a.provenance.options[i].first.size(), kMaxStringBytes);
+    limit("provenance option value", a.provenance.options[i].second.size(), kMaxStringBytes);
+    if (i > 0 && !(a.provenance.options[i - 1].first < a.provenance.options[i].first)) {
+      fail("provenance options are not sorted by unique key at " + std::to_string(i));
+    }
+  }
+}
+
+void check_nodes_and_triangles(const Asset& a) {
+  if (!a.rest_positions.empty()) {
+    if (a.rest_positions.size() != a.node_count) {
+      fail("rest_positions has " + std::to_string(a.rest_positions.size()) +
+           " entries, node_count is " + std::to_string(a.node_count));
+    }
+    for (std::size_t i = 0; i < a.rest_positions.size(); ++i) {
+      for (double x : a.rest_positions[i]) {
+        if (!std::isfinite(x)) fail(at("rest_positions", i) + " is not finite");
+      }
+    }
+  }
+  if (a.triangles.empty()) fail("asset has no surface triangles");
+  for (std::size_t t = 0; t < a.triangles.size(); ++t) {
+    const Triangle& tri = a.triangles[t];
+    for (std::uint32_t v : tri) {
+      if (v >= a.node_count) {
+        fail(at("triangles", t) + " has node " + std::to_string(v) + " >= node_count " +
+             std::to_string(a.node_count));
+      }
+    }
+    if (tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2]) {
+      fail(at("triangles", t) + " repeats a node id");
+    }
+  }
+}
+
+/// Clusters are contiguous, in order, and partition the triangles; triangle_cluster agrees.
+void check_partition(const Asset& a) {
+  const std::size_t tri_count = a.triangles.size();
+  if (a.clusters.empty()) fail("asset has triangles but no clusters");
+  if (a.triangle_cluster.size() != tri_count) {
+    fail("triangle_cluster has " + std::to_string(a.triangle_cluster.size()) + " entries for " +
+         std::to_string(tri_count) + " triangles");
+  }
+  if (a.cluster_triangles.size() != tri_count) {
+    fail("cluster_triangles has " + std::to_string(a.cluster_triangles.size()) + " entries for " +
+         std::to_string(tri_count) + " triangles");
+  }
+  std::uint64_t next_triangle = 0;
+  std::uint64_t next_bvh = 0;
+  for (std::size_t c = 0; c < a.clusters.size(); ++c) {
+    const Cluster& cl = a.clusters[c];
+    if (cl.triangle_count == 0) fail(at("clusters", c) + " has no triangles");
+    if (cl.triangle_offset != next_triangle) {
+      fail(at("clusters", c) + ".triangle_offset is " + std::to_string(cl.triangle_offset) +
+           ", expected " + std::to_string(next_triangle) + " (clusters are contiguous)");
+    }
+    next_triangle += cl.triangle_count;
+    if (next_triangle > tri_count)
+      fail(at("clusters", c) + " triangle range exceeds cluster_triangles");
+    if (cl.bvh_count == 0) fail(at("clusters", c) + " has no BVH nodes");
+    if (cl.bvh_offset != next_bvh) {
+      fail(at("clusters", c) + ".bvh_offset is " + std::to_string(cl.bvh_offset) + ", expected " +
+           std::to_string(next_bvh) + " (BVHs are contiguous)");
+    }
+    next_bvh += cl.bvh_count;
+    if (next_bvh > a.bvh_nodes.size()) fail(at("clusters", c) + " BVH range exceeds bvh_nodes");
+    if (!std::isfinite(cl.rest_positive_fraction) || cl.rest_positive_fraction < 0.0f ||
+        cl.rest_positive_fraction > 1.0f) {
+      fail(at("clusters", c) + ".rest_positive_fraction is not a finite value in [0,1]");
+    }
+    if (cl.detector_node >= a.node_count) {
+      fail(at("clusters", c) + ".detector_node " + std::to_string(cl.detector_node) +
+           " >= node_count " + std::to_string(a.node_count));
+    }
+  }
+  if (next_triangle != tri_count)
+    fail("clusters cover " + std::to_string(next_triangle) + " of " + std::to_string(tri_count) +
+         " cluster_triangles entries");
+  if (next_bvh != a.bvh_nodes.size())
+    fail("clusters use " + std::to_string(next_bvh) + " of " + std::to_string(a.bvh_nodes.size()) +
+         " BVH nodes");
+
+  std::vector<std::uint8_t> seen(tri_count, 0);
+  for (std::size_t c = 0; c < a.clusters.size(); ++c) {
+    const Cluster& cl = a.clusters[c];
+    for (std::uint32_t i = 0; i < cl.triangle_count; ++i) {
+      const std::uint32_t t = a.cluster_triangles[std::size_t(cl.triangle_offset) + i];
+      if (t >= tri_count)
+        fail(at("cluster_triangles", cl.triangle_offset + std::size_t(i)) + " is out of range");
+      if (seen[t]) fail("triangle " + std::to_string(t) + " is in more than one cluster entry");
+      seen[t] = 1;
+      if (a.triangle_cluster[t] != c) {
+        fail("triangle " + std::to_string(t) + " is listed in cluster " + std::to_string(c) +
+             " but triangle_cluster says " + std::to_string(a.triangle_cluster[t]));
+      }
+    }
+  }
+  // Every entry of cluster_triangles was visited and entries are unique, so with
+  // cluster_triangles.size() == tri_count every triangle appears exactly once.
+}
+
+/// Detector nodes are interior: not a vertex of any surface triangle.
+void check_detectors(const Asset& a) {
+  std::vector<std::uint32_t> surface;
+  surface.reserve(3 * a.triangles.size());
+  for (const Triangle& t : a.triangles) surface.insert(surface.end(), t.begin(), t.end());
+  std::sort(surface.begin(), surface.end());
+  for (std::size_t c = 0; c < a.clusters.size(); ++c) {
+    if (std::binary_search(surface.begin(), surface.end(), a.clusters[c].detector_node)) {
+      fail(at("clusters", c) + ".detector_node " + std::to_string(a.clusters[c].detector_node) +
+           " is a surface node");
+    }
+  }
+}
+
+void check_bvhs(const Asset& a) {
+  std::vector<std::uint8_t> parents;
+  std::vector<std::uint8_t> covered;
+  for (std::size_t c = 0; c < a.clusters.size(); ++c) {
+    const Cluster& cl = a.clusters[c];
+    const BvhNode* nodes = a.bvh_nodes.data() + cl.bvh_offset;
+    const std::uint32_t n = cl.bvh_count;
+    parents.assign(n, 0);
+    covered.assign(cl.triangle_count, 0);
+    std::uint64_t leaves = 0;
+    const std::string where = "cluster " + std::to_string(c) + " BVH node ";
+    for (std::uint32_t i = 0; i < n; ++i) {
+      const BvhNode& node = nodes[i];
+      if (node.count > 0) {
+        ++leaves;
+        if (node.second != 0) fail(where + std::to_string(i) + ": leaf with non-zero second");
+        if (std::uint64_t(node.first) + node.count > cl.triangle_count) {
+          fail(where + std::to_string(i) + ": leaf range exceeds the cluster's " +
+               std::to_string(cl.triangle_count) + " triangles");
+        }
+        for (std::uint32_t k = node.first; k < node.first + node.count; ++k) {
+          if (covered[k])
+            fail(where + std::to_string(i) + ": triangle position " + std::to_string(k) +
+                 " is in two leaves");
+          covered[k] = 1;
+        }
+      } else {
+        for (std::uint32_t child : {node.first, node.second}) {
+          if (child <= i || child >= n) {
+            fail(where + std::to_string(i) + ": child " + std::to_string(child) + " is not in (" +
+                 std::to_string(i) + ", " + std::to_string(n) + ")");
+          }
+          if (parents[child]) fail(where + std::to_string(child) + " has two parents");
+          parents[child] = 1;
+        }
+      }
+    }
+    for (std::uint32_t i = 1; i < n; ++i) {
+      if (!parents[i]) fail(where + std::to_string(i) + " has no parent");
+    }
+    for (std::uint32_t k = 0; k < cl.triangle_count; ++k) {
+      if (!covered[k])
+        fail("cluster " + std::to_string(c) + ": triangle position " + std::to_string(k) +
+             " is in no leaf");
+    }
+    if (std::uint64_t(n) != 2 * leaves - 1) {
+      fail("cluster " + std::to_string(c) + ": " + std::to_string(n) + " BVH nodes for " +
+           std::to_string(leaves) + " leaves");
+    }
+  }
+}
+
+void check_boundaries(const Asset& a) {
+  if (a.boundaries.empty() && a.boundary_nodes.empty()) return;
+  std::vector<std::uint64_t> edges;
+  edges.reserve(3 * a.triangles.size());
+  for (const Triangle& t : a.triangles) {
+    edges.push_back(edge_key(t[0], t[1]));
+    edges.push_back(edge_key(t[1], t[2]));
+    edges.push_back(edge_key(t[2], t[0]));
+  }
+  std::sort(edges.begin(), edges.end());
+  std::uint64_t next = 0;
+  for (std::size_t b = 0; b < a.boundaries.size(); ++b) {
+    const BoundaryLoop& loop = a.boundaries[b];
+    if (loop.node_count < 3) fail(at("boundaries", b) + " has fewer than 3 nodes");
+    if (loop.node_offset != next) {
+      fail(at("boundaries", b) + ".node_offset is " + std::to_string(loop.node_offset) +
+           ", expected " + std::to_string(next) + " (loops are contiguous)");
+    }
+    next += loop.node_count;
+    if (next > a.boundary_nodes.size()) fail(at("boundaries", b) + " exceeds boundary_nodes");
+    const std::uint32_t* ids = a.boundary_nodes.data() + loop.node_offset;
+    for (std::uint32_t i = 0; i < loop.node_count; ++i) {
+      const std::uint32_t u = ids[i];
+      const std::uint32_t v = ids[(i + 1) % loop.node_count];
+      if (u >= a.node_count)
+        fail(at("boundaries", b) + " has node " + std::to_string(u) + " >= node_count");
+      if (!std::binary_search(edges.begin(), edges.end(), edge_key(u, v))) {
+        fail(at("boundaries", b) + ": nodes " + std::to_string(u) + " and " + std::to_string(v) +
+             " are not a surface edge");
+      }
+    }
+  }
+  if (next != a.boundary_nodes.size()) {
+    fail("boundaries use " + std::to_string(next) + " of " +
+         std::to_string(a.boundary_nodes.size()) + " boundary_nodes");
+  }
+}
+
+}  // namespace
+
+Status validate(const Asset& asset, std::string* detail) noexcept {
+  std::string why;
+  try {
+    check_limits(asset);
+    check_nodes_and_triangles(asset);
+    check_partition(asset);
+    check_detectors(asset);
+    check_bvhs(asset);
+    check_boundaries(asset);
+    if (detail) detail->clear();
+    return Status::kOk;
+  } catch (Invalid& e) {
+    why = std::move(e.message);
+  } catch (const std::exception& e) {
+    try {
+      why = std::string("validation failed: ") + e.what();
+    } catch (...) {
+    }
+  } catch (...) {
+  }
+  if (detail) {
+    try {
+      *detail = std::move(why);
+    } catch (...) {
+    }
+  }
+  return Status::kInvalidContent;
+}
+
+}  // namespace tetseg::format
