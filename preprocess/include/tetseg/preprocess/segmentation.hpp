@@ -22,7 +22,7 @@ struct SegmentationOptions {
   double alpha = 0.1;           ///< triangles with equalised density < alpha are marked
   double beta_divisor = 400.0;  ///< segments larger than N / beta_divisor triangles are grown
   Equalization equalization = Equalization::kHistogram;
-  double growth_bound = 0.25;   ///< a segment never grows beyond this fraction of the surface
+  double growth_bound = 0.25;  ///< a segment never grows beyond this fraction of the surface
   std::uint32_t min_cluster_triangles = 0;  ///< 0 = derived (docs/segmentation.md)
   DetectorStrategy detector = DetectorStrategy::kVisibility;
 };
@@ -37,7 +37,7 @@ struct SegmentationCounts {
 };
 
 struct Segmentation {
-  std::vector<std::uint32_t> triangle_cluster;           ///< per surface triangle
+  std::vector<std::uint32_t> triangle_cluster;  ///< per surface triangle
   std::uint32_t cluster_count = 0;
   std::vector<std::vector<std::uint32_t>> boundary_loops;  ///< closed loops of node ids
   SegmentationCounts counts;
@@ -52,10 +52,34 @@ Segmentation segment_surface(const std::vector<Vec3>& nodes, const Surface& surf
 struct Detector {
   std::uint32_t node = 0;               ///< interior tet-mesh node id
   float rest_positive_fraction = 0.0f;  ///< share of the cluster's triangles positive at rest
+  std::uint32_t triangle_count = 0;     ///< triangles of the cluster
 };
 
-/// One detector per cluster (cluster ids 0..cluster_count-1). Requires at least one interior
-/// node; throws InputError otherwise.
+/// Candidate counts of the visibility strategy (docs/segmentation.md, "Detector nodes").
+inline constexpr std::uint32_t kDetectorNearCentroid = 24;  ///< nodes nearest the centroid
+inline constexpr std::uint32_t kDetectorNearKernel = 24;    ///< nodes nearest the kernel estimate
+
+/// Number of the cluster's triangles (ids in `triangle_ids`) that are positive from `point`:
+/// det[a-o, b-o, c-o] > 0 for outward triangles (the point lies strictly on the inner side of
+/// the triangle's plane). Plain double arithmetic.
+std::uint32_t count_positive_triangles(const std::vector<Vec3>& nodes,
+                                       const std::vector<Tri>& triangles,
+                                       const std::vector<std::uint32_t>& triangle_ids,
+                                       const Vec3& point);
+
+/// One detector per cluster (cluster ids 0..cluster_count-1), chosen among
+/// `surface.interior_nodes` from rest positions `nodes`.
+/// - kNearestCentroid: the interior node nearest the cluster's area-weighted centroid (the
+///   paper).
+/// - kVisibility: among the kDetectorNearCentroid interior nodes nearest the centroid and the
+///   kDetectorNearKernel nearest an estimate of the cluster's rest kernel (the region from which
+///   all its triangles are positive), the node with the largest share of positive triangles;
+///   ties go to the node nearer the centroid, then to the lower id.
+/// Every cluster gets a node even when none sees all its triangles positive (the runtime stays
+/// correct, only slower). A cluster without triangles gets the node nearest the surface's
+/// centroid and fraction 1. Deterministic; O(clusters x interior nodes + candidates x N).
+/// Throws InputError("", ...) when there is no interior node, and std::invalid_argument when
+/// `triangle_cluster` does not match the surface or holds an id >= cluster_count.
 std::vector<Detector> choose_detectors(const std::vector<Vec3>& nodes, const Surface& surface,
                                        const std::vector<std::uint32_t>& triangle_cluster,
                                        std::uint32_t cluster_count, DetectorStrategy strategy);

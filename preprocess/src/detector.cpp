@@ -1,0 +1,205 @@
+// Detector nodes per cluster (Wong & Yeh, section IV-C) and the visibility improvement
+// described in docs/segmentation.md.
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <utility>
+
+#include "tetseg/preprocess/segmentation.hpp"
+
+namespace tetseg::preprocess {
+namespace {
+
+Vec3 sub(const Vec3& a, const Vec3& b) {
+  return {a[0] - b[0], a[1] - b[1], a[2] - b[2]};
+}
+Vec3 cross(const Vec3& a, const Vec3& b) {
+  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+}
+double dot(const Vec3& a, const Vec3& b) {
+  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+double distance2(const Vec3& a, const Vec3& b) {
+  const Vec3 d = sub(a, b);
+  return dot(d, d);
+}
+
+bool is_positive(const std::vector<Vec3>& nodes, const Tri& t, const Vec3& o) {
+  const Vec3 a = sub(nodes[t[0]], o);
+  const Vec3 b = sub(nodes[t[1]], o);
+  const Vec3 c = sub(nodes[t[2]], o);
+  return dot(a, cross(b, c)) > 0.0;
+}
+
+/// The `k` interior nodes nearest `point`, ordered by (distance, id).
+std::vector<std::uint32_t> nearest_nodes(const std::vector<Vec3>& nodes,
+                                         const std::vector<std::uint32_t>& interior,
+                                         const Vec3& point, std::size_t k) {
+  std::vector<std::pair<double, std::uint32_t>> keyed;
+  keyed.reserve(interior.size());
+  for (std::uint32_t id : interior) keyed.emplace_back(distance2(nodes[id], point), id);
+  k = std::min(k, keyed.size());
+  std::partial_sort(keyed.begin(), keyed.begin() + static_cast<std::ptrdiff_t>(k), keyed.end());
+  std::vector<std::uint32_t> out;
+  out.reserve(k);
+  for (std::size_t i = 0; i < k; ++i) out.push_back(keyed[i].second);
+  return out;
+}
+
+/// A point inside (or near) the cluster's rest kernel: starting at the centroid, averaged
+/// projections onto the violated half-spaces n.(p - a) <= -margin (Cimmino-like relaxation),
+/// keeping the iterate with the fewest violations.
+Vec3 kernel_estimate(const std::vector<Vec3>& nodes, const std::vector<Tri>& triangles,
+                     const std::vector<std::uint32_t>& ids, const Vec3& start, double margin) {
+  struct Plane {
+    Vec3 n;
+    double offset;  // n.a
+  };
+  std::vector<Plane> planes;
+  planes.reserve(ids.size());
+  for (std::uint32_t id : ids) {
+    const Tri& t = triangles[id];
+    Vec3 n = cross(sub(nodes[t[1]], nodes[t[0]]), sub(nodes[t[2]], nodes[t[0]]));
+    const double len = std::sqrt(dot(n, n));
+    if (!(len > 0.0)) continue;
+    n = {n[0] / len, n[1] / len, n[2] / len};
+    planes.push_back({n, dot(n, nodes[t[0]])});
+  }
+  Vec3 p = start;
+  Vec3 best = start;
+  std::size_t best_violations = planes.size() + 1;
+  constexpr int kIterations = 64;
+  for (int it = 0; it < kIterations; ++it) {
+    Vec3 step{0.0, 0.0, 0.0};
+    std::size_t violations = 0;
+    for (const Plane& pl : planes) {
+      const double d = dot(pl.n, p) - pl.offset + margin;
+      if (d > 0.0) {
+        ++violations;
+        for (int k = 0; k < 3; ++k) step[k] -= d * pl.n[k];
+      }
+    }
+    if (violations < best_violations) {
+      best_violations = violations;
+      best = p;
+    }
+    if (violations == 0) break;
+    for (int k = 0; k < 3; ++k) p[k] += step[k] / static_cast<double>(violations);
+    if (!std::isfinite(p[0] + p[1] + p[2])) break;
+  }
+  return best;
+}
+
+}  // namespace
+
+std::uint32_t count_positive_triangles(const std::vector<Vec3>& nodes,
+                                       const std::vector<Tri>& triangles,
+                                       const std::vector<std::uint32_t>& triangle_ids,
+                                       const Vec3& point) {
+  std::uint32_t count = 0;
+  for (std::uint32_t id : triangle_ids) count += is_positive(nodes, triangles[id], point) ? 1 : 0;
+  return count;
+}
+
+std::vector<Detector> choose_detectors(const std::vector<Vec3>& nodes, const Surface& surface,
+                                       const std::vector<std::uint32_t>& triangle_cluster,
+                                       std::uint32_t cluster_count, DetectorStrategy strategy) {
+  if (surface.interior_nodes.empty())
+    throw InputError("", "the tet mesh has no interior node: no detector node can be chosen");
+  if (triangle_cluster.size() != surface.triangles.size())
+    throw std::invalid_argument("choose_detectors: one cluster id per surface triangle expected");
+  for (std::uint32_t id : surface.interior_nodes)
+    if (id >= nodes.size()) throw std::invalid_argument("choose_detectors: node id out of range");
+  for (const Tri& t : surface.triangles)
+    for (std::uint32_t v : t)
+      if (v >= nodes.size()) throw std::invalid_argument("choose_detectors: node id out of range");
+
+  std::vector<std::vector<std::uint32_t>> members(cluster_count);
+  for (std::uint32_t t = 0; t < triangle_cluster.size(); ++t) {
+    if (triangle_cluster[t] >= cluster_count)
+      throw std::invalid_argument("choose_detectors: cluster id out of range");
+    members[triangle_cluster[t]].push_back(t);
+  }
+
+  // Fallback point for empty clusters: the surface's vertex average.
+  Vec3 surface_center{0.0, 0.0, 0.0};
+  for (std::uint32_t v : surface.surface_nodes)
+    for (int k = 0; k < 3; ++k) surface_center[k] += nodes[v][k];
+  if (!surface.surface_nodes.empty())
+    for (int k = 0; k < 3; ++k)
+      surface_center[k] /= static_cast<double>(surface.surface_nodes.size());
+
+  std::vector<Detector> out(cluster_count);
+  for (std::uint32_t c = 0; c < cluster_count; ++c) {
+    const std::vector<std::uint32_t>& ids = members[c];
+    Detector& det = out[c];
+    det.triangle_count = static_cast<std::uint32_t>(ids.size());
+    if (ids.empty()) {
+      det.node = nearest_nodes(nodes, surface.interior_nodes, surface_center, 1).front();
+      det.rest_positive_fraction = 1.0f;
+      continue;
+    }
+    // Area-weighted centroid (vertex average when every triangle is degenerate) and box.
+    Vec3 centroid{0.0, 0.0, 0.0};
+    Vec3 average{0.0, 0.0, 0.0};
+    Vec3 lo = nodes[surface.triangles[ids[0]][0]];
+    Vec3 hi = lo;
+    double area = 0.0;
+    for (std::uint32_t id : ids) {
+      const Tri& t = surface.triangles[id];
+      const Vec3 n = cross(sub(nodes[t[1]], nodes[t[0]]), sub(nodes[t[2]], nodes[t[0]]));
+      const double a = 0.5 * std::sqrt(dot(n, n));
+      for (int k = 0; k < 3; ++k) {
+        const double m = (nodes[t[0]][k] + nodes[t[1]][k] + nodes[t[2]][k]) / 3.0;
+        centroid[k] += a * m;
+        average[k] += m;
+        for (std::uint32_t v : t) {
+          lo[k] = std::min(lo[k], nodes[v][k]);
+          hi[k] = std::max(hi[k], nodes[v][k]);
+        }
+      }
+      area += a;
+    }
+    for (int k = 0; k < 3; ++k)
+      centroid[k] = area > 0.0 ? centroid[k] / area : average[k] / static_cast<double>(ids.size());
+
+    const std::vector<std::uint32_t> near =
+        nearest_nodes(nodes, surface.interior_nodes, centroid,
+                      strategy == DetectorStrategy::kNearestCentroid ? 1 : kDetectorNearCentroid);
+    std::uint32_t best_node = near.front();
+    std::uint32_t best_count =
+        count_positive_triangles(nodes, surface.triangles, ids, nodes[best_node]);
+
+    if (strategy == DetectorStrategy::kVisibility && best_count < ids.size()) {
+      const double diagonal = std::sqrt(distance2(lo, hi));
+      const Vec3 kernel = kernel_estimate(nodes, surface.triangles, ids, centroid, 1e-3 * diagonal);
+      std::vector<std::uint32_t> candidates = near;
+      const std::vector<std::uint32_t> near_kernel =
+          nearest_nodes(nodes, surface.interior_nodes, kernel, kDetectorNearKernel);
+      candidates.insert(candidates.end(), near_kernel.begin(), near_kernel.end());
+      // Order candidates by (distance to the centroid, id) so the first best wins ties.
+      std::vector<std::pair<double, std::uint32_t>> keyed;
+      for (std::uint32_t id : candidates) keyed.emplace_back(distance2(nodes[id], centroid), id);
+      std::sort(keyed.begin(), keyed.end());
+      keyed.erase(std::unique(keyed.begin(), keyed.end()), keyed.end());
+      best_count = 0;
+      best_node = keyed.front().second;
+      for (const auto& [dist, id] : keyed) {
+        const std::uint32_t count =
+            count_positive_triangles(nodes, surface.triangles, ids, nodes[id]);
+        if (count > best_count) {
+          best_count = count;
+          best_node = id;
+          if (count == ids.size()) break;
+        }
+      }
+    }
+    det.node = best_node;
+    det.rest_positive_fraction =
+        static_cast<float>(static_cast<double>(best_count) / static_cast<double>(ids.size()));
+  }
+  return out;
+}
+
+}  // namespace tetseg::preprocess

@@ -1,0 +1,136 @@
+#include "segment_topology.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <tuple>
+
+namespace tetseg::preprocess::detail {
+
+HalfEdges::HalfEdges(const std::vector<Tri>& triangles) : m_tris(&triangles) {
+  const std::uint32_t n = static_cast<std::uint32_t>(triangles.size()) * 3;
+  m_twin.assign(n, kNone);
+  // (min node, max node, half-edge) sorted: equal edges become neighbours in the list.
+  std::vector<std::array<std::uint32_t, 3>> keyed(n);
+  for (std::uint32_t h = 0; h < n; ++h) {
+    const std::uint32_t a = from(h);
+    const std::uint32_t b = to(h);
+    keyed[h] = {std::min(a, b), std::max(a, b), h};
+  }
+  std::sort(keyed.begin(), keyed.end());
+  for (std::uint32_t i = 0; i < n;) {
+    std::uint32_t j = i;
+    while (j < n && keyed[j][0] == keyed[i][0] && keyed[j][1] == keyed[i][1]) ++j;
+    if (j - i == 2 && keyed[i][0] != keyed[i][1]) {
+      const std::uint32_t h0 = keyed[i][2];
+      const std::uint32_t h1 = keyed[i + 1][2];
+      if (from(h0) == to(h1) && to(h0) == from(h1)) {
+        m_twin[h0] = h1;
+        m_twin[h1] = h0;
+      }
+    }
+    i = j;
+  }
+}
+
+std::vector<Contour> trace_contours(const HalfEdges& mesh, const std::vector<Vec3>& nodes,
+                                    const std::vector<std::uint8_t>& in_set) {
+  const std::uint32_t n = mesh.size();
+  auto is_border = [&](std::uint32_t h) {
+    if (!in_set[h / 3]) return false;
+    const std::uint32_t t = mesh.neighbor(h);
+    return t == kNone || !in_set[t];
+  };
+  auto length_of = [&](std::uint32_t h) {
+    const Vec3& a = nodes[mesh.from(h)];
+    const Vec3& b = nodes[mesh.to(h)];
+    return std::sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) +
+                     (a[2] - b[2]) * (a[2] - b[2]));
+  };
+  // The border half-edge that follows h: rotate around its head through the triangles
+  // outside the set until the first triangle inside it.
+  auto follow = [&](std::uint32_t h) -> std::uint32_t {
+    std::uint32_t g = mesh.twin(h);
+    for (std::uint32_t guard = 0; g != kNone && guard < n; ++guard) {
+      const std::uint32_t o = mesh.twin(HalfEdges::prev(g));
+      if (o == kNone) return kNone;
+      if (in_set[o / 3]) return o;
+      g = o;
+    }
+    return kNone;
+  };
+
+  std::vector<Contour> contours;
+  std::vector<std::uint8_t> visited(n, 0);
+  for (std::uint32_t start = 0; start < n; ++start) {
+    if (visited[start] || !is_border(start)) continue;
+    Contour c;
+    std::uint32_t h = start;
+    while (true) {
+      visited[h] = 1;
+      c.half_edges.push_back(h);
+      c.length += length_of(h);
+      const std::uint32_t nh = follow(h);
+      if (nh == start) break;
+      if (nh == kNone || visited[nh]) {
+        c.closed = false;
+        break;
+      }
+      h = nh;
+    }
+    contours.push_back(std::move(c));
+  }
+  return contours;
+}
+
+std::uint32_t label_components(const HalfEdges& mesh, const std::vector<std::uint8_t>& include,
+                               const std::vector<std::uint8_t>* cut,
+                               std::vector<std::uint32_t>& labels) {
+  const std::uint32_t nt = mesh.triangle_count();
+  labels.assign(nt, kNone);
+  std::uint32_t count = 0;
+  std::vector<std::uint32_t> stack;
+  for (std::uint32_t seed = 0; seed < nt; ++seed) {
+    if (!include[seed] || labels[seed] != kNone) continue;
+    labels[seed] = count;
+    stack.push_back(seed);
+    while (!stack.empty()) {
+      const std::uint32_t t = stack.back();
+      stack.pop_back();
+      for (std::uint32_t k = 0; k < 3; ++k) {
+        const std::uint32_t h = 3 * t + k;
+        if (cut && (*cut)[h]) continue;
+        const std::uint32_t u = mesh.neighbor(h);
+        if (u == kNone || !include[u] || labels[u] != kNone) continue;
+        labels[u] = count;
+        stack.push_back(u);
+      }
+    }
+    ++count;
+  }
+  return count;
+}
+
+UnionFind::UnionFind(std::uint32_t n) : m_parent(n) {
+  for (std::uint32_t i = 0; i < n; ++i) m_parent[i] = i;
+}
+
+std::uint32_t UnionFind::find(std::uint32_t x) {
+  while (m_parent[x] != x) {
+    m_parent[x] = m_parent[m_parent[x]];
+    x = m_parent[x];
+  }
+  return x;
+}
+
+void UnionFind::unite(std::uint32_t a, std::uint32_t b) {
+  a = find(a);
+  b = find(b);
+  if (a == b) return;
+  if (a < b)
+    m_parent[b] = a;
+  else
+    m_parent[a] = b;
+}
+
+}  // namespace tetseg::preprocess::detail
