@@ -1,0 +1,286 @@
+// tetseg-ccd: the elementary continuous collision tests on reference queries and on whole
+// frames of a triangle soup. Links the runtime only.
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "ccd_io.hpp"
+#include "fast_cubic.hpp"
+#include "soup_ccd.hpp"
+#include "tetseg/runtime/ccd.hpp"
+#include "tool_support.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using namespace tetseg::tools;
+namespace io = tetseg::tools::ccd_io;
+
+constexpr const char* kTool = "tetseg-ccd";
+
+struct Tally {
+  long queries = 0;
+  long positives = 0;
+  long false_negatives = 0;
+  long false_positives = 0;
+  double seconds = 0;
+  void add(const Tally& o) {
+    queries += o.queries;
+    positives += o.positives;
+    false_negatives += o.false_negatives;
+    false_positives += o.false_positives;
+    seconds += o.seconds;
+  }
+  double mean_us() const { return queries ? seconds * 1e6 / static_cast<double>(queries) : 0.0; }
+};
+
+std::string tally_json(const Tally& t) {
+  char buf[256];
+  std::snprintf(buf, sizeof buf,
+                "{\"queries\": %ld, \"positives\": %ld, \"false_negatives\": %ld, "
+                "\"false_positives\": %ld, \"mean_us\": %.3f}",
+                t.queries, t.positives, t.false_negatives, t.false_positives, t.mean_us());
+  return buf;
+}
+
+bool run_query(const io::Query& q, bool vertex_face, bool fast, const tetseg::CcdOptions& options) {
+  const auto& x = q.points;
+  if (fast) {
+    double toi = 0;
+    return vertex_face ? fast_cubic::vertex_face(x[0], x[1], x[2], x[3], x[4], x[5], x[6], x[7], toi)
+                       : fast_cubic::edge_edge(x[0], x[1], x[2], x[3], x[4], x[5], x[6], x[7], toi);
+  }
+  return vertex_face
+             ? tetseg::vertex_face_ccd(x[0], x[1], x[2], x[3], x[4], x[5], x[6], x[7], options).hit()
+             : tetseg::edge_edge_ccd(x[0], x[1], x[2], x[3], x[4], x[5], x[6], x[7], options).hit();
+}
+
+Tally run_folder(const fs::path& folder, bool vertex_face, bool fast,
+                 const tetseg::CcdOptions& options) {
+  Tally tally;
+  if (!fs::is_directory(folder)) return tally;
+  std::vector<fs::path> files;
+  for (const auto& entry : fs::directory_iterator(folder))
+    if (entry.path().extension() == ".csv") files.push_back(entry.path());
+  std::sort(files.begin(), files.end());
+  for (const auto& file : files) {
+    std::vector<io::Query> queries;
+    try {
+      queries = io::read_query_csv(file.string());
+    } catch (const std::runtime_error& e) {
+      throw ToolError(kExitBadInput, file.string(), e.what());
+    }
+    std::vector<char> results(queries.size());
+    const auto start = std::chrono::steady_clock::now();
+    for (std::size_t i = 0; i < queries.size(); ++i)
+      results[i] = run_query(queries[i], vertex_face, fast, options);
+    tally.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    for (std::size_t i = 0; i < queries.size(); ++i) {
+      ++tally.queries;
+      tally.positives += queries[i].truth;
+      if (queries[i].truth && !results[i]) ++tally.false_negatives;
+      if (!queries[i].truth && results[i]) ++tally.false_positives;
+    }
+  }
+  return tally;
+}
+
+int command_queries(const std::string& dir, bool json, const std::string& method,
+                    const tetseg::CcdOptions& options) {
+  if (!fs::is_directory(dir)) throw ToolError(kExitBadInput, dir, "not a directory");
+  const bool fast = method == "fast-cubic";
+  std::vector<fs::path> scenes;
+  for (const auto& entry : fs::directory_iterator(dir))
+    if (entry.is_directory()) scenes.push_back(entry.path());
+  std::sort(scenes.begin(), scenes.end());
+  std::map<std::string, std::array<Tally, 2>> per_scene;
+  std::array<Tally, 2> total;
+  for (const auto& scene : scenes) {
+    const Tally vf = run_folder(scene / "vertex-face", true, fast, options);
+    const Tally ee = run_folder(scene / "edge-edge", false, fast, options);
+    if (vf.queries + ee.queries == 0) continue;
+    per_scene[scene.filename().string()] = {vf, ee};
+    total[0].add(vf);
+    total[1].add(ee);
+  }
+  if (per_scene.empty()) throw ToolError(kExitBadInput, dir, "no query CSV found (expected <scene>/{vertex-face,edge-edge}/*.csv)");
+  if (json) {
+    std::ostringstream out;
+    out << "{\"method\": \"" << method << "\",\n \"vertex_face\": " << tally_json(total[0])
+        << ",\n \"edge_edge\": " << tally_json(total[1]) << ",\n \"scenes\": {";
+    bool first = true;
+    for (const auto& [name, t] : per_scene) {
+      out << (first ? "\n" : ",\n") << "  \"" << json_escape(name)
+          << "\": {\"vertex_face\": " << tally_json(t[0]) << ", \"edge_edge\": " << tally_json(t[1])
+          << "}";
+      first = false;
+    }
+    out << "}}\n";
+    std::cout << out.str();
+  } else {
+    std::printf("%-30s %-3s %8s %9s %4s %4s %10s\n", "scene", "", "queries", "positives", "FN",
+                "FP", "mean_us");
+    auto line = [](const std::string& name, const char* kind, const Tally& t) {
+      std::printf("%-30s %-3s %8ld %9ld %4ld %4ld %10.2f\n", name.c_str(), kind, t.queries,
+                  t.positives, t.false_negatives, t.false_positives, t.mean_us());
+    };
+    for (const auto& [name, t] : per_scene) {
+      line(name, "VF", t[0]);
+      line(name, "EE", t[1]);
+    }
+    line("total (" + method + ")", "VF", total[0]);
+    line("total (" + method + ")", "EE", total[1]);
+  }
+  return kExitOk;
+}
+
+io::Mesh load_mesh(const std::string& path) {
+  try {
+    return io::read_ply(path);
+  } catch (const std::runtime_error& e) {
+    throw ToolError(kExitBadInput, path, e.what());
+  }
+}
+
+int command_frames(const std::string& path0, const std::string& path1, bool json,
+                   const tetseg::CcdOptions& options) {
+  const io::Mesh m0 = load_mesh(path0);
+  const io::Mesh m1 = load_mesh(path1);
+  if (m0.vertices.size() != m1.vertices.size())
+    throw ToolError(kExitBadInput, path1, "vertex count differs from " + path0);
+  if (m0.faces != m1.faces) throw ToolError(kExitBadInput, path1, "faces differ from " + path0);
+  const auto contacts = soup::find_contacts(m0.vertices, m1.vertices, m0.faces, options);
+  std::ostringstream out;
+  char buf[160];
+  if (json) {
+    out << "{\"vertices\": " << m0.vertices.size() << ", \"faces\": " << m0.faces.size()
+        << ", \"contacts\": [";
+    for (std::size_t i = 0; i < contacts.size(); ++i) {
+      const auto& c = contacts[i];
+      if (c.vertex_face)
+        std::snprintf(buf, sizeof buf, "{\"kind\": \"vf\", \"vertex\": %u, \"face\": [%u, %u, %u], \"toi\": %.17g}",
+                      c.ids[0], c.ids[1], c.ids[2], c.ids[3], c.toi);
+      else
+        std::snprintf(buf, sizeof buf, "{\"kind\": \"ee\", \"edges\": [[%u, %u], [%u, %u]], \"toi\": %.17g}",
+                      c.ids[0], c.ids[1], c.ids[2], c.ids[3], c.toi);
+      out << (i ? ",\n  " : "\n  ") << buf;
+    }
+    out << "]}\n";
+  } else {
+    for (const auto& c : contacts) {
+      std::snprintf(buf, sizeof buf, "%s %u %u %u %u %.17g\n", c.vertex_face ? "vf" : "ee", c.ids[0],
+                    c.ids[1], c.ids[2], c.ids[3], c.toi);
+      out << buf;
+    }
+  }
+  std::cout << out.str();
+  std::cerr << kTool << ": " << contacts.size() << " contacts\n";
+  return kExitOk;
+}
+
+/// Lists the true pairs of a scalable-CCD frame (boxes + mma_bool) in the text format of
+/// `frames` without the time of impact (used by the CLI test).
+int command_truth(const std::string& ply, const std::string& boxes_path, const std::string& truth_path,
+                  const std::string& kind) {
+  const io::Mesh mesh = load_mesh(ply);
+  std::vector<std::array<std::int64_t, 2>> boxes;
+  std::vector<bool> truth;
+  try {
+    boxes = io::parse_json_pairs(io::read_text(boxes_path));
+  } catch (const std::runtime_error& e) {
+    throw ToolError(kExitBadInput, boxes_path, e.what());
+  }
+  try {
+    truth = io::parse_json_bools(io::read_text(truth_path));
+  } catch (const std::runtime_error& e) {
+    throw ToolError(kExitBadInput, truth_path, e.what());
+  }
+  if (boxes.size() != truth.size()) throw ToolError(kExitBadInput, truth_path, "length differs from the boxes file");
+  const auto edges = io::unique_edges(mesh.faces);
+  const auto n_v = static_cast<std::int64_t>(mesh.vertices.size());
+  const auto n_e = static_cast<std::int64_t>(edges.size());
+  const auto n_f = static_cast<std::int64_t>(mesh.faces.size());
+  for (std::size_t i = 0; i < boxes.size(); ++i) {
+    if (!truth[i]) continue;
+    const auto [x, y] = boxes[i];
+    if (kind == "vf") {
+      const std::int64_t f = y - n_v - n_e;
+      if (x < 0 || x >= n_v || f < 0 || f >= n_f) throw ToolError(kExitBadInput, boxes_path, "bad VF id");
+      const auto& face = mesh.faces[static_cast<std::size_t>(f)];
+      std::printf("vf %lld %u %u %u\n", static_cast<long long>(x), face[0], face[1], face[2]);
+    } else {
+      const std::int64_t e0 = x - n_v, e1 = y - n_v;
+      if (e0 < 0 || e0 >= n_e || e1 < 0 || e1 >= n_e) throw ToolError(kExitBadInput, boxes_path, "bad EE id");
+      auto a = edges[static_cast<std::size_t>(e0)];
+      auto b = edges[static_cast<std::size_t>(e1)];
+      if (b < a) std::swap(a, b);
+      std::printf("ee %u %u %u %u\n", a[0], a[1], b[0], b[1]);
+    }
+  }
+  return kExitOk;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"tetseg-ccd " TETSEG_VERSION ": elementary continuous collision tests", kTool};
+  app.set_version_flag("--version", std::string(kTool) + " " TETSEG_VERSION);
+  app.require_subcommand(1);
+  tetseg::CcdOptions options;
+
+  auto* queries = app.add_subcommand("queries", "Run the tests on reference queries (<scene>/{vertex-face,edge-edge}/*.csv)");
+  std::string dir;
+  bool json = false;
+  std::string method = "conservative";
+  queries->add_option("dir", dir, "Folder in sample-queries layout")->required();
+  queries->add_flag("--json", json, "Print JSON");
+  queries->add_option("--method", method, "conservative (runtime) or fast-cubic (non-conservative baseline)")
+      ->check(CLI::IsMember({"conservative", "fast-cubic"}));
+  queries->add_option("--min-separation", options.min_separation, "Minimum separation (length units)")
+      ->check(CLI::NonNegativeNumber);
+  queries->add_option("--time-tolerance", options.time_tolerance, "Bisection stop width in t")
+      ->check(CLI::PositiveNumber);
+
+  auto* frames = app.add_subcommand("frames", "All contacts between two PLY frames of a triangle soup (BVH)");
+  std::string ply0, ply1;
+  frames->add_option("t0", ply0, "Frame at the start of the step (PLY)")->required();
+  frames->add_option("t1", ply1, "Frame at the end of the step (PLY, same faces)")->required();
+  frames->add_flag("--json", json, "Print JSON");
+  frames->add_option("--min-separation", options.min_separation, "Minimum separation (length units)")
+      ->check(CLI::NonNegativeNumber);
+
+  auto* truth = app.add_subcommand("truth", "List the true pairs of a scalable-CCD frame (boxes + mma_bool)");
+  std::string truth_ply, boxes_path, bools_path, kind;
+  truth->add_option("ply", truth_ply, "Frame PLY (for the numbering)")->required();
+  truth->add_option("boxes", boxes_path, "boxes/<a>{vf,ee}.json")->required();
+  truth->add_option("bools", bools_path, "mma_bool/<a>{vf,ee}_mma_bool.json")->required();
+  truth->add_option("--kind", kind, "vf or ee")->required()->check(CLI::IsMember({"vf", "ee"}));
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);
+    return code == 0 ? kExitOk : kExitUsage;
+  }
+  try {
+    if (queries->parsed()) return command_queries(dir, json, method, options);
+    if (frames->parsed()) return command_frames(ply0, ply1, json, options);
+    return command_truth(truth_ply, boxes_path, bools_path, kind);
+  } catch (const ToolError& e) {
+    print_error(kTool, e.file(), e.what());
+    return e.code();
+  } catch (const std::exception& e) {
+    print_error(kTool, "", e.what());
+    return kExitProcessingFailed;
+  }
+}

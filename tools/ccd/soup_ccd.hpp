@@ -1,0 +1,30 @@
+#pragma once
+/// \file
+/// All contacts of a deforming triangle soup over one linear step: one median-split BVH over
+/// the swept triangle boxes, self-traversal, feature pairs (vertex-face, edge-edge) that share
+/// no vertex, deduplicated, swept-box filter, then the runtime's elementary tests.
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "tetseg/runtime/ccd.hpp"
+
+namespace tetseg::tools::soup {
+
+struct Contact {
+  bool vertex_face = true;
+  /// vf: vertex, face[0], face[1], face[2] (face order); ee: a, b, c, d with a < b, c < d and
+  /// (a, b) < (c, d).
+  std::array<std::uint32_t, 4> ids{};
+  double toi = 1.0;
+};
+
+/// Contacts sorted by kind (vf first) then ids. Vertices not referenced by a face are ignored.
+/// Preconditions: face indices < x0.size() == x1.size().
+std::vector<Contact> find_contacts(const std::vector<std::array<double, 3>>& x0,
+                                   const std::vector<std::array<double, 3>>& x1,
+                                   const std::vector<std::array<std::uint32_t, 3>>& faces,
+                                   const CcdOptions& options);
+
+}  // namespace tetseg::tools::soup
