@@ -34,7 +34,8 @@ HalfEdges::HalfEdges(const std::vector<Tri>& triangles) : m_tris(&triangles) {
 }
 
 std::vector<Contour> trace_contours(const HalfEdges& mesh, const std::vector<Vec3>& nodes,
-                                    const std::vector<std::uint8_t>& in_set) {
+                                    const std::vector<std::uint8_t>& in_set,
+                                    const std::vector<std::uint32_t>& set_triangles) {
   const std::uint32_t n = mesh.size();
   auto is_border = [&](std::uint32_t h) {
     if (!in_set[h / 3]) return false;
@@ -60,19 +61,32 @@ std::vector<Contour> trace_contours(const HalfEdges& mesh, const std::vector<Vec
     return kNone;
   };
 
+  std::vector<std::uint32_t> border;  // sorted: triangles ascending, then local edge
+  for (std::uint32_t t : set_triangles)
+    for (std::uint32_t k = 0; k < 3; ++k)
+      if (is_border(3 * t + k)) border.push_back(3 * t + k);
+  std::vector<std::uint8_t> visited(border.size(), 0);
+  auto slot = [&](std::uint32_t h) -> std::size_t {
+    const auto it = std::lower_bound(border.begin(), border.end(), h);
+    return (it != border.end() && *it == h) ? static_cast<std::size_t>(it - border.begin())
+                                            : border.size();
+  };
+
   std::vector<Contour> contours;
-  std::vector<std::uint8_t> visited(n, 0);
-  for (std::uint32_t start = 0; start < n; ++start) {
-    if (visited[start] || !is_border(start)) continue;
+  for (std::size_t i = 0; i < border.size(); ++i) {
+    if (visited[i]) continue;
+    const std::uint32_t start = border[i];
     Contour c;
     std::uint32_t h = start;
+    std::size_t s = i;
     while (true) {
-      visited[h] = 1;
+      visited[s] = 1;
       c.half_edges.push_back(h);
       c.length += length_of(h);
       const std::uint32_t nh = follow(h);
       if (nh == start) break;
-      if (nh == kNone || visited[nh]) {
+      s = nh == kNone ? border.size() : slot(nh);
+      if (s == border.size() || visited[s]) {
         c.closed = false;
         break;
       }

@@ -47,10 +47,12 @@ struct Contour {
   bool closed = true;
 };
 
-/// Every contour of the set `in_set` (one flag per triangle); each starts at the smallest
-/// border half-edge not yet visited, so the result is deterministic.
+/// Every contour of the set `in_set` (one flag per triangle) whose triangles are listed, sorted
+/// ascending, in `set_triangles` (cost O(|set| + border), not O(N)). Each contour starts at the
+/// smallest border half-edge not yet visited, so the result is deterministic.
 std::vector<Contour> trace_contours(const HalfEdges& mesh, const std::vector<Vec3>& nodes,
-                                    const std::vector<std::uint8_t>& in_set);
+                                    const std::vector<std::uint8_t>& in_set,
+                                    const std::vector<std::uint32_t>& set_triangles);
 
 /// Edge-connected components of the triangles with `include[t]`, not crossing half-edges with
 /// `cut[h]` (when `cut` is non-null). Labels are 0.. in order of the smallest triangle id;

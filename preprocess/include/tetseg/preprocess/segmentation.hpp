@@ -4,6 +4,7 @@
 /// BVH topology (Wong & Yeh, section IV-B/C). Decisions on the points the paper leaves open:
 /// docs/segmentation.md.
 
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -18,33 +19,51 @@ enum class DetectorStrategy {
   kVisibility,       ///< among nearby interior nodes, the one seeing most triangles positive
 };
 
+/// Parameters of segment_surface. Defaults reproduce the paper (alpha 0.1, beta N/400); the
+/// rest fixes points it leaves open (docs/segmentation.md).
 struct SegmentationOptions {
   double alpha = 0.1;           ///< triangles with equalised density < alpha are marked
   double beta_divisor = 400.0;  ///< segments larger than N / beta_divisor triangles are grown
+  /// How `tetseg build` equalises the density before calling segment_surface (recorded only;
+  /// segment_surface takes the equalised values).
   Equalization equalization = Equalization::kHistogram;
-  double growth_bound = 0.25;  ///< a segment never grows beyond this fraction of the surface
-  std::uint32_t min_cluster_triangles = 0;  ///< 0 = derived (docs/segmentation.md)
-  DetectorStrategy detector = DetectorStrategy::kVisibility;
+  double growth_bound = 0.25;  ///< a grown segment is dropped once it exceeds this share of N
+  /// Clusters smaller than this are merged into a neighbour, and complement pieces smaller than
+  /// this never count as separated (they are filled into the segment). 0 = derived:
+  /// derived_min_cluster_triangles(N).
+  std::uint32_t min_cluster_triangles = 0;
+  DetectorStrategy detector = DetectorStrategy::kVisibility;  ///< used by choose_detectors
 };
 
+/// The default minimum cluster size for N surface triangles: max(8, ceil(N / 200)), capped at N.
+std::uint32_t derived_min_cluster_triangles(std::size_t triangle_count);
+
 struct SegmentationCounts {
-  std::uint32_t segments_found = 0;
-  std::uint32_t segments_grown = 0;
-  std::uint32_t segments_shrunk = 0;
-  std::uint32_t boundaries = 0;
-  std::uint32_t clusters = 0;
-  std::uint32_t clusters_merged = 0;
+  std::uint32_t segments_found = 0;   ///< connected components of marked triangles
+  std::uint32_t segments_grown = 0;   ///< segments that separate only after growing
+  std::uint32_t segments_shrunk = 0;  ///< separating segments shrunk to cutting triangles
+  std::uint32_t boundaries = 0;       ///< segment boundaries kept (== boundary_loops.size())
+  std::uint32_t clusters = 0;         ///< == cluster_count
+  std::uint32_t clusters_merged = 0;  ///< small clusters merged into a neighbour
 };
 
 struct Segmentation {
-  std::vector<std::uint32_t> triangle_cluster;  ///< per surface triangle
-  std::uint32_t cluster_count = 0;
-  std::vector<std::vector<std::uint32_t>> boundary_loops;  ///< closed loops of node ids
+  std::vector<std::uint32_t> triangle_cluster;  ///< per surface triangle, < cluster_count
+  std::uint32_t cluster_count = 0;              ///< clusters numbered by their smallest triangle id
+  /// Closed loops of node ids: consecutive nodes (and last -> first) share a surface edge; a
+  /// node may repeat at a pinch. Every edge of a loop has different clusters on its two sides.
+  std::vector<std::vector<std::uint32_t>> boundary_loops;
+  std::vector<double> boundary_lengths;     ///< per loop, sum of edge lengths at rest
+  std::uint32_t min_cluster_triangles = 0;  ///< the minimum actually used
   SegmentationCounts counts;
 };
 
-/// Segments the surface using the equalised density (one value per surface triangle).
-/// Deterministic. Every triangle ends in exactly one cluster.
+/// Segments the closed outward surface using the equalised density (one value per surface
+/// triangle, in (0,1]; NaN counts as unmarked). Deterministic: equal inputs give equal outputs.
+/// Every triangle ends in exactly one cluster; a surface without separating segments is one
+/// cluster per connected component. Never throws on odd geometry (non-manifold edges are
+/// treated as borders); throws std::invalid_argument when `equalized` does not have one value
+/// per triangle or a triangle names a node outside `nodes`.
 Segmentation segment_surface(const std::vector<Vec3>& nodes, const Surface& surface,
                              const std::vector<double>& equalized,
                              const SegmentationOptions& options);
