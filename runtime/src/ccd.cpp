@@ -25,7 +25,9 @@ using namespace ccd_detail;
 constexpr int kStackSize = 64;
 constexpr double kMinTolerance = 0x1p-50;
 
-IvVec exact_vec(const Vec3d& x) noexcept { return {exact(x[0]), exact(x[1]), exact(x[2])}; }
+IvVec exact_vec(const Vec3d& x) noexcept {
+  return {exact(x[0]), exact(x[1]), exact(x[2])};
+}
 
 /// Enclosure of x0 + t (x1 - x0) for an exact time t.
 IvVec position(const Vec3d& x0, const Vec3d& x1, double t) noexcept {
@@ -80,8 +82,7 @@ Range trilinear_range(const Slot& w1, const Slot& w2, const Slot& w3) noexcept {
 }
 
 /// Bernstein enclosure of the quadrilinear form (w1 x w2) . (w3 x w4) over the interval.
-Range quadrilinear_range(const Slot& w1, const Slot& w2, const Slot& w3,
-                         const Slot& w4) noexcept {
+Range quadrilinear_range(const Slot& w1, const Slot& w2, const Slot& w3, const Slot& w4) noexcept {
   IvVec left[2][2];
   IvVec right[2][2];
   for (int i = 0; i < 2; ++i) {
@@ -96,8 +97,7 @@ Range quadrilinear_range(const Slot& w1, const Slot& w2, const Slot& w3,
       for (int k = 0; k < 2; ++k)
         for (int l = 0; l < 2; ++l)
           sum[i + j + k + l] = sum[i + j + k + l] + dot(left[i][j], right[k][l]);
-  const Iv b[5] = {sum[0], divide(sum[1], 4.0), divide(sum[2], 6.0), divide(sum[3], 4.0),
-                   sum[4]};
+  const Iv b[5] = {sum[0], divide(sum[1], 4.0), divide(sum[2], 6.0), divide(sum[3], 4.0), sum[4]};
   return range_of(b, 5);
 }
 
@@ -279,7 +279,6 @@ struct EdgeEdgeTest {
   bool above_delta(const Range& r, double scale2_hi) const noexcept {
     return r.lo > 0.0 && (sep.zero() || mul_down(r.lo, r.lo) > mul_up(sep.delta2, scale2_hi));
   }
-
 };
 
 double clamp_tolerance(double tol) noexcept {
@@ -314,8 +313,8 @@ CcdResult run_bisection(const Test& test, const CcdOptions& options) noexcept {
     ++result.intervals;
     if (test.excluded(item.ta, item.tb, Depth::kFull)) continue;
     const double tm = 0.5 * item.ta + 0.5 * item.tb;
-    if (item.tb - item.ta <= tol || result.intervals >= max_intervals ||
-        top + 2 > kStackSize || !(tm > item.ta && tm < item.tb)) {
+    if (item.tb - item.ta <= tol || result.intervals >= max_intervals || top + 2 > kStackSize ||
+        !(tm > item.ta && tm < item.tb)) {
       result.outcome = CcdOutcome::kContact;
       result.toi = item.ta;
       return result;
@@ -331,24 +330,24 @@ CcdResult run_bisection(const Test& test, const CcdOptions& options) noexcept {
 CcdResult vertex_face_ccd(const Vec3d& p0, const Vec3d& a0, const Vec3d& b0, const Vec3d& c0,
                           const Vec3d& p1, const Vec3d& a1, const Vec3d& b1, const Vec3d& c1,
                           const CcdOptions& options) noexcept {
-  const VertexFaceTest test{{&p0, &a0, &b0, &c0}, {&p1, &a1, &b1, &c1},
-                            Separation(options.min_separation)};
+  const VertexFaceTest test{
+      {&p0, &a0, &b0, &c0}, {&p1, &a1, &b1, &c1}, Separation(options.min_separation)};
   return run_bisection(test, options);
 }
 
 CcdResult edge_edge_ccd(const Vec3d& a0, const Vec3d& b0, const Vec3d& c0, const Vec3d& d0,
                         const Vec3d& a1, const Vec3d& b1, const Vec3d& c1, const Vec3d& d1,
                         const CcdOptions& options) noexcept {
-  const EdgeEdgeTest test{{&a0, &b0, &c0, &d0}, {&a1, &b1, &c1, &d1},
-                          Separation(options.min_separation)};
+  const EdgeEdgeTest test{
+      {&a0, &b0, &c0, &d0}, {&a1, &b1, &c1, &d1}, Separation(options.min_separation)};
   return run_bisection(test, options);
 }
 
 bool vertex_face_ccd_filter(const Vec3d& p0, const Vec3d& a0, const Vec3d& b0, const Vec3d& c0,
                             const Vec3d& p1, const Vec3d& a1, const Vec3d& b1, const Vec3d& c1,
                             const CcdOptions& options) noexcept {
-  const VertexFaceTest test{{&p0, &a0, &b0, &c0}, {&p1, &a1, &b1, &c1},
-                            Separation(options.min_separation)};
+  const VertexFaceTest test{
+      {&p0, &a0, &b0, &c0}, {&p1, &a1, &b1, &c1}, Separation(options.min_separation)};
   if (!all_finite(test.x0, 4) || !all_finite(test.x1, 4)) return true;
   return !test.excluded(0.0, 1.0, Depth::kFilter);
 }
@@ -356,8 +355,8 @@ bool vertex_face_ccd_filter(const Vec3d& p0, const Vec3d& a0, const Vec3d& b0, c
 bool edge_edge_ccd_filter(const Vec3d& a0, const Vec3d& b0, const Vec3d& c0, const Vec3d& d0,
                           const Vec3d& a1, const Vec3d& b1, const Vec3d& c1, const Vec3d& d1,
                           const CcdOptions& options) noexcept {
-  const EdgeEdgeTest test{{&a0, &b0, &c0, &d0}, {&a1, &b1, &c1, &d1},
-                          Separation(options.min_separation)};
+  const EdgeEdgeTest test{
+      {&a0, &b0, &c0, &d0}, {&a1, &b1, &c1, &d1}, Separation(options.min_separation)};
   if (!all_finite(test.x0, 4) || !all_finite(test.x1, 4)) return true;
   return !test.excluded(0.0, 1.0, Depth::kFilter);
 }

@@ -24,7 +24,9 @@ struct Iv {
   double r;
 };
 
-inline Iv exact(double x) noexcept { return {x, 0.0}; }
+inline Iv exact(double x) noexcept {
+  return {x, 0.0};
+}
 
 inline Iv operator+(Iv a, Iv b) noexcept {
   const double m = a.m + b.m;
@@ -36,12 +38,13 @@ inline Iv operator-(Iv a, Iv b) noexcept {
   return {m, (a.r + b.r + kRel * std::fabs(m)) * kUp + kTiny};
 }
 
-inline Iv operator-(Iv a) noexcept { return {-a.m, a.r}; }
+inline Iv operator-(Iv a) noexcept {
+  return {-a.m, a.r};
+}
 
 inline Iv operator*(Iv a, Iv b) noexcept {
   const double m = a.m * b.m;
-  return {m, (std::fabs(a.m) * b.r + std::fabs(b.m) * a.r + a.r * b.r + kRel * std::fabs(m)) *
-                     kUp +
+  return {m, (std::fabs(a.m) * b.r + std::fabs(b.m) * a.r + a.r * b.r + kRel * std::fabs(m)) * kUp +
                  kTiny};
 }
 
@@ -70,8 +73,12 @@ inline Iv hull(Iv a, Iv b) noexcept {
 }
 
 /// Products of non-negative doubles rounded down / up (for comparisons of squares).
-inline double mul_down(double x, double y) noexcept { return x * y * (1.0 - 0x1p-50); }
-inline double mul_up(double x, double y) noexcept { return x * y * (1.0 + 0x1p-50) + kTiny; }
+inline double mul_down(double x, double y) noexcept {
+  return x * y * (1.0 - 0x1p-50);
+}
+inline double mul_up(double x, double y) noexcept {
+  return x * y * (1.0 + 0x1p-50) + kTiny;
+}
 
 struct IvVec {
   Iv x, y, z;
@@ -83,7 +90,9 @@ inline IvVec operator-(const IvVec& a, const IvVec& b) noexcept {
 inline IvVec cross(const IvVec& a, const IvVec& b) noexcept {
   return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
 }
-inline Iv dot(const IvVec& a, const IvVec& b) noexcept { return a.x * b.x + a.y * b.y + a.z * b.z; }
+inline Iv dot(const IvVec& a, const IvVec& b) noexcept {
+  return a.x * b.x + a.y * b.y + a.z * b.z;
+}
 inline IvVec hull(const IvVec& a, const IvVec& b) noexcept {
   return {hull(a.x, b.x), hull(a.y, b.y), hull(a.z, b.z)};
 }

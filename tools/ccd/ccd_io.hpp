@@ -156,7 +156,8 @@ inline Mesh read_ply(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw std::runtime_error("cannot open");
   std::string line;
-  if (!std::getline(in, line) || line.rfind("ply", 0) != 0) throw std::runtime_error("not a PLY file");
+  if (!std::getline(in, line) || line.rfind("ply", 0) != 0)
+    throw std::runtime_error("not a PLY file");
   enum class Format { kAscii, kLittle, kBig } format = Format::kAscii;
   struct Property {
     std::string name, type, count_type;
@@ -177,10 +178,14 @@ inline Mesh read_ply(const std::string& path) {
     if (word == "format") {
       std::string f;
       ss >> f;
-      if (f == "ascii") format = Format::kAscii;
-      else if (f == "binary_little_endian") format = Format::kLittle;
-      else if (f == "binary_big_endian") format = Format::kBig;
-      else throw std::runtime_error("unknown PLY format '" + f + "'");
+      if (f == "ascii")
+        format = Format::kAscii;
+      else if (f == "binary_little_endian")
+        format = Format::kLittle;
+      else if (f == "binary_big_endian")
+        format = Format::kBig;
+      else
+        throw std::runtime_error("unknown PLY format '" + f + "'");
     } else if (word == "element") {
       Element e;
       ss >> e.name >> e.count;
@@ -206,7 +211,8 @@ inline Mesh read_ply(const std::string& path) {
   auto type_size = [](const std::string& t) -> std::size_t {
     if (t == "char" || t == "uchar" || t == "int8" || t == "uint8") return 1;
     if (t == "short" || t == "ushort" || t == "int16" || t == "uint16") return 2;
-    if (t == "int" || t == "uint" || t == "int32" || t == "uint32" || t == "float" || t == "float32")
+    if (t == "int" || t == "uint" || t == "int32" || t == "uint32" || t == "float" ||
+        t == "float32")
       return 4;
     if (t == "double" || t == "float64") return 8;
     throw std::runtime_error("unknown PLY type '" + t + "'");
@@ -307,7 +313,8 @@ inline std::vector<std::array<std::int64_t, 2>> parse_json_pairs(const std::stri
   auto expect = [&](char c) {
     skip();
     if (i >= text.size() || text[i] != c)
-      throw std::runtime_error(std::string("JSON: expected '") + c + "' at offset " + std::to_string(i));
+      throw std::runtime_error(std::string("JSON: expected '") + c + "' at offset " +
+                               std::to_string(i));
     ++i;
   };
   auto number = [&]() -> std::int64_t {
@@ -315,7 +322,8 @@ inline std::vector<std::array<std::int64_t, 2>> parse_json_pairs(const std::stri
     std::size_t start = i;
     if (i < text.size() && text[i] == '-') ++i;
     while (i < text.size() && std::isdigit(static_cast<unsigned char>(text[i]))) ++i;
-    if (start == i || i - start > 18) throw std::runtime_error("JSON: bad integer at offset " + std::to_string(start));
+    if (start == i || i - start > 18)
+      throw std::runtime_error("JSON: bad integer at offset " + std::to_string(start));
     return std::stoll(text.substr(start, i - start));
   };
   expect('[');
@@ -387,9 +395,8 @@ inline std::vector<std::array<std::uint32_t, 2>> unique_edges(
       edges.push_back({a, b});
     }
   }
-  std::sort(edges.begin(), edges.end(), [](const auto& x, const auto& y) {
-    return x[1] != y[1] ? x[1] < y[1] : x[0] < y[0];
-  });
+  std::sort(edges.begin(), edges.end(),
+            [](const auto& x, const auto& y) { return x[1] != y[1] ? x[1] < y[1] : x[0] < y[0]; });
   edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
   return edges;
 }

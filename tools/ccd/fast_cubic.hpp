@@ -13,14 +13,18 @@ namespace tetseg::tools::fast_cubic {
 
 using V = std::array<double, 3>;
 
-inline V sub(const V& a, const V& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
+inline V sub(const V& a, const V& b) {
+  return {a[0] - b[0], a[1] - b[1], a[2] - b[2]};
+}
 inline V lerp(const V& a, const V& b, double t) {
   return {a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1]), a[2] + t * (b[2] - a[2])};
 }
 inline V cross(const V& a, const V& b) {
   return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
 }
-inline double dot(const V& a, const V& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+inline double dot(const V& a, const V& b) {
+  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
 
 /// Real roots in [0,1] of the cubic with Bernstein coefficients b (sorted); returns count.
 /// Monotone pieces between the derivative's roots, bisection with 60 steps in each.
@@ -60,8 +64,10 @@ inline int cubic_roots(const std::array<double, 4>& b, double (&roots)[3]) {
     for (int k = 0; k < 60; ++k) {
       const double mid = 0.5 * (lo + hi);
       const double fm = f(mid);
-      if ((fm > 0) == (flo > 0)) lo = mid, flo = fm;
-      else hi = mid;
+      if ((fm > 0) == (flo > 0))
+        lo = mid, flo = fm;
+      else
+        hi = mid;
     }
     if (count < 3) roots[count++] = hi;
   }
@@ -79,11 +85,12 @@ inline std::array<double, 4> triple_bernstein(const V& u0, const V& v0, const V&
 inline bool vertex_face(const V& p0, const V& a0, const V& b0, const V& c0, const V& p1,
                         const V& a1, const V& b1, const V& c1, double& toi) {
   const double eps = 1e-8;
-  const auto b = triple_bernstein(sub(b0, a0), sub(c0, a0), sub(p0, a0), sub(b1, a1),
-                                  sub(c1, a1), sub(p1, a1));
+  const auto b = triple_bernstein(sub(b0, a0), sub(c0, a0), sub(p0, a0), sub(b1, a1), sub(c1, a1),
+                                  sub(p1, a1));
   double roots[3];
   int n = cubic_roots(b, roots);
-  const double scale = std::max({std::fabs(b[0]), std::fabs(b[1]), std::fabs(b[2]), std::fabs(b[3])});
+  const double scale =
+      std::max({std::fabs(b[0]), std::fabs(b[1]), std::fabs(b[2]), std::fabs(b[3])});
   if (scale < 1e-30) {  // coplanar for the whole step: sample
     roots[0] = 0, roots[1] = 0.5, roots[2] = 1, n = 3;
   }
@@ -104,14 +111,15 @@ inline bool vertex_face(const V& p0, const V& a0, const V& b0, const V& c0, cons
   return false;
 }
 
-inline bool edge_edge(const V& a0, const V& b0, const V& c0, const V& d0, const V& a1,
-                      const V& b1, const V& c1, const V& d1, double& toi) {
+inline bool edge_edge(const V& a0, const V& b0, const V& c0, const V& d0, const V& a1, const V& b1,
+                      const V& c1, const V& d1, double& toi) {
   const double eps = 1e-8;
-  const auto b = triple_bernstein(sub(b0, a0), sub(d0, c0), sub(c0, a0), sub(b1, a1),
-                                  sub(d1, c1), sub(c1, a1));
+  const auto b = triple_bernstein(sub(b0, a0), sub(d0, c0), sub(c0, a0), sub(b1, a1), sub(d1, c1),
+                                  sub(c1, a1));
   double roots[3];
   int n = cubic_roots(b, roots);
-  const double scale = std::max({std::fabs(b[0]), std::fabs(b[1]), std::fabs(b[2]), std::fabs(b[3])});
+  const double scale =
+      std::max({std::fabs(b[0]), std::fabs(b[1]), std::fabs(b[2]), std::fabs(b[3])});
   if (scale < 1e-30) roots[0] = 0, roots[1] = 0.5, roots[2] = 1, n = 3;
   for (int i = 0; i < n; ++i) {
     const double t = roots[i];

@@ -57,11 +57,13 @@ bool run_query(const io::Query& q, bool vertex_face, bool fast, const tetseg::Cc
   const auto& x = q.points;
   if (fast) {
     double toi = 0;
-    return vertex_face ? fast_cubic::vertex_face(x[0], x[1], x[2], x[3], x[4], x[5], x[6], x[7], toi)
-                       : fast_cubic::edge_edge(x[0], x[1], x[2], x[3], x[4], x[5], x[6], x[7], toi);
+    return vertex_face
+               ? fast_cubic::vertex_face(x[0], x[1], x[2], x[3], x[4], x[5], x[6], x[7], toi)
+               : fast_cubic::edge_edge(x[0], x[1], x[2], x[3], x[4], x[5], x[6], x[7], toi);
   }
   return vertex_face
-             ? tetseg::vertex_face_ccd(x[0], x[1], x[2], x[3], x[4], x[5], x[6], x[7], options).hit()
+             ? tetseg::vertex_face_ccd(x[0], x[1], x[2], x[3], x[4], x[5], x[6], x[7], options)
+                   .hit()
              : tetseg::edge_edge_ccd(x[0], x[1], x[2], x[3], x[4], x[5], x[6], x[7], options).hit();
 }
 
@@ -84,7 +86,8 @@ Tally run_folder(const fs::path& folder, bool vertex_face, bool fast,
     const auto start = std::chrono::steady_clock::now();
     for (std::size_t i = 0; i < queries.size(); ++i)
       results[i] = run_query(queries[i], vertex_face, fast, options);
-    tally.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    tally.seconds +=
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     for (std::size_t i = 0; i < queries.size(); ++i) {
       ++tally.queries;
       tally.positives += queries[i].truth;
@@ -113,7 +116,9 @@ int command_queries(const std::string& dir, bool json, const std::string& method
     total[0].add(vf);
     total[1].add(ee);
   }
-  if (per_scene.empty()) throw ToolError(kExitBadInput, dir, "no query CSV found (expected <scene>/{vertex-face,edge-edge}/*.csv)");
+  if (per_scene.empty())
+    throw ToolError(kExitBadInput, dir,
+                    "no query CSV found (expected <scene>/{vertex-face,edge-edge}/*.csv)");
   if (json) {
     std::ostringstream out;
     out << "{\"method\": \"" << method << "\",\n \"vertex_face\": " << tally_json(total[0])
@@ -168,18 +173,20 @@ int command_frames(const std::string& path0, const std::string& path1, bool json
     for (std::size_t i = 0; i < contacts.size(); ++i) {
       const auto& c = contacts[i];
       if (c.vertex_face)
-        std::snprintf(buf, sizeof buf, "{\"kind\": \"vf\", \"vertex\": %u, \"face\": [%u, %u, %u], \"toi\": %.17g}",
+        std::snprintf(buf, sizeof buf,
+                      "{\"kind\": \"vf\", \"vertex\": %u, \"face\": [%u, %u, %u], \"toi\": %.17g}",
                       c.ids[0], c.ids[1], c.ids[2], c.ids[3], c.toi);
       else
-        std::snprintf(buf, sizeof buf, "{\"kind\": \"ee\", \"edges\": [[%u, %u], [%u, %u]], \"toi\": %.17g}",
+        std::snprintf(buf, sizeof buf,
+                      "{\"kind\": \"ee\", \"edges\": [[%u, %u], [%u, %u]], \"toi\": %.17g}",
                       c.ids[0], c.ids[1], c.ids[2], c.ids[3], c.toi);
       out << (i ? ",\n  " : "\n  ") << buf;
     }
     out << "]}\n";
   } else {
     for (const auto& c : contacts) {
-      std::snprintf(buf, sizeof buf, "%s %u %u %u %u %.17g\n", c.vertex_face ? "vf" : "ee", c.ids[0],
-                    c.ids[1], c.ids[2], c.ids[3], c.toi);
+      std::snprintf(buf, sizeof buf, "%s %u %u %u %u %.17g\n", c.vertex_face ? "vf" : "ee",
+                    c.ids[0], c.ids[1], c.ids[2], c.ids[3], c.toi);
       out << buf;
     }
   }
@@ -190,8 +197,8 @@ int command_frames(const std::string& path0, const std::string& path1, bool json
 
 /// Lists the true pairs of a scalable-CCD frame (boxes + mma_bool) in the text format of
 /// `frames` without the time of impact (used by the CLI test).
-int command_truth(const std::string& ply, const std::string& boxes_path, const std::string& truth_path,
-                  const std::string& kind) {
+int command_truth(const std::string& ply, const std::string& boxes_path,
+                  const std::string& truth_path, const std::string& kind) {
   const io::Mesh mesh = load_mesh(ply);
   std::vector<std::array<std::int64_t, 2>> boxes;
   std::vector<bool> truth;
@@ -205,7 +212,8 @@ int command_truth(const std::string& ply, const std::string& boxes_path, const s
   } catch (const std::runtime_error& e) {
     throw ToolError(kExitBadInput, truth_path, e.what());
   }
-  if (boxes.size() != truth.size()) throw ToolError(kExitBadInput, truth_path, "length differs from the boxes file");
+  if (boxes.size() != truth.size())
+    throw ToolError(kExitBadInput, truth_path, "length differs from the boxes file");
   const auto edges = io::unique_edges(mesh.faces);
   const auto n_v = static_cast<std::int64_t>(mesh.vertices.size());
   const auto n_e = static_cast<std::int64_t>(edges.size());
@@ -215,12 +223,14 @@ int command_truth(const std::string& ply, const std::string& boxes_path, const s
     const auto [x, y] = boxes[i];
     if (kind == "vf") {
       const std::int64_t f = y - n_v - n_e;
-      if (x < 0 || x >= n_v || f < 0 || f >= n_f) throw ToolError(kExitBadInput, boxes_path, "bad VF id");
+      if (x < 0 || x >= n_v || f < 0 || f >= n_f)
+        throw ToolError(kExitBadInput, boxes_path, "bad VF id");
       const auto& face = mesh.faces[static_cast<std::size_t>(f)];
       std::printf("vf %lld %u %u %u\n", static_cast<long long>(x), face[0], face[1], face[2]);
     } else {
       const std::int64_t e0 = x - n_v, e1 = y - n_v;
-      if (e0 < 0 || e0 >= n_e || e1 < 0 || e1 >= n_e) throw ToolError(kExitBadInput, boxes_path, "bad EE id");
+      if (e0 < 0 || e0 >= n_e || e1 < 0 || e1 >= n_e)
+        throw ToolError(kExitBadInput, boxes_path, "bad EE id");
       auto a = edges[static_cast<std::size_t>(e0)];
       auto b = edges[static_cast<std::size_t>(e1)];
       if (b < a) std::swap(a, b);
@@ -238,28 +248,35 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   tetseg::CcdOptions options;
 
-  auto* queries = app.add_subcommand("queries", "Run the tests on reference queries (<scene>/{vertex-face,edge-edge}/*.csv)");
+  auto* queries = app.add_subcommand(
+      "queries", "Run the tests on reference queries (<scene>/{vertex-face,edge-edge}/*.csv)");
   std::string dir;
   bool json = false;
   std::string method = "conservative";
   queries->add_option("dir", dir, "Folder in sample-queries layout")->required();
   queries->add_flag("--json", json, "Print JSON");
-  queries->add_option("--method", method, "conservative (runtime) or fast-cubic (non-conservative baseline)")
+  queries
+      ->add_option("--method", method,
+                   "conservative (runtime) or fast-cubic (non-conservative baseline)")
       ->check(CLI::IsMember({"conservative", "fast-cubic"}));
-  queries->add_option("--min-separation", options.min_separation, "Minimum separation (length units)")
+  queries
+      ->add_option("--min-separation", options.min_separation, "Minimum separation (length units)")
       ->check(CLI::NonNegativeNumber);
   queries->add_option("--time-tolerance", options.time_tolerance, "Bisection stop width in t")
       ->check(CLI::PositiveNumber);
 
-  auto* frames = app.add_subcommand("frames", "All contacts between two PLY frames of a triangle soup (BVH)");
+  auto* frames =
+      app.add_subcommand("frames", "All contacts between two PLY frames of a triangle soup (BVH)");
   std::string ply0, ply1;
   frames->add_option("t0", ply0, "Frame at the start of the step (PLY)")->required();
   frames->add_option("t1", ply1, "Frame at the end of the step (PLY, same faces)")->required();
   frames->add_flag("--json", json, "Print JSON");
-  frames->add_option("--min-separation", options.min_separation, "Minimum separation (length units)")
+  frames
+      ->add_option("--min-separation", options.min_separation, "Minimum separation (length units)")
       ->check(CLI::NonNegativeNumber);
 
-  auto* truth = app.add_subcommand("truth", "List the true pairs of a scalable-CCD frame (boxes + mma_bool)");
+  auto* truth =
+      app.add_subcommand("truth", "List the true pairs of a scalable-CCD frame (boxes + mma_bool)");
   std::string truth_ply, boxes_path, bools_path, kind;
   truth->add_option("ply", truth_ply, "Frame PLY (for the numbering)")->required();
   truth->add_option("boxes", boxes_path, "boxes/<a>{vf,ee}.json")->required();
