@@ -1,8 +1,8 @@
 #pragma once
 /// \file
 /// Surface charge density of a closed surface treated as a perfect conductor (Wong & Yeh,
-/// section IV-A), and its histogram equalisation (section IV-B). Formulation, solvers and
-/// costs: docs/charge.md.
+/// section IV-A), and its histogram equalisation (section IV-B). Formulation, far-field rule,
+/// solvers and measured accuracy: docs/charge.md.
 
 #include <cstddef>
 #include <functional>
@@ -13,38 +13,79 @@
 
 namespace tetseg::preprocess {
 
-enum class ChargeSolver { kAuto, kDirect, kGmres, kFast };
+/// Linear solver for the collocation system M y = 1.
+enum class ChargeSolver {
+  kAuto,    ///< direct for N <= 400, gmres while the dense matrix is small and fits, else fast
+  kDirect,  ///< dense LU (Eigen PartialPivLU): O(N^3) time, 8 N^2 bytes; a reference
+  kGmres,   ///< GMRES + Jacobi on the stored dense matrix: 8 N^2 bytes
+  kFast,    ///< GMRES + Jacobi, matrix-free treecode products, O(N log N) time and memory
+};
+
+/// Parses "auto", "direct", "gmres", "fast"; returns false for anything else.
+bool parse_charge_solver(const std::string& name, ChargeSolver& out);
+/// "auto", "direct", "gmres" or "fast".
+const char* to_string(ChargeSolver solver);
 
 struct ChargeOptions {
   ChargeSolver solver = ChargeSolver::kAuto;
-  double tolerance = 1e-6;      ///< relative residual for iterative solvers
-  int max_iterations = 500;
-  /// Called now and then during long stages with (stage, fraction done in [0,1]).
+  /// Relative residual ||1 - M y|| / ||1|| at which the iterative solvers stop, in (0, 1).
+  double tolerance = 1e-6;
+  int max_iterations = 500;  ///< matrix products, iterative solvers only
+  int restart = 80;          ///< GMRES restart length
+  /// Treecode opening parameter: a cluster acts through its multipoles on a target leaf when
+  /// (r_leaf + r_cluster) < theta * distance. Smaller is more accurate and slower; (0, 1).
+  double fast_theta = 0.5;
+  /// Total order of the treecode's Taylor expansions (0..12); error ~ theta^(order + 1).
+  int fast_order = 6;
+  int leaf_size = 32;  ///< cluster-tree leaf size (fast solver)
+  /// Largest dense matrix the solver may store, in bytes; 0 means half of the memory the
+  /// operating system reports as available. Explicit direct/gmres requests beyond it fail.
+  std::size_t memory_limit_bytes = 0;
+  /// Called now and then during long stages with (stage, fraction done in [0,1]); stage is
+  /// "assembly" or "solve". Called from the calling thread only.
   std::function<void(const char* stage, double fraction)> progress;
 };
 
 struct ChargeResult {
-  std::vector<double> density;  ///< per triangle, relative: 1 everywhere on a sphere
-  double capacitance = 0.0;     ///< in the input's length units (a sphere of radius r gives r)
-  std::string solver;           ///< the solver actually used: "direct", "gmres" or "fast"
-  int iterations = 0;
-  double residual = 0.0;        ///< final relative residual
-  double assembly_seconds = 0.0;
+  /// Per triangle, relative density sigma_j * (total area) / Q: 1 everywhere on a sphere,
+  /// dimensionless, invariant under scaling of the input. Positive for a valid closed surface.
+  std::vector<double> density;
+  double capacitance = 0.0;  ///< Q / V in the input's length units (4 pi eps0 = 1): sphere r -> r
+  double total_area = 0.0;   ///< sum of triangle areas
+  std::string solver;        ///< the solver actually used: "direct", "gmres" or "fast"
+  int iterations = 0;        ///< matrix products (0 for direct)
+  double residual = 0.0;     ///< final relative residual against the solver's operator
+  bool converged = false;    ///< residual <= tolerance (always true for a successful direct)
+  std::size_t near_entries = 0;   ///< analytic (near-field) matrix entries
+  double assembly_seconds = 0.0;  ///< panels, tree, near field, dense matrix or treecode lists
   double solve_seconds = 0.0;
 };
 
-/// Computes the relative charge density of the closed outward surface `triangles` over
-/// `points`. Throws InputError(file, ...) for degenerate (zero-area) triangles.
+/// Computes the relative charge density of the closed surface `triangles` over `points`
+/// (orientation does not matter). Throws InputError(file, ...) for no triangles, an index out
+/// of range, a non-finite coordinate or a degenerate (zero-area or needle) triangle; throws
+/// std::runtime_error when the requested dense solver does not fit memory_limit_bytes, when
+/// the dense matrix is singular or the iteration produces non-finite values. Non-convergence
+/// within max_iterations is not an error: check `converged`. Uses OpenMP threads internally;
+/// not reentrant with respect to Eigen's global thread count during direct solves.
 ChargeResult compute_charge(const std::vector<Vec3>& points, const std::vector<Tri>& triangles,
                             const ChargeOptions& options, const std::string& file = {});
 
 enum class Equalization {
-  kHistogram,     ///< the paper's: 256 bins, value = CDF[bin] / N
-  kRank,          ///< exact ranks: (rank + 1) / N, ties share the largest rank
-  kLogHistogram,  ///< 256 bins over log(density)
+  kHistogram,     ///< the paper's: bins over [min, max], value = CDF[bin] / N
+  kRank,          ///< exact ranks: (number of values <= v) / N, so ties share the largest rank
+  kLogHistogram,  ///< the paper's rule on bins over [log min, log max] (needs density > 0)
 };
 
-/// Maps densities to (0,1] (docs/charge.md). Deterministic.
+/// Parses "histogram", "rank", "log"; returns false for anything else.
+bool parse_equalization(const std::string& name, Equalization& out);
+const char* to_string(Equalization method);
+
+/// Maps densities to (0, 1] so that the order is kept (non-decreasing map). Histogram: bin
+/// b = floor((v - min) / (max - min) * bins) clamped to bins - 1, CDF[b] = number of values in
+/// bins <= b, result CDF[b] / N; all values equal gives 1 everywhere. Log histogram: the same
+/// on log(v); values <= 0 fall into bin 0. Deterministic; empty input gives empty output.
+/// Throws std::invalid_argument for a non-finite value or bins < 1.
 std::vector<double> equalize(const std::vector<double>& density, Equalization method,
                              int bins = 256);
 

@@ -1,0 +1,177 @@
+// compute_charge: panels, near field, solver choice and read-out (docs/charge.md).
+
+#include <chrono>
+#include <cmath>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+
+#include "charge_potential.hpp"
+#include "charge_solvers.hpp"
+#include "charge_tree.hpp"
+#include "tetseg/preprocess/charge.hpp"
+
+namespace tetseg::preprocess {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+using namespace charge_detail;
+
+constexpr std::size_t kAutoDirectMax = 400;
+constexpr std::size_t kAutoDenseMax = 3000;
+
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+/// MemAvailable from /proc/meminfo in bytes, or 4 GiB when unknown.
+std::size_t available_memory() {
+  std::ifstream in("/proc/meminfo");
+  std::string key;
+  std::size_t value = 0;
+  std::string unit;
+  while (in >> key >> value >> unit) {
+    if (key == "MemAvailable:") return value * 1024;
+  }
+  return std::size_t{4} << 30;
+}
+
+}  // namespace
+
+bool parse_charge_solver(const std::string& name, ChargeSolver& out) {
+  if (name == "auto")
+    out = ChargeSolver::kAuto;
+  else if (name == "direct")
+    out = ChargeSolver::kDirect;
+  else if (name == "gmres")
+    out = ChargeSolver::kGmres;
+  else if (name == "fast")
+    out = ChargeSolver::kFast;
+  else
+    return false;
+  return true;
+}
+
+const char* to_string(ChargeSolver solver) {
+  switch (solver) {
+    case ChargeSolver::kAuto:
+      return "auto";
+    case ChargeSolver::kDirect:
+      return "direct";
+    case ChargeSolver::kGmres:
+      return "gmres";
+    case ChargeSolver::kFast:
+      return "fast";
+  }
+  return "auto";
+}
+
+ChargeResult compute_charge(const std::vector<Vec3>& points, const std::vector<Tri>& triangles,
+                            const ChargeOptions& options, const std::string& file) {
+  const auto t0 = Clock::now();
+  auto progress = [&](const char* stage, double f) {
+    if (options.progress) options.progress(stage, f);
+  };
+  const PanelSet panels = make_panels(points, triangles, file);
+  const std::size_t n = panels.size();
+  if (!(options.tolerance > 0.0 && options.tolerance < 1.0)) {
+    throw std::invalid_argument("charge tolerance must lie in (0, 1)");
+  }
+  if (!(options.fast_theta > 0.0 && options.fast_theta < 1.0)) {
+    throw std::invalid_argument("charge fast_theta must lie in (0, 1)");
+  }
+  const std::size_t limit =
+      options.memory_limit_bytes ? options.memory_limit_bytes : available_memory() / 2;
+  const double dense_bytes = 8.0 * static_cast<double>(n) * static_cast<double>(n);
+  ChargeSolver solver = options.solver;
+  if (solver == ChargeSolver::kAuto) {
+    if (n <= kAutoDirectMax && dense_bytes <= static_cast<double>(limit)) {
+      solver = ChargeSolver::kDirect;
+    } else if (n <= kAutoDenseMax && dense_bytes <= static_cast<double>(limit)) {
+      solver = ChargeSolver::kGmres;
+    } else {
+      solver = ChargeSolver::kFast;
+    }
+  }
+  if ((solver == ChargeSolver::kDirect || solver == ChargeSolver::kGmres) &&
+      dense_bytes > static_cast<double>(limit)) {
+    std::ostringstream msg;
+    msg << "the dense " << to_string(solver) << " solver needs " << dense_bytes / 1e9 << " GB for "
+        << n << " triangles but the limit is " << static_cast<double>(limit) / 1e9
+        << " GB; use --solver fast or auto";
+    throw std::runtime_error(msg.str());
+  }
+
+  ChargeResult result;
+  result.solver = to_string(solver);
+  progress("assembly", 0.0);
+  const ClusterTree tree = build_cluster_tree(panels, options.leaf_size);
+  const NearField near = build_near_field(panels, tree);
+  result.near_entries = near.column.size();
+  progress("assembly", 0.3);
+
+  std::vector<double> b(n, 1.0), y(n, 0.0);
+  auto on_iteration = [&](int it, double res) {
+    const double f = res > 0.0 ? std::log(res) / std::log(options.tolerance) : 1.0;
+    progress("solve", std::min(1.0, std::max(0.0, f)));
+    (void)it;
+  };
+  if (solver == ChargeSolver::kFast) {
+    const TreecodeOperator op(panels, tree, near, options.fast_theta, options.fast_order);
+    result.assembly_seconds = seconds_since(t0);
+    progress("assembly", 1.0);
+    const auto t1 = Clock::now();
+    const GmresOutcome g = solve_gmres(
+        n, [&](const double* x, double* out) { op.apply(x, out); }, near.diagonal, b, y,
+        options.tolerance, options.max_iterations, options.restart, on_iteration);
+    result.solve_seconds = seconds_since(t1);
+    result.iterations = g.iterations;
+    result.residual = g.residual;
+    result.converged = g.converged;
+  } else {
+    const std::vector<double> m = assemble_dense(panels, near);
+    result.assembly_seconds = seconds_since(t0);
+    progress("assembly", 1.0);
+    const auto t1 = Clock::now();
+    if (solver == ChargeSolver::kDirect) {
+      progress("solve", 0.0);
+      if (!solve_dense_lu(m, n, b, y)) {
+        throw std::runtime_error("the collocation matrix is singular (overlapping triangles?)");
+      }
+      std::vector<double> r(n);
+      dense_apply(m, n, y.data(), r.data());
+      double rr = 0.0;
+      for (std::size_t i = 0; i < n; ++i) rr += (1.0 - r[i]) * (1.0 - r[i]);
+      result.residual = std::sqrt(rr / static_cast<double>(n));
+      result.converged = true;
+    } else {
+      const GmresOutcome g = solve_gmres(
+          n, [&](const double* x, double* out) { dense_apply(m, n, x, out); }, near.diagonal, b, y,
+          options.tolerance, options.max_iterations, options.restart, on_iteration);
+      result.iterations = g.iterations;
+      result.residual = g.residual;
+      result.converged = g.converged;
+    }
+    result.solve_seconds = seconds_since(t1);
+  }
+  progress("solve", 1.0);
+
+  double capacitance = 0.0, total_area = 0.0;
+  for (std::size_t j = 0; j < n; ++j) {
+    capacitance += panels.area[j] * y[j];
+    total_area += panels.area[j];
+  }
+  if (!std::isfinite(capacitance) || !(capacitance > 0.0)) {
+    throw std::runtime_error("the charge solve produced no usable solution (capacitance " +
+                             std::to_string(capacitance) + ")");
+  }
+  result.capacitance = capacitance;
+  result.total_area = total_area;
+  result.density.resize(n);
+  const double scale = total_area / capacitance;
+  for (std::size_t j = 0; j < n; ++j) result.density[j] = y[j] * scale;
+  return result;
+}
+
+}  // namespace tetseg::preprocess

@@ -1,0 +1,47 @@
+#pragma once
+// Internal: closed-form potential of a uniformly charged flat triangle (Wilton et al. 1984,
+// Graglia 1993), the collocation self term, and the per-triangle geometry the charge solvers
+// share. Not a public header.
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "tetseg/preprocess/mesh.hpp"
+
+namespace tetseg::preprocess::charge_detail {
+
+/// Integral over triangle (a, b, c) of 1 / |r - y| dS_y (unit surface density; length units of
+/// the input). Finite everywhere, including r on the triangle or on an edge line. Orientation
+/// of the triangle does not matter. A zero-area triangle gives 0.
+double triangle_potential(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& r);
+
+/// The same integral evaluated at the triangle's own centroid (the collocation diagonal),
+/// sum_i t_i [asinh(l_i+ / t_i) - asinh(l_i- / t_i)].
+double triangle_self_potential(const Vec3& a, const Vec3& b, const Vec3& c);
+
+/// Per-triangle data of a surface, in structure-of-arrays form.
+struct PanelSet {
+  std::vector<std::array<Vec3, 3>> corners;
+  std::vector<Vec3> centroid;
+  std::vector<double> area;
+  std::vector<double> diameter;  ///< longest edge
+  std::size_t size() const { return area.size(); }
+};
+
+/// Builds the panels and rejects bad input with InputError(file, ...): no triangles, an index
+/// out of range, a non-finite coordinate, or a degenerate triangle (area below 1e-12 times the
+/// squared longest edge of the whole mesh, or of the triangle's own squared longest edge
+/// times 1e-10: needles are as bad as zero area).
+PanelSet make_panels(const std::vector<Vec3>& points, const std::vector<Tri>& triangles,
+                     const std::string& file);
+
+/// Far-field rule: entry (i, j) uses the point-charge form A_j / |c_i - c_j| when
+/// |c_i - c_j| > kNearFactor * diameter_j, and the closed form otherwise.
+constexpr double kNearFactor = 2.0;
+
+/// The collocation matrix entry M_ij (potential at centroid i of unit density on triangle j).
+double matrix_entry(const PanelSet& panels, std::size_t i, std::size_t j);
+
+}  // namespace tetseg::preprocess::charge_detail

@@ -1,0 +1,42 @@
+#pragma once
+// Internal: the linear solvers behind compute_charge (dense LU, restarted GMRES with Jacobi
+// preconditioning) and the dense collocation matrix.
+
+#include <functional>
+#include <vector>
+
+#include "charge_potential.hpp"
+#include "charge_tree.hpp"
+
+namespace tetseg::preprocess::charge_detail {
+
+/// y = A x for vectors of length n.
+using ApplyFn = std::function<void(const double* x, double* y)>;
+/// Called after each iteration with (iteration, relative residual estimate).
+using IterationFn = std::function<void(int iteration, double residual)>;
+
+struct GmresOutcome {
+  int iterations = 0;
+  double residual = 0.0;  ///< true relative residual ||b - A x|| / ||b|| at exit
+  bool converged = false;
+};
+
+/// Restarted right-preconditioned GMRES(restart) with modified Gram-Schmidt and Givens
+/// rotations; preconditioner x = z / diagonal. Starts from the given x. Stops when the
+/// relative residual is <= tolerance or after max_iterations matrix products.
+GmresOutcome solve_gmres(std::size_t n, const ApplyFn& apply, const std::vector<double>& diagonal,
+                         const std::vector<double>& b, std::vector<double>& x, double tolerance,
+                         int max_iterations, int restart, const IterationFn& on_iteration);
+
+/// Dense row-major collocation matrix: far entries A_j / r_ij, near entries and the diagonal
+/// from `near`. n * n doubles.
+std::vector<double> assemble_dense(const PanelSet& panels, const NearField& near);
+
+/// y = M x for a dense row-major n x n matrix (OpenMP over rows).
+void dense_apply(const std::vector<double>& m, std::size_t n, const double* x, double* y);
+
+/// Solves M x = b by LU with partial pivoting (Eigen). Returns false if M is singular.
+bool solve_dense_lu(const std::vector<double>& m, std::size_t n, const std::vector<double>& b,
+                    std::vector<double>& x);
+
+}  // namespace tetseg::preprocess::charge_detail

@@ -1,0 +1,396 @@
+// Cluster tree, analytic near field and treecode operator for the charge solvers.
+
+#include "charge_tree.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+namespace tetseg::preprocess::charge_detail {
+namespace {
+
+double box_distance_sq(const Cluster& c, const Vec3& p) {
+  double s = 0.0;
+  for (int a = 0; a < 3; ++a) {
+    const double lo = c.box_min[a] - p[a];
+    const double hi = p[a] - c.box_max[a];
+    const double d = std::max({lo, hi, 0.0});
+    s += d * d;
+  }
+  return s;
+}
+
+}  // namespace
+
+ClusterTree build_cluster_tree(const PanelSet& panels, int leaf_size) {
+  const std::size_t n = panels.size();
+  leaf_size = std::max(leaf_size, 1);
+  ClusterTree tree;
+  tree.order.resize(n);
+  std::iota(tree.order.begin(), tree.order.end(), 0u);
+  tree.nodes.reserve(4 * n / static_cast<std::size_t>(leaf_size) + 4);
+  Cluster root;
+  root.begin = 0;
+  root.end = static_cast<std::uint32_t>(n);
+  tree.nodes.push_back(root);
+  std::vector<std::int32_t> stack = {0};
+  while (!stack.empty()) {
+    const std::int32_t id = stack.back();
+    stack.pop_back();
+    Cluster c = tree.nodes[static_cast<std::size_t>(id)];
+    Vec3 lo = {1e300, 1e300, 1e300}, hi = {-1e300, -1e300, -1e300};
+    double max_d = 0.0;
+    for (std::uint32_t k = c.begin; k < c.end; ++k) {
+      const std::uint32_t j = tree.order[k];
+      for (int a = 0; a < 3; ++a) {
+        lo[a] = std::min(lo[a], panels.centroid[j][a]);
+        hi[a] = std::max(hi[a], panels.centroid[j][a]);
+      }
+      max_d = std::max(max_d, panels.diameter[j]);
+    }
+    c.box_min = lo;
+    c.box_max = hi;
+    c.center = {0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]), 0.5 * (lo[2] + hi[2])};
+    double r2 = 0.0;
+    for (std::uint32_t k = c.begin; k < c.end; ++k) {
+      const Vec3& p = panels.centroid[tree.order[k]];
+      const double dx = p[0] - c.center[0], dy = p[1] - c.center[1], dz = p[2] - c.center[2];
+      r2 = std::max(r2, dx * dx + dy * dy + dz * dz);
+    }
+    c.radius = std::sqrt(r2);
+    c.max_diameter = max_d;
+    if (c.end - c.begin > static_cast<std::uint32_t>(leaf_size)) {
+      int axis = 0;
+      for (int a = 1; a < 3; ++a) {
+        if (hi[a] - lo[a] > hi[axis] - lo[axis]) axis = a;
+      }
+      const std::uint32_t mid = c.begin + (c.end - c.begin) / 2;
+      std::nth_element(tree.order.begin() + c.begin, tree.order.begin() + mid,
+                       tree.order.begin() + c.end, [&](std::uint32_t u, std::uint32_t v) {
+                         const double cu = panels.centroid[u][axis];
+                         const double cv = panels.centroid[v][axis];
+                         return cu < cv || (cu == cv && u < v);
+                       });
+      Cluster left, right;
+      left.begin = c.begin;
+      left.end = mid;
+      right.begin = mid;
+      right.end = c.end;
+      c.left = static_cast<std::int32_t>(tree.nodes.size());
+      tree.nodes.push_back(left);
+      c.right = static_cast<std::int32_t>(tree.nodes.size());
+      tree.nodes.push_back(right);
+      stack.push_back(c.right);
+      stack.push_back(c.left);
+    }
+    tree.nodes[static_cast<std::size_t>(id)] = c;
+  }
+  // Leaves in left-to-right order (depth-first).
+  stack = {0};
+  while (!stack.empty()) {
+    const std::int32_t id = stack.back();
+    stack.pop_back();
+    const Cluster& c = tree.nodes[static_cast<std::size_t>(id)];
+    if (c.left < 0) {
+      tree.leaves.push_back(id);
+    } else {
+      stack.push_back(c.right);
+      stack.push_back(c.left);
+    }
+  }
+  return tree;
+}
+
+NearField build_near_field(const PanelSet& panels, const ClusterTree& tree) {
+  const std::size_t n = panels.size();
+  std::vector<std::vector<std::uint32_t>> cols(n);
+#if defined(TETSEG_HAVE_OPENMP)
+#pragma omp parallel for schedule(dynamic, 64)
+#endif
+  for (std::ptrdiff_t ii = 0; ii < static_cast<std::ptrdiff_t>(n); ++ii) {
+    const std::size_t i = static_cast<std::size_t>(ii);
+    const Vec3& p = panels.centroid[i];
+    std::vector<std::int32_t> stack = {0};
+    auto& row = cols[i];
+    while (!stack.empty()) {
+      const Cluster& c = tree.nodes[static_cast<std::size_t>(stack.back())];
+      stack.pop_back();
+      const double limit = kNearFactor * c.max_diameter;
+      if (box_distance_sq(c, p) > limit * limit) continue;
+      if (c.left >= 0) {
+        stack.push_back(c.right);
+        stack.push_back(c.left);
+        continue;
+      }
+      for (std::uint32_t k = c.begin; k < c.end; ++k) {
+        const std::uint32_t j = tree.order[k];
+        const Vec3& q = panels.centroid[j];
+        const double dx = p[0] - q[0], dy = p[1] - q[1], dz = p[2] - q[2];
+        const double lim = kNearFactor * panels.diameter[j];
+        if (j == i || dx * dx + dy * dy + dz * dz <= lim * lim) row.push_back(j);
+      }
+    }
+    std::sort(row.begin(), row.end());
+  }
+  NearField near;
+  near.row_start.resize(n + 1, 0);
+  for (std::size_t i = 0; i < n; ++i) near.row_start[i + 1] = near.row_start[i] + cols[i].size();
+  const std::size_t nnz = near.row_start[n];
+  near.column.resize(nnz);
+  near.value.resize(nnz);
+  near.correction.resize(nnz);
+  near.diagonal.resize(n);
+#if defined(TETSEG_HAVE_OPENMP)
+#pragma omp parallel for schedule(dynamic, 64)
+#endif
+  for (std::ptrdiff_t ii = 0; ii < static_cast<std::ptrdiff_t>(n); ++ii) {
+    const std::size_t i = static_cast<std::size_t>(ii);
+    const Vec3& p = panels.centroid[i];
+    std::size_t e = near.row_start[i];
+    for (const std::uint32_t j : cols[i]) {
+      const auto& t = panels.corners[j];
+      double value, point = 0.0;
+      if (j == i) {
+        value = triangle_self_potential(t[0], t[1], t[2]);
+        near.diagonal[i] = value;
+      } else {
+        value = triangle_potential(t[0], t[1], t[2], p);
+        const Vec3& q = panels.centroid[j];
+        const double dx = p[0] - q[0], dy = p[1] - q[1], dz = p[2] - q[2];
+        const double r2 = dx * dx + dy * dy + dz * dz;
+        if (r2 > 0.0) point = panels.area[j] / std::sqrt(r2);
+      }
+      near.column[e] = j;
+      near.value[e] = value;
+      near.correction[e] = value - point;
+      ++e;
+    }
+    std::vector<std::uint32_t>().swap(cols[i]);
+  }
+  return near;
+}
+
+TreecodeOperator::TreecodeOperator(const PanelSet& panels, const ClusterTree& tree,
+                                   const NearField& near, double theta, int order)
+    : m_n(panels.size()), m_order(std::max(order, 0)), m_tree(tree), m_near(near) {
+  // Multi-index tables.
+  const int p = m_order;
+  std::vector<int> lookup(static_cast<std::size_t>((p + 1) * (p + 1) * (p + 1)), -1);
+  auto at = [&](int a, int b, int c) -> int& {
+    return lookup[static_cast<std::size_t>((a * (p + 1) + b) * (p + 1) + c)];
+  };
+  for (int total = 0; total <= p; ++total) {
+    for (int a = total; a >= 0; --a) {
+      for (int b = total - a; b >= 0; --b) {
+        const int c = total - a - b;
+        at(a, b, c) = static_cast<int>(m_index.size());
+        m_index.push_back({a, b, c});
+      }
+    }
+  }
+  for (const auto& k : m_index) {
+    std::array<int, 3> m1{-1, -1, -1}, m2{-1, -1, -1};
+    for (int i = 0; i < 3; ++i) {
+      std::array<int, 3> q = k;
+      if (q[i] >= 1) {
+        --q[i];
+        m1[i] = at(q[0], q[1], q[2]);
+      }
+      if (q[i] >= 1) {
+        --q[i];
+        m2[i] = at(q[0], q[1], q[2]);
+      }
+    }
+    m_minus1.push_back(m1);
+    m_minus2.push_back(m2);
+  }
+  auto binom = [](int a, int b) {
+    double r = 1.0;
+    for (int i = 1; i <= b; ++i) r = r * (a - b + i) / i;
+    return r;
+  };
+  for (std::size_t ni = 0; ni < m_index.size(); ++ni) {
+    for (std::size_t mi = 0; mi < m_index.size(); ++mi) {
+      const auto& n = m_index[ni];
+      const auto& m = m_index[mi];
+      if (n[0] + n[1] + n[2] + m[0] + m[1] + m[2] > p) continue;
+      double coef = ((m[0] + m[1] + m[2]) % 2) ? -1.0 : 1.0;
+      for (int i = 0; i < 3; ++i) coef *= binom(n[i] + m[i], n[i]);
+      m_terms.push_back({static_cast<int>(ni), static_cast<int>(mi),
+                         at(n[0] + m[0], n[1] + m[1], n[2] + m[2]), coef});
+    }
+  }
+
+  m_x.resize(m_n);
+  m_y.resize(m_n);
+  m_z.resize(m_n);
+  m_area.resize(m_n);
+  for (std::size_t k = 0; k < m_n; ++k) {
+    const std::uint32_t j = tree.order[k];
+    m_x[k] = panels.centroid[j][0];
+    m_y[k] = panels.centroid[j][1];
+    m_z[k] = panels.centroid[j][2];
+    m_area[k] = panels.area[j];
+  }
+  const std::size_t leaf_count = tree.leaves.size();
+  std::vector<std::vector<std::int32_t>> far(leaf_count), direct(leaf_count);
+#if defined(TETSEG_HAVE_OPENMP)
+#pragma omp parallel for schedule(dynamic, 8)
+#endif
+  for (std::ptrdiff_t ll = 0; ll < static_cast<std::ptrdiff_t>(leaf_count); ++ll) {
+    const std::size_t l = static_cast<std::size_t>(ll);
+    const Cluster& target = tree.nodes[static_cast<std::size_t>(tree.leaves[l])];
+    std::vector<std::int32_t> stack = {0};
+    while (!stack.empty()) {
+      const std::int32_t id = stack.back();
+      stack.pop_back();
+      const Cluster& s = tree.nodes[static_cast<std::size_t>(id)];
+      const double dx = s.center[0] - target.center[0];
+      const double dy = s.center[1] - target.center[1];
+      const double dz = s.center[2] - target.center[2];
+      const double dist = std::sqrt(dx * dx + dy * dy + dz * dz);
+      if (target.radius + s.radius < theta * dist) {
+        far[l].push_back(id);
+      } else if (s.left < 0) {
+        direct[l].push_back(id);
+      } else {
+        stack.push_back(s.right);
+        stack.push_back(s.left);
+      }
+    }
+  }
+  m_far_start.assign(leaf_count + 1, 0);
+  m_direct_start.assign(leaf_count + 1, 0);
+  double far_count = 0.0, direct_work = 0.0;
+  for (std::size_t l = 0; l < leaf_count; ++l) {
+    const Cluster& target = tree.nodes[static_cast<std::size_t>(tree.leaves[l])];
+    const double targets = target.end - target.begin;
+    m_far_start[l + 1] = m_far_start[l] + far[l].size();
+    m_direct_start[l + 1] = m_direct_start[l] + direct[l].size();
+    m_far.insert(m_far.end(), far[l].begin(), far[l].end());
+    m_direct.insert(m_direct.end(), direct[l].begin(), direct[l].end());
+    far_count += static_cast<double>(far[l].size());
+    for (const std::int32_t id : direct[l]) {
+      const Cluster& s = tree.nodes[static_cast<std::size_t>(id)];
+      direct_work += targets * (s.end - s.begin);
+    }
+  }
+  m_far_per_leaf = leaf_count ? far_count / static_cast<double>(leaf_count) : 0.0;
+  m_direct_per_target = direct_work / static_cast<double>(m_n);
+  m_charge.resize(m_n);
+  m_moments.assign(tree.nodes.size() * m_index.size(), 0.0);
+}
+
+void TreecodeOperator::apply(const double* x, double* y) const {
+  const std::ptrdiff_t n = static_cast<std::ptrdiff_t>(m_n);
+  const auto& order = m_tree.order;
+  const auto& nodes = m_tree.nodes;
+  const auto& leaves = m_tree.leaves;
+  const std::size_t kc = m_index.size();
+  double* charge = m_charge.data();
+  const double* px = m_x.data();
+  const double* py = m_y.data();
+  const double* pz = m_z.data();
+  // Monomials w^k for |k| <= order, graded order, from k - e_i.
+  auto monomials = [&](double wx, double wy, double wz, double* out) {
+    out[0] = 1.0;
+    const double w[3] = {wx, wy, wz};
+    for (std::size_t k = 1; k < kc; ++k) {
+      const auto& m1 = m_minus1[k];
+      const int i = m1[0] >= 0 ? 0 : (m1[1] >= 0 ? 1 : 2);
+      out[k] = out[m1[i]] * w[i];
+    }
+  };
+#if defined(TETSEG_HAVE_OPENMP)
+#pragma omp parallel
+#endif
+  {
+    std::vector<double> mono(kc), deriv(kc), local(kc), pot;
+#if defined(TETSEG_HAVE_OPENMP)
+#pragma omp for schedule(static)
+#endif
+    for (std::ptrdiff_t k = 0; k < n; ++k) {
+      charge[k] = m_area[static_cast<std::size_t>(k)] * x[order[static_cast<std::size_t>(k)]];
+    }
+    // Moments straight from the members of each node (O(N depth K)).
+#if defined(TETSEG_HAVE_OPENMP)
+#pragma omp for schedule(dynamic, 16)
+#endif
+    for (std::ptrdiff_t id = 0; id < static_cast<std::ptrdiff_t>(nodes.size()); ++id) {
+      const Cluster& c = nodes[static_cast<std::size_t>(id)];
+      double* mom = m_moments.data() + static_cast<std::size_t>(id) * kc;
+      std::fill(mom, mom + kc, 0.0);
+      if (id == 0) continue;  // the root is never far from anything
+      for (std::uint32_t k = c.begin; k < c.end; ++k) {
+        monomials(px[k] - c.center[0], py[k] - c.center[1], pz[k] - c.center[2], mono.data());
+        const double q = charge[k];
+        for (std::size_t e = 0; e < kc; ++e) mom[e] += q * mono[e];
+      }
+    }
+#if defined(TETSEG_HAVE_OPENMP)
+#pragma omp for schedule(dynamic, 4)
+#endif
+    for (std::ptrdiff_t ll = 0; ll < static_cast<std::ptrdiff_t>(leaves.size()); ++ll) {
+      const std::size_t l = static_cast<std::size_t>(ll);
+      const Cluster& target = nodes[static_cast<std::size_t>(leaves[l])];
+      const std::uint32_t count = target.end - target.begin;
+      pot.assign(count, 0.0);
+      std::fill(local.begin(), local.end(), 0.0);
+      for (std::size_t f = m_far_start[l]; f < m_far_start[l + 1]; ++f) {
+        const Cluster& s = nodes[static_cast<std::size_t>(m_far[f])];
+        const double* mom = m_moments.data() + static_cast<std::size_t>(m_far[f]) * kc;
+        const double r[3] = {target.center[0] - s.center[0], target.center[1] - s.center[1],
+                             target.center[2] - s.center[2]};
+        const double r2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+        // Taylor coefficients of 1 / |R + w| in w (Duan & Krasny recurrence).
+        deriv[0] = 1.0 / std::sqrt(r2);
+        for (std::size_t k = 1; k < kc; ++k) {
+          const auto& idx = m_index[k];
+          const int order_k = idx[0] + idx[1] + idx[2];
+          double s1 = 0.0, s2 = 0.0;
+          for (int i = 0; i < 3; ++i) {
+            if (m_minus1[k][i] >= 0) s1 += r[i] * deriv[m_minus1[k][i]];
+            if (m_minus2[k][i] >= 0) s2 += deriv[m_minus2[k][i]];
+          }
+          deriv[k] = -((2 * order_k - 1) * s1 + (order_k - 1) * s2) / (order_k * r2);
+        }
+        for (const Term& t : m_terms) local[t.n] += t.coef * deriv[t.k] * mom[t.m];
+      }
+      for (std::uint32_t k = target.begin; k < target.end; ++k) {
+        monomials(px[k] - target.center[0], py[k] - target.center[1], pz[k] - target.center[2],
+                  mono.data());
+        double sum = 0.0;
+        for (std::size_t e = 0; e < kc; ++e) sum += local[e] * mono[e];
+        pot[k - target.begin] = sum;
+      }
+      for (std::size_t d = m_direct_start[l]; d < m_direct_start[l + 1]; ++d) {
+        const Cluster& s = nodes[static_cast<std::size_t>(m_direct[d])];
+        for (std::uint32_t k = target.begin; k < target.end; ++k) {
+          const double tx = px[k], ty = py[k], tz = pz[k];
+          double sum = 0.0;
+          for (std::uint32_t j = s.begin; j < s.end; ++j) {
+            const double dx = tx - px[j], dy = ty - py[j], dz = tz - pz[j];
+            const double r2 = dx * dx + dy * dy + dz * dz;
+            sum += r2 > 0.0 ? charge[j] / std::sqrt(r2) : 0.0;
+          }
+          pot[k - target.begin] += sum;
+        }
+      }
+      for (std::uint32_t k = target.begin; k < target.end; ++k) y[order[k]] = pot[k - target.begin];
+    }
+    // Exact near field: analytic minus the point charge already counted.
+#if defined(TETSEG_HAVE_OPENMP)
+#pragma omp for schedule(static)
+#endif
+    for (std::ptrdiff_t i = 0; i < n; ++i) {
+      double sum = 0.0;
+      for (std::size_t e = m_near.row_start[static_cast<std::size_t>(i)];
+           e < m_near.row_start[static_cast<std::size_t>(i) + 1]; ++e) {
+        sum += m_near.correction[e] * x[m_near.column[e]];
+      }
+      y[i] += sum;
+    }
+  }
+}
+
+}  // namespace tetseg::preprocess::charge_detail

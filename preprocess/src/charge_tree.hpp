@@ -1,0 +1,84 @@
+#pragma once
+// Internal: cluster tree over triangle centroids, the analytic near field (sparse), and the
+// treecode matrix-free operator of the collocation matrix (docs/charge.md, "fast").
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "charge_potential.hpp"
+
+namespace tetseg::preprocess::charge_detail {
+
+/// A node of the binary cluster tree. Members of a node are order[begin, end).
+struct Cluster {
+  Vec3 center{};        ///< bounding-box centre
+  double radius = 0.0;  ///< max distance of a member centroid from `center`
+  Vec3 box_min{}, box_max{};
+  double max_diameter = 0.0;  ///< longest triangle edge among the members
+  std::uint32_t begin = 0, end = 0;
+  std::int32_t left = -1, right = -1;  ///< children, -1 for a leaf
+};
+
+struct ClusterTree {
+  std::vector<Cluster> nodes;        ///< nodes[0] is the root
+  std::vector<std::uint32_t> order;  ///< triangle ids in tree order
+  std::vector<std::int32_t> leaves;  ///< node ids of the leaves, left to right
+};
+
+/// Median splits along the longest box axis until a node has at most `leaf_size` members.
+ClusterTree build_cluster_tree(const PanelSet& panels, int leaf_size);
+
+/// The near field of the collocation matrix in CSR form: for row i, the columns j with
+/// |c_i - c_j| <= kNearFactor * diameter_j (always including j = i) and the analytic entry
+/// M_ij, plus `correction` = M_ij minus the point-charge entry A_j / r_ij (M_ii for j = i).
+struct NearField {
+  std::vector<std::size_t> row_start;  ///< size n + 1
+  std::vector<std::uint32_t> column;
+  std::vector<double> value;
+  std::vector<double> correction;
+  std::vector<double> diagonal;  ///< M_ii
+};
+
+NearField build_near_field(const PanelSet& panels, const ClusterTree& tree);
+
+/// y = M x with M's far part (point charges) approximated by a Cartesian Taylor treecode:
+/// every source cluster carries its moments up to total order `order` about its box centre;
+/// each target leaf gathers the far clusters (r_leaf + r_cluster < theta * distance) into one
+/// local Taylor expansion of total order `order` about its own centre (multipole-to-local,
+/// truncated at |n| + |m| <= order, error ~ theta^(order + 1)) and evaluates it at its
+/// targets; the rest is summed directly, and the near field is exact. Interaction lists are
+/// built once in the constructor. apply() uses internal scratch: one caller at a time.
+class TreecodeOperator {
+ public:
+  TreecodeOperator(const PanelSet& panels, const ClusterTree& tree, const NearField& near,
+                   double theta, int order);
+  std::size_t size() const { return m_n; }
+  void apply(const double* x, double* y) const;
+  /// Average number of far clusters and direct source points per target (cost indicators).
+  double far_per_leaf() const { return m_far_per_leaf; }
+  double direct_per_target() const { return m_direct_per_target; }
+
+ private:
+  std::size_t m_n;
+  int m_order;
+  const ClusterTree& m_tree;
+  const NearField& m_near;
+  std::vector<double> m_x, m_y, m_z, m_area;             ///< sources in tree order
+  std::vector<std::size_t> m_far_start, m_direct_start;  ///< per leaf (CSR)
+  std::vector<std::int32_t> m_far, m_direct;             ///< node ids
+  double m_far_per_leaf = 0.0, m_direct_per_target = 0.0;
+  // Multi-indices k with |k| <= order, graded order.
+  std::vector<std::array<int, 3>> m_index;
+  std::vector<std::array<int, 3>> m_minus1;  ///< index of k - e_i, or -1
+  std::vector<std::array<int, 3>> m_minus2;  ///< index of k - 2 e_i, or -1
+  struct Term {
+    int n, m, k;
+    double coef;
+  };
+  std::vector<Term> m_terms;  ///< L_n += coef * D_k(R) * M_m with k = n + m
+  mutable std::vector<double> m_charge;
+  mutable std::vector<double> m_moments;  ///< nodes x index count
+};
+
+}  // namespace tetseg::preprocess::charge_detail
