@@ -10,6 +10,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "mesh_output.hpp"
 #include "tetseg/runtime/asset.hpp"
 #include "tool_support.hpp"
 
@@ -117,6 +118,11 @@ int main(int argc, char** argv) {
   bool json = false;
   app.add_option("asset", path, "Asset file written by `tetseg build`")->required();
   app.add_flag("--json", json, "Print JSON instead of the human summary");
+  std::string vtu_path, ply_path;
+  app.add_option("--vtu", vtu_path, "Also write the surface with cluster ids, boundaries and "
+                 "detector nodes as ParaView .vtu (needs rest positions)");
+  app.add_option("--ply", ply_path, "Also write the surface with cluster colours and boundary "
+                 "edges as .ply (needs rest positions)");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -132,6 +138,8 @@ int main(int argc, char** argv) {
                   std::string(tetseg::to_string(status)) + (detail.empty() ? "" : ": " + detail));
       return kExitBadInput;
     }
+    if (!vtu_path.empty()) write_file_atomic(vtu_path, asset_to_vtu(asset.data(), path));
+    if (!ply_path.empty()) write_file_atomic(ply_path, asset_to_ply(asset.data(), path));
     if (json) {
       print_json(asset.data());
     } else {
