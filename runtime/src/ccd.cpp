@@ -51,8 +51,8 @@ Slot difference(const IvVec (&x)[2], const IvVec (&y)[2]) noexcept {
 Range range_of(const Iv* coefficients, int count) noexcept {
   Range r{lower(coefficients[0]), upper(coefficients[0])};
   for (int i = 1; i < count; ++i) {
-    r.lo = std::fmin(r.lo, lower(coefficients[i]));
-    r.hi = std::fmax(r.hi, upper(coefficients[i]));
+    r.lo = min_nan(r.lo, lower(coefficients[i]));
+    r.hi = max_nan(r.hi, upper(coefficients[i]));
   }
   // NaN anywhere makes the range useless: widen to everything.
   if (std::isnan(r.lo) || std::isnan(r.hi)) r = {-INFINITY, INFINITY};
@@ -154,14 +154,14 @@ bool boxes_disjoint(const IvVec (*first)[2], int first_count, const IvVec (*seco
     double b_hi = -INFINITY;
     for (int k = 0; k < first_count; ++k) {
       for (int e = 0; e < 2; ++e) {
-        a_lo = std::fmin(a_lo, lower(coord(first[k][e])));
-        a_hi = std::fmax(a_hi, upper(coord(first[k][e])));
+        a_lo = min_nan(a_lo, lower(coord(first[k][e])));
+        a_hi = max_nan(a_hi, upper(coord(first[k][e])));
       }
     }
     for (int k = 0; k < second_count; ++k) {
       for (int e = 0; e < 2; ++e) {
-        b_lo = std::fmin(b_lo, lower(coord(second[k][e])));
-        b_hi = std::fmax(b_hi, upper(coord(second[k][e])));
+        b_lo = min_nan(b_lo, lower(coord(second[k][e])));
+        b_hi = max_nan(b_hi, upper(coord(second[k][e])));
       }
     }
     // Gaps rounded down; a NaN gap compares false and proves nothing.
@@ -254,13 +254,22 @@ struct EdgeEdgeTest {
     const Slot da = difference(x[3], x[0]);
     if (below_minus_delta(quadrilinear_range(ba, da, ba, dc), sep, ba2)) return true;
 
+    // Planes containing one edge and turned towards an endpoint of the other (decide parallel
+    // and coplanar edges, where n vanishes): m = (b-a) x ((b-a) x (c-a)) puts c at
+    // (c-a).m = -|(b-a) x (c-a)|^2 <= 0; if d is strictly on that side too,
+    // (d-a).m = ((d-a) x (b-a)).((b-a) x (c-a)) < 0, the plane separates the edges. With a
+    // separation: c's distance to line ab, |(b-a) x (c-a)| / |b-a|, and d's, |(d-a).m| / |m|,
+    // must both exceed delta. Same with the roles of the edges swapped.
+    const Slot ac = difference(x[0], x[2]);
+    if (separated_by_edge_plane(da, ba, ca, ba) || separated_by_edge_plane(bc, dc, ac, dc))
+      return true;
+
     // End caps (decide parallel edges): both points of one edge beyond the plane through an
     // endpoint of the other, perpendicular to it.
     const Slot ab = difference(x[0], x[1]);
     const Slot cd = difference(x[2], x[3]);
     const double ab2 = sep.zero() ? 0.0 : norm2_upper(ab);
     const double cd2 = sep.zero() ? 0.0 : norm2_upper(cd);
-    const Slot ac = difference(x[0], x[2]);
     const Slot bd = difference(x[1], x[3]);
     // cap at a: (c-a).(a-b) > delta |a-b| and (d-a).(a-b) > delta |a-b|.
     if (above_delta(bilinear_range(ca, ab), ab2) && above_delta(bilinear_range(da, ab), ab2))
@@ -276,6 +285,20 @@ struct EdgeEdgeTest {
            above_delta(bilinear_range(difference(x[3], x[1]), cd), cd2);
   }
 
+  /// Plane through the edge with direction e (from point o), normal e x (e x (near - o)):
+  /// true when far - o and near - o are both strictly (by delta) on the near side.
+  bool separated_by_edge_plane(const Slot& far_o, const Slot& e, const Slot& near_o,
+                               const Slot& e_again) const noexcept {
+    const Range far_side = quadrilinear_range(far_o, e, e_again, near_o);
+    if (!(far_side.hi < 0.0)) return false;
+    if (sep.zero()) return true;
+    const double e2 = norm2_upper(e);
+    const Range near2 = quadrilinear_range(e, near_o, e, near_o);  // |e x (near - o)|^2
+    if (!(near2.lo > 0.0) || !(mul_down(near2.lo, 1.0) > mul_up(sep.delta2, e2))) return false;
+    return mul_down(far_side.hi, far_side.hi) >
+           mul_up(sep.delta2, mul_up(e2, cross_norm2_upper(e, near_o)));
+  }
+
   bool above_delta(const Range& r, double scale2_hi) const noexcept {
     return r.lo > 0.0 && (sep.zero() || mul_down(r.lo, r.lo) > mul_up(sep.delta2, scale2_hi));
   }
@@ -283,7 +306,7 @@ struct EdgeEdgeTest {
 
 double clamp_tolerance(double tol) noexcept {
   if (!(tol > kMinTolerance)) return kMinTolerance;  // also NaN
-  return std::fmin(tol, 1.0);
+  return min_nan(tol, 1.0);
 }
 
 template <class Test>

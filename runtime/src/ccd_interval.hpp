@@ -54,6 +54,11 @@ inline Iv divide(Iv a, double k) noexcept {
   return {m, (a.r / k + kRel * std::fabs(m)) * kUp + kTiny};
 }
 
+/// Minimum / maximum that propagate NaN from either argument (std::fmin drops NaN, and is an
+/// out-of-line call without -ffast-math).
+inline double min_nan(double a, double b) noexcept { return (a < b || a != a) ? a : b; }
+inline double max_nan(double a, double b) noexcept { return (a > b || a != a) ? a : b; }
+
 /// Rounded-down lower end and rounded-up upper end of an interval.
 inline double lower(Iv a) noexcept {
   const double x = a.m - a.r;
@@ -66,10 +71,10 @@ inline double upper(Iv a) noexcept {
 
 /// Interval hull of two intervals.
 inline Iv hull(Iv a, Iv b) noexcept {
-  const double lo = std::fmin(lower(a), lower(b));
-  const double hi = std::fmax(upper(a), upper(b));
+  const double lo = min_nan(lower(a), lower(b));
+  const double hi = max_nan(upper(a), upper(b));
   const double m = 0.5 * lo + 0.5 * hi;
-  return {m, std::fmax(hi - m, m - lo) * kUp + kTiny};
+  return {m, max_nan(hi - m, m - lo) * kUp + kTiny};
 }
 
 /// Products of non-negative doubles rounded down / up (for comparisons of squares).

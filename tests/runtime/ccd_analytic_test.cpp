@@ -240,6 +240,14 @@ TEST_CASE("Near-degenerate edge-edge motions are decided correctly.", "[ccd]") {
     expect_outcome(false, edge_vs_xaxis({2, 1, 0}, {3, 1, 0}, {2, -1, 0}, {3, -1, 0}),
                    CcdOutcome::kNoContact);
   }
+  SECTION("Parallel coplanar edges side by side, like neighbours in a grid, never touch.") {
+    // Regression: cloth-funnel frame 227, edges 9330-9340 and 9331-9341 (static, coplanar,
+    // parallel, boxes touching) were reported in contact at the start.
+    expect_outcome(false, edge_vs_xaxis({-1, 1, 0}, {1, 1, 0}, {-1, 1, 0}, {1, 1, 0}),
+                   CcdOutcome::kNoContact);
+    const Vec3d a{-1, 1.25, -2}, b{-1.25, 1, -2}, c{-0.75, 1.25, -2}, d{-1, 1, -2};
+    expect_outcome(false, {{a, b, c, d}, {a, b, c, d}}, CcdOutcome::kNoContact);
+  }
   SECTION("Parallel edges in parallel planes never touch.") {
     expect_outcome(false, edge_vs_xaxis({0, 1, 0.5}, {2, 1, 0.5}, {0, -1, 0.5}, {2, -1, 0.5}),
                    CcdOutcome::kNoContact);
