@@ -2,6 +2,7 @@
 
 #include <cereal/archives/portable_binary.hpp>
 
+#include <cstddef>
 #include <cstring>
 #include <istream>
 #include <limits>
@@ -15,6 +16,15 @@ namespace {
 
 static_assert(sizeof(Triangle) == 3 * sizeof(std::uint32_t), "Triangle must be packed");
 static_assert(sizeof(std::array<double, 3>) == 3 * sizeof(double), "position must be packed");
+// BVH nodes and boundary loops are stored as runs of u32, in member order.
+static_assert(std::is_trivially_copyable<BvhNode>::value && sizeof(BvhNode) == 12 &&
+                  offsetof(BvhNode, first) == 0 && offsetof(BvhNode, second) == 4 &&
+                  offsetof(BvhNode, count) == 8,
+              "BvhNode must be three packed u32");
+static_assert(std::is_trivially_copyable<BoundaryLoop>::value && sizeof(BoundaryLoop) == 8 &&
+                  offsetof(BoundaryLoop, node_offset) == 0 &&
+                  offsetof(BoundaryLoop, node_count) == 4,
+              "BoundaryLoop must be two packed u32");
 static_assert(std::numeric_limits<float>::is_iec559 && std::numeric_limits<double>::is_iec559,
               "the payload stores IEEE 754 floats");
 
@@ -144,6 +154,7 @@ class Decoder {
   cereal::PortableBinaryInputArchive m_ar;
 };
 
+/// Vectors of u32 or of records made only of u32 members (checked by the static_asserts).
 template <class T>
 void decode_u32_vector(Decoder& d, const char* what, std::uint64_t limit, std::vector<T>& v) {
   static_assert(sizeof(T) % sizeof(std::uint32_t) == 0, "u32 records only");
@@ -154,7 +165,18 @@ void decode_u32_vector(Decoder& d, const char* what, std::uint64_t limit, std::v
 
 }  // namespace
 
+std::size_t payload_bytes(const Asset& a) {
+  std::size_t n = 1 + 4 + 8 * 11;
+  n += 24 * a.rest_positions.size() + 12 * a.triangles.size() + 4 * a.triangle_cluster.size();
+  n += 24 * a.clusters.size() + 4 * a.cluster_triangles.size() + 12 * a.bvh_nodes.size();
+  n += 8 * a.boundaries.size() + 4 * a.boundary_nodes.size();
+  n += a.provenance.tool_version.size() + a.provenance.source.size();
+  for (const auto& [key, value] : a.provenance.options) n += 16 + key.size() + value.size();
+  return n;
+}
+
 void encode_payload(const Asset& a, std::vector<std::uint8_t>& out) {
+  out.reserve(out.size() + payload_bytes(a));
   Encoder e(out);  // writes the little-endian tag byte
   e.scalar(a.node_count);
   e.count(a.rest_positions.size());
@@ -176,16 +198,9 @@ void encode_payload(const Asset& a, std::vector<std::uint8_t>& out) {
   e.count(a.cluster_triangles.size());
   e.array(a.cluster_triangles.data(), a.cluster_triangles.size());
   e.count(a.bvh_nodes.size());
-  for (const BvhNode& n : a.bvh_nodes) {
-    e.scalar(n.first);
-    e.scalar(n.second);
-    e.scalar(n.count);
-  }
+  e.array(reinterpret_cast<const std::uint32_t*>(a.bvh_nodes.data()), 3 * a.bvh_nodes.size());
   e.count(a.boundaries.size());
-  for (const BoundaryLoop& b : a.boundaries) {
-    e.scalar(b.node_offset);
-    e.scalar(b.node_count);
-  }
+  e.array(reinterpret_cast<const std::uint32_t*>(a.boundaries.data()), 2 * a.boundaries.size());
   e.count(a.boundary_nodes.size());
   e.array(a.boundary_nodes.data(), a.boundary_nodes.size());
   e.string(a.provenance.tool_version);
@@ -234,23 +249,8 @@ Status decode_payload(const std::uint8_t* data, std::size_t size, Asset& a,
       }
     }
     decode_u32_vector(d, "cluster_triangles", kMaxTriangles, a.cluster_triangles);
-    {
-      const std::size_t n = d.count("bvh_nodes", kMaxBvhNodes, 12);
-      a.bvh_nodes.resize(n);
-      for (BvhNode& node : a.bvh_nodes) {
-        node.first = d.scalar<std::uint32_t>();
-        node.second = d.scalar<std::uint32_t>();
-        node.count = d.scalar<std::uint32_t>();
-      }
-    }
-    {
-      const std::size_t n = d.count("boundaries", kMaxBoundaryLoops, 8);
-      a.boundaries.resize(n);
-      for (BoundaryLoop& b : a.boundaries) {
-        b.node_offset = d.scalar<std::uint32_t>();
-        b.node_count = d.scalar<std::uint32_t>();
-      }
-    }
+    decode_u32_vector(d, "bvh_nodes", kMaxBvhNodes, a.bvh_nodes);
+    decode_u32_vector(d, "boundaries", kMaxBoundaryLoops, a.boundaries);
     decode_u32_vector(d, "boundary_nodes", kMaxBoundaryNodes, a.boundary_nodes);
     d.string("provenance.tool_version", a.provenance.tool_version);
     d.string("provenance.source", a.provenance.source);

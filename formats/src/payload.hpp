@@ -13,6 +13,9 @@
 
 namespace tetseg::format::detail {
 
+/// Exact size in bytes of the payload of `asset`.
+std::size_t payload_bytes(const Asset& asset);
+
 /// Appends the payload of `asset` to `out`. Deterministic. Throws std::bad_alloc only.
 void encode_payload(const Asset& asset, std::vector<std::uint8_t>& out);
 

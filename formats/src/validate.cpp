@@ -149,16 +149,24 @@ void check_partition(const Asset& a) {
   // cluster_triangles.size() == tri_count every triangle appears exactly once.
 }
 
-/// Detector nodes are interior: not a vertex of any surface triangle.
+/// Detector nodes are interior: not a vertex of any surface triangle. Searches the (few)
+/// detector ids for every triangle corner rather than sorting all surface nodes.
 void check_detectors(const Asset& a) {
-  std::vector<std::uint32_t> surface;
-  surface.reserve(3 * a.triangles.size());
-  for (const Triangle& t : a.triangles) surface.insert(surface.end(), t.begin(), t.end());
-  std::sort(surface.begin(), surface.end());
-  for (std::size_t c = 0; c < a.clusters.size(); ++c) {
-    if (std::binary_search(surface.begin(), surface.end(), a.clusters[c].detector_node)) {
-      fail(at("clusters", c) + ".detector_node " + std::to_string(a.clusters[c].detector_node) +
-           " is a surface node");
+  std::vector<std::uint32_t> detectors;
+  detectors.reserve(a.clusters.size());
+  for (const Cluster& c : a.clusters) detectors.push_back(c.detector_node);
+  std::sort(detectors.begin(), detectors.end());
+  detectors.erase(std::unique(detectors.begin(), detectors.end()), detectors.end());
+  for (std::size_t t = 0; t < a.triangles.size(); ++t) {
+    for (std::uint32_t v : a.triangles[t]) {
+      if (std::binary_search(detectors.begin(), detectors.end(), v)) {
+        for (std::size_t c = 0; c < a.clusters.size(); ++c) {
+          if (a.clusters[c].detector_node == v) {
+            fail(at("clusters", c) + ".detector_node " + std::to_string(v) +
+                 " is a surface node (of triangle " + std::to_string(t) + ")");
+          }
+        }
+      }
     }
   }
 }
@@ -216,16 +224,10 @@ void check_bvhs(const Asset& a) {
 }
 
 void check_boundaries(const Asset& a) {
-  if (a.boundaries.empty() && a.boundary_nodes.empty()) return;
-  std::vector<std::uint64_t> edges;
-  edges.reserve(3 * a.triangles.size());
-  for (const Triangle& t : a.triangles) {
-    edges.push_back(edge_key(t[0], t[1]));
-    edges.push_back(edge_key(t[1], t[2]));
-    edges.push_back(edge_key(t[2], t[0]));
-  }
-  std::sort(edges.begin(), edges.end());
+  // Structure first, then one pass over the surface edges that marks the loop edges found.
   std::uint64_t next = 0;
+  std::vector<std::uint64_t> loop_edges;
+  loop_edges.reserve(a.boundary_nodes.size());
   for (std::size_t b = 0; b < a.boundaries.size(); ++b) {
     const BoundaryLoop& loop = a.boundaries[b];
     if (loop.node_count < 3) fail(at("boundaries", b) + " has fewer than 3 nodes");
@@ -237,19 +239,56 @@ void check_boundaries(const Asset& a) {
     if (next > a.boundary_nodes.size()) fail(at("boundaries", b) + " exceeds boundary_nodes");
     const std::uint32_t* ids = a.boundary_nodes.data() + loop.node_offset;
     for (std::uint32_t i = 0; i < loop.node_count; ++i) {
+      if (ids[i] >= a.node_count) {
+        fail(at("boundaries", b) + " has node " + std::to_string(ids[i]) + " >= node_count " +
+             std::to_string(a.node_count));
+      }
+    }
+    for (std::uint32_t i = 0; i < loop.node_count; ++i) {
       const std::uint32_t u = ids[i];
       const std::uint32_t v = ids[(i + 1) % loop.node_count];
-      if (u >= a.node_count)
-        fail(at("boundaries", b) + " has node " + std::to_string(u) + " >= node_count");
-      if (!std::binary_search(edges.begin(), edges.end(), edge_key(u, v))) {
+      if (u == v) {
         fail(at("boundaries", b) + ": nodes " + std::to_string(u) + " and " + std::to_string(v) +
              " are not a surface edge");
       }
+      loop_edges.push_back(edge_key(u, v));
     }
   }
   if (next != a.boundary_nodes.size()) {
     fail("boundaries use " + std::to_string(next) + " of " +
          std::to_string(a.boundary_nodes.size()) + " boundary_nodes");
+  }
+  if (loop_edges.empty()) return;
+  std::sort(loop_edges.begin(), loop_edges.end());
+  loop_edges.erase(std::unique(loop_edges.begin(), loop_edges.end()), loop_edges.end());
+  std::vector<std::uint8_t> found(loop_edges.size(), 0);
+  auto mark = [&](std::uint32_t u, std::uint32_t v) {
+    const auto it = std::lower_bound(loop_edges.begin(), loop_edges.end(), edge_key(u, v));
+    if (it != loop_edges.end() && *it == edge_key(u, v)) found[it - loop_edges.begin()] = 1;
+  };
+  for (const Triangle& t : a.triangles) {
+    mark(t[0], t[1]);
+    mark(t[1], t[2]);
+    mark(t[2], t[0]);
+  }
+  for (std::size_t e = 0; e < loop_edges.size(); ++e) {
+    if (found[e]) continue;
+    const auto u = static_cast<std::uint32_t>(loop_edges[e] >> 32);
+    const auto v = static_cast<std::uint32_t>(loop_edges[e] & 0xFFFFFFFFu);
+    // Name the first loop that uses the missing edge, as "nodes <u> and <v>" in loop order.
+    for (std::size_t b = 0; b < a.boundaries.size(); ++b) {
+      const BoundaryLoop& loop = a.boundaries[b];
+      const std::uint32_t* ids = a.boundary_nodes.data() + loop.node_offset;
+      for (std::uint32_t i = 0; i < loop.node_count; ++i) {
+        const std::uint32_t x = ids[i];
+        const std::uint32_t y = ids[(i + 1) % loop.node_count];
+        if (edge_key(x, y) == loop_edges[e]) {
+          fail(at("boundaries", b) + ": nodes " + std::to_string(x) + " and " + std::to_string(y) +
+               " are not a surface edge");
+        }
+      }
+    }
+    fail("boundary edge " + std::to_string(u) + "-" + std::to_string(v) + " is not a surface edge");
   }
 }
 
