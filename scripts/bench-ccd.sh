@@ -1,0 +1,35 @@
+#!/usr/bin/env bash
+# Benchmark of the elementary CCD tests (docs/benchmarks.md, "Elementary CCD tests"): builds
+# tetseg-ccd in Release and runs it on the reference queries (conservative runtime test and the
+# non-conservative fast-cubic baseline), then on whole scalable-CCD frames.
+# Usage: scripts/bench-ccd.sh [build-dir]   (default build-bench-ccd; data from ../shared)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+build=${1:-build-bench-ccd}
+data=${TETSEG_SHARED_DIR:-$PWD/../shared}/data/ccd-queries
+cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DTETSEG_BUILD_PREPROCESS=OFF \
+  -DTETSEG_BUILD_TESTS=OFF >/dev/null
+cmake --build "$build" --target tetseg-ccd -j 2 >/dev/null
+tool="$build/tools/ccd/tetseg-ccd"
+[ -d "$data/sample-queries" ] || { echo "reference data not found under $data" >&2; exit 1; }
+
+echo "== machine: $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | xargs)"
+for method in conservative fast-cubic; do
+  echo "== reference queries, --method $method (3 runs; the tool times the test calls only)"
+  for run in 1 2 3; do
+    "$tool" queries "$data/sample-queries" --method "$method" | tail -2 | sed "s/^/run $run: /"
+  done
+done
+echo "== per-scene table (conservative)"
+"$tool" queries "$data/sample-queries"
+
+echo "== whole frames (BVH + dedup + tests, wall time of the tool including PLY reading)"
+for scene in "cloth-funnel 227 228" "rod-twist 3036 3037" "cloth-ball cloth_ball92 cloth_ball93"; do
+  set -- $scene
+  dir="$data/sample-scalable-ccd-data/$1/frames"
+  [ -f "$dir/$2.ply" ] || continue
+  start=$(date +%s.%N)
+  count=$("$tool" frames "$dir/$2.ply" "$dir/$3.ply" 2>/dev/null | wc -l)
+  end=$(date +%s.%N)
+  printf '%s: %s contacts, %.2f s\n' "$1" "$count" "$(awk -v a="$start" -v b="$end" "BEGIN{print b-a}")"
+done
