@@ -1,0 +1,183 @@
+#pragma once
+/// \file
+/// Per-frame continuous self-collision queries for the surface of one deformable tetrahedral
+/// object (paper section V; docs/runtime.md). A `Collider` is built once from an `Asset`,
+/// allocates all of its scratch memory in the constructor, and then answers queries for each
+/// step `x(t) = (1-t) x0 + t x1`, t in [0,1], without allocating.
+///
+/// Usage per step: `step(x0, x1)`, then any of `any_collision()`, `earliest_toi()`,
+/// `contacts()`. Queries do only the work they need and share results within a step.
+///
+/// Thread safety: one `Collider` is used by one thread at a time. Several colliders may share
+/// one `Asset` (read-only) across threads. No function throws; failures are statuses.
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+
+#include "tetseg/runtime/asset.hpp"
+#include "tetseg/runtime/ccd.hpp"
+#include "tetseg/runtime/classify.hpp"
+
+namespace tetseg {
+
+/// How candidate feature pairs are found. All modes use the same elementary tests.
+enum class ColliderMode : std::uint8_t {
+  kRvbc = 0,   ///< per-cluster BVHs + radial-view orientation culling (default)
+  kBvh = 1,    ///< one BVH over the whole surface, overlap culling only
+  kBrute = 2,  ///< every feature pair with 4 distinct nodes and overlapping swept boxes
+};
+
+/// Short stable name: "rvbc", "bvh", "brute".
+const char* to_string(ColliderMode mode) noexcept;
+/// Parses a name of `to_string`; false when unknown.
+bool parse_collider_mode(const char* name, ColliderMode& out) noexcept;
+
+/// Result of collider calls that can fail.
+enum class ColliderStatus : std::uint8_t {
+  kOk = 0,
+  kNotReady,      ///< construction failed (out of memory), or no successful step yet
+  kNullInput,     ///< a position pointer is null
+  kSizeMismatch,  ///< value count differs from node_count * 3
+  kNonFinite,     ///< a position is NaN or infinite (step rejected, previous state dropped)
+  kInternal,      ///< internal limit exceeded (traversal stack); never expected
+};
+const char* to_string(ColliderStatus status) noexcept;
+
+struct ColliderOptions {
+  ColliderMode mode = ColliderMode::kRvbc;
+  /// Passed to the elementary tests. With `min_separation > 0` swept boxes are inflated and
+  /// the coplanarity filter is off, but orientation culling (rvbc) still only guarantees
+  /// exact contacts: use `kBvh` when every near contact must be found.
+  CcdOptions ccd;
+  /// Leaf size of the `kBvh` mode's BVH (clamped to [1, 16]).
+  std::uint32_t bvh_leaf_size = 4;
+  /// Parallelise refit and classification with OpenMP when built with it. Results are
+  /// bit-identical to serial. Off by default.
+  bool use_openmp = false;
+  /// Run `check_rest_intersection` on the start positions of the first step (cost: one
+  /// overlap-only traversal with static triangle tests). Result in `rest_intersection()`.
+  bool check_first_step = false;
+  /// Time the elementary tests separately (two clock reads per test). When off, test time
+  /// is counted as traversal.
+  bool time_tests = true;
+};
+
+enum class ContactKind : std::uint8_t {
+  kVertexFace = 0,  ///< nodes = {p, a, b, c}: vertex p against triangle (a, b, c)
+  kEdgeEdge = 1,    ///< nodes = {a, b, c, d}: edge (a, b) against edge (c, d)
+};
+
+/// One feature pair found in contact. Tet-mesh node ids. Edge-edge pairs are normalised:
+/// a < b, c < d, (a, b) < (c, d) lexicographically.
+struct Contact {
+  ContactKind kind = ContactKind::kVertexFace;
+  std::array<std::uint32_t, 4> nodes{};
+  std::uint32_t triangle = 0;  ///< vertex-face: the surface triangle id of the face
+  double toi = 1.0;            ///< lower bound on the first contact time in [0,1]
+  bool at_start = false;       ///< touching at t = 0 (toi == 0)
+};
+
+/// Strict total order used for deterministic results: by toi, then kind, then nodes.
+bool contact_less(const Contact& a, const Contact& b) noexcept;
+
+struct EarliestContact {
+  bool found = false;
+  Contact contact;  ///< valid when found: the smallest contact in `contact_less` order
+};
+
+struct ContactsResult {
+  ColliderStatus status = ColliderStatus::kOk;
+  std::size_t found = 0;    ///< contacts found in this step (all of them)
+  std::size_t written = 0;  ///< min(found, capacity): written to the buffer
+  bool truncated() const noexcept { return found > written; }
+};
+
+/// Counts and times of the current step (reset by `step`; queries add to them).
+struct ColliderStats {
+  double refit_ms = 0, classify_ms = 0, traversal_ms = 0, tests_ms = 0;
+  std::uint64_t nodes_moved = 0;
+  std::uint64_t triangles_positive = 0, triangles_negative = 0, triangles_uncertain = 0;
+  std::uint64_t triangles_moving = 0;
+  std::uint64_t clusters_skipped = 0;    ///< intra-cluster work skipped (one sign / static)
+  std::uint64_t node_pairs_visited = 0;  ///< BVH node pairs popped by traversal
+  std::uint64_t node_pairs_orientation_culled = 0;
+  std::uint64_t triangle_pairs = 0;          ///< non-culled triangle pairs examined
+  std::uint64_t feature_pairs = 0;           ///< distinct feature pairs reaching the filter
+  std::uint64_t feature_pairs_filtered = 0;  ///< rejected by box or coplanarity filter
+  std::uint64_t feature_tests = 0;           ///< elementary tests run
+  std::uint64_t contacts = 0;                ///< elementary tests that reported contact
+  bool nothing_moved = false;
+  bool full_traversal = false;  ///< a complete traversal ran this step
+};
+
+/// Result of a static intersection check of the surface at one instant.
+struct RestCheck {
+  ColliderStatus status = ColliderStatus::kOk;
+  bool intersecting = false;                     ///< some pair of triangles may intersect or touch
+  std::uint32_t triangle_a = 0, triangle_b = 0;  ///< a witness pair when intersecting
+};
+
+class Collider {
+ public:
+  /// Builds the collider and allocates all scratch memory. `asset` must outlive the collider
+  /// and stay unchanged. On allocation failure `status()` is kNotReady and every call fails.
+  Collider(const Asset& asset, const ColliderOptions& options = {}) noexcept;
+  ~Collider();
+  Collider(Collider&&) noexcept;
+  Collider& operator=(Collider&&) noexcept;
+  Collider(const Collider&) = delete;
+  Collider& operator=(const Collider&) = delete;
+
+  /// kOk when constructed, else kNotReady.
+  ColliderStatus status() const noexcept;
+  const ColliderOptions& options() const noexcept;
+
+  /// Starts a step. `x0`, `x1`: node_count * 3 doubles each (xyz per tet-mesh node, length
+  /// units), `value_count` must equal node_count * 3. The collider keeps the pointers: both
+  /// arrays must stay valid and unchanged until the next `step` (queries read them).
+  /// Refits and classifies (rvbc). Nodes with x0 == x1 (bitwise) are "still".
+  /// Rule for still geometry: a feature pair whose four nodes are all still is never
+  /// tested (it can only touch during the whole step, i.e. at t = 0, which the previous step
+  /// or `check_rest_intersection` reports); so still clusters, pairs of still clusters and
+  /// a step where nothing moved cost no traversal. Rejects non-finite input (kNonFinite).
+  ColliderStatus step(const double* x0, const double* x1, std::size_t value_count) noexcept;
+  /// Same with value_count = node_count * 3 assumed.
+  ColliderStatus step(const double* x0, const double* x1) noexcept;
+
+  /// Whether any feature pair is in contact during the step. Stops at the first contact
+  /// unless a full traversal already ran. False when there is no valid step.
+  bool any_collision() noexcept;
+  /// The earliest contact of the step (deterministic: smallest in `contact_less`).
+  /// Runs a full traversal once per step; later queries reuse it.
+  EarliestContact earliest_toi() noexcept;
+  /// All contacts of the step: the first `capacity` found are written to `buffer`
+  /// (caller-owned; may be null when capacity is 0), then the written part is sorted with
+  /// `contact_less`. `found` counts all of them, so truncation is visible. Runs a traversal
+  /// each call (the list is not stored).
+  ContactsResult contacts(Contact* buffer, std::size_t capacity) noexcept;
+
+  /// Statistics of the current step.
+  const ColliderStats& stats() const noexcept;
+
+  /// Static check of positions `x` (node_count * 3 doubles): do two non-adjacent parts of
+  /// the surface intersect or touch? Conservative in floating point (an uncertain
+  /// orientation counts as touching): may report a false "intersecting" for near-touching
+  /// surfaces, never misses a proper edge-through-triangle crossing. Allocation-free.
+  /// Culling assumes an intersection-free start: call this on the initial state.
+  RestCheck check_rest_intersection(const double* x, std::size_t value_count) noexcept;
+  /// Result of `options.check_first_step` (intersecting = false when not run).
+  const RestCheck& rest_intersection() const noexcept;
+
+  /// Orientation class of surface triangle `t` in the current step (rvbc mode; kUncertain
+  /// otherwise or when out of range). For diagnostics and tests.
+  Orientation triangle_class(std::size_t t) const noexcept;
+
+  struct Impl;
+
+ private:
+  std::unique_ptr<Impl> m_impl;
+};
+
+}  // namespace tetseg

@@ -1,0 +1,448 @@
+// Collider: construction (topology, scratch), step validation, refit and classification,
+// and the public query entry points. Traversal: collider_traverse.cpp; kBvh mode's BVH and
+// the rest-intersection check: collider_bvh.cpp.
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <new>
+
+#include "collider_impl.hpp"
+
+namespace tetseg {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double ms_since(Clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+}  // namespace
+
+const char* to_string(ColliderMode mode) noexcept {
+  switch (mode) {
+    case ColliderMode::kRvbc:
+      return "rvbc";
+    case ColliderMode::kBvh:
+      return "bvh";
+    case ColliderMode::kBrute:
+      return "brute";
+  }
+  return "unknown";
+}
+
+bool parse_collider_mode(const char* name, ColliderMode& out) noexcept {
+  if (!name) return false;
+  for (ColliderMode m : {ColliderMode::kRvbc, ColliderMode::kBvh, ColliderMode::kBrute}) {
+    if (std::strcmp(name, to_string(m)) == 0) {
+      out = m;
+      return true;
+    }
+  }
+  return false;
+}
+
+const char* to_string(ColliderStatus status) noexcept {
+  switch (status) {
+    case ColliderStatus::kOk:
+      return "ok";
+    case ColliderStatus::kNotReady:
+      return "not ready";
+    case ColliderStatus::kNullInput:
+      return "null input";
+    case ColliderStatus::kSizeMismatch:
+      return "size mismatch";
+    case ColliderStatus::kNonFinite:
+      return "non-finite position";
+    case ColliderStatus::kInternal:
+      return "internal limit exceeded";
+  }
+  return "unknown";
+}
+
+bool contact_less(const Contact& a, const Contact& b) noexcept {
+  if (a.toi != b.toi) return a.toi < b.toi;
+  if (a.kind != b.kind) return a.kind < b.kind;
+  if (a.nodes != b.nodes) return a.nodes < b.nodes;
+  return a.triangle < b.triangle;
+}
+
+void Collider::Impl::construct(const Asset& a, const ColliderOptions& o) {
+  asset = &a.data();
+  opt = o;
+  opt.bvh_leaf_size = std::min<std::uint32_t>(16, std::max<std::uint32_t>(1, opt.bvh_leaf_size));
+  const format::Asset& fa = *asset;
+  node_count = fa.node_count;
+  tri_count = static_cast<std::uint32_t>(fa.triangles.size());
+
+  // Surface vertices and vertex -> triangle adjacency.
+  surf_index.assign(node_count, kNone);
+  for (const auto& t : fa.triangles)
+    for (std::uint32_t v : t) surf_index[v] = 0;
+  for (std::uint32_t n = 0; n < node_count; ++n) {
+    if (surf_index[n] == 0) {
+      surf_index[n] = static_cast<std::uint32_t>(surf_nodes.size());
+      surf_nodes.push_back(n);
+    }
+  }
+  const std::size_t nv = surf_nodes.size();
+  vt_offset.assign(nv + 1, 0);
+  for (const auto& t : fa.triangles)
+    for (std::uint32_t v : t) ++vt_offset[surf_index[v] + 1];
+  for (std::size_t i = 0; i < nv; ++i) vt_offset[i + 1] += vt_offset[i];
+  vt_list.resize(vt_offset[nv]);
+  {
+    std::vector<std::uint32_t> fill(vt_offset.begin(), vt_offset.end() - 1);
+    for (std::uint32_t t = 0; t < tri_count; ++t)
+      for (std::uint32_t v : fa.triangles[t]) vt_list[fill[surf_index[v]]++] = t;
+  }
+
+  // Unique edges and edge -> triangle adjacency.
+  std::vector<std::array<std::uint32_t, 3>> half;  // lo, hi, triangle*3+slot
+  half.reserve(std::size_t(tri_count) * 3);
+  for (std::uint32_t t = 0; t < tri_count; ++t) {
+    for (std::uint32_t s = 0; s < 3; ++s) {
+      std::uint32_t u = fa.triangles[t][s], v = fa.triangles[t][(s + 1) % 3];
+      if (u > v) std::swap(u, v);
+      half.push_back({u, v, t * 3 + s});
+    }
+  }
+  std::sort(half.begin(), half.end());
+  tri_edges.assign(tri_count, {0, 0, 0});
+  et_offset.clear();
+  for (std::size_t i = 0; i < half.size(); ++i) {
+    if (i == 0 || half[i][0] != half[i - 1][0] || half[i][1] != half[i - 1][1]) {
+      edges.push_back({half[i][0], half[i][1]});
+      et_offset.push_back(static_cast<std::uint32_t>(i));
+    }
+    const std::uint32_t e = static_cast<std::uint32_t>(edges.size() - 1);
+    tri_edges[half[i][2] / 3][half[i][2] % 3] = e;
+    et_list.push_back(half[i][2] / 3);
+  }
+  et_offset.push_back(static_cast<std::uint32_t>(half.size()));
+
+  // Per-node static triangle counts and BVH depth (children have larger indices).
+  const std::size_t nn = fa.bvh_nodes.size();
+  cluster_node_ntris.assign(nn, 0);
+  std::vector<std::uint32_t> depth(nn, 0);
+  for (const auto& c : fa.clusters) {
+    const format::BvhNode* nodes = fa.bvh_nodes.data() + c.bvh_offset;
+    std::uint32_t* cnt = cluster_node_ntris.data() + c.bvh_offset;
+    std::uint32_t* dep = depth.data() + c.bvh_offset;
+    for (std::uint32_t i = 0; i < c.bvh_count; ++i) {
+      if (nodes[i].count == 0) {
+        dep[nodes[i].first] = dep[i] + 1;
+        dep[nodes[i].second] = dep[i] + 1;
+      }
+      max_depth = std::max(max_depth, dep[i]);
+    }
+    for (std::uint32_t i = c.bvh_count; i-- > 0;) {
+      cnt[i] = nodes[i].count > 0 ? nodes[i].count : cnt[nodes[i].first] + cnt[nodes[i].second];
+    }
+  }
+  // The kBvh tree is a median split: depth <= log2(triangles) + 1 < 64.
+  const std::size_t stack_size = 4 * (std::size_t(std::max<std::uint32_t>(max_depth, 64)) + 4);
+  stack.resize(stack_size);
+
+  // Per-step scratch.
+  vmoved.assign(nv, 0);
+  vbox.resize(nv);
+  tbox.resize(tri_count);
+  tcls.assign(tri_count, static_cast<std::uint8_t>(Orientation::kUncertain));
+  tmov.assign(tri_count, 0);
+  nbox.resize(nn);
+  nneg.assign(nn, 0);
+  nunc.assign(nn, 0);
+  nmov.assign(nn, 0);
+
+  // kBvh topology storage (built from rest positions now when available, else on the first
+  // step or rest check, without allocating).
+  if (opt.mode == ColliderMode::kBvh) {
+    const std::size_t cap = tri_count == 0 ? 1 : 2 * std::size_t(tri_count) - 1;
+    gnodes.resize(cap);
+    gleaf.resize(tri_count);
+    gcentroid.resize(std::size_t(tri_count) * 3);
+    gbuild_stack.resize(128);
+    gbox.resize(cap);
+    gntris.assign(cap, 0);
+    gmov.assign(cap, 0);
+    if (fa.rest_positions.size() == node_count && node_count > 0) {
+      build_global_bvh(fa.rest_positions[0].data());
+    }
+  }
+  ctor_status = ColliderStatus::kOk;
+}
+
+ColliderStatus Collider::Impl::begin_step(const double* p0, const double* p1,
+                                          std::size_t count) noexcept {
+  have_step = false;
+  stats = ColliderStats{};
+  any_known = any_value = full_done = has_best = false;
+  full_found = 0;
+  if (ctor_status != ColliderStatus::kOk) return ColliderStatus::kNotReady;
+  if (count != std::size_t(node_count) * 3) return ColliderStatus::kSizeMismatch;
+  if (node_count > 0 && (!p0 || !p1)) return ColliderStatus::kNullInput;
+  // Only surface vertices and detector nodes are read; check exactly those.
+  for (std::uint32_t n : surf_nodes) {
+    for (int k = 0; k < 3; ++k) {
+      if (!std::isfinite(p0[std::size_t(n) * 3 + k]) || !std::isfinite(p1[std::size_t(n) * 3 + k]))
+        return ColliderStatus::kNonFinite;
+    }
+  }
+  for (const auto& c : asset->clusters) {
+    for (int k = 0; k < 3; ++k) {
+      if (!std::isfinite(p0[std::size_t(c.detector_node) * 3 + k]) ||
+          !std::isfinite(p1[std::size_t(c.detector_node) * 3 + k]))
+        return ColliderStatus::kNonFinite;
+    }
+  }
+  x0 = p0;
+  x1 = p1;
+  have_step = true;
+  return ColliderStatus::kOk;
+}
+
+void Collider::Impl::refit_and_classify() noexcept {
+  const format::Asset& fa = *asset;
+  const auto t_refit = Clock::now();
+  const std::int64_t nv = static_cast<std::int64_t>(surf_nodes.size());
+  std::uint64_t moved = 0;
+#if defined(TETSEG_HAVE_OPENMP)
+#pragma omp parallel for reduction(+ : moved) if (opt.use_openmp && nv > 4096)
+#endif
+  for (std::int64_t i = 0; i < nv; ++i) {
+    const double* a = pos0(surf_nodes[i]);
+    const double* b = pos1(surf_nodes[i]);
+    Box& box = vbox[i];
+    const bool m = !rest_mode && (a[0] != b[0] || a[1] != b[1] || a[2] != b[2]);
+    vmoved[i] = m ? 1 : 0;
+    moved += m ? 1 : 0;
+    if (!m) {
+      for (int k = 0; k < 3; ++k) box.lo[k] = box.hi[k] = a[k];
+    } else {
+      for (int k = 0; k < 3; ++k) {
+        box.lo[k] = std::min(a[k], b[k]);
+        box.hi[k] = std::max(a[k], b[k]);
+      }
+    }
+  }
+  stats.nodes_moved = moved;
+  stats.nothing_moved = moved == 0 && !rest_mode;
+  if (stats.nothing_moved) {
+    stats.refit_ms = ms_since(t_refit);
+    return;  // every feature pair is still: no test can run this step
+  }
+  const std::int64_t nt = tri_count;
+#if defined(TETSEG_HAVE_OPENMP)
+#pragma omp parallel for if (opt.use_openmp && nt > 4096)
+#endif
+  for (std::int64_t t = 0; t < nt; ++t) {
+    const auto& tri = fa.triangles[t];
+    const std::uint32_t i0 = surf_index[tri[0]], i1 = surf_index[tri[1]], i2 = surf_index[tri[2]];
+    Box b = vbox[i0];
+    box_union(b, vbox[i1]);
+    box_union(b, vbox[i2]);
+    tbox[t] = b;
+    tmov[t] = (vmoved[i0] | vmoved[i1] | vmoved[i2]) ? 1 : 0;
+  }
+  if (opt.mode == ColliderMode::kRvbc || rest_mode) {
+    for (std::size_t c = 0; c < fa.clusters.size(); ++c) {
+      const format::Cluster& cl = fa.clusters[c];
+      const format::BvhNode* nodes = fa.bvh_nodes.data() + cl.bvh_offset;
+      const std::uint32_t* leaf = fa.cluster_triangles.data() + cl.triangle_offset;
+      Box* nb = nbox.data() + cl.bvh_offset;
+      std::uint32_t* nm = nmov.data() + cl.bvh_offset;
+      for (std::uint32_t i = cl.bvh_count; i-- > 0;) {
+        const format::BvhNode& n = nodes[i];
+        if (n.count > 0) {
+          Box b = tbox[leaf[n.first]];
+          std::uint32_t m = 0;
+          for (std::uint32_t k = 0; k < n.count; ++k) {
+            box_union(b, tbox[leaf[n.first + k]]);
+            m += tmov[leaf[n.first + k]];
+          }
+          nb[i] = b;
+          nm[i] = m;
+        } else {
+          Box b = nb[n.first];
+          box_union(b, nb[n.second]);
+          nb[i] = b;
+          nm[i] = nm[n.first] + nm[n.second];
+        }
+      }
+    }
+  } else if (opt.mode == ColliderMode::kBvh) {
+    if (!gbvh_built) build_global_bvh(x0);
+    refit_global_bvh();
+  }
+  std::uint64_t moving = 0;
+  for (std::uint32_t t = 0; t < tri_count; ++t) moving += tmov[t];
+  stats.triangles_moving = moving;
+  stats.refit_ms = ms_since(t_refit);
+
+  if (opt.mode != ColliderMode::kRvbc || rest_mode) return;
+  const auto t_class = Clock::now();
+#if defined(TETSEG_HAVE_OPENMP)
+#pragma omp parallel for if (opt.use_openmp && nt > 2048)
+#endif
+  for (std::int64_t t = 0; t < nt; ++t) {
+    const auto& tri = fa.triangles[t];
+    const std::uint32_t o = fa.clusters[fa.triangle_cluster[t]].detector_node;
+    tcls[t] = static_cast<std::uint8_t>(classify_orientation(pos0(o), pos0(tri[0]), pos0(tri[1]),
+                                                             pos0(tri[2]), pos1(o), pos1(tri[0]),
+                                                             pos1(tri[1]), pos1(tri[2])));
+  }
+  std::uint64_t count[3] = {0, 0, 0};
+  for (std::uint32_t t = 0; t < tri_count; ++t) ++count[tcls[t]];
+  stats.triangles_positive = count[0];
+  stats.triangles_negative = count[1];
+  stats.triangles_uncertain = count[2];
+  // Per-node counters of negative and uncertain triangles, bottom-up, from this step.
+  for (const format::Cluster& cl : fa.clusters) {
+    const format::BvhNode* nodes = fa.bvh_nodes.data() + cl.bvh_offset;
+    const std::uint32_t* leaf = fa.cluster_triangles.data() + cl.triangle_offset;
+    std::uint32_t* ng = nneg.data() + cl.bvh_offset;
+    std::uint32_t* nu = nunc.data() + cl.bvh_offset;
+    for (std::uint32_t i = cl.bvh_count; i-- > 0;) {
+      const format::BvhNode& n = nodes[i];
+      if (n.count > 0) {
+        std::uint32_t g = 0, u = 0;
+        for (std::uint32_t k = 0; k < n.count; ++k) {
+          const std::uint8_t c = tcls[leaf[n.first + k]];
+          g += c == static_cast<std::uint8_t>(Orientation::kNegative);
+          u += c == static_cast<std::uint8_t>(Orientation::kUncertain);
+        }
+        ng[i] = g;
+        nu[i] = u;
+      } else {
+        ng[i] = ng[n.first] + ng[n.second];
+        nu[i] = nu[n.first] + nu[n.second];
+      }
+    }
+  }
+  stats.classify_ms = ms_since(t_class);
+}
+
+// ---------------------------------------------------------------- public API
+
+Collider::Collider(const Asset& asset, const ColliderOptions& options) noexcept {
+  try {
+    m_impl = std::make_unique<Impl>();
+    m_impl->construct(asset, options);
+  } catch (...) {
+    if (m_impl) {
+      m_impl->ctor_status = ColliderStatus::kNotReady;
+      m_impl->opt = options;
+    }
+  }
+}
+
+Collider::~Collider() = default;
+Collider::Collider(Collider&&) noexcept = default;
+Collider& Collider::operator=(Collider&&) noexcept = default;
+
+ColliderStatus Collider::status() const noexcept {
+  return m_impl ? m_impl->ctor_status : ColliderStatus::kNotReady;
+}
+
+const ColliderOptions& Collider::options() const noexcept {
+  static const ColliderOptions kDefault{};
+  return m_impl ? m_impl->opt : kDefault;
+}
+
+ColliderStatus Collider::step(const double* x0, const double* x1) noexcept {
+  if (!m_impl) return ColliderStatus::kNotReady;
+  return step(x0, x1, std::size_t(m_impl->node_count) * 3);
+}
+
+ColliderStatus Collider::step(const double* x0, const double* x1,
+                              std::size_t value_count) noexcept {
+  if (!m_impl) return ColliderStatus::kNotReady;
+  Impl& s = *m_impl;
+  const ColliderStatus st = s.begin_step(x0, x1, value_count);
+  if (st != ColliderStatus::kOk) return st;
+  if (s.opt.check_first_step && !s.first_step_done) {
+    s.first_step_done = true;
+    s.rest = check_rest_intersection(x0, value_count);
+    s.begin_step(x0, x1, value_count);  // the check reused the step's scratch
+  }
+  s.first_step_done = true;
+  s.refit_and_classify();
+  return ColliderStatus::kOk;
+}
+
+bool Collider::any_collision() noexcept {
+  if (!m_impl || !m_impl->have_step) return false;
+  Impl& s = *m_impl;
+  if (s.any_known) return s.any_value;
+  s.qkind = QueryKind::kAny;
+  s.out = nullptr;
+  s.out_cap = 0;
+  if (!s.run_query()) return true;  // internal overflow: conservatively "maybe"
+  s.any_known = true;
+  s.any_value = s.stop;
+  return s.any_value;
+}
+
+EarliestContact Collider::earliest_toi() noexcept {
+  EarliestContact r;
+  if (!m_impl || !m_impl->have_step) return r;
+  Impl& s = *m_impl;
+  if (!s.full_done) {
+    s.qkind = QueryKind::kFull;
+    s.out = nullptr;
+    s.out_cap = 0;
+    if (!s.run_query()) return r;
+  }
+  r.found = s.has_best;
+  r.contact = s.best;
+  return r;
+}
+
+ContactsResult Collider::contacts(Contact* buffer, std::size_t capacity) noexcept {
+  ContactsResult r;
+  if (!m_impl || !m_impl->have_step) {
+    r.status = ColliderStatus::kNotReady;
+    return r;
+  }
+  Impl& s = *m_impl;
+  if (!buffer) capacity = 0;
+  if (s.full_done && capacity == 0) {
+    r.found = s.full_found;
+    return r;
+  }
+  s.qkind = QueryKind::kFull;
+  s.out = buffer;
+  s.out_cap = capacity;
+  if (!s.run_query()) {
+    r.status = ColliderStatus::kInternal;
+    return r;
+  }
+  r.found = s.full_found;
+  r.written = s.out_written;
+  std::sort(buffer, buffer + r.written, contact_less);
+  s.out = nullptr;
+  s.out_cap = 0;
+  return r;
+}
+
+const ColliderStats& Collider::stats() const noexcept {
+  static const ColliderStats kEmpty{};
+  return m_impl ? m_impl->stats : kEmpty;
+}
+
+const RestCheck& Collider::rest_intersection() const noexcept {
+  static const RestCheck kEmpty{};
+  return m_impl ? m_impl->rest : kEmpty;
+}
+
+Orientation Collider::triangle_class(std::size_t t) const noexcept {
+  if (!m_impl || !m_impl->have_step || t >= m_impl->tri_count ||
+      m_impl->opt.mode != ColliderMode::kRvbc)
+    return Orientation::kUncertain;
+  return static_cast<Orientation>(m_impl->tcls[t]);
+}
+
+}  // namespace tetseg

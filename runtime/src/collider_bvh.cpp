@@ -1,0 +1,204 @@
+// The kBvh mode's single BVH (median split, built once without allocation into storage
+// reserved at construction) and the static rest-intersection check.
+
+#include <algorithm>
+#include <cmath>
+
+#include "collider_impl.hpp"
+
+namespace tetseg {
+
+void Collider::Impl::build_global_bvh(const double* positions) noexcept {
+  // Topology from `positions` (rest positions when the asset has them, else the first step's
+  // start): recursive median split of triangle centroids along the widest centroid axis,
+  // children allocated after their parent (as in the asset's per-cluster BVHs).
+  const format::Asset& fa = *asset;
+  gnode_count = 0;
+  if (tri_count == 0) {
+    gbvh_built = true;
+    return;
+  }
+  for (std::uint32_t t = 0; t < tri_count; ++t) {
+    gleaf[t] = t;
+    for (int k = 0; k < 3; ++k) {
+      double s = 0;
+      for (std::uint32_t v : fa.triangles[t]) s += positions[std::size_t(v) * 3 + k];
+      gcentroid[std::size_t(t) * 3 + k] = s / 3.0;
+    }
+  }
+  const std::uint32_t leaf_size = opt.bvh_leaf_size;
+  std::size_t top = 0;
+  gnodes[0] = {0, 0, 0};
+  gnode_count = 1;
+  gbuild_stack[top++] = {0, 0, tri_count};
+  while (top > 0) {
+    const auto item = gbuild_stack[--top];
+    const std::uint32_t node = item[0], begin = item[1], end = item[2];
+    if (end - begin <= leaf_size || top + 2 > gbuild_stack.size()) {
+      gnodes[node] = {begin, 0, end - begin};
+      continue;
+    }
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (std::uint32_t i = begin; i < end; ++i) {
+      for (int k = 0; k < 3; ++k) {
+        const double c = gcentroid[std::size_t(gleaf[i]) * 3 + k];
+        lo[k] = std::min(lo[k], c);
+        hi[k] = std::max(hi[k], c);
+      }
+    }
+    int axis = 0;
+    for (int k = 1; k < 3; ++k)
+      if (hi[k] - lo[k] > hi[axis] - lo[axis]) axis = k;
+    const std::uint32_t mid = begin + (end - begin) / 2;
+    const double* cen = gcentroid.data();
+    std::nth_element(gleaf.begin() + begin, gleaf.begin() + mid, gleaf.begin() + end,
+                     [cen, axis](std::uint32_t a, std::uint32_t b) {
+                       const double ca = cen[std::size_t(a) * 3 + axis];
+                       const double cb = cen[std::size_t(b) * 3 + axis];
+                       return ca < cb || (ca == cb && a < b);
+                     });
+    const std::uint32_t left = gnode_count++, right = gnode_count++;
+    gnodes[node] = {left, right, 0};
+    gbuild_stack[top++] = {right, mid, end};
+    gbuild_stack[top++] = {left, begin, mid};
+  }
+  for (std::uint32_t i = gnode_count; i-- > 0;) {
+    const format::BvhNode& n = gnodes[i];
+    gntris[i] = n.count > 0 ? n.count : gntris[n.first] + gntris[n.second];
+  }
+  gbvh_built = true;
+}
+
+void Collider::Impl::refit_global_bvh() noexcept {
+  for (std::uint32_t i = gnode_count; i-- > 0;) {
+    const format::BvhNode& n = gnodes[i];
+    if (n.count > 0) {
+      Box b = tbox[gleaf[n.first]];
+      std::uint32_t m = 0;
+      for (std::uint32_t k = 0; k < n.count; ++k) {
+        box_union(b, tbox[gleaf[n.first + k]]);
+        m += tmov[gleaf[n.first + k]];
+      }
+      gbox[i] = b;
+      gmov[i] = m;
+    } else {
+      Box b = gbox[n.first];
+      box_union(b, gbox[n.second]);
+      gbox[i] = b;
+      gmov[i] = gmov[n.first] + gmov[n.second];
+    }
+  }
+}
+
+namespace {
+
+// Static orientation sign of det[a-o, b-o, c-o] with an error bound: +1, -1 or 0 (unknown).
+int orient(const double* o, const double* a, const double* b, const double* c) noexcept {
+  const BernsteinCubic k = orientation_bernstein(o, a, b, c, o, a, b, c);
+  if (k.k[0] > k.err[0]) return 1;
+  if (k.k[0] < -k.err[0]) return -1;
+  return 0;
+}
+
+// Can segment pq meet triangle abc? False only when proven disjoint (floating point, with
+// error bounds); near-degenerate and coplanar configurations count as meeting unless a 2D
+// separation in the coplanar case is clear.
+bool segment_meets_triangle(const double* p, const double* q, const double* a, const double* b,
+                            const double* c) noexcept {
+  const int sp = orient(a, b, c, p), sq = orient(a, b, c, q);
+  if (sp != 0 && sp == sq) return false;
+  const int s0 = orient(p, q, a, b), s1 = orient(p, q, b, c), s2 = orient(p, q, c, a);
+  if ((s0 > 0 && (s1 < 0 || s2 < 0)) || (s0 < 0 && (s1 > 0 || s2 > 0)) || (s1 * s2 < 0))
+    return false;
+  if (sp == 0 && sq == 0) {
+    // Coplanar (up to rounding): separate in the projection along the dominant normal axis.
+    const double e1[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+    const double e2[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+    const double n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
+                         e1[0] * e2[1] - e1[1] * e2[0]};
+    int ax = 0;
+    for (int k = 1; k < 3; ++k)
+      if (std::fabs(n[k]) > std::fabs(n[ax])) ax = k;
+    const int i = (ax + 1) % 3, j = (ax + 2) % 3;
+    const double* tri[3] = {a, b, c};
+    // Separating axis test in 2D over the triangle's edge normals and the segment's normal.
+    auto separated = [&](double dx, double dy) {
+      double tmin = INFINITY, tmax = -INFINITY, smin = INFINITY, smax = -INFINITY;
+      for (const double* v : tri) {
+        const double d = v[i] * dx + v[j] * dy;
+        tmin = std::min(tmin, d);
+        tmax = std::max(tmax, d);
+      }
+      for (const double* v : {p, q}) {
+        const double d = v[i] * dx + v[j] * dy;
+        smin = std::min(smin, d);
+        smax = std::max(smax, d);
+      }
+      const double scale =
+          1e-12 * (std::fabs(tmin) + std::fabs(tmax) + std::fabs(smin) + std::fabs(smax));
+      return smax < tmin - scale || tmax < smin - scale;
+    };
+    for (int k = 0; k < 3; ++k) {
+      const double* u = tri[k];
+      const double* w = tri[(k + 1) % 3];
+      if (separated(-(w[j] - u[j]), w[i] - u[i])) return false;
+    }
+    if (separated(-(q[j] - p[j]), q[i] - p[i])) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+void Collider::Impl::rest_triangle_pair(std::uint32_t t1, std::uint32_t t2) noexcept {
+  const auto& A = asset->triangles[t1];
+  const auto& B = asset->triangles[t2];
+  int shared = 0;
+  for (std::uint32_t u : A)
+    for (std::uint32_t w : B) shared += u == w;
+  if (shared >= 2) return;  // edge neighbours: only a flat fold could touch; not checked
+  for (int dir = 0; dir < 2 && !stop; ++dir) {
+    const auto& E = dir == 0 ? A : B;
+    const auto& F = dir == 0 ? B : A;
+    for (int k = 0; k < 3; ++k) {
+      const std::uint32_t p = E[k], q = E[(k + 1) % 3];
+      if (p == F[0] || p == F[1] || p == F[2] || q == F[0] || q == F[1] || q == F[2]) continue;
+      if (segment_meets_triangle(pos0(p), pos0(q), pos0(F[0]), pos0(F[1]), pos0(F[2]))) {
+        rest_hit = true;
+        rest_a = std::min(t1, t2);
+        rest_b = std::max(t1, t2);
+        stop = true;
+        return;
+      }
+    }
+  }
+}
+
+RestCheck Collider::check_rest_intersection(const double* x, std::size_t value_count) noexcept {
+  RestCheck r;
+  if (!m_impl) {
+    r.status = ColliderStatus::kNotReady;
+    return r;
+  }
+  Impl& s = *m_impl;
+  r.status = s.begin_step(x, x, value_count);  // invalidates the current step
+  if (r.status != ColliderStatus::kOk) return r;
+  s.rest_mode = true;
+  s.rest_hit = false;
+  s.refit_and_classify();
+  s.qkind = QueryKind::kAny;
+  const bool ok = s.run_query();
+  s.rest_mode = false;
+  s.have_step = false;
+  s.stats = ColliderStats{};
+  if (!ok) {
+    r.status = ColliderStatus::kInternal;
+    return r;
+  }
+  r.intersecting = s.rest_hit;
+  r.triangle_a = s.rest_a;
+  r.triangle_b = s.rest_b;
+  return r;
+}
+
+}  // namespace tetseg

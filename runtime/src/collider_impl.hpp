@@ -1,0 +1,146 @@
+#pragma once
+// Private state of tetseg::Collider, shared by collider*.cpp. Not installed.
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "tetseg/runtime/classify.hpp"
+#include "tetseg/runtime/collider.hpp"
+
+namespace tetseg {
+
+inline constexpr std::uint32_t kNone = 0xffffffffu;
+
+/// Axis-aligned box.
+struct Box {
+  double lo[3];
+  double hi[3];
+};
+
+inline bool boxes_overlap(const Box& a, const Box& b, double margin) noexcept {
+  // Written so that NaN never yields "disjoint" (positions are checked finite anyway).
+  for (int k = 0; k < 3; ++k) {
+    if (a.lo[k] > b.hi[k] + margin || b.lo[k] > a.hi[k] + margin) return false;
+  }
+  return true;
+}
+
+inline void box_union(Box& a, const Box& b) noexcept {
+  for (int k = 0; k < 3; ++k) {
+    if (b.lo[k] < a.lo[k]) a.lo[k] = b.lo[k];
+    if (b.hi[k] > a.hi[k]) a.hi[k] = b.hi[k];
+  }
+}
+
+/// A BVH seen by the traversal: node topology plus per-step node data.
+struct TreeView {
+  const format::BvhNode* nodes = nullptr;
+  const std::uint32_t* leaf_tris = nullptr;  // global triangle ids in leaf order
+  const Box* box = nullptr;
+  const std::uint32_t* ntris = nullptr;
+  const std::uint32_t* nneg = nullptr;  // null: no orientation culling
+  const std::uint32_t* nunc = nullptr;
+  const std::uint32_t* nmov = nullptr;
+};
+
+struct StackItem {
+  std::uint32_t a;
+  std::uint32_t b;  // kNone: self item of node a
+};
+
+enum class QueryKind : std::uint8_t { kAny, kFull };
+
+struct Collider::Impl {
+  // --- construction-time data
+  const format::Asset* asset = nullptr;
+  ColliderOptions opt;
+  ColliderStatus ctor_status = ColliderStatus::kNotReady;
+  std::uint32_t node_count = 0;
+  std::uint32_t tri_count = 0;
+  std::vector<std::uint32_t> surf_nodes;                // surface vertex -> node id (sorted)
+  std::vector<std::uint32_t> surf_index;                // node id -> surface vertex or kNone
+  std::vector<std::uint32_t> vt_offset, vt_list;        // surface vertex -> triangles (CSR)
+  std::vector<std::array<std::uint32_t, 2>> edges;      // node ids, [0] < [1], sorted
+  std::vector<std::array<std::uint32_t, 3>> tri_edges;  // edge ids of each triangle
+  std::vector<std::uint32_t> et_offset, et_list;        // edge -> triangles (CSR)
+  std::vector<std::uint32_t> cluster_node_ntris;        // per asset BVH node (static)
+  std::uint32_t max_depth = 0;
+
+  // global BVH of the kBvh mode (topology built once, from rest or first positions)
+  bool gbvh_built = false;
+  std::vector<format::BvhNode> gnodes;
+  std::uint32_t gnode_count = 0;
+  std::vector<std::uint32_t> gleaf;  // triangle ids in leaf order
+  std::vector<double> gcentroid;     // scratch for the build
+  std::vector<std::array<std::uint32_t, 3>> gbuild_stack;
+  std::vector<Box> gbox;
+  std::vector<std::uint32_t> gntris, gmov;
+
+  // --- per-step data
+  const double* x0 = nullptr;
+  const double* x1 = nullptr;
+  bool have_step = false;
+  bool first_step_done = false;
+  bool rest_mode = false;            // check_rest_intersection: static positions, no still rule
+  std::vector<std::uint8_t> vmoved;  // per surface vertex
+  std::vector<Box> vbox;             // per surface vertex, swept
+  std::vector<Box> tbox;
+  std::vector<std::uint8_t> tcls;  // Orientation
+  std::vector<std::uint8_t> tmov;
+  std::vector<Box> nbox;  // per asset BVH node
+  std::vector<std::uint32_t> nneg, nunc, nmov;
+  std::vector<StackItem> stack;
+  ColliderStats stats;
+  RestCheck rest;
+
+  // query state within a step
+  bool any_known = false, any_value = false;
+  bool full_done = false;
+  bool has_best = false;
+  Contact best;
+  std::size_t full_found = 0;
+
+  // running query
+  QueryKind qkind = QueryKind::kFull;
+  bool stop = false;
+  bool overflow = false;
+  Contact* out = nullptr;
+  std::size_t out_cap = 0, out_written = 0, q_found = 0;
+  bool q_has_best = false;
+  Contact q_best;
+  double tests_seconds = 0;
+  // rest check running state
+  bool rest_hit = false;
+  std::uint32_t rest_a = 0, rest_b = 0;
+
+  // --- collider.cpp
+  void construct(const Asset& a, const ColliderOptions& o);
+  ColliderStatus begin_step(const double* p0, const double* p1, std::size_t count) noexcept;
+  void refit_and_classify() noexcept;
+  const double* pos0(std::uint32_t node) const noexcept { return x0 + std::size_t(node) * 3; }
+  const double* pos1(std::uint32_t node) const noexcept { return x1 + std::size_t(node) * 3; }
+
+  // --- collider_traverse.cpp
+  /// Runs the query over all candidates; honours `stop`. Returns false on stack overflow.
+  bool run_query() noexcept;
+  bool non_culled(std::uint32_t t1, std::uint32_t t2) const noexcept;
+  void process_triangle_pair(std::uint32_t t1, std::uint32_t t2) noexcept;
+  void process_vertex_face(std::uint32_t p, std::uint32_t face) noexcept;
+  void process_edge_edge(std::uint32_t e1, std::uint32_t e2) noexcept;
+  void record(const Contact& c) noexcept;
+  bool traverse_self(const TreeView& tree) noexcept;
+  bool traverse_pair(const TreeView& ta, const TreeView& tb, bool same_cluster) noexcept;
+  void leaf_pair(const TreeView& ta, std::uint32_t a, const TreeView& tb, std::uint32_t b) noexcept;
+  void run_brute() noexcept;
+  TreeView cluster_view(std::uint32_t c) const noexcept;
+  TreeView global_view() const noexcept;
+
+  // --- collider_bvh.cpp
+  void build_global_bvh(const double* positions) noexcept;
+  void refit_global_bvh() noexcept;
+  void rest_triangle_pair(std::uint32_t t1, std::uint32_t t2) noexcept;
+};
+
+}  // namespace tetseg

@@ -1,0 +1,285 @@
+// The collider against brute force on deforming closed surfaces (tests/runtime/support).
+
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <random>
+
+#include "runtime/support/compare.hpp"
+#include "runtime/support/scenes.hpp"
+#include "tetseg/runtime/collider.hpp"
+
+using namespace tetseg;
+using namespace tetseg::test;
+
+namespace {
+
+double smoothstep(double x, double a, double b) {
+  const double s = std::clamp((x - a) / (b - a), 0.0, 1.0);
+  return s * s * (3 - 2 * s);
+}
+
+/// Pushes both poles of a sphere towards the centre until the dents meet (t ~ 0.77). The dents
+/// are off-centre so that the first contact is generic (a vertex-vertex meeting of the poles
+/// makes many feature pairs touch at one point at once, see docs/runtime.md).
+P3 press(const P3& p, double t) {
+  const double cx = p[2] > 0 ? 0.15 : -0.1, cy = p[2] > 0 ? 0.1 : -0.05;
+  const double w = std::exp(-((p[0] - cx) * (p[0] - cx) + (p[1] - cy) * (p[1] - cy)) / 0.3);
+  const double dz = (p[2] > 0 ? -1.0 : 1.0) * 1.3 * t * w * std::min(1.0, std::fabs(p[2]) * 4);
+  return {p[0] + 0.15 * dz, p[1] + 0.05 * dz, p[2] + dz};
+}
+
+/// Rotates everything above the dumbbell's neck about the x axis, blended over the neck.
+P3 bend(const P3& p, double t, double max_angle, double z0, double z1, double pivot_z) {
+  const double a = t * max_angle * smoothstep(p[2], z0, z1);
+  const double y = p[1], z = p[2] - pivot_z;
+  return {p[0], y * std::cos(a) - z * std::sin(a), pivot_z + y * std::sin(a) + z * std::cos(a)};
+}
+
+P3 twist_bend(const P3& p, double t) {
+  const double tw = t * 2.5 * smoothstep(p[2], 0.5, 3.5);
+  const P3 q = {p[0] * std::cos(tw) - p[1] * std::sin(tw),
+                p[0] * std::sin(tw) + p[1] * std::cos(tw), p[2]};
+  return bend(q, t, 3.0, 0.8, 2.6, 1.0);
+}
+
+struct Waves {
+  std::vector<std::array<double, 7>> w;  // k (3), phase, direction (3)
+  double amplitude;
+  explicit Waves(unsigned seed, double amp) : amplitude(amp) {
+    std::mt19937 rng(seed);
+    auto u = [&] { return (rng() / 4294967296.0) * 2 - 1; };
+    for (int i = 0; i < 4; ++i) w.push_back({3 * u(), 3 * u(), 3 * u(), 3 * u(), u(), u(), u()});
+  }
+  P3 operator()(const P3& p, double t) const {
+    P3 q = p;
+    for (const auto& a : w) {
+      const double s = std::sin(a[0] * p[0] + a[1] * p[1] + a[2] * p[2] + a[3]);
+      for (int k = 0; k < 3; ++k) q[k] += t * amplitude * s * a[4 + k];
+    }
+    return q;
+  }
+};
+
+Scene sphere_scene(int clusters) {
+  const Surface s = sphere(1.0, 20, 11);
+  if (clusters == 1)
+    return make_scene(s, std::vector<std::uint32_t>(s.tris.size(), 0), {{0.3, 0.1, 0.05}});
+  return make_axial_scene(s, {0.0}, {-0.45, 0.45});
+}
+
+Scene dumbbell_scene() {
+  return make_axial_scene(dumbbell(16, 26), {-0.6, 0.6}, {-1.6, 0.0, 1.6});
+}
+
+Scene pawn_scene() {
+  return make_axial_scene(pawn(16, 30), {1.0, 2.6}, {0.4, 1.6, 3.3});
+}
+
+}  // namespace
+
+TEST_CASE("Radial-view culling finds the first contact of a pressed sphere", "[collider][rvbc]") {
+  for (int clusters : {1, 2}) {
+    CAPTURE(clusters);
+    const Scene scene = sphere_scene(clusters);
+    const auto frames = make_frames(scene, 16, press);
+    const SequenceReport rep = compare_with_brute(scene, frames);
+    REQUIRE(rep.contact_frames == 1);
+    CHECK(rep.rvbc_tests < rep.brute_tests);
+  }
+}
+
+TEST_CASE("Radial-view culling finds the bells of a bent dumbbell touching, wedge tip included",
+          "[collider][rvbc][wedge]") {
+  const Scene scene = dumbbell_scene();
+  const auto frames =
+      make_frames(scene, 16, [](const P3& p, double t) { return bend(p, t, 2.6, -0.5, 0.5, 0.0); });
+  const SequenceReport rep = compare_with_brute(scene, frames);
+  REQUIRE(rep.contact_frames == 1);
+  CHECK(rep.orientation_culled > 0);
+  CHECK(rep.rvbc_tests < rep.brute_tests);
+  // The wedge-tip trap of the design note occurs here: an earliest contact whose feature pair
+  // also lies in an orientation-culled triangle pair, found through a non-culled one.
+  CHECK(rep.wedge_contacts > 0);
+}
+
+TEST_CASE("Radial-view culling finds the contacts of a twisted and bent pawn", "[collider][rvbc]") {
+  const Scene scene = pawn_scene();
+  const auto frames = make_frames(scene, 16, twist_bend);
+  const SequenceReport rep = compare_with_brute(scene, frames);
+  REQUIRE(rep.contact_frames == 1);
+  CHECK(rep.orientation_culled > 0);
+}
+
+TEST_CASE("Radial-view culling matches brute force under random smooth deformations",
+          "[collider][rvbc]") {
+  const unsigned seed = GENERATE(1u, 2u, 3u, 4u);
+  const int shape = GENERATE(0, 1, 2);
+  CAPTURE(seed, shape);
+  const Scene scene = shape == 0 ? sphere_scene(2) : shape == 1 ? dumbbell_scene() : pawn_scene();
+  const Waves waves(seed, 0.9);
+  const auto frames = make_frames(scene, 12, waves);
+  const SequenceReport rep = compare_with_brute(scene, frames);
+  CHECK(rep.frames_compared > 0);
+}
+
+TEST_CASE("A drooping mushroom rim touching its base agrees with brute force",
+          "[collider][rvbc][wedge]") {
+  // Mushroom whose thin cap rim (a wedge: upper triangles positive, lower ones negative
+  // against the detector) droops locally onto the conical base.
+  const Surface s = mushroom(24);
+  const Scene scene =
+      make_scene(s, std::vector<std::uint32_t>(s.tris.size(), 0), {{0.0, 0.0, 0.3}});
+  // p: the rim-tip vertex (largest radius above the stem) nearest angle 0. The rim around p
+  // droops towards the conical base along the cone's normal (a smooth bump, largest at p):
+  // p is the first point to reach the base face B.
+  std::uint32_t p = 0;
+  double best = -1;
+  for (std::uint32_t v = 0; v < s.verts.size(); ++v) {
+    const double score = std::hypot(s.verts[v][0], s.verts[v][1]) + 0.01 * s.verts[v][0];
+    if (score > best && s.verts[v][2] > 1.6) best = score, p = v;
+  }
+  const P3 tip = s.verts[p];
+  const double phi_p = std::atan2(tip[1], tip[0]);
+  const double r_p = std::hypot(tip[0], tip[1]);
+  const auto frames = make_frames(scene, 16, [&](const P3& q, double t) {
+    const double r = std::hypot(q[0], q[1]);
+    const double arc = r_p * std::remainder(std::atan2(q[1], q[0]) - phi_p, 2 * M_PI);
+    const double d2 = (r - r_p) * (r - r_p) + (q[2] - tip[2]) * (q[2] - tip[2]);
+    const double w = std::exp(-arc * arc / 1.0 - d2 / 0.09);
+    const double dr = -1.4 * t * w / std::sqrt(2.0), dz = dr;
+    const double c = std::cos(phi_p + 0.05), sn = std::sin(phi_p + 0.05);
+    return P3{q[0] + dr * c, q[1] + dr * sn, q[2] + dz};
+  });
+  const SequenceReport rep = compare_with_brute(scene, frames);
+  REQUIRE(rep.contact_frames == 1);
+  REQUIRE_FALSE(rep.first_contacts.empty());
+}
+
+TEST_CASE("Results do not depend on translation far from the origin or on scale",
+          "[collider][numerics]") {
+  const Scene scene = dumbbell_scene();
+  const auto base =
+      make_frames(scene, 12, [](const P3& p, double t) { return bend(p, t, 2.6, -0.5, 0.5, 0.0); });
+  const auto offset = GENERATE(P3{0, 0, 0}, P3{1e6, -1e6, 1e6});
+  const double scale = GENERATE(1e-4, 1.0, 1e4);
+  CAPTURE(offset[0], scale);
+  const auto frames =
+      transformed(base, scale, {offset[0] * scale, offset[1] * scale, offset[2] * scale});
+  const SequenceReport rep = compare_with_brute(scene, frames);
+  CHECK(rep.contact_frames == 1);
+}
+
+TEST_CASE("Rigid motions and zero motion report no contact", "[collider][numerics]") {
+  const Scene scene = pawn_scene();
+  SECTION("A rigid rotation and translation of the whole object has no self-contact.") {
+    const auto frames = make_frames(scene, 6, [](const P3& p, double t) {
+      const double a = 2.0 * t;
+      return P3{p[0] * std::cos(a) - p[2] * std::sin(a) + 3 * t, p[1] - 2 * t,
+                p[0] * std::sin(a) + p[2] * std::cos(a)};
+    });
+    for (ColliderMode mode : {ColliderMode::kRvbc, ColliderMode::kBvh, ColliderMode::kBrute}) {
+      ColliderOptions o;
+      o.mode = mode;
+      Collider c(scene.asset, o);
+      for (std::size_t f = 0; f + 1 < frames.size(); ++f) {
+        REQUIRE(c.step(frames[f].data(), frames[f + 1].data()) == ColliderStatus::kOk);
+        CHECK_FALSE(c.any_collision());
+        CHECK(c.contacts(nullptr, 0).found == 0);
+        CHECK_FALSE(c.earliest_toi().found);
+      }
+    }
+  }
+  SECTION("A step where nothing moves returns at once with no contact.") {
+    Collider c(scene.asset);
+    REQUIRE(c.step(scene.rest.data(), scene.rest.data()) == ColliderStatus::kOk);
+    CHECK(c.stats().nothing_moved);
+    CHECK_FALSE(c.any_collision());
+    CHECK(c.stats().feature_tests == 0);
+    CHECK(c.stats().node_pairs_visited == 0);
+  }
+  SECTION("A still cluster skips its intra-cluster work but contacts with it are still found.") {
+    const Scene db = dumbbell_scene();
+    // Only the top bell moves (bend pivot above the neck): bottom bell cluster is still.
+    const auto frames =
+        make_frames(db, 16, [](const P3& p, double t) { return bend(p, t, 2.6, 0.6, 0.9, 0.6); });
+    Collider c(db.asset);
+    REQUIRE(c.step(frames[0].data(), frames[1].data()) == ColliderStatus::kOk);
+    c.earliest_toi();
+    CHECK(c.stats().clusters_skipped >= 1);
+    const SequenceReport rep = compare_with_brute(db, frames);
+    CHECK(rep.contact_frames == 1);
+  }
+}
+
+TEST_CASE("Near-degenerate motions agree with brute force", "[collider][numerics]") {
+  const Scene scene = sphere_scene(2);
+  SECTION("Tiny motions of 1e-12 relative size give the same answers.") {
+    const auto frames = make_frames(scene, 4, [](const P3& p, double t) {
+      return P3{p[0] + 1e-12 * t * p[1], p[1], p[2] - 1e-12 * t};
+    });
+    const SequenceReport rep = compare_with_brute(scene, frames);
+    CHECK(rep.contact_frames == 0);
+  }
+  SECTION("Sliding every node tangentially along the sphere gives no contact.") {
+    const auto frames = make_frames(scene, 5, [](const P3& p, double t) {
+      const double a = 0.3 * t;  // rotation about z keeps the sphere on itself
+      return P3{p[0] * std::cos(a) - p[1] * std::sin(a), p[0] * std::sin(a) + p[1] * std::cos(a),
+                p[2]};
+    });
+    const SequenceReport rep = compare_with_brute(scene, frames);
+    CHECK(rep.contact_frames == 0);
+  }
+}
+
+TEST_CASE("Invalid step input is rejected with a status", "[collider][api]") {
+  const Scene scene = sphere_scene(1);
+  Collider c(scene.asset);
+  std::vector<double> x = scene.rest;
+  CHECK(c.step(x.data(), x.data(), x.size() - 3) == ColliderStatus::kSizeMismatch);
+  CHECK(c.step(nullptr, x.data()) == ColliderStatus::kNullInput);
+  x[4] = std::nan("");
+  CHECK(c.step(scene.rest.data(), x.data()) == ColliderStatus::kNonFinite);
+  CHECK_FALSE(c.any_collision());
+  CHECK(c.contacts(nullptr, 0).status == ColliderStatus::kNotReady);
+  x[4] = INFINITY;
+  CHECK(c.step(x.data(), scene.rest.data()) == ColliderStatus::kNonFinite);
+}
+
+TEST_CASE("Contacts are truncated to the caller's capacity and the count is reported",
+          "[collider][api]") {
+  const Scene scene = sphere_scene(1);
+  const auto frames = make_frames(scene, 3, press);  // one big step through the centre
+  Collider c(scene.asset);
+  REQUIRE(c.step(frames[0].data(), frames[2].data()) == ColliderStatus::kOk);
+  const ContactsResult all = c.contacts(nullptr, 0);
+  REQUIRE(all.found > 3);
+  std::vector<Contact> buf(2);
+  const ContactsResult r = c.contacts(buf.data(), buf.size());
+  CHECK(r.found == all.found);
+  CHECK(r.written == 2);
+  CHECK(r.truncated());
+  const EarliestContact e = c.earliest_toi();
+  REQUIRE(e.found);
+  std::vector<Contact> full(all.found);
+  const ContactsResult f = c.contacts(full.data(), full.size());
+  REQUIRE_FALSE(f.truncated());
+  CHECK(full.front().toi == e.contact.toi);
+  CHECK(same_feature(full.front(), e.contact));
+}
+
+TEST_CASE("A self-intersecting start state is reported", "[collider][rest]") {
+  const Scene scene = sphere_scene(2);
+  Collider c(scene.asset);
+  const RestCheck clean = c.check_rest_intersection(scene.rest.data(), scene.rest.size());
+  REQUIRE(clean.status == ColliderStatus::kOk);
+  CHECK_FALSE(clean.intersecting);
+  const auto frames = make_frames(scene, 2, press);  // poles pushed through each other
+  const RestCheck bad = c.check_rest_intersection(frames[1].data(), frames[1].size());
+  REQUIRE(bad.status == ColliderStatus::kOk);
+  CHECK(bad.intersecting);
+  ColliderOptions o;
+  o.check_first_step = true;
+  Collider d(scene.asset, o);
+  REQUIRE(d.step(frames[1].data(), frames[1].data()) == ColliderStatus::kOk);
+  CHECK(d.rest_intersection().intersecting);
+}

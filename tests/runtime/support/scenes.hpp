@@ -1,0 +1,256 @@
+#pragma once
+// Test support for the collider: closed surfaces over tet-node ids (surfaces of revolution:
+// sphere, dumbbell, pawn, mushroom), clusters cut along z with detector nodes on the axis,
+// per-cluster median-split BVHs, assets validated through tetseg::format, and deforming
+// frame sequences. Header-only; used by tests/runtime/collider*_test.cpp.
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <functional>
+#include <numeric>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "tetseg/format/asset.hpp"
+#include "tetseg/format/asset_io.hpp"
+#include "tetseg/runtime/asset.hpp"
+
+namespace tetseg::test {
+
+using P3 = std::array<double, 3>;
+
+struct Surface {
+  std::vector<P3> verts;
+  std::vector<format::Triangle> tris;
+};
+
+/// Closed surface of revolution about the z axis. `profile` = (r, z) from the bottom pole
+/// (r = 0) to the top pole (r = 0); `segments` vertices per ring; ring i is rotated by
+/// i * `twist` radians (breaks symmetry). Triangles wound outward.
+inline Surface revolve(const std::vector<std::array<double, 2>>& profile, int segments,
+                       double twist = 0.0) {
+  Surface s;
+  const int m = static_cast<int>(profile.size());
+  s.verts.push_back({0, 0, profile[0][1]});
+  for (int i = 1; i < m - 1; ++i) {
+    for (int j = 0; j < segments; ++j) {
+      const double a = 2 * M_PI * j / segments + i * twist;
+      s.verts.push_back({profile[i][0] * std::cos(a), profile[i][0] * std::sin(a), profile[i][1]});
+    }
+  }
+  const std::uint32_t top = static_cast<std::uint32_t>(s.verts.size());
+  s.verts.push_back({0, 0, profile[m - 1][1]});
+  auto ring = [&](int i, int j) {
+    return static_cast<std::uint32_t>(1 + (i - 1) * segments +
+                                      ((j % segments) + segments) % segments);
+  };
+  for (int j = 0; j < segments; ++j) s.tris.push_back({0, ring(1, j + 1), ring(1, j)});
+  for (int i = 1; i < m - 2; ++i) {
+    for (int j = 0; j < segments; ++j) {
+      s.tris.push_back({ring(i, j), ring(i, j + 1), ring(i + 1, j + 1)});
+      s.tris.push_back({ring(i, j), ring(i + 1, j + 1), ring(i + 1, j)});
+    }
+  }
+  for (int j = 0; j < segments; ++j) s.tris.push_back({top, ring(m - 2, j), ring(m - 2, j + 1)});
+  // Orientation: make the signed volume positive.
+  double vol = 0;
+  for (const auto& t : s.tris) {
+    const P3 &a = s.verts[t[0]], &b = s.verts[t[1]], &c = s.verts[t[2]];
+    vol += a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
+           a[2] * (b[0] * c[1] - b[1] * c[0]);
+  }
+  if (vol < 0)
+    for (auto& t : s.tris) std::swap(t[1], t[2]);
+  return s;
+}
+
+inline std::vector<std::array<double, 2>> sample_profile(const std::function<double(double)>& r,
+                                                         double z0, double z1, int rings) {
+  std::vector<std::array<double, 2>> p;
+  for (int i = 0; i <= rings + 1; ++i) {
+    const double z = z0 + (z1 - z0) * i / (rings + 1);
+    p.push_back({(i == 0 || i == rings + 1) ? 0.0 : r(z), z});
+  }
+  return p;
+}
+
+inline Surface sphere(double radius, int segments, int rings) {
+  std::vector<std::array<double, 2>> p;
+  for (int i = 0; i <= rings + 1; ++i) {
+    const double th = M_PI * i / (rings + 1);
+    p.push_back({i == 0 || i == rings + 1 ? 0.0 : radius * std::sin(th), -radius * std::cos(th)});
+  }
+  return revolve(p, segments, 0.37);
+}
+
+/// Two bells of radius 1 centred at z = -1.6 and z = 1.6 joined by a neck of radius 0.35.
+inline Surface dumbbell(int segments, int rings) {
+  auto r = [](double z) {
+    const double a = std::fabs(z);
+    const double bell = a > 0.6 ? std::sqrt(std::max(0.0, 1.0 - (a - 1.6) * (a - 1.6))) : 0.0;
+    return std::max(0.35, bell);
+  };
+  return revolve(sample_profile(r, -2.6, 2.6, rings), segments, 0.21);
+}
+
+/// A chess pawn: base, body tapering to a collar, neck and a ball head. Height about 4.
+inline Surface pawn(int segments, int rings) {
+  auto r = [](double z) {
+    if (z < 0.4) return 1.2;
+    if (z < 0.6) return 1.2 - (z - 0.4) * 2.0;
+    if (z < 2.4) return 0.8 - 0.4 * (z - 0.6) / 1.8;
+    if (z < 2.6) return 0.75;
+    if (z < 2.8) return 0.3;
+    const double d = z - 3.3;
+    return std::max(0.3, std::sqrt(std::max(0.0, 0.5 * 0.5 - d * d)) * 1.0 + 0.0);
+  };
+  return revolve(sample_profile(r, 0.0, 3.8, rings), segments, 0.13);
+}
+
+/// A mushroom: a cone stem widening downwards, a cap whose rim is a thin wedge (tip lower
+/// than the underside at the stem). The rim's upper triangles face the detector, the lower
+/// ones face away: the design note's wedge-tip configuration.
+inline Surface mushroom(int segments) {
+  std::vector<std::array<double, 2>> p = {
+      {0.0, 0.0},  {2.6, 0.0},  {2.1, 0.5}, {1.6, 1.0},  {1.1, 1.5}, {0.6, 2.0},  // stem
+      {0.9, 1.98}, {1.3, 1.9},  {1.7, 1.8}, {2.0, 1.72},                          // underside
+      {2.2, 1.7},                                                                 // rim tip
+      {2.0, 1.95}, {1.6, 2.15}, {1.1, 2.3}, {0.5, 2.4},  {0.0, 2.42}};            // top
+  return revolve(p, segments, 0.0);
+}
+
+/// A median-split BVH over `tris` (global ids) by centroid, written into the asset's layout:
+/// `order` receives the leaf order, `nodes` the nodes (children after parents).
+inline void build_bvh(const Surface& s, std::vector<std::uint32_t> tris, std::uint32_t leaf_size,
+                      std::vector<std::uint32_t>& order, std::vector<format::BvhNode>& nodes) {
+  struct Item {
+    std::uint32_t node, begin, end;
+  };
+  auto centroid = [&](std::uint32_t t, int k) {
+    return (s.verts[s.tris[t][0]][k] + s.verts[s.tris[t][1]][k] + s.verts[s.tris[t][2]][k]) / 3;
+  };
+  nodes.assign(1, {});
+  std::vector<Item> stack = {{0, 0, static_cast<std::uint32_t>(tris.size())}};
+  while (!stack.empty()) {
+    const Item it = stack.back();
+    stack.pop_back();
+    if (it.end - it.begin <= leaf_size) {
+      nodes[it.node] = {it.begin, 0, it.end - it.begin};
+      continue;
+    }
+    int axis = 0;
+    double lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300};
+    for (std::uint32_t i = it.begin; i < it.end; ++i)
+      for (int k = 0; k < 3; ++k) {
+        lo[k] = std::min(lo[k], centroid(tris[i], k));
+        hi[k] = std::max(hi[k], centroid(tris[i], k));
+      }
+    for (int k = 1; k < 3; ++k)
+      if (hi[k] - lo[k] > hi[axis] - lo[axis]) axis = k;
+    const std::uint32_t mid = it.begin + (it.end - it.begin) / 2;
+    std::nth_element(
+        tris.begin() + it.begin, tris.begin() + mid, tris.begin() + it.end,
+        [&](std::uint32_t a, std::uint32_t b) { return centroid(a, axis) < centroid(b, axis); });
+    const std::uint32_t left = static_cast<std::uint32_t>(nodes.size());
+    nodes.push_back({});
+    nodes.push_back({});
+    nodes[it.node] = {left, left + 1, 0};
+    stack.push_back({left + 1, mid, it.end});
+    stack.push_back({left, it.begin, mid});
+  }
+  order = tris;
+}
+
+/// A scene: the asset plus rest positions of all nodes (surface vertices, then detectors).
+struct Scene {
+  Asset asset;
+  std::vector<double> rest;  // node_count * 3
+  std::uint32_t surface_nodes = 0;
+};
+
+/// Assembles, validates and loads an asset. `cluster_of[t]` in [0, detectors.size()).
+inline Scene make_scene(const Surface& s, const std::vector<std::uint32_t>& cluster_of,
+                        const std::vector<P3>& detectors, std::uint32_t leaf_size = 2) {
+  format::Asset a;
+  const std::uint32_t nv = static_cast<std::uint32_t>(s.verts.size());
+  a.node_count = nv + static_cast<std::uint32_t>(detectors.size());
+  a.rest_positions = s.verts;
+  a.rest_positions.insert(a.rest_positions.end(), detectors.begin(), detectors.end());
+  a.triangles = s.tris;
+  a.triangle_cluster = cluster_of;
+  for (std::uint32_t c = 0; c < detectors.size(); ++c) {
+    std::vector<std::uint32_t> tris;
+    for (std::uint32_t t = 0; t < s.tris.size(); ++t)
+      if (cluster_of[t] == c) tris.push_back(t);
+    if (tris.empty()) throw std::runtime_error("empty cluster in test scene");
+    std::vector<std::uint32_t> order;
+    std::vector<format::BvhNode> nodes;
+    build_bvh(s, tris, leaf_size, order, nodes);
+    format::Cluster cl;
+    cl.detector_node = nv + c;
+    cl.rest_positive_fraction = 1.0f;
+    cl.triangle_offset = static_cast<std::uint32_t>(a.cluster_triangles.size());
+    cl.triangle_count = static_cast<std::uint32_t>(order.size());
+    cl.bvh_offset = static_cast<std::uint32_t>(a.bvh_nodes.size());
+    cl.bvh_count = static_cast<std::uint32_t>(nodes.size());
+    a.cluster_triangles.insert(a.cluster_triangles.end(), order.begin(), order.end());
+    a.bvh_nodes.insert(a.bvh_nodes.end(), nodes.begin(), nodes.end());
+    a.clusters.push_back(cl);
+  }
+  a.provenance.tool_version = "tetseg tests";
+  std::string why;
+  if (format::validate(a, &why) != format::Status::kOk)
+    throw std::runtime_error("invalid test asset: " + why);
+  const std::vector<std::uint8_t> bytes = format::write_asset(a);
+  Scene scene;
+  if (load_asset(bytes.data(), bytes.size(), scene.asset, &why) != format::Status::kOk)
+    throw std::runtime_error("test asset does not load: " + why);
+  for (const P3& p : a.rest_positions) scene.rest.insert(scene.rest.end(), p.begin(), p.end());
+  scene.surface_nodes = nv;
+  return scene;
+}
+
+/// Clusters by triangle-centroid z: cut at `cuts` (ascending); detectors on the axis at
+/// `detector_z` (one more than cuts).
+inline Scene make_axial_scene(const Surface& s, const std::vector<double>& cuts,
+                              const std::vector<double>& detector_z) {
+  std::vector<std::uint32_t> cluster_of(s.tris.size());
+  for (std::size_t t = 0; t < s.tris.size(); ++t) {
+    const double z =
+        (s.verts[s.tris[t][0]][2] + s.verts[s.tris[t][1]][2] + s.verts[s.tris[t][2]][2]) / 3;
+    cluster_of[t] =
+        static_cast<std::uint32_t>(std::upper_bound(cuts.begin(), cuts.end(), z) - cuts.begin());
+  }
+  std::vector<P3> det;
+  for (double z : detector_z) det.push_back({0.0, 0.0, z});
+  return make_scene(s, cluster_of, det);
+}
+
+/// Frames of a deformation: frame f = map(rest position, f / (frames - 1)) for every node.
+using Deformation = std::function<P3(const P3&, double)>;
+inline std::vector<std::vector<double>> make_frames(const Scene& scene, int frames,
+                                                    const Deformation& map) {
+  std::vector<std::vector<double>> out(frames);
+  for (int f = 0; f < frames; ++f) {
+    const double t = frames > 1 ? double(f) / (frames - 1) : 0.0;
+    out[f].resize(scene.rest.size());
+    for (std::size_t n = 0; n < scene.rest.size() / 3; ++n) {
+      const P3 p = map({scene.rest[3 * n], scene.rest[3 * n + 1], scene.rest[3 * n + 2]}, t);
+      for (int k = 0; k < 3; ++k) out[f][3 * n + k] = p[k];
+    }
+  }
+  return out;
+}
+
+/// Applies x -> scale * x + offset to every frame.
+inline std::vector<std::vector<double>> transformed(std::vector<std::vector<double>> frames,
+                                                    double scale, const P3& offset) {
+  for (auto& f : frames)
+    for (std::size_t i = 0; i < f.size(); ++i) f[i] = scale * f[i] + offset[i % 3];
+  return frames;
+}
+
+}  // namespace tetseg::test
