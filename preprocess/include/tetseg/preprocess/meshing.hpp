@@ -10,13 +10,16 @@
 namespace tetseg::preprocess {
 
 /// Mesh size controls, in the input's length units (procedural shapes: the shape's own
-/// units, about 1 across). 0 means "derive from the bounding box" as documented in docs/cli.md.
+/// units, about 1 across). 0 means "derive" by the rule documented in docs/cli.md
+/// ("## Meshing options"): facet_size from the shape (or 1/40 of the surface's bounding-box
+/// diagonal), cell_size = facet_size, facet_distance = facet_size / 10.
 struct MeshingOptions {
-  double cell_size = 0.0;              ///< target tet edge length
-  double facet_distance = 0.0;         ///< max surface approximation error
-  double facet_angle = 25.0;           ///< min facet angle, degrees
-  double cell_radius_edge_ratio = 3.0; ///< tet quality bound
-  bool optimize = true;                ///< ODT/lloyd off, perturb + exude on
+  double cell_size = 0.0;               ///< max tet circumradius (Mesh_3 cell_size); >= 0
+  double facet_size = 0.0;              ///< max surface Delaunay ball radius; 0: = cell_size if set
+  double facet_distance = 0.0;          ///< max surface approximation error; >= 0
+  double facet_angle = 25.0;            ///< min facet angle, degrees, in (0, 30]
+  double cell_radius_edge_ratio = 3.0;  ///< tet quality bound, >= 2
+  bool optimize = true;                 ///< ODT/lloyd off, perturb + exude on
 };
 
 /// Procedural shapes made with Mesh_3's implicit domain.
@@ -25,20 +28,35 @@ enum class Shape { kSphere, kEllipsoid, kDumbbell, kPawn };
 /// Parameters of the procedural shapes. `size` scales the default mesh density: 1 = default,
 /// 2 = about twice as fine along an edge.
 struct ShapeOptions {
-  double radius = 1.0;                          ///< sphere
-  double axes[3] = {1.0, 0.6, 0.3};             ///< ellipsoid semi-axes
+  double radius = 1.0;               ///< sphere
+  double axes[3] = {1.0, 0.6, 0.3};  ///< ellipsoid semi-axes
   double size = 1.0;
 };
 
-/// Throws std::invalid_argument on an unknown name.
+/// "sphere", "ellipsoid", "dumbbell", "pawn". Throws std::invalid_argument on an unknown name.
 Shape shape_from_name(const std::string& name);
 
+/// Meshes a procedural shape: sphere of `radius` at the origin; ellipsoid with semi-axes
+/// `axes` along x, y, z; dumbbell along x (balls of radius 0.5 at x = +-0.8, smooth neck of
+/// radius 0.2); pawn of revolution about z from z = 0 to about 1.65. Returns compacted nodes
+/// and positively oriented tets; deterministic. Throws std::invalid_argument on
+/// non-positive or non-finite parameters. Thread safety: resets CGAL's default random
+/// generator, so do not mesh concurrently from several threads.
 TetMesh generate_shape(Shape shape, const ShapeOptions& shape_options,
                        const MeshingOptions& meshing = {});
 
-/// Tetrahedralises a closed, manifold surface (interior nodes included). Throws InputError
-/// (naming `file`) when the surface is not usable.
+/// Tetrahedralises a closed, manifold surface (interior nodes included). The boundary is
+/// re-meshed (Mesh_3 does not keep the input triangles). Unlike validate_closed_surface,
+/// pinch points (separate fans of triangles touching at one vertex position, common in
+/// modelled meshes) are accepted; callers should validate the resulting tet mesh. Throws InputError
+/// (naming `file`) when the surface is not usable (validate_closed_surface) or meshing yields no
+/// tets; std::invalid_argument on bad options. Same threading note as generate_shape.
 TetMesh tetrahedralize(const TriangleMesh& surface, const MeshingOptions& meshing,
                        const std::string& file);
+
+/// Default facet size (before `size` scaling) of a procedural shape, and for a surface of
+/// bounding-box diagonal `diagonal`: the rules behind "0 = derive".
+double default_facet_size(Shape shape, const ShapeOptions& shape_options);
+double default_facet_size_for_diagonal(double diagonal);
 
 }  // namespace tetseg::preprocess

@@ -1,0 +1,257 @@
+// Shared text I/O helpers and the format dispatch of read_tet_mesh / write_tet_mesh.
+
+#include <algorithm>
+#include <cctype>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+
+#include "io_text.hpp"
+#include "tetseg/preprocess/io.hpp"
+
+namespace tetseg::preprocess {
+namespace detail {
+
+std::string read_file_text(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path, "cannot open file");
+  std::ostringstream buffer;
+  buffer << in.rdbuf();
+  if (in.bad()) throw InputError(path, "cannot read file");
+  return buffer.str();
+}
+
+Tokenizer::Tokenizer(std::string file, std::string_view text, char comment)
+    : m_file(std::move(file)), m_text(text), m_comment(comment) {}
+
+void Tokenizer::skip_space(bool stop_at_newline) {
+  while (m_pos < m_text.size()) {
+    const char c = m_text[m_pos];
+    if (c == '\n') {
+      if (stop_at_newline) return;
+      ++m_line;
+      ++m_pos;
+    } else if (c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v') {
+      ++m_pos;
+    } else if (m_comment != '\0' && c == m_comment) {
+      while (m_pos < m_text.size() && m_text[m_pos] != '\n') ++m_pos;
+    } else {
+      return;
+    }
+  }
+}
+
+std::string_view Tokenizer::next_or_end() {
+  skip_space(false);
+  if (m_pos >= m_text.size()) {
+    m_token_line = m_line;
+    return {};
+  }
+  const std::size_t begin = m_pos;
+  while (m_pos < m_text.size()) {
+    const char c = m_text[m_pos];
+    if (std::isspace(static_cast<unsigned char>(c)) || (m_comment != '\0' && c == m_comment)) break;
+    ++m_pos;
+  }
+  m_token_line = m_line;
+  return m_text.substr(begin, m_pos - begin);
+}
+
+std::string_view Tokenizer::next(const char* what) {
+  const std::string_view token = next_or_end();
+  if (token.empty()) fail(std::string("unexpected end of file (expected ") + what + ")");
+  return token;
+}
+
+std::vector<std::string_view> Tokenizer::rest_of_line() {
+  std::vector<std::string_view> tokens;
+  for (;;) {
+    skip_space(true);
+    if (m_pos >= m_text.size()) break;
+    if (m_text[m_pos] == '\n') {
+      ++m_pos;
+      ++m_line;
+      break;
+    }
+    const std::size_t begin = m_pos;
+    while (m_pos < m_text.size()) {
+      const char c = m_text[m_pos];
+      if (std::isspace(static_cast<unsigned char>(c)) || (m_comment != '\0' && c == m_comment))
+        break;
+      ++m_pos;
+    }
+    tokens.push_back(m_text.substr(begin, m_pos - begin));
+  }
+  return tokens;
+}
+
+bool Tokenizer::next_record(std::vector<std::string_view>& tokens, std::size_t& line) {
+  while (!at_end()) {
+    line = m_line;
+    tokens = rest_of_line();
+    if (!tokens.empty()) {
+      m_token_line = line;
+      return true;
+    }
+  }
+  tokens.clear();
+  line = m_line;
+  m_token_line = line;
+  return false;
+}
+
+bool Tokenizer::at_end() {
+  skip_space(false);
+  return m_pos >= m_text.size();
+}
+
+double Tokenizer::next_double(const char* what) {
+  const std::string_view token = next(what);
+  double value = 0.0;
+  if (!parse_double(token, value))
+    fail(std::string("expected ") + what + ", got '" + std::string(token.substr(0, 40)) + "'");
+  if (!std::isfinite(value)) fail(std::string(what) + " is not finite");
+  return value;
+}
+
+std::int64_t Tokenizer::next_int(const char* what) {
+  const std::string_view token = next(what);
+  std::int64_t value = 0;
+  if (!parse_int(token, value))
+    fail(std::string("expected ") + what + ", got '" + std::string(token.substr(0, 40)) + "'");
+  return value;
+}
+
+void Tokenizer::fail(const std::string& message) const {
+  fail_at(m_token_line, message);
+}
+
+void Tokenizer::fail_at(std::size_t line, const std::string& message) const {
+  throw InputError(m_file, "line " + std::to_string(line) + ": " + message);
+}
+
+bool parse_double(std::string_view token, double& value) {
+  if (token.empty() || token.size() > 64) return false;
+  char buffer[65];
+  std::copy(token.begin(), token.end(), buffer);
+  buffer[token.size()] = '\0';
+  char* end = nullptr;
+  errno = 0;
+  value = std::strtod(buffer, &end);
+  if (end != buffer + token.size()) return false;
+  return true;  // over/underflow gives inf/0; callers check finiteness
+}
+
+bool parse_int(std::string_view token, std::int64_t& value) {
+  if (token.empty() || token.size() > 30) return false;
+  char buffer[32];
+  std::copy(token.begin(), token.end(), buffer);
+  buffer[token.size()] = '\0';
+  char* end = nullptr;
+  errno = 0;
+  const long long parsed = std::strtoll(buffer, &end, 10);
+  if (end != buffer + token.size() || errno == ERANGE) return false;
+  value = parsed;
+  return true;
+}
+
+void append_double(std::string& out, double value) {
+  char buffer[40];
+  const int n = std::snprintf(buffer, sizeof buffer, "%.17g", value);
+  out.append(buffer, static_cast<std::size_t>(n));
+}
+
+void append_uint(std::string& out, std::uint64_t value) {
+  char buffer[24];
+  const int n =
+      std::snprintf(buffer, sizeof buffer, "%llu", static_cast<unsigned long long>(value));
+  out.append(buffer, static_cast<std::size_t>(n));
+}
+
+void write_text_file(const std::string& path, const std::string& text) {
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  if (!out) throw OutputError(path, "cannot open file for writing");
+  out.write(text.data(), static_cast<std::streamsize>(text.size()));
+  out.flush();
+  if (!out) throw OutputError(path, "write failed");
+}
+
+std::string lower_extension(const std::string& path) {
+  const std::size_t slash = path.find_last_of("/\\");
+  const std::size_t dot = path.find_last_of('.');
+  if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) return "";
+  std::string ext = path.substr(dot);
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext;
+}
+
+void orient_consistently_negative_meshes(TetMesh& mesh) {
+  std::size_t negative = 0;
+  std::size_t positive = 0;
+  for (const Tet& t : mesh.tets) {
+    if (t[0] >= mesh.nodes.size() || t[1] >= mesh.nodes.size() || t[2] >= mesh.nodes.size() ||
+        t[3] >= mesh.nodes.size())
+      return;
+    const Vec3& a = mesh.nodes[t[0]];
+    const Vec3& b = mesh.nodes[t[1]];
+    const Vec3& c = mesh.nodes[t[2]];
+    const Vec3& d = mesh.nodes[t[3]];
+    const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+    const double v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+    const double w[3] = {d[0] - a[0], d[1] - a[1], d[2] - a[2]};
+    const double det = u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0]) +
+                       u[2] * (v[0] * w[1] - v[1] * w[0]);
+    if (det > 0) ++positive;
+    if (det < 0) ++negative;
+  }
+  if (positive == 0 && negative > 0)
+    for (Tet& t : mesh.tets) std::swap(t[2], t[3]);
+}
+
+}  // namespace detail
+
+bool is_tet_mesh_path(const std::string& path) {
+  const std::string ext = detail::lower_extension(path);
+  return ext == ".mesh" || ext == ".node" || ext == ".ele" || ext == ".msh";
+}
+
+TetMesh read_tet_mesh(const std::string& path) {
+  const std::string ext = detail::lower_extension(path);
+  TetMesh mesh;
+  if (ext == ".mesh") {
+    mesh = detail::read_medit(path);
+  } else if (ext == ".node" || ext == ".ele") {
+    mesh = detail::read_tetgen(path);
+  } else if (ext == ".msh") {
+    mesh = detail::read_gmsh(path);
+  } else {
+    throw InputError(path,
+                     "unknown tet mesh format '" + ext + "' (expected .mesh, .node/.ele or .msh)");
+  }
+  if (mesh.tets.empty()) throw InputError(path, "no tetrahedra in file");
+  detail::orient_consistently_negative_meshes(mesh);
+  return mesh;
+}
+
+void write_tet_mesh(const std::string& path, const TetMesh& mesh) {
+  const std::string ext = detail::lower_extension(path);
+  if (ext == ".mesh") {
+    detail::write_medit(path, mesh);
+  } else if (ext == ".node" || ext == ".ele") {
+    detail::write_tetgen(path, mesh);
+  } else if (ext == ".msh") {
+    detail::write_gmsh41(path, mesh);
+  } else {
+    throw OutputError(path,
+                      "unknown tet mesh format '" + ext + "' (expected .mesh, .node/.ele or .msh)");
+  }
+}
+
+void write_gmsh22(const std::string& path, const TetMesh& mesh) {
+  detail::write_gmsh22_impl(path, mesh);
+}
+
+}  // namespace tetseg::preprocess

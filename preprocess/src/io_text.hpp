@@ -1,0 +1,84 @@
+#pragma once
+// Private helpers of the text mesh readers and writers (not installed): a tokenizer that keeps
+// line numbers, strict number parsing, and a buffered writer. Errors are InputError with
+// "line N: ..." messages.
+
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "tetseg/preprocess/mesh.hpp"
+
+namespace tetseg::preprocess::detail {
+
+/// Reads a whole file into memory. Throws InputError when it cannot be opened or read.
+std::string read_file_text(const std::string& path);
+
+/// A whitespace tokenizer over a text buffer that tracks line numbers. Comments starting with
+/// `comment` (when not '\0') run to the end of the line.
+class Tokenizer {
+ public:
+  Tokenizer(std::string file, std::string_view text, char comment);
+
+  /// Next token; throws "line N: unexpected end of file (<what>)" when there is none.
+  std::string_view next(const char* what);
+  /// Next token or an empty view at the end of the input.
+  std::string_view next_or_end();
+  /// Tokens left on the current line (after the last token returned), consumed.
+  std::vector<std::string_view> rest_of_line();
+  /// Whether only whitespace and comments remain.
+  bool at_end();
+  /// Line of the last token returned (1-based).
+  std::size_t line() const { return m_token_line; }
+  /// Line the read position is on.
+  std::size_t current_line() const { return m_line; }
+  /// The next line holding a token, split into tokens; false at the end of the input. `line`
+  /// receives its number.
+  bool next_record(std::vector<std::string_view>& tokens, std::size_t& line);
+  const std::string& file() const { return m_file; }
+
+  double next_double(const char* what);
+  std::int64_t next_int(const char* what);
+
+  [[noreturn]] void fail(const std::string& message) const;
+  [[noreturn]] void fail_at(std::size_t line, const std::string& message) const;
+
+ private:
+  void skip_space(bool stop_at_newline);
+
+  std::string m_file;
+  std::string_view m_text;
+  char m_comment;
+  std::size_t m_pos = 0;
+  std::size_t m_line = 1;
+  std::size_t m_token_line = 1;
+};
+
+/// Strict parsers: the whole token must be a number. Return false otherwise.
+bool parse_double(std::string_view token, double& value);
+bool parse_int(std::string_view token, std::int64_t& value);
+
+/// Appends "%.17g" of `value` (round-trips exactly).
+void append_double(std::string& out, double value);
+void append_uint(std::string& out, std::uint64_t value);
+
+/// Writes `text` to `path`; throws OutputError.
+void write_text_file(const std::string& path, const std::string& text);
+
+/// Lower-case extension with the dot, or "".
+std::string lower_extension(const std::string& path);
+
+/// If every tet with a nonzero volume is negatively oriented (a mirrored convention), swaps
+/// two vertices of every tet. Mixed orientations are left for validation to report.
+void orient_consistently_negative_meshes(TetMesh& mesh);
+
+TetMesh read_medit(const std::string& path);
+TetMesh read_tetgen(const std::string& path);
+TetMesh read_gmsh(const std::string& path);
+void write_medit(const std::string& path, const TetMesh& mesh);
+void write_tetgen(const std::string& path, const TetMesh& mesh);
+void write_gmsh41(const std::string& path, const TetMesh& mesh);
+void write_gmsh22_impl(const std::string& path, const TetMesh& mesh);
+
+}  // namespace tetseg::preprocess::detail

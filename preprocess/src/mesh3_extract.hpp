@@ -1,0 +1,77 @@
+#pragma once
+// Private, CGAL-only: shared by the Mesh_3 translation units. Turns a C3T3 into a TetMesh
+// (cells in complex only, vertices compacted in order of first use, positive orientation),
+// and builds the criteria and optimisation parameters. Include only from mesh3_*.cpp.
+
+#include <CGAL/Mesh_criteria_3.h>
+#include <CGAL/make_mesh_3.h>
+
+#include <unordered_map>
+
+#include "meshing_internal.hpp"
+
+namespace tetseg::preprocess::detail {
+
+template <class C3t3>
+TetMesh c3t3_to_tet_mesh(const C3t3& c3t3) {
+  using Tr = typename C3t3::Triangulation;
+  using VertexHandle = typename Tr::Vertex_handle;
+  const Tr& tr = c3t3.triangulation();
+  TetMesh mesh;
+  std::unordered_map<VertexHandle, std::uint32_t, CGAL::Handle_hash_function> index_of;
+  for (auto c = c3t3.cells_in_complex_begin(); c != c3t3.cells_in_complex_end(); ++c) {
+    Tet tet;
+    for (int k = 0; k < 4; ++k) {
+      const VertexHandle v = c->vertex(k);
+      const auto [it, inserted] =
+          index_of.emplace(v, static_cast<std::uint32_t>(mesh.nodes.size()));
+      if (inserted) {
+        const auto& p = tr.point(v).point();
+        mesh.nodes.push_back(
+            {CGAL::to_double(p.x()), CGAL::to_double(p.y()), CGAL::to_double(p.z())});
+      }
+      tet[static_cast<std::size_t>(k)] = it->second;
+    }
+    const Vec3& a = mesh.nodes[tet[0]];
+    const Vec3& b = mesh.nodes[tet[1]];
+    const Vec3& c2 = mesh.nodes[tet[2]];
+    const Vec3& d = mesh.nodes[tet[3]];
+    const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+    const double v[3] = {c2[0] - a[0], c2[1] - a[1], c2[2] - a[2]};
+    const double w[3] = {d[0] - a[0], d[1] - a[1], d[2] - a[2]};
+    const double det = u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0]) +
+                       u[2] * (v[0] * w[1] - v[1] * w[0]);
+    if (det < 0) std::swap(tet[2], tet[3]);
+    mesh.tets.push_back(tet);
+  }
+  return mesh;
+}
+
+template <class Criteria>
+Criteria make_criteria(const Mesh3Criteria& c) {
+  namespace params = CGAL::parameters;
+  return Criteria(params::facet_angle = c.facet_angle, params::facet_size = c.facet_size,
+                  params::facet_distance = c.facet_distance,
+                  params::facet_topology = CGAL::FACET_VERTICES_ON_SAME_SURFACE_PATCH,
+                  params::cell_radius_edge_ratio = c.cell_radius_edge_ratio,
+                  params::cell_size = c.cell_size);
+}
+
+/// Runs make_mesh_3 deterministically: the default random generator is reset to seed 0 and
+/// the optimisers get no time limit (their default limit is the refinement time, which would
+/// make the result depend on the machine's speed).
+template <class C3t3, class Domain, class Criteria>
+C3t3 run_mesh_3(const Domain& domain, const Criteria& criteria, bool optimize) {
+  namespace params = CGAL::parameters;
+  CGAL::get_default_random() = CGAL::Random(0);
+  if (optimize) {
+    return CGAL::make_mesh_3<C3t3>(
+        domain, criteria, params::no_odt(), params::no_lloyd(),
+        params::perturb(params::time_limit = 0, params::sliver_bound = 10),
+        params::exude(params::time_limit = 0, params::sliver_bound = 0));
+  }
+  return CGAL::make_mesh_3<C3t3>(domain, criteria, params::no_odt(), params::no_lloyd(),
+                                 params::no_perturb(), params::no_exude());
+}
+
+}  // namespace tetseg::preprocess::detail

@@ -1,0 +1,26 @@
+#pragma once
+// Private interface between meshing.cpp (options, rules; no CGAL) and the two CGAL Mesh_3
+// translation units (mesh3_implicit.cpp, mesh3_polyhedral.cpp).
+
+#include "tetseg/preprocess/meshing.hpp"
+
+namespace tetseg::preprocess::detail {
+
+/// Fully resolved Mesh_3 criteria (every size > 0).
+struct Mesh3Criteria {
+  double facet_angle = 25.0;
+  double facet_size = 0.0;
+  double facet_distance = 0.0;
+  double cell_radius_edge_ratio = 3.0;
+  double cell_size = 0.0;
+  bool optimize = true;
+};
+
+/// Mesh_3 on the implicit function of `shape`. Returns compacted, positively oriented tets.
+TetMesh mesh_implicit_shape(Shape shape, const ShapeOptions& shape_options,
+                            const Mesh3Criteria& criteria);
+
+/// Mesh_3 on a closed, manifold, self-intersection-free triangle surface.
+TetMesh mesh_polyhedral_surface(const TriangleMesh& surface, const Mesh3Criteria& criteria);
+
+}  // namespace tetseg::preprocess::detail

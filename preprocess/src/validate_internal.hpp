@@ -1,0 +1,32 @@
+#pragma once
+// Private: the CGAL self-intersection test, kept in its own translation unit.
+
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "tetseg/preprocess/mesh.hpp"
+
+namespace tetseg::preprocess::detail {
+
+/// Pairs of intersecting triangles (indices into `triangles`; empty when none) of a closed,
+/// edge- and vertex-manifold, consistently oriented triangle surface whose indices are in
+/// range. Triangles sharing a vertex or an edge only count if they overlap beyond it.
+std::vector<std::pair<std::size_t, std::size_t>> self_intersecting_pairs(
+    const std::vector<Vec3>& points, const std::vector<Tri>& triangles);
+
+/// Options of the surface checks shared by validate_closed_surface and tetrahedralize.
+struct SurfaceCheck {
+  /// Accept vertices where several fans touch at one point (a "pinch", e.g. two vertices of
+  /// a modelled surface that coincide): the Mesh_3 domain oracle handles them, and triangle
+  /// pairs that only meet at such a point are not reported as self-intersections.
+  bool allow_pinched_vertices = false;
+};
+
+/// validate_closed_surface with options. When pinches are allowed and found, `split`
+/// (if not null) receives the surface with every pinched vertex duplicated once per fan, so
+/// it can be turned into a manifold polygon mesh.
+void validate_closed_surface(const TriangleMesh& mesh, const std::string& file,
+                             const SurfaceCheck& options, TriangleMesh* split);
+
+}  // namespace tetseg::preprocess::detail

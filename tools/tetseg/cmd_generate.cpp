@@ -1,0 +1,180 @@
+// `tetseg generate`: procedural tet meshes (sphere, ellipsoid, dumbbell, pawn) with CGAL Mesh_3.
+// Also defines the meshing-option and output helpers shared with cmd_tetrahedralize.cpp.
+
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "commands.hpp"
+#include "tetseg/preprocess/io.hpp"
+#include "tetseg/preprocess/meshing.hpp"
+#include "tetseg/preprocess/surface.hpp"
+#include "tool_support.hpp"
+
+namespace tetseg::tools {
+
+namespace mesh_cli {
+
+// Shared with cmd_tetrahedralize.cpp (declared there).
+void add_meshing_options(CLI::App& cmd, preprocess::MeshingOptions& m, bool& gmsh22);
+void check_output_path(const std::string& path);
+void finish_tet_mesh(const preprocess::TetMesh& mesh, const std::string& output, bool gmsh22,
+                     const std::string& what);
+
+/// Wall-clock stage timer that prints "tetseg: <label> ... <s> s, <details>" to stderr.
+class Stage {
+ public:
+  explicit Stage(std::string label)
+      : m_label(std::move(label)), m_start(std::chrono::steady_clock::now()) {}
+  void done(const std::string& details) const {
+    const double s =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - m_start).count();
+    std::fprintf(stderr, "tetseg: %s ... %.2f s%s%s\n", m_label.c_str(), s,
+                 details.empty() ? "" : ", ", details.c_str());
+  }
+
+ private:
+  std::string m_label;
+  std::chrono::steady_clock::time_point m_start;
+};
+
+void add_meshing_options(CLI::App& cmd, preprocess::MeshingOptions& m, bool& gmsh22) {
+  cmd.add_option("--cell-size", m.cell_size,
+                 "Max tet circumradius (0 = facet size; see docs/cli.md, Meshing options)")
+      ->check(CLI::NonNegativeNumber);
+  cmd.add_option("--facet-size", m.facet_size,
+                 "Max surface Delaunay-ball radius (0 = cell size, else derived)")
+      ->check(CLI::NonNegativeNumber);
+  cmd.add_option("--facet-distance", m.facet_distance,
+                 "Max distance of the meshed surface from the input (0 = facet size / 10)")
+      ->check(CLI::NonNegativeNumber);
+  cmd.add_option("--facet-angle", m.facet_angle, "Min facet angle in degrees, (0, 30]")
+      ->check(CLI::Range(0.01, 30.0));
+  cmd.add_option("--radius-edge-ratio", m.cell_radius_edge_ratio,
+                 "Tet quality bound (circumradius / shortest edge), >= 2")
+      ->check(CLI::Range(2.0, 1000.0));
+  cmd.add_flag("--no-optimize{false}", m.optimize, "Skip sliver perturbation and exudation");
+  cmd.add_flag("--gmsh22", gmsh22, "Write Gmsh 2.2 instead of 4.1 when the output is .msh");
+}
+
+void check_output_path(const std::string& path) {
+  if (!preprocess::is_tet_mesh_path(path))
+    throw CLI::ValidationError("--output",
+                               "output must end in .mesh, .node, .ele or .msh: " + path);
+}
+
+namespace {
+
+void write_one(const std::string& path, const preprocess::TetMesh& mesh, bool gmsh22) {
+  if (gmsh22 && extension_of(path) == ".msh") {
+    preprocess::write_gmsh22(path, mesh);
+  } else {
+    preprocess::write_tet_mesh(path, mesh);
+  }
+}
+
+/// Writes through temporary files in the output's directory and renames them into place;
+/// on failure no temporary file is left behind.
+void write_atomic(const std::string& output, const preprocess::TetMesh& mesh, bool gmsh22) {
+  const std::string ext = extension_of(output);
+  const std::string stem = output.substr(0, output.size() - ext.size());
+  const std::string temp_stem = stem + ".tmp" + std::to_string(::getpid());
+  std::vector<std::string> finals;
+  if (ext == ".node" || ext == ".ele") {
+    finals = {stem + ".node", stem + ".ele"};
+  } else {
+    finals = {output};
+  }
+  std::vector<std::string> temps;
+  for (const std::string& f : finals) temps.push_back(temp_stem + f.substr(stem.size()));
+  auto remove_temps = [&] {
+    for (const std::string& t : temps) std::remove(t.c_str());
+  };
+  try {
+    write_one(temps.front(), mesh, gmsh22);
+  } catch (const preprocess::OutputError& e) {
+    remove_temps();
+    throw preprocess::OutputError(output, e.what());
+  }
+  for (std::size_t i = 0; i < finals.size(); ++i)
+    if (std::rename(temps[i].c_str(), finals[i].c_str()) != 0) {
+      remove_temps();
+      throw preprocess::OutputError(finals[i], "cannot rename the temporary file into place");
+    }
+}
+
+}  // namespace
+
+void finish_tet_mesh(const preprocess::TetMesh& mesh, const std::string& output, bool gmsh22,
+                     const std::string& what) {
+  {
+    Stage stage("validating " + what);
+    const preprocess::Surface surface = preprocess::extract_surface(mesh);
+    try {
+      preprocess::validate_tet_mesh(mesh, surface, output);
+    } catch (const preprocess::InputError& e) {
+      throw ToolError(kExitProcessingFailed, output,
+                      std::string("meshing produced an invalid mesh: ") + e.what());
+    }
+    stage.done(std::to_string(surface.triangles.size()) + " surface triangles, " +
+               std::to_string(surface.interior_nodes.size()) + " interior nodes");
+  }
+  Stage stage("writing " + base_name(output));
+  write_atomic(output, mesh, gmsh22);
+  stage.done("");
+}
+
+}  // namespace mesh_cli
+
+namespace {
+
+struct GenerateArgs {
+  std::string shape;
+  std::string output;
+  preprocess::ShapeOptions shape_options;
+  std::vector<double> axes;
+  preprocess::MeshingOptions meshing;
+  bool gmsh22 = false;
+};
+
+void run_generate(const GenerateArgs& args) {
+  mesh_cli::check_output_path(args.output);
+  preprocess::ShapeOptions shape_options = args.shape_options;
+  if (!args.axes.empty())
+    for (int k = 0; k < 3; ++k) shape_options.axes[k] = args.axes[static_cast<std::size_t>(k)];
+  const preprocess::Shape shape = preprocess::shape_from_name(args.shape);
+  mesh_cli::Stage stage("meshing " + args.shape);
+  const preprocess::TetMesh mesh = preprocess::generate_shape(shape, shape_options, args.meshing);
+  stage.done(std::to_string(mesh.nodes.size()) + " nodes, " + std::to_string(mesh.tets.size()) +
+             " tets");
+  mesh_cli::finish_tet_mesh(mesh, args.output, args.gmsh22, args.shape);
+}
+
+}  // namespace
+
+void add_generate_command(CLI::App& root) {
+  auto args = std::make_shared<GenerateArgs>();
+  CLI::App* cmd = root.add_subcommand(
+      "generate", "Mesh a procedural shape (sphere, ellipsoid, dumbbell, pawn) into tets");
+  cmd->add_option("shape", args->shape, "sphere | ellipsoid | dumbbell | pawn")
+      ->required()
+      ->check(CLI::IsMember({"sphere", "ellipsoid", "dumbbell", "pawn"}));
+  cmd->add_option("-o,--output", args->output, "Output tet mesh (.mesh, .node/.ele, .msh)")
+      ->required();
+  cmd->add_option("--size", args->shape_options.size,
+                  "Mesh density: 1 = default, 2 = twice as fine along an edge")
+      ->check(CLI::Range(0.05, 64.0));
+  cmd->add_option("--radius", args->shape_options.radius, "Sphere radius")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--axes", args->axes, "Ellipsoid semi-axes a b c")
+      ->expected(3)
+      ->check(CLI::PositiveNumber);
+  mesh_cli::add_meshing_options(*cmd, args->meshing, args->gmsh22);
+  cmd->callback([args] { run_generate(*args); });
+}
+
+}  // namespace tetseg::tools

@@ -1,0 +1,68 @@
+// `tetseg tetrahedralize`: a closed surface (OBJ, PLY, STL, OFF, glTF, ...) to a tet mesh with
+// CGAL Mesh_3.
+
+#include <chrono>
+#include <cstdio>
+#include <memory>
+#include <string>
+
+#include "commands.hpp"
+#include "tetseg/preprocess/io.hpp"
+#include "tetseg/preprocess/meshing.hpp"
+#include "tetseg/preprocess/surface.hpp"
+#include "tool_support.hpp"
+
+namespace tetseg::tools {
+
+namespace mesh_cli {
+// Defined in cmd_generate.cpp.
+void add_meshing_options(CLI::App& cmd, preprocess::MeshingOptions& m, bool& gmsh22);
+void check_output_path(const std::string& path);
+void finish_tet_mesh(const preprocess::TetMesh& mesh, const std::string& output, bool gmsh22,
+                     const std::string& what);
+}  // namespace mesh_cli
+
+namespace {
+
+struct TetrahedralizeArgs {
+  std::string input;
+  std::string output;
+  preprocess::MeshingOptions meshing;
+  bool gmsh22 = false;
+};
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+void run_tetrahedralize(const TetrahedralizeArgs& args) {
+  mesh_cli::check_output_path(args.output);
+  auto start = std::chrono::steady_clock::now();
+  const preprocess::TriangleMesh surface = preprocess::read_triangle_mesh(args.input);
+  std::fprintf(stderr, "tetseg: reading %s ... %.2f s, %zu vertices, %zu triangles\n",
+               base_name(args.input).c_str(), seconds_since(start), surface.vertices.size(),
+               surface.triangles.size());
+  start = std::chrono::steady_clock::now();
+  const preprocess::TetMesh mesh = preprocess::tetrahedralize(surface, args.meshing, args.input);
+  std::fprintf(stderr, "tetseg: meshing %s ... %.2f s, %zu nodes, %zu tets\n",
+               base_name(args.input).c_str(), seconds_since(start), mesh.nodes.size(),
+               mesh.tets.size());
+  mesh_cli::finish_tet_mesh(mesh, args.output, args.gmsh22, base_name(args.input));
+}
+
+}  // namespace
+
+void add_tetrahedralize_command(CLI::App& root) {
+  auto args = std::make_shared<TetrahedralizeArgs>();
+  CLI::App* cmd = root.add_subcommand(
+      "tetrahedralize",
+      "Fill a closed triangle surface with tets (CGAL Mesh_3; the boundary is re-meshed)");
+  cmd->add_option("surface", args->input, "Closed surface: OBJ, PLY, STL, OFF, glTF, ...")
+      ->required();
+  cmd->add_option("-o,--output", args->output, "Output tet mesh (.mesh, .node/.ele, .msh)")
+      ->required();
+  mesh_cli::add_meshing_options(*cmd, args->meshing, args->gmsh22);
+  cmd->callback([args] { run_tetrahedralize(*args); });
+}
+
+}  // namespace tetseg::tools
