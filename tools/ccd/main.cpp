@@ -121,7 +121,7 @@ int command_queries(const std::string& dir, bool json, const std::string& method
                     "no query CSV found (expected <scene>/{vertex-face,edge-edge}/*.csv)");
   if (json) {
     std::ostringstream out;
-    out << "{\"method\": \"" << method << "\",\n \"vertex_face\": " << tally_json(total[0])
+    out << "{\n \"vertex_face\": " << tally_json(total[0])
         << ",\n \"edge_edge\": " << tally_json(total[1]) << ",\n \"scenes\": {";
     bool first = true;
     for (const auto& [name, t] : per_scene) {
