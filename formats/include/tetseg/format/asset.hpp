@@ -66,10 +66,11 @@ struct BoundaryLoop {
 struct Provenance {
   std::string tool_version;                                  ///< e.g. "tetseg 0.1.0"
   std::string source;                                        ///< input file name (no directories)
-  std::vector<std::pair<std::string, std::string>> options;  ///< sorted by key
+  std::vector<std::pair<std::string, std::string>> options;  ///< strictly increasing keys
 };
 
-/// The whole asset. Clusters are stored contiguously: cluster c owns
+/// The whole asset. Clusters are stored contiguously, in order and without gaps (cluster 0
+/// starts at offset 0, each next one where the previous ends): cluster c owns
 /// `cluster_triangles[clusters[c].triangle_offset ..+ triangle_count]` (surface triangle ids,
 /// in BVH leaf order) and `bvh_nodes[clusters[c].bvh_offset ..+ bvh_count]`.
 struct Asset {
@@ -84,7 +85,7 @@ struct Asset {
   std::vector<std::uint32_t> cluster_triangles;  ///< surface triangle ids grouped by cluster
   std::vector<BvhNode> bvh_nodes;                ///< all clusters' BVH nodes, grouped
   std::vector<BoundaryLoop> boundaries;
-  std::vector<std::uint32_t> boundary_nodes;  ///< loops' node ids, grouped
+  std::vector<std::uint32_t> boundary_nodes;  ///< loops' node ids, grouped, in loop order
   Provenance provenance;
 };
 

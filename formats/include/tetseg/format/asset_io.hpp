@@ -19,14 +19,15 @@ inline constexpr std::size_t kEnvelopeBytes = 36;
 /// Result of reading an asset. Checks run in this order and stop at the first failure.
 enum class Status : std::uint8_t {
   kOk = 0,
-  kTooShort,            ///< fewer bytes than the envelope header
+  kTooShort,            ///< fewer than kEnvelopeBytes bytes
   kBadMagic,            ///< not a tetseg asset
-  kUnsupportedVersion,  ///< major differs, or minor is newer than this library
-  kHeaderChecksum,      ///< header bytes corrupted
+  kUnsupportedVersion,  ///< major differs, minor is newer, or unknown header size / flags
+  kHeaderChecksum,      ///< header bytes corrupted (CRC-32C of envelope bytes 0..31)
   kPayloadSize,         ///< payload shorter than the header says, or trailing bytes
-  kPayloadChecksum,     ///< payload bytes corrupted
-  kDecodeFailed,        ///< payload checksum fine but it does not decode
-  kInvalidContent,      ///< decodes, but indices, counts, partition or floats are invalid
+  kPayloadChecksum,     ///< payload bytes corrupted (CRC-32C)
+  kDecodeFailed,        ///< checksum fine but it does not decode (sizes that do not fit,
+                        ///< truncated fields, bytes after the last field, out of memory)
+  kInvalidContent,      ///< a count over a documented limit, or a validation rule broken
   kIoError,             ///< the file could not be opened or read
 };
 
@@ -34,20 +35,30 @@ enum class Status : std::uint8_t {
 const char* to_string(Status status) noexcept;
 
 /// Serialises `asset` (envelope + payload) into bytes. Deterministic: equal assets give equal
-/// bytes. Does not validate; call `validate` first when the asset is built by hand.
+/// bytes, and `write_asset` of an asset read from bytes `b` gives `b` again. Does not
+/// validate; call `validate` first when the asset is built by hand (an invalid asset is
+/// written, and then refused by `read_asset`). Throws std::bad_alloc only. Thread-safe.
 std::vector<std::uint8_t> write_asset(const Asset& asset);
 
-/// Parses and validates `size` bytes at `data` into `out`. On failure `out` is left empty
-/// and `detail`, when given, receives a one-line explanation. Thread-safe; never throws.
+/// Parses and validates `size` bytes at `data` into `out`. Safe on untrusted input: reads
+/// only `[data, data + size)`, and allocates at most a small multiple of `size` (every
+/// vector or string size is checked against the remaining bytes first). On failure `out` is
+/// left empty and `detail`, when given, receives a one-line explanation; on success `detail`
+/// is cleared. The caller keeps ownership of `data`. Thread-safe; never throws.
 Status read_asset(const std::uint8_t* data, std::size_t size, Asset& out,
                   std::string* detail = nullptr) noexcept;
 
-/// Reads a whole file and calls `read_asset`. Returns kIoError when the file cannot be read.
+/// Reads a whole file and calls `read_asset`. Returns kIoError (and an empty `out`) when the
+/// file cannot be opened or read. Thread-safe; never throws.
 Status read_asset_file(const std::string& path, Asset& out, std::string* detail = nullptr) noexcept;
 
-/// Semantic validation alone (what `read_asset` checks after decoding): indices in range,
-/// counts within the documented limits, clusters partition the triangles, BVHs well formed,
-/// detector nodes not on the surface, floats finite. Returns kOk or kInvalidContent.
+/// Semantic validation alone (what `read_asset` checks after decoding; the full rule list
+/// is in docs/format.md, "Validation rules"): counts within the documented limits, indices
+/// in range, clusters and loops contiguous, clusters partition the triangles, BVHs are
+/// trees whose leaves cover each cluster once, detector nodes interior, loop edges on the
+/// surface, floats finite, provenance keys sorted. Returns kOk or kInvalidContent (with the
+/// first broken rule in `detail`). Memory is proportional to the asset's vectors, never to
+/// `node_count`. Thread-safe; never throws.
 Status validate(const Asset& asset, std::string* detail = nullptr) noexcept;
 
 }  // namespace tetseg::format
