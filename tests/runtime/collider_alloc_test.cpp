@@ -1,0 +1,129 @@
+// A collider step and its queries allocate nothing; OpenMP results equal serial results.
+// This file replaces the global operator new/delete of the runtime test executable with
+// counting versions (counting only while a test enables it).
+
+#include <atomic>
+#include <catch2/catch.hpp>
+#include <cstdlib>
+#include <new>
+#include <random>
+
+#include "runtime/support/scenes.hpp"
+#include "tetseg/runtime/collider.hpp"
+
+namespace {
+std::atomic<bool> g_counting{false};
+std::atomic<std::size_t> g_allocations{0};
+
+void* counted_allocate(std::size_t size) {
+  if (g_counting.load(std::memory_order_relaxed)) g_allocations.fetch_add(1);
+  if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
+  throw std::bad_alloc();
+}
+
+struct CountAllocations {
+  CountAllocations() {
+    g_allocations = 0;
+    g_counting = true;
+  }
+  ~CountAllocations() { g_counting = false; }
+  std::size_t count() const { return g_allocations.load(); }
+};
+}  // namespace
+
+void* operator new(std::size_t size) {
+  return counted_allocate(size);
+}
+void* operator new[](std::size_t size) {
+  return counted_allocate(size);
+}
+void* operator new(std::size_t size, const std::nothrow_t&) noexcept {
+  try {
+    return counted_allocate(size);
+  } catch (...) {
+    return nullptr;
+  }
+}
+void* operator new[](std::size_t size, const std::nothrow_t&) noexcept {
+  try {
+    return counted_allocate(size);
+  } catch (...) {
+    return nullptr;
+  }
+}
+void operator delete(void* p) noexcept {
+  std::free(p);
+}
+void operator delete[](void* p) noexcept {
+  std::free(p);
+}
+void operator delete(void* p, std::size_t) noexcept {
+  std::free(p);
+}
+void operator delete[](void* p, std::size_t) noexcept {
+  std::free(p);
+}
+
+using namespace tetseg;
+using namespace tetseg::test;
+
+namespace {
+P3 squash(const P3& p, double t) {
+  const double w = std::exp(-(p[0] * p[0] + p[1] * p[1]) / 0.3);
+  const double dz = (p[2] > 0 ? -1.0 : 1.0) * 1.4 * t * w * std::min(1.0, std::fabs(p[2]) * 4);
+  return {p[0] + 0.1 * dz + 0.05 * t * std::sin(5 * p[2]), p[1] + 0.05 * dz, p[2] + dz};
+}
+}  // namespace
+
+TEST_CASE("A step and its queries allocate nothing", "[collider][alloc]") {
+  const Scene scene = make_axial_scene(sphere(1.0, 24, 13), {0.0}, {-0.4, 0.4});
+  const auto frames = make_frames(scene, 6, squash);
+  std::vector<Contact> buffer(4096);
+  for (ColliderMode mode : {ColliderMode::kRvbc, ColliderMode::kBvh, ColliderMode::kBrute}) {
+    CAPTURE(to_string(mode));
+    ColliderOptions o;
+    o.mode = mode;
+    o.check_first_step = true;
+    Collider c(scene.asset, o);
+    REQUIRE(c.status() == ColliderStatus::kOk);
+    std::size_t contacts = 0;
+    for (std::size_t f = 0; f + 1 < frames.size(); ++f) {
+      CountAllocations counter;
+      REQUIRE(c.step(frames[f].data(), frames[f + 1].data()) == ColliderStatus::kOk);
+      c.any_collision();
+      c.earliest_toi();
+      contacts += c.contacts(buffer.data(), buffer.size()).found;
+      c.check_rest_intersection(frames[f].data(), frames[f].size());
+      CHECK(counter.count() == 0);
+    }
+    CHECK(contacts > 0);  // the sequence exercises the contact paths
+  }
+}
+
+TEST_CASE("OpenMP refit and classification give the same results as serial", "[collider][openmp]") {
+  // Large enough (> 4096 surface nodes) for the parallel loops to engage.
+  const Scene scene = make_axial_scene(sphere(1.0, 96, 60), {-0.3, 0.3}, {-0.6, 0.0, 0.6});
+  const auto frames =
+      make_frames(scene, 5, [](const P3& p, double t) { return squash(p, 0.75 * t); });
+  std::size_t total = 0;
+  ColliderOptions serial_options, parallel_options;
+  parallel_options.use_openmp = true;
+  Collider serial(scene.asset, serial_options), parallel(scene.asset, parallel_options);
+  std::vector<Contact> a(1 << 16), b(1 << 16);
+  for (std::size_t f = 0; f + 1 < frames.size(); ++f) {
+    REQUIRE(serial.step(frames[f].data(), frames[f + 1].data()) == ColliderStatus::kOk);
+    REQUIRE(parallel.step(frames[f].data(), frames[f + 1].data()) == ColliderStatus::kOk);
+    const ContactsResult ra = serial.contacts(a.data(), a.size());
+    const ContactsResult rb = parallel.contacts(b.data(), b.size());
+    REQUIRE(ra.found == rb.found);
+    total += ra.found;
+    for (std::size_t i = 0; i < ra.written; ++i) {
+      CHECK(a[i].nodes == b[i].nodes);
+      CHECK(a[i].toi == b[i].toi);
+    }
+    CHECK(serial.stats().triangles_positive == parallel.stats().triangles_positive);
+    CHECK(serial.stats().triangles_uncertain == parallel.stats().triangles_uncertain);
+    CHECK(serial.stats().feature_tests == parallel.stats().feature_tests);
+  }
+  CHECK(total > 0);
+}
