@@ -118,7 +118,7 @@ struct Separation {
   double delta = 0.0;
   double delta2 = 0.0;
   explicit Separation(double d) noexcept {
-    if (d > 0.0 && std::isfinite(d)) {
+    if (d > 0.0) {  // NaN and negative values mean 0; +inf reports everything
       delta = d;
       delta2 = mul_up(d, d);
     }

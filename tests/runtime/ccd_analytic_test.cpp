@@ -308,3 +308,16 @@ TEST_CASE("Non-finite input is reported as a contact, never as a proof of separa
   const Vec3d inf{INFINITY, 0, 0};
   CHECK(tetseg::edge_edge_ccd(z, x, inf, y, z, x, inf, y).hit());
 }
+
+TEST_CASE("An infinite minimum separation reports every pair; negative or NaN means zero.",
+          "[ccd]") {
+  const Motion far = point_vs_triangle({5, 5, 5}, {6, 6, 6});
+  const Transform identity;
+  CcdOptions o;
+  o.min_separation = INFINITY;
+  CHECK(run(true, far, identity, o).outcome == CcdOutcome::kContactAtStart);
+  o.min_separation = -1.0;
+  CHECK(run(true, far, identity, o).outcome == CcdOutcome::kNoContact);
+  o.min_separation = std::nan("");
+  CHECK(run(true, far, identity, o).outcome == CcdOutcome::kNoContact);
+}
