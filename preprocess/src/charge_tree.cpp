@@ -371,7 +371,9 @@ void TreecodeOperator::apply(const double* x, double* y) const {
           for (std::uint32_t j = s.begin; j < s.end; ++j) {
             const double dx = tx - px[j], dy = ty - py[j], dz = tz - pz[j];
             const double r2 = dx * dx + dy * dy + dz * dz;
-            sum += r2 > 0.0 ? charge[j] / std::sqrt(r2) : 0.0;
+            // Branch-free so it vectorises; r2 == 0 only for the target itself.
+            const double inv = 1.0 / std::sqrt(r2 > 0.0 ? r2 : 1.0);
+            sum += r2 > 0.0 ? charge[j] * inv : 0.0;
           }
           pot[k - target.begin] += sum;
         }

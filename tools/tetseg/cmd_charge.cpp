@@ -1,0 +1,292 @@
+// `tetseg charge`: relative charge density of a tet mesh's boundary or of a closed surface,
+// with its equalisation, written as CSV, VTU (ParaView, cell data) or PLY (face colours).
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "commands.hpp"
+#include "tetseg/preprocess/charge.hpp"
+#include "tetseg/preprocess/io.hpp"
+#include "tetseg/preprocess/surface.hpp"
+#include "tool_support.hpp"
+
+namespace tetseg::tools {
+namespace {
+
+struct ChargeArgs {
+  std::string input;
+  std::string output;
+  std::string report;
+  std::string solver = "auto";
+  std::string equalization = "histogram";
+  double tolerance = 1e-6;
+  int max_iterations = 500;
+  double theta = 0.5;
+  int order = 6;
+  int bins = 256;
+};
+
+/// Progress on stderr: a live bar when stderr is a terminal, otherwise a line per quarter.
+class Progress {
+ public:
+  Progress() : m_tty(::isatty(2) != 0) {}
+  ~Progress() { finish(); }
+  void update(const char* stage, double fraction) {
+    const std::string s = stage;
+    if (m_tty) {
+      const auto now = std::chrono::steady_clock::now();
+      if (s == m_stage && fraction < 1.0 && now - m_last < std::chrono::milliseconds(100)) return;
+      m_last = now;
+      const int width = 30, filled = static_cast<int>(fraction * width + 0.5);
+      std::fprintf(stderr, "\rtetseg: charge %-8s [%s%s] %3d%%", stage,
+                   std::string(static_cast<std::size_t>(filled), '#').c_str(),
+                   std::string(static_cast<std::size_t>(width - filled), ' ').c_str(),
+                   static_cast<int>(fraction * 100 + 0.5));
+      std::fflush(stderr);
+      m_dirty = true;
+    } else {
+      const int quarter = static_cast<int>(fraction * 4.0);
+      if (s != m_stage) m_quarter = -1;
+      if (quarter > m_quarter && quarter < 4) {
+        std::fprintf(stderr, "tetseg: charge %s %d%%\n", stage, quarter * 25);
+        m_quarter = quarter;
+      }
+    }
+    m_stage = s;
+  }
+  void finish() {
+    if (m_dirty) std::fprintf(stderr, "\n");
+    m_dirty = false;
+  }
+
+ private:
+  bool m_tty;
+  bool m_dirty = false;
+  int m_quarter = -1;
+  std::string m_stage;
+  std::chrono::steady_clock::time_point m_last{};
+};
+
+struct Outputs {
+  const std::vector<preprocess::Vec3>& points;
+  const std::vector<preprocess::Tri>& triangles;
+  const std::vector<double>& density;
+  const std::vector<double>& equalized;
+};
+
+preprocess::Vec3 centroid_of(const Outputs& o, std::size_t j) {
+  const auto& t = o.triangles[j];
+  preprocess::Vec3 c{0, 0, 0};
+  for (int e = 0; e < 3; ++e) {
+    for (int a = 0; a < 3; ++a) c[a] += o.points[t[e]][a] / 3.0;
+  }
+  return c;
+}
+
+double area_of(const Outputs& o, std::size_t j) {
+  const auto& t = o.triangles[j];
+  const auto& a = o.points[t[0]];
+  const auto& b = o.points[t[1]];
+  const auto& c = o.points[t[2]];
+  const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+  const double v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+  const double x = u[1] * v[2] - u[2] * v[1], y = u[2] * v[0] - u[0] * v[2],
+               z = u[0] * v[1] - u[1] * v[0];
+  return 0.5 * std::sqrt(x * x + y * y + z * z);
+}
+
+/// Used vertices in first-use order and the triangles renumbered over them.
+void compact(const Outputs& o, std::vector<preprocess::Vec3>& points,
+             std::vector<preprocess::Tri>& triangles) {
+  std::vector<std::int64_t> map(o.points.size(), -1);
+  triangles = o.triangles;
+  for (auto& t : triangles) {
+    for (auto& v : t) {
+      if (map[v] < 0) {
+        map[v] = static_cast<std::int64_t>(points.size());
+        points.push_back(o.points[v]);
+      }
+      v = static_cast<std::uint32_t>(map[v]);
+    }
+  }
+}
+
+std::string format_csv(const Outputs& o) {
+  std::string s = "triangle,cx,cy,cz,area,density,equalized\n";
+  char line[256];
+  for (std::size_t j = 0; j < o.triangles.size(); ++j) {
+    const auto c = centroid_of(o, j);
+    std::snprintf(line, sizeof line, "%zu,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g\n", j, c[0], c[1], c[2],
+                  area_of(o, j), o.density[j], o.equalized[j]);
+    s += line;
+  }
+  return s;
+}
+
+std::string format_vtu(const Outputs& o) {
+  std::vector<preprocess::Vec3> pts;
+  std::vector<preprocess::Tri> tris;
+  compact(o, pts, tris);
+  std::ostringstream s;
+  s.precision(9);
+  s << "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" "
+       "byte_order=\"LittleEndian\">\n<UnstructuredGrid>\n<Piece NumberOfPoints=\""
+    << pts.size() << "\" NumberOfCells=\"" << tris.size() << "\">\n";
+  s << "<Points>\n<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n";
+  for (const auto& p : pts) s << p[0] << ' ' << p[1] << ' ' << p[2] << '\n';
+  s << "</DataArray>\n</Points>\n<Cells>\n"
+       "<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n";
+  for (const auto& t : tris) s << t[0] << ' ' << t[1] << ' ' << t[2] << '\n';
+  s << "</DataArray>\n<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n";
+  for (std::size_t j = 0; j < tris.size(); ++j) s << 3 * (j + 1) << '\n';
+  s << "</DataArray>\n<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">\n";
+  for (std::size_t j = 0; j < tris.size(); ++j) s << "5\n";
+  s << "</DataArray>\n</Cells>\n<CellData Scalars=\"density\">\n";
+  const std::pair<const char*, const std::vector<double>*> arrays[] = {{"density", &o.density},
+                                                                       {"equalized", &o.equalized}};
+  for (const auto& [name, values] : arrays) {
+    s << "<DataArray type=\"Float64\" Name=\"" << name << "\" format=\"ascii\">\n";
+    for (const double v : *values) s << v << '\n';
+    s << "</DataArray>\n";
+  }
+  s << "</CellData>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n";
+  return s.str();
+}
+
+/// ASCII PLY, faces in gray levels of the equalised density (the paper's Fig. 4 encoding:
+/// darker = less charge), plus the two values as face properties.
+std::string format_ply(const Outputs& o) {
+  std::vector<preprocess::Vec3> pts;
+  std::vector<preprocess::Tri> tris;
+  compact(o, pts, tris);
+  std::ostringstream s;
+  s.precision(9);
+  s << "ply\nformat ascii 1.0\ncomment tetseg charge: gray = equalized density\n"
+    << "element vertex " << pts.size() << "\nproperty double x\nproperty double y\n"
+    << "property double z\nelement face " << tris.size()
+    << "\nproperty list uchar int vertex_indices\nproperty uchar red\nproperty uchar green\n"
+       "property uchar blue\nproperty double density\nproperty double equalized\nend_header\n";
+  for (const auto& p : pts) s << p[0] << ' ' << p[1] << ' ' << p[2] << '\n';
+  for (std::size_t j = 0; j < tris.size(); ++j) {
+    const int g = static_cast<int>(std::lround(std::clamp(o.equalized[j], 0.0, 1.0) * 255.0));
+    s << "3 " << tris[j][0] << ' ' << tris[j][1] << ' ' << tris[j][2] << ' ' << g << ' ' << g << ' '
+      << g << ' ' << o.density[j] << ' ' << o.equalized[j] << '\n';
+  }
+  return s.str();
+}
+
+void run_charge(const ChargeArgs& args) {
+  const std::string ext = extension_of(args.output);
+  if (ext != ".csv" && ext != ".vtu" && ext != ".ply") {
+    throw CLI::ValidationError("--output", "output must end in .csv, .vtu or .ply: " + args.output);
+  }
+  preprocess::ChargeOptions options;
+  if (!preprocess::parse_charge_solver(args.solver, options.solver)) {
+    throw CLI::ValidationError("--solver", "unknown solver: " + args.solver);
+  }
+  preprocess::Equalization method;
+  if (!preprocess::parse_equalization(args.equalization, method)) {
+    throw CLI::ValidationError("--equalize", "unknown equalisation: " + args.equalization);
+  }
+  options.tolerance = args.tolerance;
+  options.max_iterations = args.max_iterations;
+  options.fast_theta = args.theta;
+  options.fast_order = args.order;
+
+  auto t0 = std::chrono::steady_clock::now();
+  std::vector<preprocess::Vec3> points;
+  std::vector<preprocess::Tri> triangles;
+  if (preprocess::is_tet_mesh_path(args.input)) {
+    preprocess::TetMesh mesh = preprocess::read_tet_mesh(args.input);
+    const preprocess::Surface surface = preprocess::extract_surface(mesh);
+    preprocess::validate_tet_mesh(mesh, surface, args.input);
+    points = std::move(mesh.nodes);
+    triangles = surface.triangles;
+  } else {
+    preprocess::TriangleMesh mesh = preprocess::read_triangle_mesh(args.input);
+    preprocess::validate_closed_surface(mesh, args.input);
+    points = std::move(mesh.vertices);
+    triangles = std::move(mesh.triangles);
+  }
+  std::fprintf(stderr, "tetseg: reading %s ... %.2f s, %zu surface triangles\n",
+               base_name(args.input).c_str(),
+               std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(),
+               triangles.size());
+
+  Progress progress;
+  options.progress = [&](const char* stage, double f) { progress.update(stage, f); };
+  const preprocess::ChargeResult r =
+      preprocess::compute_charge(points, triangles, options, args.input);
+  progress.finish();
+  std::fprintf(stderr,
+               "tetseg: charge ... %.2f s (assembly %.2f s, solve %.2f s), solver %s, %d "
+               "iterations, residual %.2e, capacitance %.6g\n",
+               r.assembly_seconds + r.solve_seconds, r.assembly_seconds, r.solve_seconds,
+               r.solver.c_str(), r.iterations, r.residual, r.capacitance);
+  if (!r.converged) {
+    std::fprintf(stderr,
+                 "tetseg: warning: the solver stopped at residual %.2e above the tolerance %.2e "
+                 "after %d iterations (raise --max-iterations)\n",
+                 r.residual, args.tolerance, r.iterations);
+  }
+  const std::vector<double> eq = preprocess::equalize(r.density, method, args.bins);
+  const Outputs out{points, triangles, r.density, eq};
+  const std::string text =
+      ext == ".csv" ? format_csv(out) : (ext == ".vtu" ? format_vtu(out) : format_ply(out));
+  write_file_atomic(args.output, text);
+  std::fprintf(stderr, "tetseg: wrote %s\n", base_name(args.output).c_str());
+
+  if (!args.report.empty()) {
+    std::ostringstream j;
+    j.precision(10);
+    j << "{\n  \"input\": \"" << json_escape(args.input)
+      << "\",\n  \"triangles\": " << triangles.size() << ",\n  \"solver\": \"" << r.solver
+      << "\",\n  \"iterations\": " << r.iterations << ",\n  \"residual\": " << r.residual
+      << ",\n  \"converged\": " << (r.converged ? "true" : "false")
+      << ",\n  \"tolerance\": " << args.tolerance << ",\n  \"capacitance\": " << r.capacitance
+      << ",\n  \"total_area\": " << r.total_area << ",\n  \"equalization\": \""
+      << preprocess::to_string(method) << "\",\n  \"assembly_seconds\": " << r.assembly_seconds
+      << ",\n  \"solve_seconds\": " << r.solve_seconds << "\n}\n";
+    write_file_atomic(args.report, j.str());
+  }
+}
+
+}  // namespace
+
+void add_charge_command(CLI::App& root) {
+  auto args = std::make_shared<ChargeArgs>();
+  CLI::App* cmd = root.add_subcommand(
+      "charge", "Charge density of a tet mesh's boundary or a closed surface (as given)");
+  cmd->add_option("input", args->input,
+                  "Tet mesh (.mesh, .node/.ele, .msh) or closed surface (.off, .obj, .ply, ...)")
+      ->required();
+  cmd->add_option("-o,--output", args->output,
+                  "Per-triangle output: .csv (triangle,cx,cy,cz,area,density,equalized), "
+                  ".vtu (cell data) or .ply (gray faces)")
+      ->required();
+  cmd->add_option("--solver", args->solver, "auto | direct | gmres | fast")
+      ->check(CLI::IsMember({"auto", "direct", "gmres", "fast"}));
+  cmd->add_option("--tolerance", args->tolerance, "Relative residual of the iterative solvers")
+      ->check(CLI::Range(1e-14, 0.5));
+  cmd->add_option("--max-iterations", args->max_iterations, "Iteration cap")
+      ->check(CLI::Range(1, 100000));
+  cmd->add_option("--theta", args->theta, "Fast solver opening parameter, (0, 1)")
+      ->check(CLI::Range(0.05, 0.95));
+  cmd->add_option("--order", args->order, "Fast solver expansion order")->check(CLI::Range(0, 12));
+  cmd->add_option("--equalize", args->equalization, "histogram (paper) | rank | log")
+      ->check(CLI::IsMember({"histogram", "rank", "log"}));
+  cmd->add_option("--bins", args->bins, "Histogram bins")->check(CLI::Range(1, 1 << 20));
+  cmd->add_option("--report", args->report, "Write a JSON report (solver, iterations, times)");
+  cmd->callback([args] { run_charge(*args); });
+}
+
+}  // namespace tetseg::tools
