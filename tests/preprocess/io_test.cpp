@@ -1,0 +1,340 @@
+// Tet mesh readers/writers (MEDIT, TetGen, Gmsh 2.2/4.1) and surface import through assimp.
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <catch2/catch.hpp>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "tetseg/preprocess/io.hpp"
+#include "tetseg/preprocess/surface.hpp"
+
+namespace fs = std::filesystem;
+using namespace tetseg::preprocess;
+
+namespace {
+
+/// A temporary directory removed at the end of the test.
+struct TempDir {
+  explicit TempDir(const std::string& name)
+      : path(fs::temp_directory_path() /
+             ("tetseg_io_test_" + std::to_string(::getpid()) + "_" + name)) {
+    fs::remove_all(path);
+    fs::create_directories(path);
+  }
+  ~TempDir() { fs::remove_all(path); }
+  std::string file(const std::string& name) const { return (path / name).string(); }
+  std::string write(const std::string& name, const std::string& text) const {
+    std::ofstream(file(name), std::ios::binary) << text;
+    return file(name);
+  }
+  fs::path path;
+};
+
+/// An n^3 grid of cubes over [0,1]^3 (with an irrational jitter so coordinates need all 17
+/// digits), each cube split into 6 positively oriented tets (Kuhn triangulation).
+TetMesh grid_mesh(int n) {
+  TetMesh m;
+  auto id = [n](int i, int j, int k) {
+    return static_cast<std::uint32_t>((i * (n + 1) + j) * (n + 1) + k);
+  };
+  for (int i = 0; i <= n; ++i)
+    for (int j = 0; j <= n; ++j)
+      for (int k = 0; k <= n; ++k)
+        m.nodes.push_back(
+            {i / double(n) + 1e-3 / 3.0 * j, j / double(n) + 1e-3 / 7.0 * k, k / double(n) * 1.1});
+  const int perms[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j)
+      for (int k = 0; k < n; ++k)
+        for (const auto& p : perms) {
+          int c[3] = {i, j, k};
+          Tet t;
+          t[0] = id(c[0], c[1], c[2]);
+          for (int s = 0; s < 3; ++s) {
+            ++c[p[s]];
+            t[static_cast<std::size_t>(s + 1)] = id(c[0], c[1], c[2]);
+          }
+          m.tets.push_back(t);
+        }
+  // Orient positively.
+  for (Tet& t : m.tets) {
+    const Vec3& a = m.nodes[t[0]];
+    const Vec3& b = m.nodes[t[1]];
+    const Vec3& c = m.nodes[t[2]];
+    const Vec3& d = m.nodes[t[3]];
+    const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+    const double v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+    const double w[3] = {d[0] - a[0], d[1] - a[1], d[2] - a[2]};
+    const double det = u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0]) +
+                       u[2] * (v[0] * w[1] - v[1] * w[0]);
+    if (det < 0) std::swap(t[2], t[3]);
+  }
+  return m;
+}
+
+bool same_mesh(const TetMesh& a, const TetMesh& b) {
+  return a.nodes == b.nodes && a.tets == b.tets;
+}
+
+std::string error_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+}  // namespace
+
+TEST_CASE("Tet meshes round-trip exactly through every format", "[format][io]") {
+  const TempDir dir("roundtrip");
+  const TetMesh mesh = grid_mesh(3);
+  SECTION("Each writer's output reads back to the same nodes and tets.") {
+    for (const char* name : {"a.mesh", "a.node", "b.ele", "a.msh"}) {
+      CAPTURE(name);
+      write_tet_mesh(dir.file(name), mesh);
+      CHECK(same_mesh(read_tet_mesh(dir.file(name)), mesh));
+    }
+    write_gmsh22(dir.file("c.msh"), mesh);
+    CHECK(same_mesh(read_tet_mesh(dir.file("c.msh")), mesh));
+  }
+  SECTION("A chain MEDIT -> TetGen -> Gmsh 2.2 -> Gmsh 4.1 -> MEDIT changes nothing.") {
+    write_tet_mesh(dir.file("1.mesh"), mesh);
+    write_tet_mesh(dir.file("2.node"), read_tet_mesh(dir.file("1.mesh")));
+    write_gmsh22(dir.file("3.msh"), read_tet_mesh(dir.file("2.ele")));
+    write_tet_mesh(dir.file("4.msh"), read_tet_mesh(dir.file("3.msh")));
+    write_tet_mesh(dir.file("5.mesh"), read_tet_mesh(dir.file("4.msh")));
+    const TetMesh back = read_tet_mesh(dir.file("5.mesh"));
+    CHECK(same_mesh(back, mesh));
+    const Surface s = extract_surface(back);
+    CHECK(enclosed_volume(back.nodes, s.triangles) ==
+          Approx(total_tet_volume(back)).epsilon(1e-12));
+  }
+}
+
+TEST_CASE("The MEDIT reader accepts the format's variations", "[format][io]") {
+  const TempDir dir("medit");
+  SECTION("Keywords are case-insensitive, comments are skipped and other sections ignored.") {
+    const std::string path = dir.write("m.mesh",
+                                       "# a comment\nMeshVersionFormatted 2\ndimension\n3\n"
+                                       "VERTICES 5 # five\n"
+                                       "0 0 0 1\n1 0 0 1\n0 1 0 1\n0 0 1 1\n1 1 1 2\n"
+                                       "Edges 1\n1 2 0\nCorners 2 1 2\n"
+                                       "Triangles 2\n1 2 3 0\n1 2 3 0\n"
+                                       "tetrahedra 2\n1 2 3 4 0\n2 5 3 4 0\n"
+                                       "Ridges 1\n1\nEnd\n");
+    const TetMesh m = read_tet_mesh(path);
+    REQUIRE(m.nodes.size() == 5);
+    REQUIRE(m.tets.size() == 2);
+    CHECK(m.tets[0] == Tet{0, 1, 2, 3});
+    CHECK(m.nodes[4] == Vec3{1, 1, 1});
+  }
+  SECTION("A malformed number is reported with its line.") {
+    const std::string path = dir.write(
+        "bad.mesh", "MeshVersionFormatted 1\nDimension 3\nVertices 2\n0 0 0 0\n1 x 0 0\n");
+    CHECK_THAT(error_of([&] { read_tet_mesh(path); }),
+               Catch::Contains("line 5: expected a vertex coordinate, got 'x'"));
+  }
+  SECTION("An index out of range is reported with its line.") {
+    const std::string path = dir.write(
+        "range.mesh",
+        "Dimension 3\nVertices 4\n0 0 0 0\n1 0 0 0\n0 1 0 0\n0 0 1 0\nTetrahedra 1\n1 2 3 9 0\n");
+    CHECK_THAT(error_of([&] { read_tet_mesh(path); }),
+               Catch::Contains("line 8: vertex index 9 out of range (4 vertices)"));
+  }
+  SECTION("A NaN coordinate is rejected.") {
+    const std::string path = dir.write("nan.mesh", "Dimension 3\nVertices 1\n0 nan 0 0\n");
+    CHECK_THAT(error_of([&] { read_tet_mesh(path); }),
+               Catch::Contains("line 3: a vertex coordinate is not finite"));
+  }
+  SECTION("A truncated file reports an unexpected end of file.") {
+    const std::string path = dir.write("eof.mesh", "Dimension 3\nVertices 3\n0 0 0 0\n1 0 0 0\n");
+    CHECK_THAT(error_of([&] { read_tet_mesh(path); }), Catch::Contains("unexpected end of file"));
+  }
+  SECTION("An unknown keyword is an error naming it.") {
+    const std::string path = dir.write("kw.mesh", "Dimension 3\nBananas 2\n");
+    CHECK_THAT(error_of([&] { read_tet_mesh(path); }),
+               Catch::Contains("line 2: unknown keyword 'Bananas'"));
+  }
+  SECTION("A missing file names the file.") {
+    try {
+      read_tet_mesh(dir.file("missing.mesh"));
+      FAIL("no error");
+    } catch (const InputError& e) {
+      CHECK(e.file() == dir.file("missing.mesh"));
+      CHECK_THAT(e.what(), Catch::Contains("cannot open"));
+    }
+  }
+}
+
+TEST_CASE("The TetGen reader accepts 0- and 1-based files with attributes", "[format][io]") {
+  const TempDir dir("tetgen");
+  SECTION("1-based, attributes, boundary markers, comments and 10-node tets are read.") {
+    dir.write("t.node",
+              "# header\n5 3 2 1\n1 0 0 0 7 8 1\n2 1 0 0 7 8 1\n3 0 1 0 7 8 1\n"
+              "4 0 0 1 7 8 0 # interior?\n5 1 1 1 0 0 1\n");
+    dir.write("t.ele", "2 10 1\n1 1 2 3 4 1 1 1 1 1 1 5\n2 2 5 3 4 1 1 1 1 1 1 5\n");
+    const TetMesh m = read_tet_mesh(dir.file("t.ele"));
+    REQUIRE(m.nodes.size() == 5);
+    REQUIRE(m.tets.size() == 2);
+    CHECK(m.tets[0] == Tet{0, 1, 2, 3});
+    CHECK(m.tets[1] == Tet{1, 4, 2, 3});
+  }
+  SECTION("0-based files give the same ids.") {
+    dir.write("z.node", "4 3 0 0\n0 0 0 0\n1 1 0 0\n2 0 1 0\n3 0 0 1\n");
+    dir.write("z.ele", "1 4 0\n0 0 1 2 3\n");
+    const TetMesh m = read_tet_mesh(dir.file("z.node"));
+    CHECK(m.tets[0] == Tet{0, 1, 2, 3});
+  }
+  SECTION("An index out of range names the line and the valid range.") {
+    dir.write("r.node", "4 3 0 0\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 1\n");
+    dir.write("r.ele", "1 4 0\n\n1 1 2 3 5\n");
+    CHECK_THAT(error_of([&] { read_tet_mesh(dir.file("r.ele")); }),
+               Catch::Contains("line 3: point index 5 out of range (1..4)"));
+  }
+  SECTION("A count that does not match the lines is an error.") {
+    dir.write("c.node", "3 3 0 0\n1 0 0 0\n2 1 0 0\n");
+    CHECK_THAT(error_of([&] { read_tet_mesh(dir.file("c.node")); }),
+               Catch::Contains("unexpected end of file (expected 1 more point)"));
+    dir.write("d.node", "1 3 0 0\n1 0 0 0\n2 1 0 0\n");
+    CHECK_THAT(error_of([&] { read_tet_mesh(dir.file("d.node")); }),
+               Catch::Contains("line 3: more points than the header's count 1"));
+  }
+  SECTION("A line with the wrong number of values is reported.") {
+    dir.write("v.node", "2 3 0 1\n1 0 0 0 1\n2 1 0\n");
+    CHECK_THAT(error_of([&] { read_tet_mesh(dir.file("v.node")); }),
+               Catch::Contains("line 3: expected 5 values, got 3"));
+  }
+}
+
+TEST_CASE("The Gmsh reader handles 2.2 and 4.1 ASCII files", "[format][io]") {
+  const TempDir dir("gmsh");
+  SECTION("4.1 with entity blocks, sparse tags, parametric nodes and other element types.") {
+    const std::string path = dir.write(
+        "g.msh",
+        "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$PhysicalNames\n1\n3 1 \"body\"\n$EndPhysicalNames\n"
+        "$Entities\n0 0 0 1\n1 0 0 0 1 1 1 1 1 0\n$EndEntities\n"
+        "$Nodes\n2 5 10 50\n3 1 0 3\n10\n20\n30\n0 0 0\n1 0 0\n0 1 0\n"
+        "2 7 1 2\n40\n50\n0 0 1 0.5 0.5\n1 1 1 0.25 0.25\n$EndNodes\n"
+        "$Elements\n2 3 1 3\n2 7 2 1\n1 10 20 30\n3 1 4 2\n2 10 20 30 40\n3 20 50 30 40\n"
+        "$EndElements\n$Comments\nanything $Nodes here\n$EndComments\n");
+    const TetMesh m = read_tet_mesh(path);
+    REQUIRE(m.nodes.size() == 5);
+    REQUIRE(m.tets.size() == 2);
+    CHECK(m.tets[0] == Tet{0, 1, 2, 3});
+    CHECK(m.tets[1] == Tet{1, 4, 2, 3});
+    CHECK(m.nodes[4] == Vec3{1, 1, 1});
+  }
+  SECTION("2.2 with tags, triangles and lines mixed in.") {
+    const std::string path = dir.write(
+        "h.msh",
+        "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n4\n7 0 0 0\n8 1 0 0\n9 0 1 0\n11 0 0 1\n"
+        "$EndNodes\n$Elements\n3\n1 1 2 0 1 7 8\n2 2 2 0 1 7 8 9\n3 4 3 0 1 5 7 8 9 "
+        "11\n$EndElements\n");
+    const TetMesh m = read_tet_mesh(path);
+    REQUIRE(m.tets.size() == 1);
+    CHECK(m.tets[0] == Tet{0, 1, 2, 3});
+  }
+  SECTION("Binary files are refused with a clear message.") {
+    const std::string path =
+        dir.write("b.msh", "$MeshFormat\n4.1 1 8\n\x01\x00\x00\x00\n$EndMeshFormat\n");
+    CHECK_THAT(error_of([&] { read_tet_mesh(path); }),
+               Catch::Contains("line 2: binary Gmsh not supported"));
+  }
+  SECTION("A node count that does not match its blocks is an error.") {
+    const std::string path = dir.write("n.msh",
+                                       "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n1 3 1 3\n3 1 "
+                                       "0 2\n1\n2\n0 0 0\n1 0 0\n$EndNodes\n");
+    CHECK_THAT(error_of([&] { read_tet_mesh(path); }),
+               Catch::Contains("node blocks hold 2 nodes, header says 3"));
+  }
+  SECTION("A tet that refers to a missing node tag names the line.") {
+    const std::string path = dir.write(
+        "t.msh",
+        "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n4\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 1\n"
+        "$EndNodes\n$Elements\n1\n1 4 0 1 2 3 99\n$EndElements\n");
+    CHECK_THAT(error_of([&] { read_tet_mesh(path); }),
+               Catch::Contains("line 13: node tag 99 out of range"));
+  }
+  SECTION("An infinite coordinate is rejected with its line.") {
+    const std::string path = dir.write(
+        "i.msh",
+        "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n2\n1 0 0 0\n2 inf 0 0\n$EndNodes\n");
+    CHECK_THAT(error_of([&] { read_tet_mesh(path); }),
+               Catch::Contains("line 7: a node coordinate is not finite"));
+  }
+  SECTION("A missing end marker is an unexpected end of file.") {
+    const std::string path =
+        dir.write("e.msh", "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Entities\n0 0 0 0\n");
+    CHECK_THAT(error_of([&] { read_tet_mesh(path); }), Catch::Contains("unexpected end of file"));
+  }
+}
+
+TEST_CASE("A mesh whose tets are all negatively oriented is flipped on reading", "[format][io]") {
+  const TempDir dir("flip");
+  dir.write("f.node", "4 3 0 0\n0 0 0 0\n1 1 0 0\n2 0 1 0\n3 0 0 1\n");
+  dir.write("f.ele", "1 4 0\n0 0 2 1 3\n");
+  const TetMesh m = read_tet_mesh(dir.file("f.ele"));
+  CHECK(total_tet_volume(m) == Approx(1.0 / 6.0));
+}
+
+TEST_CASE("Surfaces are imported through assimp with coincident vertices merged",
+          "[format][io][assimp]") {
+  const TempDir dir("assimp");
+  // A unit cube: 8 corners, 12 outward triangles.
+  const double c[8][3] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0},
+                          {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}};
+  const int f[12][3] = {{0, 2, 1}, {0, 3, 2}, {4, 5, 6}, {4, 6, 7}, {0, 1, 5}, {0, 5, 4},
+                        {1, 2, 6}, {1, 6, 5}, {2, 3, 7}, {2, 7, 6}, {3, 0, 4}, {3, 4, 7}};
+  auto check_cube = [](const TriangleMesh& m) {
+    CHECK(m.vertices.size() == 8);
+    CHECK(m.triangles.size() == 12);
+    CHECK(enclosed_volume(m.vertices, m.triangles) == Approx(1.0));
+    validate_closed_surface(m, "cube");
+  };
+  SECTION("OFF with a quad-free triangle list.") {
+    std::string text = "OFF\n8 12 0\n";
+    for (const auto& p : c)
+      text += std::to_string(p[0]) + " " + std::to_string(p[1]) + " " + std::to_string(p[2]) + "\n";
+    for (const auto& t : f)
+      text += "3 " + std::to_string(t[0]) + " " + std::to_string(t[1]) + " " +
+              std::to_string(t[2]) + "\n";
+    check_cube(read_triangle_mesh(dir.write("cube.off", text)));
+  }
+  SECTION("OBJ with quads is triangulated.") {
+    std::string text;
+    for (const auto& p : c)
+      text += "v " + std::to_string(p[0]) + " " + std::to_string(p[1]) + " " +
+              std::to_string(p[2]) + "\n";
+    const int q[6][4] = {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4},
+                         {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}};
+    for (const auto& t : q)
+      text += "f " + std::to_string(t[0] + 1) + " " + std::to_string(t[1] + 1) + " " +
+              std::to_string(t[2] + 1) + " " + std::to_string(t[3] + 1) + "\n";
+    check_cube(read_triangle_mesh(dir.write("cube.obj", text)));
+  }
+  SECTION("ASCII STL repeats every corner; vertices are merged by position.") {
+    std::string text = "solid cube\n";
+    for (const auto& t : f) {
+      text += " facet normal 0 0 0\n  outer loop\n";
+      for (int k : t)
+        text += "   vertex " + std::to_string(c[k][0]) + " " + std::to_string(c[k][1]) + " " +
+                std::to_string(c[k][2]) + "\n";
+      text += "  endloop\n endfacet\n";
+    }
+    text += "endsolid cube\n";
+    check_cube(read_triangle_mesh(dir.write("cube.stl", text)));
+  }
+  SECTION("A file with no triangles is an error.") {
+    const std::string path = dir.write("empty.obj", "v 0 0 0\nv 1 0 0\n");
+    CHECK_THROWS_AS(read_triangle_mesh(path), InputError);
+  }
+  SECTION("A missing file is an error naming it.") {
+    CHECK_THAT(error_of([&] { read_triangle_mesh(dir.file("nope.obj")); }),
+               Catch::Contains("cannot open"));
+  }
+}
