@@ -38,6 +38,31 @@ grep -q '"vertices": 6, "faces": 2' "$work/soup.json" || fail "frames JSON heade
 grep -q '{"kind": "vf", "vertex": 3, "face": \[0, 1, 2\], "toi": 0.4999' "$work/soup.json" ||
   fail "frames JSON contact: $(cat "$work/soup.json")"
 
+# The BVH finds the same contacts as all face pairs, on a random soup: 150 separate small
+# triangles and a strip of 100 triangles sharing vertices, moving randomly.
+awk -v out0="$work/r0.ply" -v out1="$work/r1.ply" 'BEGIN {
+  srand(5); nv = 552; nf = 250
+  for (f = 0; f < 2; f++) {
+    o = f ? out1 : out0
+    printf "ply\nformat ascii 1.0\nelement vertex %d\nproperty double x\nproperty double y\nproperty double z\nelement face %d\nproperty list uchar int vertex_indices\nend_header\n", nv, nf > o
+  }
+  for (i = 0; i < 150; i++) { cx = rand(); cy = rand(); cz = rand()
+    for (k = 0; k < 3; k++) { x = cx + 0.15 * rand(); y = cy + 0.15 * rand(); z = cz + 0.15 * rand()
+      print x, y, z > out0; print x + 0.2 * (rand() - 0.5), y + 0.2 * (rand() - 0.5), z + 0.2 * (rand() - 0.5) > out1 } }
+  for (i = 0; i < 102; i++) { x = i / 102; y = 0.5 + 0.05 * (i % 2); z = 0.3 + 0.4 * rand()
+    print x, y, z > out0; print x, y + 0.3 * (rand() - 0.5), z + 0.1 * (rand() - 0.5) > out1 }
+  for (f = 0; f < 2; f++) { o = f ? out1 : out0
+    for (i = 0; i < 150; i++) print 3, 3 * i, 3 * i + 1, 3 * i + 2 > o
+    for (i = 0; i < 100; i++) print 3, 450 + i, 451 + i, 452 + i > o }
+}'
+for sep in 0 0.01; do
+  "$tool" frames "$work/r0.ply" "$work/r1.ply" --min-separation $sep 2>/dev/null > "$work/bvh"
+  "$tool" frames "$work/r0.ply" "$work/r1.ply" --min-separation $sep --brute 2>/dev/null > "$work/brute"
+  [ "$(wc -l < "$work/brute")" -gt 20 ] || fail "random soup: too few contacts to compare"
+  cmp -s "$work/bvh" "$work/brute" || fail "random soup (min separation $sep): BVH and brute force differ"
+  echo "random soup, min separation $sep: $(wc -l < "$work/bvh") contacts, BVH = brute force"
+done
+
 if [ ! -d "$data" ]; then
   echo "WARN: reference data not found under $data: data checks skipped" >&2
   exit 0

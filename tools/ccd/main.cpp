@@ -158,13 +158,13 @@ io::Mesh load_mesh(const std::string& path) {
 }
 
 int command_frames(const std::string& path0, const std::string& path1, bool json,
-                   const tetseg::CcdOptions& options) {
+                   const tetseg::CcdOptions& options, bool brute) {
   const io::Mesh m0 = load_mesh(path0);
   const io::Mesh m1 = load_mesh(path1);
   if (m0.vertices.size() != m1.vertices.size())
     throw ToolError(kExitBadInput, path1, "vertex count differs from " + path0);
   if (m0.faces != m1.faces) throw ToolError(kExitBadInput, path1, "faces differ from " + path0);
-  const auto contacts = soup::find_contacts(m0.vertices, m1.vertices, m0.faces, options);
+  const auto contacts = soup::find_contacts(m0.vertices, m1.vertices, m0.faces, options, brute);
   std::ostringstream out;
   char buf[160];
   if (json) {
@@ -271,6 +271,8 @@ int main(int argc, char** argv) {
   frames->add_option("t0", ply0, "Frame at the start of the step (PLY)")->required();
   frames->add_option("t1", ply1, "Frame at the end of the step (PLY, same faces)")->required();
   frames->add_flag("--json", json, "Print JSON");
+  bool brute = false;
+  frames->add_flag("--brute", brute, "All face pairs instead of the BVH (quadratic; for tests)");
   frames
       ->add_option("--min-separation", options.min_separation, "Minimum separation (length units)")
       ->check(CLI::NonNegativeNumber);
@@ -291,7 +293,7 @@ int main(int argc, char** argv) {
   }
   try {
     if (queries->parsed()) return command_queries(dir, json, method, options);
-    if (frames->parsed()) return command_frames(ply0, ply1, json, options);
+    if (frames->parsed()) return command_frames(ply0, ply1, json, options, brute);
     return command_truth(truth_ply, boxes_path, bools_path, kind);
   } catch (const ToolError& e) {
     print_error(kTool, e.file(), e.what());

@@ -78,7 +78,7 @@ bool shares(const std::array<std::uint32_t, 3>& f, std::uint32_t v) {
 std::vector<Contact> find_contacts(const std::vector<std::array<double, 3>>& x0,
                                    const std::vector<std::array<double, 3>>& x1,
                                    const std::vector<std::array<std::uint32_t, 3>>& faces,
-                                   const CcdOptions& options) {
+                                   const CcdOptions& options, bool brute) {
   const double delta = options.min_separation > 0 ? options.min_separation : 0.0;
   // Swept vertex boxes, enlarged by the minimum separation (rounded outwards).
   std::vector<Box> vertex_boxes(x0.size());
@@ -139,8 +139,13 @@ std::vector<Contact> find_contacts(const std::vector<std::array<double, 3>>& x0,
         if (face_boxes[f].overlaps(face_boxes[g])) face_pair(f, g);
       }
   };
+  if (brute) {
+    for (std::uint32_t f = 0; f < faces.size(); ++f)
+      for (std::uint32_t g = f + 1; g < faces.size(); ++g)
+        if (face_boxes[f].overlaps(face_boxes[g])) face_pair(f, g);
+  }
   std::vector<std::pair<std::int32_t, std::int32_t>> stack;
-  if (!bvh.nodes.empty()) stack.push_back({0, 0});
+  if (!bvh.nodes.empty() && !brute) stack.push_back({0, 0});
   while (!stack.empty()) {
     const auto [pi, qi] = stack.back();
     stack.pop_back();

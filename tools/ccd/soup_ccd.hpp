@@ -21,10 +21,11 @@ struct Contact {
 };
 
 /// Contacts sorted by kind (vf first) then ids. Vertices not referenced by a face are ignored.
-/// Preconditions: face indices < x0.size() == x1.size().
+/// Preconditions: face indices < x0.size() == x1.size(). `brute` replaces the BVH by all
+/// face pairs (quadratic; a reference for tests).
 std::vector<Contact> find_contacts(const std::vector<std::array<double, 3>>& x0,
                                    const std::vector<std::array<double, 3>>& x1,
                                    const std::vector<std::array<std::uint32_t, 3>>& faces,
-                                   const CcdOptions& options);
+                                   const CcdOptions& options, bool brute = false);
 
 }  // namespace tetseg::tools::soup
