@@ -55,10 +55,61 @@ TEST_CASE("Every truncated prefix of a valid asset is rejected", "[format][hosti
                                     bytes.begin() + static_cast<std::ptrdiff_t>(len));
       reseal(cut);
       Asset out = dirty();
-      CHECK(read_exact(cut, out) == Status::kDecodeFailed);
+      Status s;
+      std::size_t largest = 0;
+      {
+        AllocationProbe probe;
+        s = read_exact(cut, out);
+        largest = probe.largest();
+      }
+      CHECK(s == Status::kDecodeFailed);
       CHECK(is_empty(out));
+      CHECK(largest <= 4 * len + 1024);
     }
   }
+}
+
+TEST_CASE("Any payload byte changed behind a consistent envelope is decoded safely",
+          "[format][hostile]") {
+  // Every payload byte is set to each of a few values and the envelope resealed, so the
+  // change reaches the decoder and the validator. Whatever the status, a failure leaves the
+  // asset empty, an accepted result re-writes to the same bytes, and no single allocation
+  // exceeds a small multiple of the input size.
+  const auto good = write_asset(make_octahedron_asset());
+  std::size_t accepted = 0;
+  std::size_t decode_failed = 0;
+  std::size_t invalid = 0;
+  for (std::size_t at = kHeaderBytes; at < good.size(); ++at) {
+    for (std::uint8_t value : {0x00, 0x01, 0x7F, 0x80, 0xFF}) {
+      if (good[at] == value) continue;
+      CAPTURE(at, int(value));
+      auto b = good;
+      b[at] = value;
+      reseal(b);
+      Asset out = dirty();
+      Status s;
+      std::size_t largest = 0;
+      {
+        AllocationProbe probe;
+        s = read_exact(b, out);
+        largest = probe.largest();
+      }
+      CHECK(largest <= 4 * b.size() + 1024);
+      if (s == Status::kOk) {
+        ++accepted;
+        CHECK(write_asset(out) == b);
+      } else {
+        CHECK(is_empty(out));
+        CHECK((s == Status::kDecodeFailed || s == Status::kInvalidContent));
+        (s == Status::kDecodeFailed ? decode_failed : invalid) += 1;
+      }
+    }
+  }
+  // All three outcomes occur: changed coordinates load, changed sizes do not decode, changed
+  // indices are invalid.
+  CHECK(accepted > 0);
+  CHECK(decode_failed > 0);
+  CHECK(invalid > 0);
 }
 
 TEST_CASE("Bytes after the payload are rejected", "[format][hostile]") {

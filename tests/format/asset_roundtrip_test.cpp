@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <fstream>
 #include <set>
+#include <thread>
 
 #include "format/test_assets.hpp"
 
@@ -147,6 +148,32 @@ TEST_CASE("The golden asset of version 1.0 still loads with its original content
       const Vec3& d = loaded.rest_positions[c.detector_node];
       CHECK(std::abs(d[0]) + std::abs(d[1]) + std::abs(d[2]) < 1.0);  // strictly inside
     }
+  }
+}
+
+TEST_CASE("Concurrent reads of shared bytes agree", "[format]") {
+  const Asset a = make_cube_asset(6);
+  const auto bytes = write_asset(a);
+  auto bad = bytes;
+  bad[bad.size() / 2] ^= 0x40;
+  std::vector<int> ok(4, 0);
+  std::vector<int> rejected(4, 0);
+  std::vector<std::thread> threads;
+  for (int t = 0; t < 4; ++t) {
+    threads.emplace_back([&, t] {
+      for (int i = 0; i < 20; ++i) {
+        Asset out;
+        if (read_asset(bytes.data(), bytes.size(), out) == Status::kOk && assets_equal(out, a))
+          ++ok[t];
+        if (read_asset(bad.data(), bad.size(), out) == Status::kPayloadChecksum && is_empty(out))
+          ++rejected[t];
+      }
+    });
+  }
+  for (std::thread& th : threads) th.join();
+  for (int t = 0; t < 4; ++t) {
+    CHECK(ok[t] == 20);
+    CHECK(rejected[t] == 20);
   }
 }
 
