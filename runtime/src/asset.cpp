@@ -24,11 +24,13 @@ Status load_asset_file(const std::string& path, Asset& out, std::string* detail)
                                     std::istreambuf_iterator<char>());
     if (in.bad()) {
       if (detail) *detail = "read error";
+      out.m_data = format::Asset{};
       return Status::kIoError;
     }
     return load_asset(bytes.data(), bytes.size(), out, detail);
   } catch (...) {
     if (detail) *detail = "out of memory while reading";
+    out.m_data = format::Asset{};
     return Status::kIoError;
   }
 }
