@@ -172,18 +172,20 @@ NearField build_near_field(const PanelSet& panels, const ClusterTree& tree) {
 
 TreecodeOperator::TreecodeOperator(const PanelSet& panels, const ClusterTree& tree,
                                    const NearField& near, double theta, int order)
-    : m_n(panels.size()), m_order(std::max(order, 0)), m_tree(tree), m_near(near) {
+    : m_n(panels.size()), m_order(std::clamp(order, 0, 16)), m_tree(tree), m_near(near) {
   // Multi-index tables.
   const int p = m_order;
   std::vector<int> lookup(static_cast<std::size_t>((p + 1) * (p + 1) * (p + 1)), -1);
-  auto at = [&](int a, int b, int c) -> int& {
+  auto at = [&](int a, int b, int c) -> int {
+    if (a < 0 || b < 0 || c < 0 || a + b + c > p) return -1;
     return lookup[static_cast<std::size_t>((a * (p + 1) + b) * (p + 1) + c)];
   };
   for (int total = 0; total <= p; ++total) {
     for (int a = total; a >= 0; --a) {
       for (int b = total - a; b >= 0; --b) {
         const int c = total - a - b;
-        at(a, b, c) = static_cast<int>(m_index.size());
+        lookup[static_cast<std::size_t>((a * (p + 1) + b) * (p + 1) + c)] =
+            static_cast<int>(m_index.size());
         m_index.push_back({a, b, c});
       }
     }
@@ -192,14 +194,10 @@ TreecodeOperator::TreecodeOperator(const PanelSet& panels, const ClusterTree& tr
     std::array<int, 3> m1{-1, -1, -1}, m2{-1, -1, -1};
     for (int i = 0; i < 3; ++i) {
       std::array<int, 3> q = k;
-      if (q[i] >= 1) {
-        --q[i];
-        m1[i] = at(q[0], q[1], q[2]);
-      }
-      if (q[i] >= 1) {
-        --q[i];
-        m2[i] = at(q[0], q[1], q[2]);
-      }
+      q[i] -= 1;
+      m1[i] = at(q[0], q[1], q[2]);
+      q[i] -= 1;
+      m2[i] = at(q[0], q[1], q[2]);
     }
     m_minus1.push_back(m1);
     m_minus2.push_back(m2);
@@ -209,15 +207,26 @@ TreecodeOperator::TreecodeOperator(const PanelSet& panels, const ClusterTree& tr
     for (int i = 1; i <= b; ++i) r = r * (a - b + i) / i;
     return r;
   };
-  for (std::size_t ni = 0; ni < m_index.size(); ++ni) {
-    for (std::size_t mi = 0; mi < m_index.size(); ++mi) {
-      const auto& n = m_index[ni];
-      const auto& m = m_index[mi];
-      if (n[0] + n[1] + n[2] + m[0] + m[1] + m[2] > p) continue;
-      double coef = ((m[0] + m[1] + m[2]) % 2) ? -1.0 : 1.0;
-      for (int i = 0; i < 3; ++i) coef *= binom(n[i] + m[i], n[i]);
-      m_terms.push_back({static_cast<int>(ni), static_cast<int>(mi),
-                         at(n[0] + m[0], n[1] + m[1], n[2] + m[2]), coef});
+  const int kc = static_cast<int>(m_index.size());
+  for (int ni = 0; ni < kc; ++ni) {
+    for (int mi = 0; mi < kc; ++mi) {
+      const auto& n = m_index[static_cast<std::size_t>(ni)];
+      const auto& m = m_index[static_cast<std::size_t>(mi)];
+      // M2L: 1/|R + u - s| = sum_k D_k(R) (u - s)^k, D_k the Taylor coefficients.
+      const int sum = at(n[0] + m[0], n[1] + m[1], n[2] + m[2]);
+      if (sum >= 0) {
+        double coef = ((m[0] + m[1] + m[2]) % 2) ? -1.0 : 1.0;
+        for (int i = 0; i < 3; ++i) coef *= binom(n[i] + m[i], n[i]);
+        m_m2l.push_back({ni, mi, sum, coef});
+      }
+      // Shifts: (s + d)^n = sum_{m <= n} C(n, m) d^(n - m) s^m.
+      const int diff = at(n[0] - m[0], n[1] - m[1], n[2] - m[2]);
+      if (diff >= 0) {
+        double coef = 1.0;
+        for (int i = 0; i < 3; ++i) coef *= binom(n[i], m[i]);
+        m_m2m.push_back({ni, mi, diff, coef});  // M_n(parent) from M_m(child)
+        m_l2l.push_back({mi, ni, diff, coef});  // L_m(child) from L_n(parent)
+      }
     }
   }
 
@@ -232,53 +241,69 @@ TreecodeOperator::TreecodeOperator(const PanelSet& panels, const ClusterTree& tr
     m_z[k] = panels.centroid[j][2];
     m_area[k] = panels.area[j];
   }
-  const std::size_t leaf_count = tree.leaves.size();
-  std::vector<std::vector<std::int32_t>> far(leaf_count), direct(leaf_count);
-#if defined(TETSEG_HAVE_OPENMP)
-#pragma omp parallel for schedule(dynamic, 8)
-#endif
-  for (std::ptrdiff_t ll = 0; ll < static_cast<std::ptrdiff_t>(leaf_count); ++ll) {
-    const std::size_t l = static_cast<std::size_t>(ll);
-    const Cluster& target = tree.nodes[static_cast<std::size_t>(tree.leaves[l])];
-    std::vector<std::int32_t> stack = {0};
-    while (!stack.empty()) {
-      const std::int32_t id = stack.back();
-      stack.pop_back();
-      const Cluster& s = tree.nodes[static_cast<std::size_t>(id)];
-      const double dx = s.center[0] - target.center[0];
-      const double dy = s.center[1] - target.center[1];
-      const double dz = s.center[2] - target.center[2];
-      const double dist = std::sqrt(dx * dx + dy * dy + dz * dz);
-      if (target.radius + s.radius < theta * dist) {
-        far[l].push_back(id);
-      } else if (s.left < 0) {
-        direct[l].push_back(id);
-      } else {
-        stack.push_back(s.right);
-        stack.push_back(s.left);
-      }
+  const std::size_t node_count = tree.nodes.size();
+  m_parent.assign(node_count, -1);
+  for (std::size_t id = 0; id < node_count; ++id) {
+    const Cluster& c = tree.nodes[id];
+    if (c.left >= 0) {
+      m_parent[static_cast<std::size_t>(c.left)] = static_cast<std::int32_t>(id);
+      m_parent[static_cast<std::size_t>(c.right)] = static_cast<std::int32_t>(id);
     }
   }
-  m_far_start.assign(leaf_count + 1, 0);
-  m_direct_start.assign(leaf_count + 1, 0);
-  double far_count = 0.0, direct_work = 0.0;
-  for (std::size_t l = 0; l < leaf_count; ++l) {
-    const Cluster& target = tree.nodes[static_cast<std::size_t>(tree.leaves[l])];
-    const double targets = target.end - target.begin;
-    m_far_start[l + 1] = m_far_start[l] + far[l].size();
+  m_leaf_of_node.assign(node_count, -1);
+  for (std::size_t l = 0; l < tree.leaves.size(); ++l) {
+    m_leaf_of_node[static_cast<std::size_t>(tree.leaves[l])] = static_cast<std::int32_t>(l);
+  }
+
+  // Dual-tree traversal: admissible pairs become M2L, leaf pairs direct sums, otherwise the
+  // larger cluster (or the one that is not a leaf) is split.
+  std::vector<std::vector<std::int32_t>> far(node_count), direct(tree.leaves.size());
+  std::vector<std::pair<std::int32_t, std::int32_t>> stack = {{0, 0}};
+  while (!stack.empty()) {
+    const auto [ti, si] = stack.back();
+    stack.pop_back();
+    const Cluster& t = tree.nodes[static_cast<std::size_t>(ti)];
+    const Cluster& s = tree.nodes[static_cast<std::size_t>(si)];
+    const double dx = s.center[0] - t.center[0];
+    const double dy = s.center[1] - t.center[1];
+    const double dz = s.center[2] - t.center[2];
+    const double dist = std::sqrt(dx * dx + dy * dy + dz * dz);
+    if (ti != si && t.radius + s.radius < theta * dist) {
+      far[static_cast<std::size_t>(ti)].push_back(si);
+      continue;
+    }
+    const bool t_leaf = t.left < 0, s_leaf = s.left < 0;
+    if (t_leaf && s_leaf) {
+      direct[static_cast<std::size_t>(m_leaf_of_node[static_cast<std::size_t>(ti)])].push_back(si);
+    } else if (s_leaf || (!t_leaf && t.radius >= s.radius)) {
+      stack.push_back({t.right, si});
+      stack.push_back({t.left, si});
+    } else {
+      stack.push_back({ti, s.right});
+      stack.push_back({ti, s.left});
+    }
+  }
+  m_far_start.assign(node_count + 1, 0);
+  for (std::size_t id = 0; id < node_count; ++id) {
+    m_far_start[id + 1] = m_far_start[id] + far[id].size();
+    m_far.insert(m_far.end(), far[id].begin(), far[id].end());
+  }
+  m_direct_start.assign(tree.leaves.size() + 1, 0);
+  double direct_work = 0.0;
+  for (std::size_t l = 0; l < tree.leaves.size(); ++l) {
+    const Cluster& t = tree.nodes[static_cast<std::size_t>(tree.leaves[l])];
+    std::sort(direct[l].begin(), direct[l].end());
     m_direct_start[l + 1] = m_direct_start[l] + direct[l].size();
-    m_far.insert(m_far.end(), far[l].begin(), far[l].end());
     m_direct.insert(m_direct.end(), direct[l].begin(), direct[l].end());
-    far_count += static_cast<double>(far[l].size());
     for (const std::int32_t id : direct[l]) {
       const Cluster& s = tree.nodes[static_cast<std::size_t>(id)];
-      direct_work += targets * (s.end - s.begin);
+      direct_work += static_cast<double>(t.end - t.begin) * (s.end - s.begin);
     }
   }
-  m_far_per_leaf = leaf_count ? far_count / static_cast<double>(leaf_count) : 0.0;
   m_direct_per_target = direct_work / static_cast<double>(m_n);
   m_charge.resize(m_n);
-  m_moments.assign(tree.nodes.size() * m_index.size(), 0.0);
+  m_moments.assign(node_count * m_index.size(), 0.0);
+  m_local.assign(node_count * m_index.size(), 0.0);
 }
 
 void TreecodeOperator::apply(const double* x, double* y) const {
@@ -287,6 +312,7 @@ void TreecodeOperator::apply(const double* x, double* y) const {
   const auto& nodes = m_tree.nodes;
   const auto& leaves = m_tree.leaves;
   const std::size_t kc = m_index.size();
+  const std::ptrdiff_t node_count = static_cast<std::ptrdiff_t>(nodes.size());
   double* charge = m_charge.data();
   const double* px = m_x.data();
   const double* py = m_y.data();
@@ -298,29 +324,33 @@ void TreecodeOperator::apply(const double* x, double* y) const {
     for (std::size_t k = 1; k < kc; ++k) {
       const auto& m1 = m_minus1[k];
       const int i = m1[0] >= 0 ? 0 : (m1[1] >= 0 ? 1 : 2);
-      out[k] = out[m1[i]] * w[i];
+      out[k] = out[m1[static_cast<std::size_t>(i)]] * w[i];
     }
+  };
+  auto shift = [&](const std::vector<Term>& terms, const double* d_mono, const double* from,
+                   double* to) {
+    for (const Term& t : terms) to[t.a] += t.coef * d_mono[t.c] * from[t.b];
   };
 #if defined(TETSEG_HAVE_OPENMP)
 #pragma omp parallel
 #endif
   {
-    std::vector<double> mono(kc), deriv(kc), local(kc), pot;
+    std::vector<double> mono(kc), deriv(kc), pot;
 #if defined(TETSEG_HAVE_OPENMP)
 #pragma omp for schedule(static)
 #endif
     for (std::ptrdiff_t k = 0; k < n; ++k) {
       charge[k] = m_area[static_cast<std::size_t>(k)] * x[order[static_cast<std::size_t>(k)]];
     }
-    // Moments straight from the members of each node (O(N depth K)).
+    // Upward pass: leaf moments from the members.
 #if defined(TETSEG_HAVE_OPENMP)
 #pragma omp for schedule(dynamic, 16)
 #endif
-    for (std::ptrdiff_t id = 0; id < static_cast<std::ptrdiff_t>(nodes.size()); ++id) {
-      const Cluster& c = nodes[static_cast<std::size_t>(id)];
-      double* mom = m_moments.data() + static_cast<std::size_t>(id) * kc;
+    for (std::ptrdiff_t ll = 0; ll < static_cast<std::ptrdiff_t>(leaves.size()); ++ll) {
+      const std::size_t id = static_cast<std::size_t>(leaves[static_cast<std::size_t>(ll)]);
+      const Cluster& c = nodes[id];
+      double* mom = m_moments.data() + id * kc;
       std::fill(mom, mom + kc, 0.0);
-      if (id == 0) continue;  // the root is never far from anything
       for (std::uint32_t k = c.begin; k < c.end; ++k) {
         monomials(px[k] - c.center[0], py[k] - c.center[1], pz[k] - c.center[2], mono.data());
         const double q = charge[k];
@@ -328,15 +358,33 @@ void TreecodeOperator::apply(const double* x, double* y) const {
       }
     }
 #if defined(TETSEG_HAVE_OPENMP)
-#pragma omp for schedule(dynamic, 4)
+#pragma omp single
 #endif
-    for (std::ptrdiff_t ll = 0; ll < static_cast<std::ptrdiff_t>(leaves.size()); ++ll) {
-      const std::size_t l = static_cast<std::size_t>(ll);
-      const Cluster& target = nodes[static_cast<std::size_t>(leaves[l])];
-      const std::uint32_t count = target.end - target.begin;
-      pot.assign(count, 0.0);
-      std::fill(local.begin(), local.end(), 0.0);
-      for (std::size_t f = m_far_start[l]; f < m_far_start[l + 1]; ++f) {
+    {
+      // Parents after children: children have larger ids than their parent.
+      for (std::ptrdiff_t id = node_count - 1; id >= 0; --id) {
+        const Cluster& c = nodes[static_cast<std::size_t>(id)];
+        if (c.left < 0) continue;
+        double* mom = m_moments.data() + static_cast<std::size_t>(id) * kc;
+        std::fill(mom, mom + kc, 0.0);
+        for (const std::int32_t child : {c.left, c.right}) {
+          const Cluster& ch = nodes[static_cast<std::size_t>(child)];
+          monomials(ch.center[0] - c.center[0], ch.center[1] - c.center[1],
+                    ch.center[2] - c.center[2], mono.data());
+          shift(m_m2m, mono.data(), m_moments.data() + static_cast<std::size_t>(child) * kc, mom);
+        }
+      }
+    }
+    // Multipole-to-local for every target cluster.
+#if defined(TETSEG_HAVE_OPENMP)
+#pragma omp for schedule(dynamic, 8)
+#endif
+    for (std::ptrdiff_t ti = 0; ti < node_count; ++ti) {
+      const Cluster& target = nodes[static_cast<std::size_t>(ti)];
+      double* local = m_local.data() + static_cast<std::size_t>(ti) * kc;
+      std::fill(local, local + kc, 0.0);
+      for (std::size_t f = m_far_start[static_cast<std::size_t>(ti)];
+           f < m_far_start[static_cast<std::size_t>(ti) + 1]; ++f) {
         const Cluster& s = nodes[static_cast<std::size_t>(m_far[f])];
         const double* mom = m_moments.data() + static_cast<std::size_t>(m_far[f]) * kc;
         const double r[3] = {target.center[0] - s.center[0], target.center[1] - s.center[1],
@@ -349,13 +397,43 @@ void TreecodeOperator::apply(const double* x, double* y) const {
           const int order_k = idx[0] + idx[1] + idx[2];
           double s1 = 0.0, s2 = 0.0;
           for (int i = 0; i < 3; ++i) {
-            if (m_minus1[k][i] >= 0) s1 += r[i] * deriv[m_minus1[k][i]];
-            if (m_minus2[k][i] >= 0) s2 += deriv[m_minus2[k][i]];
+            if (m_minus1[k][static_cast<std::size_t>(i)] >= 0)
+              s1 +=
+                  r[i] * deriv[static_cast<std::size_t>(m_minus1[k][static_cast<std::size_t>(i)])];
+            if (m_minus2[k][static_cast<std::size_t>(i)] >= 0)
+              s2 += deriv[static_cast<std::size_t>(m_minus2[k][static_cast<std::size_t>(i)])];
           }
           deriv[k] = -((2 * order_k - 1) * s1 + (order_k - 1) * s2) / (order_k * r2);
         }
-        for (const Term& t : m_terms) local[t.n] += t.coef * deriv[t.k] * mom[t.m];
+        for (const Term& t : m_m2l)
+          local[t.a] += t.coef * deriv[static_cast<std::size_t>(t.c)] * mom[t.b];
       }
+    }
+#if defined(TETSEG_HAVE_OPENMP)
+#pragma omp single
+#endif
+    {
+      // Downward pass: parents before children.
+      for (std::ptrdiff_t id = 1; id < node_count; ++id) {
+        const Cluster& c = nodes[static_cast<std::size_t>(id)];
+        const std::int32_t parent = m_parent[static_cast<std::size_t>(id)];
+        const Cluster& pc = nodes[static_cast<std::size_t>(parent)];
+        monomials(c.center[0] - pc.center[0], c.center[1] - pc.center[1],
+                  c.center[2] - pc.center[2], mono.data());
+        shift(m_l2l, mono.data(), m_local.data() + static_cast<std::size_t>(parent) * kc,
+              m_local.data() + static_cast<std::size_t>(id) * kc);
+      }
+    }
+    // Leaves: evaluate the local expansion and the direct sums.
+#if defined(TETSEG_HAVE_OPENMP)
+#pragma omp for schedule(dynamic, 4)
+#endif
+    for (std::ptrdiff_t ll = 0; ll < static_cast<std::ptrdiff_t>(leaves.size()); ++ll) {
+      const std::size_t l = static_cast<std::size_t>(ll);
+      const std::size_t id = static_cast<std::size_t>(leaves[l]);
+      const Cluster& target = nodes[id];
+      const double* local = m_local.data() + id * kc;
+      pot.assign(target.end - target.begin, 0.0);
       for (std::uint32_t k = target.begin; k < target.end; ++k) {
         monomials(px[k] - target.center[0], py[k] - target.center[1], pz[k] - target.center[2],
                   mono.data());

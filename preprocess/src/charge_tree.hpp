@@ -42,43 +42,52 @@ struct NearField {
 
 NearField build_near_field(const PanelSet& panels, const ClusterTree& tree);
 
-/// y = M x with M's far part (point charges) approximated by a Cartesian Taylor treecode:
-/// every source cluster carries its moments up to total order `order` about its box centre;
-/// each target leaf gathers the far clusters (r_leaf + r_cluster < theta * distance) into one
-/// local Taylor expansion of total order `order` about its own centre (multipole-to-local,
-/// truncated at |n| + |m| <= order, error ~ theta^(order + 1)) and evaluates it at its
-/// targets; the rest is summed directly, and the near field is exact. Interaction lists are
-/// built once in the constructor. apply() uses internal scratch: one caller at a time.
+/// y = M x with M's far part (point charges) approximated by a Cartesian Taylor fast
+/// multipole method on the binary cluster tree: moments up to total order `order` (leaves
+/// from their members, parents by exact shifts), a dual-tree traversal that turns every pair
+/// of clusters with (r_target + r_source) < theta * distance into a multipole-to-local
+/// translation truncated at total order `order` (error ~ theta^(order + 1)), exact local
+/// shifts down the tree, and direct sums between the remaining leaf pairs. The near field is
+/// exact. Interaction lists are built once in the constructor; apply() uses internal scratch
+/// buffers, so one caller at a time.
 class TreecodeOperator {
  public:
   TreecodeOperator(const PanelSet& panels, const ClusterTree& tree, const NearField& near,
                    double theta, int order);
   std::size_t size() const { return m_n; }
   void apply(const double* x, double* y) const;
-  /// Average number of far clusters and direct source points per target (cost indicators).
-  double far_per_leaf() const { return m_far_per_leaf; }
+  /// Cost indicators: multipole-to-local translations, and direct source points per target.
+  std::size_t m2l_count() const { return m_far.size(); }
   double direct_per_target() const { return m_direct_per_target; }
 
  private:
+  void shift_terms(std::vector<std::array<int, 3>>& out, bool upward) const;
   std::size_t m_n;
   int m_order;
   const ClusterTree& m_tree;
   const NearField& m_near;
-  std::vector<double> m_x, m_y, m_z, m_area;             ///< sources in tree order
-  std::vector<std::size_t> m_far_start, m_direct_start;  ///< per leaf (CSR)
-  std::vector<std::int32_t> m_far, m_direct;             ///< node ids
-  double m_far_per_leaf = 0.0, m_direct_per_target = 0.0;
+  std::vector<double> m_x, m_y, m_z, m_area;  ///< sources in tree order
+  std::vector<std::int32_t> m_parent;         ///< per node, -1 for the root
+  std::vector<std::int32_t> m_leaf_of_node;   ///< leaf index or -1
+  std::vector<std::size_t> m_far_start;       ///< per node (CSR): M2L sources
+  std::vector<std::int32_t> m_far;
+  std::vector<std::size_t> m_direct_start;  ///< per leaf (CSR): source leaves (node ids)
+  std::vector<std::int32_t> m_direct;
+  double m_direct_per_target = 0.0;
   // Multi-indices k with |k| <= order, graded order.
   std::vector<std::array<int, 3>> m_index;
   std::vector<std::array<int, 3>> m_minus1;  ///< index of k - e_i, or -1
   std::vector<std::array<int, 3>> m_minus2;  ///< index of k - 2 e_i, or -1
   struct Term {
-    int n, m, k;
+    int a, b, c;
     double coef;
   };
-  std::vector<Term> m_terms;  ///< L_n += coef * D_k(R) * M_m with k = n + m
+  std::vector<Term> m_m2l;  ///< L_a += coef * D_c(R) * M_b with c = a + b
+  std::vector<Term> m_m2m;  ///< M_a(parent) += coef * d^c * M_b(child), c = a - b
+  std::vector<Term> m_l2l;  ///< L_a(child) += coef * d^c * L_b(parent), c = b - a
   mutable std::vector<double> m_charge;
   mutable std::vector<double> m_moments;  ///< nodes x index count
+  mutable std::vector<double> m_local;    ///< nodes x index count
 };
 
 }  // namespace tetseg::preprocess::charge_detail
