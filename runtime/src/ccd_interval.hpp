@@ -56,8 +56,12 @@ inline Iv divide(Iv a, double k) noexcept {
 
 /// Minimum / maximum that propagate NaN from either argument (std::fmin drops NaN, and is an
 /// out-of-line call without -ffast-math).
-inline double min_nan(double a, double b) noexcept { return (a < b || a != a) ? a : b; }
-inline double max_nan(double a, double b) noexcept { return (a > b || a != a) ? a : b; }
+inline double min_nan(double a, double b) noexcept {
+  return (a < b || a != a) ? a : b;
+}
+inline double max_nan(double a, double b) noexcept {
+  return (a > b || a != a) ? a : b;
+}
 
 /// Rounded-down lower end and rounded-up upper end of an interval.
 inline double lower(Iv a) noexcept {
@@ -85,21 +89,129 @@ inline double mul_up(double x, double y) noexcept {
   return x * y * (1.0 + 0x1p-50) + kTiny;
 }
 
-struct IvVec {
-  Iv x, y, z;
+// ---------------------------------------------------------------------------------------------
+// Double-double midpoint with a double radius: Dd {hi, lo, r} stands for [hi+lo-r, hi+lo+r].
+// Sums and products of the midpoints use the double-word algorithms of Joldes, Muller and
+// Popescu ("Tight and rigorous error bounds for basic building blocks of double-word
+// arithmetic", ACM TOMS 2017): AccurateDWPlusDW (relative error < 3u^2 + 13u^3) and
+// DWTimesDW3 (relative error < 4u^2), u = 2^-53. The radius charges 2^-96 |result| per
+// operation (more than 1000 u^2, a wide margin over both bounds) plus the propagated radii,
+// rounded upwards as for Iv. Used only where doubles cannot decide (near-degenerate leaves).
+
+constexpr double kRelDd = 0x1p-96;
+
+struct Dd {
+  double hi;
+  double lo;
+  double r;
 };
 
-inline IvVec operator-(const IvVec& a, const IvVec& b) noexcept {
+inline void two_sum(double a, double b, double& s, double& e) noexcept {
+  s = a + b;
+  const double bb = s - a;
+  e = (a - (s - bb)) + (b - bb);
+}
+inline void fast_two_sum(double a, double b, double& s, double& e) noexcept {
+  s = a + b;
+  e = b - (s - a);
+}
+inline void two_prod(double a, double b, double& p, double& e) noexcept {
+  p = a * b;
+  e = std::fma(a, b, -p);
+}
+
+inline Dd exact_dd(double x) noexcept {
+  return {x, 0.0, 0.0};
+}
+
+inline Dd operator+(Dd a, Dd b) noexcept {
+  double sh, sl, th, tl, vh, vl, zh, zl;
+  two_sum(a.hi, b.hi, sh, sl);
+  two_sum(a.lo, b.lo, th, tl);
+  const double c = sl + th;
+  fast_two_sum(sh, c, vh, vl);
+  const double w = tl + vl;
+  fast_two_sum(vh, w, zh, zl);
+  return {zh, zl, (a.r + b.r + kRelDd * std::fabs(zh)) * kUp + kTiny};
+}
+
+inline Dd operator-(Dd a) noexcept {
+  return {-a.hi, -a.lo, a.r};
+}
+inline Dd operator-(Dd a, Dd b) noexcept {
+  return a + (-b);
+}
+
+inline Dd operator*(Dd a, Dd b) noexcept {
+  double ch, cl1, zh, zl;
+  two_prod(a.hi, b.hi, ch, cl1);
+  const double tl0 = a.lo * b.lo;
+  const double tl1 = std::fma(a.hi, b.lo, tl0);
+  const double cl2 = std::fma(a.lo, b.hi, tl1);
+  const double cl3 = cl1 + cl2;
+  fast_two_sum(ch, cl3, zh, zl);
+  // |a.hi + a.lo| <= |a.hi| (1 + 2^-52): magnitudes bounded through the hi parts.
+  const double ma = std::fabs(a.hi) * (1.0 + 0x1p-51);
+  const double mb = std::fabs(b.hi) * (1.0 + 0x1p-51);
+  return {zh, zl, (ma * b.r + mb * a.r + a.r * b.r + kRelDd * std::fabs(zh)) * kUp + kTiny};
+}
+
+/// Division by a small positive integer k: multiplication by a double-double enclosure of
+/// 1/k (hi = RN(1/k), lo = RN((1 - k hi) / k) with 1 - k hi exact by fma, radius 2^-100).
+inline Dd divide(Dd a, double k) noexcept {
+  const double h = 1.0 / k;
+  const double l = std::fma(-h, k, 1.0) / k;
+  return a * Dd{h, l, 0x1p-100};
+}
+
+/// Conversion to a double interval (hi, radius |lo| + r rounded up).
+inline Iv to_iv(Dd a) noexcept {
+  return {a.hi, (std::fabs(a.lo) + a.r) * kUp + kTiny};
+}
+inline Iv to_iv(Iv a) noexcept {
+  return a;
+}
+
+inline double lower(Dd a) noexcept {
+  return lower(to_iv(a));
+}
+inline double upper(Dd a) noexcept {
+  return upper(to_iv(a));
+}
+
+/// Constructors by type, for templates.
+template <class I>
+I make(double x) noexcept;
+template <>
+inline Iv make<Iv>(double x) noexcept {
+  return exact(x);
+}
+template <>
+inline Dd make<Dd>(double x) noexcept {
+  return exact_dd(x);
+}
+
+template <class I>
+struct Vec {
+  I x, y, z;
+};
+using IvVec = Vec<Iv>;
+
+template <class I>
+inline Vec<I> operator-(const Vec<I>& a, const Vec<I>& b) noexcept {
   return {a.x - b.x, a.y - b.y, a.z - b.z};
 }
-inline IvVec cross(const IvVec& a, const IvVec& b) noexcept {
+template <class I>
+inline Vec<I> cross(const Vec<I>& a, const Vec<I>& b) noexcept {
   return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
 }
-inline Iv dot(const IvVec& a, const IvVec& b) noexcept {
+template <class I>
+inline I dot(const Vec<I>& a, const Vec<I>& b) noexcept {
   return a.x * b.x + a.y * b.y + a.z * b.z;
 }
-inline IvVec hull(const IvVec& a, const IvVec& b) noexcept {
-  return {hull(a.x, b.x), hull(a.y, b.y), hull(a.z, b.z)};
+template <class I>
+inline IvVec hull(const Vec<I>& a, const Vec<I>& b) noexcept {
+  return {hull(to_iv(a.x), to_iv(b.x)), hull(to_iv(a.y), to_iv(b.y)), hull(to_iv(a.z), to_iv(b.z))};
 }
 
 /// Rigorous enclosure [lo, hi] of a real function over a time interval.
