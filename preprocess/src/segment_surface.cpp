@@ -35,8 +35,7 @@ class Segmenter {
         m_options(options),
         m_mesh(surface.triangles),
         m_n(static_cast<std::uint32_t>(surface.triangles.size())),
-        m_in_set(m_n, 0),
-        m_cut(3 * static_cast<std::size_t>(m_n), 0) {
+        m_in_set(m_n, 0) {
     m_min_cluster = options.min_cluster_triangles > 0 ? options.min_cluster_triangles
                                                       : derived_min_cluster_triangles(m_n);
   }
@@ -57,6 +56,8 @@ class Segmenter {
   bool grow(std::vector<std::uint32_t>& set);
   void shrink(std::vector<std::uint32_t>& set);
   bool pick_boundary(const std::vector<std::uint32_t>& set);
+  std::vector<std::uint32_t> cluster_labels(const std::vector<std::uint8_t>& active,
+                                            std::uint32_t& pieces);
   void make_clusters(Segmentation& out);
 
   const std::vector<Vec3>& m_nodes;
@@ -67,7 +68,6 @@ class Segmenter {
   std::uint32_t m_n;
   std::uint32_t m_min_cluster = 1;
   std::vector<std::uint8_t> m_in_set;               // the segment being processed
-  std::vector<std::uint8_t> m_cut;                  // per half-edge: on a chosen segment boundary
   std::vector<std::vector<std::uint32_t>> m_loops;  // half-edges of chosen boundaries
   std::vector<std::uint32_t> m_labels;              // scratch
   SegmentationCounts m_counts;
@@ -199,23 +199,30 @@ bool Segmenter::pick_boundary(const std::vector<std::uint32_t>& set) {
     std::uint32_t left = labels[c.half_edges.front() / 3];
     std::uint32_t right = m_mesh.neighbor(c.half_edges.front());
     if (right == kNone || labels[right] == left) continue;
-    for (std::uint32_t h : c.half_edges) {
-      m_cut[h] = 1;
-      if (m_mesh.twin(h) != kNone) m_cut[m_mesh.twin(h)] = 1;
-    }
     m_loops.push_back(c.half_edges);
     return true;
   }
   return false;
 }
 
-// Clusters: components of the surface cut along every boundary; clusters smaller than the
-// minimum merge into the neighbour sharing the longest boundary (smallest cluster first, ties
-// by id); boundaries that no longer separate two clusters are dropped.
-void Segmenter::make_clusters(Segmentation& out) {
+// Clusters: components of the surface cut along the active boundaries; clusters smaller than
+// the minimum merge into the neighbour sharing the longest boundary (smallest cluster first,
+// ties by id). Returns the label per triangle (not yet renumbered); `pieces` receives the
+// number of components before merging.
+std::vector<std::uint32_t> Segmenter::cluster_labels(const std::vector<std::uint8_t>& active,
+                                                     std::uint32_t& pieces) {
+  std::vector<std::uint8_t> cut(3 * static_cast<std::size_t>(m_n), 0);
+  for (std::size_t l = 0; l < m_loops.size(); ++l) {
+    if (!active[l]) continue;
+    for (std::uint32_t h : m_loops[l]) {
+      cut[h] = 1;
+      if (m_mesh.twin(h) != kNone) cut[m_mesh.twin(h)] = 1;
+    }
+  }
   const std::vector<std::uint8_t> all(m_n, 1);
   std::vector<std::uint32_t> labels;
-  const std::uint32_t count = detail::label_components(m_mesh, all, &m_cut, labels);
+  const std::uint32_t count = detail::label_components(m_mesh, all, &cut, labels);
+  pieces = count;
   std::vector<std::vector<std::uint32_t>> members(count);
   for (std::uint32_t t = 0; t < m_n; ++t) members[labels[t]].push_back(t);
   std::vector<std::uint8_t> alive(count, 1), stuck(count, 0);
@@ -248,10 +255,48 @@ void Segmenter::make_clusters(Segmentation& out) {
     members[small].clear();
     alive[small] = 0;
     --alive_count;
-    ++m_counts.clusters_merged;
+  }
+  return labels;
+}
+
+// Clusters and the boundaries that remain. A boundary some edge of which ends up inside one
+// cluster (after merging, or when boundaries overlap) is dropped and the clusters are
+// recomputed from the remaining boundaries, until every remaining boundary edge lies between
+// two different clusters; then clusters differ only across boundary edges. Duplicate loops
+// (same edge set) are dropped first.
+void Segmenter::make_clusters(Segmentation& out) {
+  std::vector<std::uint8_t> active(m_loops.size(), 1);
+  std::set<std::vector<std::pair<std::uint32_t, std::uint32_t>>> seen;
+  for (std::size_t l = 0; l < m_loops.size(); ++l) {
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> edges;
+    for (std::uint32_t h : m_loops[l])
+      edges.emplace_back(std::min(m_mesh.from(h), m_mesh.to(h)),
+                         std::max(m_mesh.from(h), m_mesh.to(h)));
+    std::sort(edges.begin(), edges.end());
+    if (!seen.insert(edges).second) active[l] = 0;
+  }
+  std::vector<std::uint32_t> labels;
+  std::uint32_t initial_pieces = 0;
+  for (bool first = true;; first = false) {
+    std::uint32_t pieces = 0;
+    labels = cluster_labels(active, pieces);
+    if (first) initial_pieces = pieces;
+    bool dropped = false;
+    for (std::size_t l = 0; l < m_loops.size(); ++l) {
+      if (!active[l]) continue;
+      for (std::uint32_t h : m_loops[l]) {
+        const std::uint32_t u = m_mesh.neighbor(h);
+        if (u == kNone || labels[u] == labels[h / 3]) {
+          active[l] = 0;
+          dropped = true;
+          break;
+        }
+      }
+    }
+    if (!dropped) break;
   }
   // Renumber by smallest triangle id.
-  std::vector<std::uint32_t> renumber(count, kNone);
+  std::vector<std::uint32_t> renumber(m_n, kNone);
   std::uint32_t next = 0;
   out.triangle_cluster.assign(m_n, 0);
   for (std::uint32_t t = 0; t < m_n; ++t) {
@@ -259,23 +304,12 @@ void Segmenter::make_clusters(Segmentation& out) {
     out.triangle_cluster[t] = renumber[labels[t]];
   }
   out.cluster_count = next;
-
-  // Keep boundaries whose every edge separates two clusters; drop duplicates.
-  std::set<std::vector<std::pair<std::uint32_t, std::uint32_t>>> seen;
-  for (const std::vector<std::uint32_t>& loop : m_loops) {
-    bool keep = true;
-    std::vector<std::pair<std::uint32_t, std::uint32_t>> edges;
-    for (std::uint32_t h : loop) {
-      const std::uint32_t u = m_mesh.neighbor(h);
-      if (u == kNone || out.triangle_cluster[u] == out.triangle_cluster[h / 3]) keep = false;
-      edges.emplace_back(std::min(m_mesh.from(h), m_mesh.to(h)),
-                         std::max(m_mesh.from(h), m_mesh.to(h)));
-    }
-    std::sort(edges.begin(), edges.end());
-    if (!keep || !seen.insert(edges).second) continue;
+  m_counts.clusters_merged = initial_pieces - next;
+  for (std::size_t l = 0; l < m_loops.size(); ++l) {
+    if (!active[l]) continue;
     std::vector<std::uint32_t> nodes;
     double length = 0.0;
-    for (std::uint32_t h : loop) {
+    for (std::uint32_t h : m_loops[l]) {
       nodes.push_back(m_mesh.from(h));
       length += edge_length(h);
     }

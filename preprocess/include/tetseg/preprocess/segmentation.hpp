@@ -44,7 +44,9 @@ struct SegmentationCounts {
   std::uint32_t segments_shrunk = 0;  ///< separating segments shrunk to cutting triangles
   std::uint32_t boundaries = 0;       ///< segment boundaries kept (== boundary_loops.size())
   std::uint32_t clusters = 0;         ///< == cluster_count
-  std::uint32_t clusters_merged = 0;  ///< small clusters merged into a neighbour
+  /// Pieces of the surface cut along every boundary, minus the final clusters: small clusters
+  /// merged into a neighbour, and pieces joined when a boundary was dropped.
+  std::uint32_t clusters_merged = 0;
 };
 
 struct Segmentation {
