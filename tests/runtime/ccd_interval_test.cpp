@@ -13,7 +13,11 @@
 namespace {
 
 using namespace tetseg::ccd_detail;
+#if defined(__SIZEOF_FLOAT128__)
 __extension__ typedef __float128 Quad;
+#else
+typedef long double Quad;  // IEEE quad on the 64-bit ARM ABIs
+#endif
 
 template <class I>
 bool contains(const I& x, Quad q) {
