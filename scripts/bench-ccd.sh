@@ -15,7 +15,7 @@ tool="$build/tools/ccd/tetseg-ccd"
 
 echo "== machine: $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | xargs)"
 for method in conservative fast-cubic; do
-  echo "== reference queries, --method $method (3 runs; the tool times the test calls only)"
+  echo "== reference queries, --method $method (3 runs; mean CPU time of the test calls per query)"
   for run in 1 2 3; do
     "$tool" queries "$data/sample-queries" --method "$method" | tail -2 | sed "s/^/run $run: /"
   done
@@ -23,13 +23,12 @@ done
 echo "== per-scene table (conservative)"
 "$tool" queries "$data/sample-queries"
 
-echo "== whole frames (BVH + dedup + tests, wall time of the tool including PLY reading)"
+echo "== whole frames (BVH + dedup + tests, including PLY reading; user CPU and wall seconds)"
 for scene in "cloth-funnel 227 228" "rod-twist 3036 3037" "cloth-ball cloth_ball92 cloth_ball93"; do
   set -- $scene
   dir="$data/sample-scalable-ccd-data/$1/frames"
   [ -f "$dir/$2.ply" ] || continue
-  start=$(date +%s.%N)
-  count=$("$tool" frames "$dir/$2.ply" "$dir/$3.ply" 2>/dev/null | wc -l)
-  end=$(date +%s.%N)
-  printf '%s: %s contacts, %.2f s\n' "$1" "$count" "$(awk -v a="$start" -v b="$end" "BEGIN{print b-a}")"
+  TIMEFORMAT="%U s user, %R s wall"
+  { time "$tool" frames "$dir/$2.ply" "$dir/$3.ply" 2>/dev/null | wc -l > "$build/contacts.txt"; } 2> "$build/time.txt"
+  echo "$1: $(cat "$build/contacts.txt") contacts, $(cat "$build/time.txt")"
 done
