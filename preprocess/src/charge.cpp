@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cmath>
 #include <fstream>
+#include <memory>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -112,6 +113,17 @@ ChargeResult compute_charge(const std::vector<Vec3>& points, const std::vector<T
   progress("assembly", 0.3);
 
   std::vector<double> b(n, 1.0), y(n, 0.0);
+  std::unique_ptr<BlockJacobi> block;
+  if (options.preconditioner == ChargePreconditioner::kBlock && solver != ChargeSolver::kDirect) {
+    block = std::make_unique<BlockJacobi>(panels, tree);
+  }
+  const ApplyFn precondition = [&](const double* in, double* out) {
+    if (block) {
+      block->apply(in, out);
+    } else {
+      for (std::size_t i = 0; i < n; ++i) out[i] = in[i] / near.diagonal[i];
+    }
+  };
   auto on_iteration = [&](int it, double res) {
     const double f = res > 0.0 ? std::log(res) / std::log(options.tolerance) : 1.0;
     progress("solve", std::min(1.0, std::max(0.0, f)));
@@ -123,7 +135,7 @@ ChargeResult compute_charge(const std::vector<Vec3>& points, const std::vector<T
     progress("assembly", 1.0);
     const auto t1 = Clock::now();
     const GmresOutcome g = solve_gmres(
-        n, [&](const double* x, double* out) { op.apply(x, out); }, near.diagonal, b, y,
+        n, [&](const double* x, double* out) { op.apply(x, out); }, precondition, b, y,
         options.tolerance, options.max_iterations, options.restart, on_iteration);
     result.solve_seconds = seconds_since(t1);
     result.iterations = g.iterations;
@@ -147,7 +159,7 @@ ChargeResult compute_charge(const std::vector<Vec3>& points, const std::vector<T
       result.converged = true;
     } else {
       const GmresOutcome g = solve_gmres(
-          n, [&](const double* x, double* out) { dense_apply(m, n, x, out); }, near.diagonal, b, y,
+          n, [&](const double* x, double* out) { dense_apply(m, n, x, out); }, precondition, b, y,
           options.tolerance, options.max_iterations, options.restart, on_iteration);
       result.iterations = g.iterations;
       result.residual = g.residual;

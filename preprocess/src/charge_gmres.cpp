@@ -17,7 +17,7 @@ double norm2(const std::vector<double>& v) {
 
 }  // namespace
 
-GmresOutcome solve_gmres(std::size_t n, const ApplyFn& apply, const std::vector<double>& diagonal,
+GmresOutcome solve_gmres(std::size_t n, const ApplyFn& apply, const ApplyFn& precondition,
                          const std::vector<double>& b, std::vector<double>& x, double tolerance,
                          int max_iterations, int restart, const IterationFn& on_iteration) {
   GmresOutcome out;
@@ -50,7 +50,7 @@ GmresOutcome solve_gmres(std::size_t n, const ApplyFn& apply, const std::vector<
     g[0] = beta;
     std::size_t k = 0;
     for (; k < m && out.iterations < max_iterations; ++k) {
-      for (std::size_t i = 0; i < n; ++i) z[i] = basis[k][i] / diagonal[i];
+      precondition(basis[k].data(), z.data());
       apply(z.data(), w.data());
       ++out.iterations;
       for (std::size_t j = 0; j <= k; ++j) {
@@ -91,11 +91,14 @@ GmresOutcome solve_gmres(std::size_t n, const ApplyFn& apply, const std::vector<
       for (std::size_t j = ii + 1; j < k; ++j) s -= hh(ii, j) * y[j];
       y[ii] = hh(ii, ii) != 0.0 ? s / hh(ii, ii) : 0.0;
     }
+    std::fill(w.begin(), w.end(), 0.0);
     for (std::size_t j = 0; j < k; ++j) {
       const auto& v = basis[j];
       const double yj = y[j];
-      for (std::size_t i = 0; i < n; ++i) x[i] += yj * v[i] / diagonal[i];
+      for (std::size_t i = 0; i < n; ++i) w[i] += yj * v[i];
     }
+    precondition(w.data(), z.data());
+    for (std::size_t i = 0; i < n; ++i) x[i] += z[i];
   }
 }
 
@@ -167,6 +170,57 @@ bool solve_dense_lu(const std::vector<double>& m, std::size_t n, const std::vect
     if (!std::isfinite(v)) return false;
   }
   return true;
+}
+
+}  // namespace tetseg::preprocess::charge_detail
+
+namespace tetseg::preprocess::charge_detail {
+
+BlockJacobi::BlockJacobi(const PanelSet& panels, const ClusterTree& tree) : m_tree(tree) {
+  const std::size_t leaves = tree.leaves.size();
+  m_offset.resize(leaves + 1, 0);
+  for (std::size_t l = 0; l < leaves; ++l) {
+    const Cluster& c = tree.nodes[static_cast<std::size_t>(tree.leaves[l])];
+    const std::size_t m = c.end - c.begin;
+    m_offset[l + 1] = m_offset[l] + m * m;
+  }
+  m_inverse.resize(m_offset[leaves]);
+#if defined(TETSEG_HAVE_OPENMP)
+#pragma omp parallel for schedule(dynamic, 8)
+#endif
+  for (std::ptrdiff_t ll = 0; ll < static_cast<std::ptrdiff_t>(leaves); ++ll) {
+    const std::size_t l = static_cast<std::size_t>(ll);
+    const Cluster& c = tree.nodes[static_cast<std::size_t>(tree.leaves[l])];
+    const Eigen::Index m = c.end - c.begin;
+    Eigen::MatrixXd block(m, m);
+    for (Eigen::Index a = 0; a < m; ++a) {
+      for (Eigen::Index b = 0; b < m; ++b) {
+        block(a, b) = matrix_entry(panels, tree.order[c.begin + static_cast<std::size_t>(a)],
+                                   tree.order[c.begin + static_cast<std::size_t>(b)]);
+      }
+    }
+    const Eigen::MatrixXd inv = block.partialPivLu().inverse();
+    Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(
+        m_inverse.data() + m_offset[l], m, m) = inv;
+  }
+}
+
+void BlockJacobi::apply(const double* in, double* out) const {
+  const std::size_t leaves = m_tree.leaves.size();
+#if defined(TETSEG_HAVE_OPENMP)
+#pragma omp parallel for schedule(static)
+#endif
+  for (std::ptrdiff_t ll = 0; ll < static_cast<std::ptrdiff_t>(leaves); ++ll) {
+    const std::size_t l = static_cast<std::size_t>(ll);
+    const Cluster& c = m_tree.nodes[static_cast<std::size_t>(m_tree.leaves[l])];
+    const std::size_t m = c.end - c.begin;
+    const double* inv = m_inverse.data() + m_offset[l];
+    for (std::size_t a = 0; a < m; ++a) {
+      double s = 0.0;
+      for (std::size_t b = 0; b < m; ++b) s += inv[a * m + b] * in[m_tree.order[c.begin + b]];
+      out[m_tree.order[c.begin + a]] = s;
+    }
+  }
 }
 
 }  // namespace tetseg::preprocess::charge_detail

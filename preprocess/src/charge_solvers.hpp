@@ -22,11 +22,24 @@ struct GmresOutcome {
 };
 
 /// Restarted right-preconditioned GMRES(restart) with modified Gram-Schmidt and Givens
-/// rotations; preconditioner x = z / diagonal. Starts from the given x. Stops when the
-/// relative residual is <= tolerance or after max_iterations matrix products.
-GmresOutcome solve_gmres(std::size_t n, const ApplyFn& apply, const std::vector<double>& diagonal,
+/// rotations; `precondition` applies an approximate inverse. Starts from the given x. Stops when
+/// the relative residual is <= tolerance or after max_iterations matrix products.
+GmresOutcome solve_gmres(std::size_t n, const ApplyFn& apply, const ApplyFn& precondition,
                          const std::vector<double>& b, std::vector<double>& x, double tolerance,
                          int max_iterations, int restart, const IterationFn& on_iteration);
+
+/// Block-Jacobi preconditioner: the exact inverse of the collocation matrix restricted to
+/// each leaf of the cluster tree (leaf_size^2 doubles per leaf).
+class BlockJacobi {
+ public:
+  BlockJacobi(const PanelSet& panels, const ClusterTree& tree);
+  void apply(const double* in, double* out) const;
+
+ private:
+  const ClusterTree& m_tree;
+  std::vector<std::size_t> m_offset;
+  std::vector<double> m_inverse;
+};
 
 /// Dense row-major collocation matrix: far entries A_j / r_ij, near entries and the diagonal
 /// from `near`. n * n doubles.

@@ -148,6 +148,23 @@ TEST_CASE("All solvers agree with the dense direct solve", "[charge]") {
   }
 }
 
+TEST_CASE("The block-Jacobi preconditioner converges to the same solution", "[charge]") {
+  const TriangleMesh m = tetseg::test::dumbbell(0.1);
+  ChargeOptions o;
+  o.tolerance = 1e-10;
+  o.solver = ChargeSolver::kDirect;
+  const ChargeResult direct = compute_charge(m.vertices, m.triangles, o);
+  o.preconditioner = ChargePreconditioner::kBlock;
+  for (const ChargeSolver solver : {ChargeSolver::kGmres, ChargeSolver::kFast}) {
+    o.solver = solver;
+    const ChargeResult r = compute_charge(m.vertices, m.triangles, o);
+    CAPTURE(r.solver, r.iterations);
+    CHECK(r.converged);
+    CHECK(max_relative_difference(r.density, direct.density) <
+          (solver == ChargeSolver::kGmres ? 1e-6 : 5e-3));
+  }
+}
+
 TEST_CASE("The fast solver's error against GMRES is bounded at 20k triangles", "[charge][slow]") {
   const TriangleMesh m = tetseg::test::ellipsoid(32, 1.0, 0.6, 0.3);
   REQUIRE(m.triangles.size() == 20480);

@@ -26,12 +26,19 @@ bool parse_charge_solver(const std::string& name, ChargeSolver& out);
 /// "auto", "direct", "gmres" or "fast".
 const char* to_string(ChargeSolver solver);
 
+/// Preconditioner of the iterative solvers.
+enum class ChargePreconditioner {
+  kJacobi,  ///< the diagonal M_ii
+  kBlock,   ///< exact inverses of the diagonal blocks of the cluster-tree leaves
+};
+
 struct ChargeOptions {
   ChargeSolver solver = ChargeSolver::kAuto;
   /// Relative residual ||1 - M y|| / ||1|| at which the iterative solvers stop, in (0, 1).
   double tolerance = 1e-6;
   int max_iterations = 500;  ///< matrix products, iterative solvers only
   int restart = 80;          ///< GMRES restart length
+  ChargePreconditioner preconditioner = ChargePreconditioner::kJacobi;
   /// Treecode opening parameter: a cluster acts through its multipoles on a target leaf when
   /// (r_leaf + r_cluster) < theta * distance. Smaller is more accurate and slower; (0, 1).
   double fast_theta = 0.5;
