@@ -5,15 +5,18 @@
 ///
 /// Guarantees (docs/ccd.md): conservative in floating point. Every decision "no contact" is
 /// proved with rigorous interval arithmetic (round-to-nearest with outward error bounds on
-/// every operation), so a contact that exact arithmetic finds is never missed, and the
+/// every operation; doubles first, double-double where doubles cannot decide), so a contact
+/// that exact arithmetic finds is never missed, and the
 /// reported time of impact is a lower bound of the true first contact time. "Contact" may be
 /// reported for primitives that only come within the resolution of the bisection (false
 /// positive); never the converse. Degenerate input (coplanar for the whole step, zero motion,
 /// parallel edges, degenerate triangles) is handled by the same rule. Non-finite input is
 /// reported as a contact (kContact, toi 0): the test never proves separation it cannot see.
 ///
+/// Cost: about 5 us per query on the reference queries (docs/benchmarks.md); well-separated
+/// pairs exit after one interval (< 1 us); near-degenerate ones are bounded by max_intervals.
 /// Thread safety: every function is reentrant (no global state). No allocation, no
-/// exceptions.
+/// exceptions. The floating-point environment must be round-to-nearest (the default).
 
 #include <array>
 #include <cstdint>
