@@ -24,29 +24,46 @@ expect_exit 3 "tetseg-render: error: missing.tetseg: " -- "$bin/tetseg-render" m
 [ ! -e x.png ] || fail "a failed render left a file"
 expect_exit 4 "tetseg-render: error: nodir/x.png" -- "$bin/tetseg-render" "$golden" -o nodir/x.png
 
-# checkpng FILE WIDTH HEIGHT MIN_COLOURS: valid PNG (CRCs, zlib, Adler-32, filter bytes), the
-# corners are background, and at least MIN_COLOURS distinct non-background colours appear.
+# decode FILE: pixels of a PNG decoded independently (python zlib; filters None and Sub),
+# after checking signature, chunk CRCs, IHDR and the zlib stream (with its Adler-32).
+cat > png.py <<'PY'
+import struct, zlib
+def decode(path):
+    d = open(path, "rb").read()
+    assert d[:8] == b"\x89PNG\r\n\x1a\n", "signature"
+    pos, idat, ihdr = 8, b"", None
+    while pos < len(d):
+        n, = struct.unpack(">I", d[pos:pos + 4])
+        kind, body = d[pos + 4:pos + 8], d[pos + 8:pos + 8 + n]
+        crc, = struct.unpack(">I", d[pos + 8 + n:pos + 12 + n])
+        assert zlib.crc32(kind + body) & 0xffffffff == crc, "CRC of %r" % kind
+        if kind == b"IHDR": ihdr = body
+        if kind == b"IDAT": idat += body
+        pos += 12 + n
+    w, h, depth, ctype, comp, filt, lace = struct.unpack(">IIBBBBB", ihdr)
+    assert (depth, ctype, comp, filt, lace) == (8, 2, 0, 0, 0), "IHDR"
+    raw = zlib.decompress(idat)
+    assert len(raw) == h * (3 * w + 1), "size"
+    rows = []
+    for y in range(h):
+        f, line = raw[y * (3 * w + 1)], bytearray(raw[y * (3 * w + 1) + 1:(y + 1) * (3 * w + 1)])
+        assert f in (0, 1), "filter %d" % f
+        if f == 1:
+            for x in range(3, len(line)): line[x] = (line[x] + line[x - 3]) & 255
+        rows.append(bytes(line))
+    return w, h, rows
+PY
+# checkpng FILE WIDTH HEIGHT MIN_COLOURS: a valid PNG of that size whose corners are background
+# and with at least MIN_COLOURS distinct non-background colours.
 checkpng() {
   python3 - "$@" <<'PY'
-import struct, sys, zlib
+import sys
+sys.path.insert(0, ".")
+from png import decode
 path, w, h, min_colours = sys.argv[1], int(sys.argv[2]), int(sys.argv[3]), int(sys.argv[4])
-d = open(path, "rb").read()
-assert d[:8] == b"\x89PNG\r\n\x1a\n", "signature"
-pos, idat, ihdr = 8, b"", None
-while pos < len(d):
-    n, = struct.unpack(">I", d[pos:pos + 4])
-    kind, body = d[pos + 4:pos + 8], d[pos + 8:pos + 8 + n]
-    crc, = struct.unpack(">I", d[pos + 8 + n:pos + 12 + n])
-    assert zlib.crc32(kind + body) & 0xffffffff == crc, "CRC of %r" % kind
-    if kind == b"IHDR": ihdr = body
-    if kind == b"IDAT": idat += body
-    pos += 12 + n
-assert struct.unpack(">IIBBBBB", ihdr) == (w, h, 8, 2, 0, 0, 0), "IHDR"
-raw = zlib.decompress(idat)  # also checks Adler-32
-assert len(raw) == h * (3 * w + 1), "size"
-rows = [raw[y * (3 * w + 1):(y + 1) * (3 * w + 1)] for y in range(h)]
-assert all(r[0] == 0 for r in rows), "filter bytes"
-px = lambda x, y: tuple(rows[y][1 + 3 * x:4 + 3 * x])
+W, H, rows = decode(path)
+assert (W, H) == (w, h), (W, H)
+px = lambda x, y: tuple(rows[y][3 * x:3 * x + 3])
 for x, y in ((0, 0), (w - 1, 0), (0, h - 1), (w - 1, h - 1)):
     assert px(x, y) == (255, 255, 255), "corner %s" % (px(x, y),)
 colours = {px(x, y) for y in range(h) for x in range(w)} - {(255, 255, 255)}
@@ -62,20 +79,19 @@ cmp golden.png again.png || fail "two renders differ"
 "$bin/tetseg-render" "$golden" -o side.png --view 0,0,-1 --up 0,1,0 --no-boundaries
 checkpng side.png 800 600 1 || fail "side.png"
 
-# Looking down -z at the octahedron shows only the upper cluster (0): its palette colour,
-# shaded, and nothing of the lower one.
-python3 - side.png <<'PY'
-import struct, sys, zlib
-d = open(sys.argv[1], "rb").read()
-w, h = struct.unpack(">II", d[16:24])
-pos, idat = 8, b""
-while pos < len(d):
-    n, = struct.unpack(">I", d[pos:pos + 4])
-    if d[pos + 4:pos + 8] == b"IDAT": idat += d[pos + 8:pos + 8 + n]
-    pos += 12 + n
-raw = zlib.decompress(idat)
-r, g, b = raw[(h // 2) * (3 * w + 1) + 1 + 3 * (w // 2):][:3]
-# palette colour 0 is (31, 119, 180): blue dominant, shaded by a factor in [0.45, 1]
+# The compressed and the stored encodings hold the same pixels; compression pays.
+"$bin/tetseg-render" "$golden" -o side_stored.png --view 0,0,-1 --up 0,1,0 --no-boundaries --png-stored
+python3 - side.png side_stored.png <<'PY'
+import os, sys
+sys.path.insert(0, ".")
+from png import decode
+a, b = decode(sys.argv[1]), decode(sys.argv[2])
+assert a == b, "pixels differ between encodings"
+assert os.path.getsize(sys.argv[1]) * 5 < os.path.getsize(sys.argv[2]), "no compression"
+# Looking down -z at the octahedron shows only the upper cluster (0): palette colour 0,
+# (31, 119, 180), shaded by a factor in [0.45, 1]; nothing of the lower one.
+w, h, rows = a
+r, g, b = rows[h // 2][3 * (w // 2):3 * (w // 2) + 3]
 assert b > g > r and 0.45 * 180 - 2 <= b <= 181, (r, g, b)
 PY
 

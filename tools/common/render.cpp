@@ -84,36 +84,113 @@ std::uint32_t adler32(const std::uint8_t* data, std::size_t size) noexcept {
   return (b << 16) | a;
 }
 
-std::vector<std::uint8_t> encode_png(const std::vector<std::uint8_t>& rgb, int width, int height) {
+namespace {
+
+/// Deflate bit writer: bits go LSB first; Huffman codes are written most significant bit first.
+class BitWriter {
+ public:
+  explicit BitWriter(std::vector<std::uint8_t>& out) : m_out(out) {}
+  void bits(std::uint32_t value, int count) {
+    for (int i = 0; i < count; ++i) {
+      if (m_used == 0) m_out.push_back(0);
+      m_out.back() |= static_cast<std::uint8_t>(((value >> i) & 1u) << m_used);
+      m_used = (m_used + 1) & 7;
+    }
+  }
+  void code(std::uint32_t value, int count) {
+    for (int i = count - 1; i >= 0; --i) bits((value >> i) & 1u, 1);
+  }
+
+ private:
+  std::vector<std::uint8_t>& m_out;
+  int m_used = 0;
+};
+
+/// A literal/length symbol with the fixed Huffman code of RFC 1951, 3.2.6.
+void fixed_symbol(BitWriter& w, std::uint32_t symbol) {
+  if (symbol < 144)
+    w.code(0x30 + symbol, 8);
+  else if (symbol < 256)
+    w.code(0x190 + symbol - 144, 9);
+  else if (symbol < 280)
+    w.code(symbol - 256, 7);
+  else
+    w.code(0xC0 + symbol - 280, 8);
+}
+
+/// One fixed-Huffman block: literals, and runs of the previous byte as (length, distance 1).
+void deflate_fixed(const std::vector<std::uint8_t>& data, std::vector<std::uint8_t>& out) {
+  static constexpr std::uint16_t kBase[29] = {3,  4,  5,  6,   7,   8,   9,   10,  11, 13,
+                                              15, 17, 19, 23,  27,  31,  35,  43,  51, 59,
+                                              67, 83, 99, 115, 131, 163, 195, 227, 258};
+  static constexpr std::uint8_t kExtra[29] = {0, 0, 0, 0, 0, 0, 0, 0, 1, 1, 1, 1, 2, 2, 2,
+                                              2, 3, 3, 3, 3, 4, 4, 4, 4, 5, 5, 5, 5, 0};
+  BitWriter w(out);
+  w.bits(1, 1);  // final block
+  w.bits(1, 2);  // fixed Huffman codes
+  std::size_t i = 0;
+  while (i < data.size()) {
+    std::size_t run = 0;
+    if (i > 0)
+      while (run < 258 && i + run < data.size() && data[i + run] == data[i - 1]) ++run;
+    if (run >= 3) {
+      int k = 28;
+      while (kBase[k] > run) --k;
+      fixed_symbol(w, 257 + static_cast<std::uint32_t>(k));
+      w.bits(static_cast<std::uint32_t>(run - kBase[k]), kExtra[k]);
+      w.code(0, 5);  // distance code 0: distance 1
+      i += run;
+    } else {
+      fixed_symbol(w, data[i]);
+      ++i;
+    }
+  }
+  fixed_symbol(w, 256);  // end of block
+}
+
+}  // namespace
+
+std::vector<std::uint8_t> encode_png(const std::vector<std::uint8_t>& rgb, int width, int height,
+                                     bool compress) {
   const std::size_t row = static_cast<std::size_t>(width) * 3;
   std::vector<std::uint8_t> raw;
   raw.reserve((row + 1) * static_cast<std::size_t>(height));
   for (int y = 0; y < height; ++y) {
-    raw.push_back(0);  // filter: none
-    raw.insert(raw.end(), rgb.begin() + static_cast<std::ptrdiff_t>(row * y),
-               rgb.begin() + static_cast<std::ptrdiff_t>(row * (y + 1)));
+    const std::uint8_t* line = rgb.data() + row * static_cast<std::size_t>(y);
+    if (compress) {
+      raw.push_back(1);  // filter: Sub (flat areas become runs of zeros)
+      for (std::size_t x = 0; x < row; ++x)
+        raw.push_back(static_cast<std::uint8_t>(line[x] - (x >= 3 ? line[x - 3] : 0)));
+    } else {
+      raw.push_back(0);  // filter: none
+      raw.insert(raw.end(), line, line + row);
+    }
   }
   std::vector<std::uint8_t> z{0x78, 0x01};
-  std::size_t pos = 0;
-  do {
-    const std::size_t len = std::min<std::size_t>(65535, raw.size() - pos);
-    const bool last = pos + len == raw.size();
-    z.push_back(last ? 1 : 0);
-    z.push_back(static_cast<std::uint8_t>(len & 0xFF));
-    z.push_back(static_cast<std::uint8_t>(len >> 8));
-    z.push_back(static_cast<std::uint8_t>(~len & 0xFF));
-    z.push_back(static_cast<std::uint8_t>((~len >> 8) & 0xFF));
-    z.insert(z.end(), raw.begin() + static_cast<std::ptrdiff_t>(pos),
-             raw.begin() + static_cast<std::ptrdiff_t>(pos + len));
-    pos += len;
-  } while (pos < raw.size());
+  if (compress) {
+    deflate_fixed(raw, z);
+  } else {
+    std::size_t pos = 0;
+    do {
+      const std::size_t len = std::min<std::size_t>(65535, raw.size() - pos);
+      const bool last = pos + len == raw.size();
+      z.push_back(last ? 1 : 0);
+      z.push_back(static_cast<std::uint8_t>(len & 0xFF));
+      z.push_back(static_cast<std::uint8_t>(len >> 8));
+      z.push_back(static_cast<std::uint8_t>(~len & 0xFF));
+      z.push_back(static_cast<std::uint8_t>((~len >> 8) & 0xFF));
+      z.insert(z.end(), raw.begin() + static_cast<std::ptrdiff_t>(pos),
+               raw.begin() + static_cast<std::ptrdiff_t>(pos + len));
+      pos += len;
+    } while (pos < raw.size());
+  }
   put_be32(z, adler32(raw.data(), raw.size()));
 
   std::vector<std::uint8_t> png{0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
   std::vector<std::uint8_t> ihdr;
   put_be32(ihdr, static_cast<std::uint32_t>(width));
   put_be32(ihdr, static_cast<std::uint32_t>(height));
-  ihdr.insert(ihdr.end(), {8, 2, 0, 0, 0});  // 8-bit, RGB, deflate, no filter, no interlace
+  ihdr.insert(ihdr.end(), {8, 2, 0, 0, 0});  // 8-bit, RGB, deflate, adaptive filters, no interlace
   put_chunk(png, "IHDR", ihdr);
   put_chunk(png, "IDAT", z);
   put_chunk(png, "IEND", {});

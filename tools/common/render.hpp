@@ -2,8 +2,9 @@
 /// \file
 /// A small software rasteriser for pictures of meshes (clusters, charge): orthographic view,
 /// z-buffer, flat Lambert shading, optional poly-lines drawn on top, 2x2 supersampling; and a
-/// PNG writer with no dependency (zlib stored blocks, CRC-32, Adler-32). Deterministic: the
-/// same mesh and options give the same bytes. Single-threaded; no global state.
+/// PNG writer with no dependency (own deflate: fixed Huffman + runs, or stored blocks; CRC-32,
+/// Adler-32). Deterministic: the same mesh and options give the same bytes. Single-threaded;
+/// no global state.
 
 #include <array>
 #include <cstdint>
@@ -43,8 +44,11 @@ struct RenderOptions {
 /// skipped. Throws ToolError(kExitUsage) for sizes outside 16..8192 or a zero view vector.
 std::vector<std::uint8_t> render_rgb(const RenderMesh& mesh, const RenderOptions& options);
 
-/// PNG (8-bit RGB, no interlace, zlib stored blocks) of `rgb` (width * height * 3 bytes).
-std::vector<std::uint8_t> encode_png(const std::vector<std::uint8_t>& rgb, int width, int height);
+/// PNG (8-bit RGB, no interlace) of `rgb` (width * height * 3 bytes, rows top to bottom).
+/// `compress`: Sub-filtered rows in one fixed-Huffman deflate block whose only matches are runs
+/// of the previous byte (flat areas shrink ~50x); otherwise unfiltered rows in stored blocks.
+std::vector<std::uint8_t> encode_png(const std::vector<std::uint8_t>& rgb, int width, int height,
+                                     bool compress = true);
 
 /// CRC-32 (ISO-HDLC, as PNG uses) and Adler-32 (as zlib uses), exposed for tests.
 std::uint32_t crc32(const std::uint8_t* data, std::size_t size, std::uint32_t crc = 0) noexcept;

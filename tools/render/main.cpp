@@ -53,7 +53,7 @@ int main(int argc, char** argv) {
   std::string input, output, scalar;
   std::array<double, 3> view{-1.0, -0.6, -0.8}, up{0.0, 0.0, 1.0};
   int width = 800, height = 600;
-  bool no_boundaries = false, detectors = false;
+  bool no_boundaries = false, detectors = false, stored = false;
   app.add_option("input", input,
                  "Asset from `tetseg build`, or a .ply with face colours (e.g. `tetseg charge -o`)")
       ->required();
@@ -70,6 +70,7 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_flag("--no-boundaries", no_boundaries, "Asset: do not draw segment boundaries");
   app.add_flag("--detectors", detectors, "Asset: draw detector nodes (black squares, on top)");
+  app.add_flag("--png-stored", stored, "Write the PNG uncompressed (zlib stored blocks)");
   app.add_option("--scalar", scalar,
                  "PLY: colour faces by this face property (rescaled to [min,max]) instead of "
                  "their colours, e.g. --scalar charge");
@@ -93,7 +94,7 @@ int main(int argc, char** argv) {
     if (std::abs(view[0]) + std::abs(view[1]) + std::abs(view[2]) == 0.0)
       throw ToolError(kExitUsage, "", "--view must not be zero");
     const std::vector<std::uint8_t> rgb = render_rgb(mesh, options);
-    write_file_atomic(output, encode_png(rgb, width, height));
+    write_file_atomic(output, encode_png(rgb, width, height, !stored));
     return kExitOk;
   } catch (const ToolError& e) {
     print_error("tetseg-render", e.file(), e.what());
