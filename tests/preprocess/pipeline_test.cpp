@@ -1,0 +1,113 @@
+#include <algorithm>
+#include <catch2/catch.hpp>
+#include <set>
+
+#include "tetseg/format/asset_io.hpp"
+#include "tetseg/preprocess/meshing.hpp"
+#include "tetseg/preprocess/pipeline.hpp"
+#include "tetseg/preprocess/surface.hpp"
+
+using namespace tetseg::preprocess;
+
+namespace {
+
+const TetMesh& coarse_dumbbell() {
+  static const TetMesh mesh = [] {
+    ShapeOptions shape;
+    shape.size = 0.6;
+    return generate_shape(Shape::kDumbbell, shape);
+  }();
+  return mesh;
+}
+
+}  // namespace
+
+TEST_CASE("The pipeline turns a dumbbell into a valid, loadable asset", "[pipeline]") {
+  const TetMesh& mesh = coarse_dumbbell();
+  BuildOptions options;
+  BuildReport report;
+  std::vector<std::string> stages;
+  const tetseg::format::Asset asset =
+      build_asset(mesh, "dir/dumbbell.mesh", options, report,
+                  [&](const StageReport& stage) { stages.push_back(stage.name); });
+
+  REQUIRE(stages == std::vector<std::string>{"surface", "charge", "equalize", "segmentation",
+                                             "detectors", "bvh"});
+  const Surface surface = extract_surface(mesh);
+  REQUIRE(asset.node_count == mesh.nodes.size());
+  REQUIRE(asset.triangles == surface.triangles);
+  REQUIRE(asset.rest_positions == mesh.nodes);
+  REQUIRE(report.surface_triangles == surface.triangles.size());
+  REQUIRE(report.clusters == asset.clusters.size());
+  REQUIRE(report.rest_positive_fraction.size() == asset.clusters.size());
+
+  // Detector nodes are interior nodes, and every triangle is in exactly one cluster.
+  const std::set<std::uint32_t> interior(surface.interior_nodes.begin(),
+                                         surface.interior_nodes.end());
+  std::vector<int> seen(asset.triangles.size(), 0);
+  for (std::size_t c = 0; c < asset.clusters.size(); ++c) {
+    const auto& cluster = asset.clusters[c];
+    REQUIRE(interior.count(cluster.detector_node) == 1);
+    for (std::uint32_t i = 0; i < cluster.triangle_count; ++i) {
+      const std::uint32_t t = asset.cluster_triangles[cluster.triangle_offset + i];
+      ++seen[t];
+      REQUIRE(asset.triangle_cluster[t] == c);
+    }
+  }
+  REQUIRE(std::all_of(seen.begin(), seen.end(), [](int n) { return n == 1; }));
+
+  // The provenance records every option, the tool and the file name without directories.
+  REQUIRE(asset.provenance.source == "dumbbell.mesh");
+  REQUIRE(asset.provenance.tool_version.rfind("tetseg ", 0) == 0);
+  REQUIRE(asset.provenance.options == provenance_options(options));
+
+  // The bytes load back into the same asset.
+  const auto bytes = tetseg::format::write_asset(asset);
+  tetseg::format::Asset loaded;
+  std::string detail;
+  REQUIRE(tetseg::format::read_asset(bytes.data(), bytes.size(), loaded, &detail) ==
+          tetseg::format::Status::kOk);
+  REQUIRE(tetseg::format::write_asset(loaded) == bytes);
+}
+
+TEST_CASE("Two builds with the same input and options give byte-identical assets", "[pipeline]") {
+  const TetMesh& mesh = coarse_dumbbell();
+  BuildOptions options;
+  BuildReport first_report;
+  BuildReport second_report;
+  const auto first = tetseg::format::write_asset(build_asset(mesh, "a.mesh", options, first_report));
+  const auto second =
+      tetseg::format::write_asset(build_asset(mesh, "a.mesh", options, second_report));
+  REQUIRE(first == second);
+
+  options.segmentation.alpha = 0.05;
+  BuildReport third_report;
+  const auto third = tetseg::format::write_asset(build_asset(mesh, "a.mesh", options, third_report));
+  REQUIRE(third != first);  // at least the provenance differs
+}
+
+TEST_CASE("A single-cluster build skips charge and segmentation", "[pipeline]") {
+  BuildOptions options;
+  options.clusters = ClusterMethod::kSingle;
+  options.keep_rest_positions = false;
+  BuildReport report;
+  const auto asset = build_asset(coarse_dumbbell(), "d.mesh", options, report);
+  REQUIRE(asset.clusters.size() == 1);
+  REQUIRE(asset.boundaries.empty());
+  REQUIRE(asset.rest_positions.empty());
+  REQUIRE(report.charge.solver.empty());
+  for (const auto& stage : report.stages) REQUIRE(stage.name != "charge");
+}
+
+TEST_CASE("A tet mesh without interior nodes is rejected with a clear message", "[pipeline]") {
+  TetMesh mesh;
+  mesh.nodes = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  mesh.tets = {{0, 1, 2, 3}};
+  BuildReport report;
+  REQUIRE_THROWS_MATCHES(build_asset(mesh, "tet.mesh", BuildOptions{}, report), InputError,
+                         Catch::Matchers::Predicate<InputError>([](const InputError& e) {
+                           return e.file() == "tet.mesh" &&
+                                  std::string(e.what()).find("no interior node") !=
+                                      std::string::npos;
+                         }));
+}
