@@ -202,6 +202,19 @@ TreecodeOperator::TreecodeOperator(const PanelSet& panels, const ClusterTree& tr
     m_minus1.push_back(m1);
     m_minus2.push_back(m2);
   }
+  m_recurrence.resize(m_index.size());
+  for (std::size_t k = 1; k < m_index.size(); ++k) {
+    const int o = m_index[k][0] + m_index[k][1] + m_index[k][2];
+    Recurrence& rc = m_recurrence[k];
+    for (std::size_t i = 0; i < 3; ++i) {
+      rc.m1[i] = m_minus1[k][i] >= 0 ? static_cast<std::uint32_t>(m_minus1[k][i])
+                                     : static_cast<std::uint32_t>(m_index.size());
+      rc.m2[i] = m_minus2[k][i] >= 0 ? static_cast<std::uint32_t>(m_minus2[k][i])
+                                     : static_cast<std::uint32_t>(m_index.size());
+    }
+    rc.alpha = -(2.0 * o - 1.0) / o;
+    rc.beta = -(o - 1.0) / o;
+  }
   auto binom = [](int a, int b) {
     double r = 1.0;
     for (int i = 1; i <= b; ++i) r = r * (a - b + i) / i;
@@ -228,6 +241,12 @@ TreecodeOperator::TreecodeOperator(const PanelSet& panels, const ClusterTree& tr
         m_l2l.push_back({mi, ni, diff, coef});  // L_m(child) from L_n(parent)
       }
     }
+  }
+
+  m_m2l_start.assign(static_cast<std::size_t>(kc) + 1, 0);
+  for (const Term& t : m_m2l) ++m_m2l_start[static_cast<std::size_t>(t.a) + 1];
+  for (std::size_t a = 0; a < static_cast<std::size_t>(kc); ++a) {
+    m_m2l_start[a + 1] += m_m2l_start[a];
   }
 
   m_x.resize(m_n);
@@ -307,7 +326,6 @@ TreecodeOperator::TreecodeOperator(const PanelSet& panels, const ClusterTree& tr
 }
 
 void TreecodeOperator::apply(const double* x, double* y) const {
-  const std::ptrdiff_t n = static_cast<std::ptrdiff_t>(m_n);
   const auto& order = m_tree.order;
   const auto& nodes = m_tree.nodes;
   const auto& leaves = m_tree.leaves;
@@ -335,13 +353,7 @@ void TreecodeOperator::apply(const double* x, double* y) const {
 #pragma omp parallel
 #endif
   {
-    std::vector<double> mono(kc), deriv(kc), pot;
-#if defined(TETSEG_HAVE_OPENMP)
-#pragma omp for schedule(static)
-#endif
-    for (std::ptrdiff_t k = 0; k < n; ++k) {
-      charge[k] = m_area[static_cast<std::size_t>(k)] * x[order[static_cast<std::size_t>(k)]];
-    }
+    std::vector<double> mono(kc), deriv(kc + 1), pot;
     // Upward pass: leaf moments from the members.
 #if defined(TETSEG_HAVE_OPENMP)
 #pragma omp for schedule(dynamic, 16)
@@ -353,7 +365,8 @@ void TreecodeOperator::apply(const double* x, double* y) const {
       std::fill(mom, mom + kc, 0.0);
       for (std::uint32_t k = c.begin; k < c.end; ++k) {
         monomials(px[k] - c.center[0], py[k] - c.center[1], pz[k] - c.center[2], mono.data());
-        const double q = charge[k];
+        const double q = m_area[k] * x[order[k]];
+        charge[k] = q;
         for (std::size_t e = 0; e < kc; ++e) mom[e] += q * mono[e];
       }
     }
@@ -391,22 +404,25 @@ void TreecodeOperator::apply(const double* x, double* y) const {
                              target.center[2] - s.center[2]};
         const double r2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
         // Taylor coefficients of 1 / |R + w| in w (Duan & Krasny recurrence).
-        deriv[0] = 1.0 / std::sqrt(r2);
+        // Branch-free: missing predecessors point at deriv[kc] = 0.
+        const double inv_r2 = 1.0 / r2;
+        deriv[0] = std::sqrt(inv_r2);
+        deriv[kc] = 0.0;
         for (std::size_t k = 1; k < kc; ++k) {
-          const auto& idx = m_index[k];
-          const int order_k = idx[0] + idx[1] + idx[2];
-          double s1 = 0.0, s2 = 0.0;
-          for (int i = 0; i < 3; ++i) {
-            if (m_minus1[k][static_cast<std::size_t>(i)] >= 0)
-              s1 +=
-                  r[i] * deriv[static_cast<std::size_t>(m_minus1[k][static_cast<std::size_t>(i)])];
-            if (m_minus2[k][static_cast<std::size_t>(i)] >= 0)
-              s2 += deriv[static_cast<std::size_t>(m_minus2[k][static_cast<std::size_t>(i)])];
-          }
-          deriv[k] = -((2 * order_k - 1) * s1 + (order_k - 1) * s2) / (order_k * r2);
+          const Recurrence& rc = m_recurrence[k];
+          const double s1 =
+              r[0] * deriv[rc.m1[0]] + r[1] * deriv[rc.m1[1]] + r[2] * deriv[rc.m1[2]];
+          const double s2 = deriv[rc.m2[0]] + deriv[rc.m2[1]] + deriv[rc.m2[2]];
+          deriv[k] = (rc.alpha * s1 + rc.beta * s2) * inv_r2;
         }
-        for (const Term& t : m_m2l)
-          local[t.a] += t.coef * deriv[static_cast<std::size_t>(t.c)] * mom[t.b];
+        // m_m2l is sorted by the target index a: accumulate each L_a in a register.
+        const Term* term = m_m2l.data();
+        for (std::size_t a = 0; a < kc; ++a) {
+          const Term* end = m_m2l.data() + m_m2l_start[a + 1];
+          double acc = 0.0;
+          for (; term < end; ++term) acc += term->coef * deriv[term->c] * mom[term->b];
+          local[a] += acc;
+        }
       }
     }
 #if defined(TETSEG_HAVE_OPENMP)
@@ -456,19 +472,15 @@ void TreecodeOperator::apply(const double* x, double* y) const {
           pot[k - target.begin] += sum;
         }
       }
-      for (std::uint32_t k = target.begin; k < target.end; ++k) y[order[k]] = pot[k - target.begin];
-    }
-    // Exact near field: analytic minus the point charge already counted.
-#if defined(TETSEG_HAVE_OPENMP)
-#pragma omp for schedule(static)
-#endif
-    for (std::ptrdiff_t i = 0; i < n; ++i) {
-      double sum = 0.0;
-      for (std::size_t e = m_near.row_start[static_cast<std::size_t>(i)];
-           e < m_near.row_start[static_cast<std::size_t>(i) + 1]; ++e) {
-        sum += m_near.correction[e] * x[m_near.column[e]];
+      // Exact near field of each target: analytic minus the point charge counted above.
+      for (std::uint32_t k = target.begin; k < target.end; ++k) {
+        const std::size_t i = order[k];
+        double sum = pot[k - target.begin];
+        for (std::size_t e = m_near.row_start[i]; e < m_near.row_start[i + 1]; ++e) {
+          sum += m_near.correction[e] * x[m_near.column[e]];
+        }
+        y[i] = sum;
       }
-      y[i] += sum;
     }
   }
 }

@@ -78,13 +78,19 @@ class TreecodeOperator {
   std::vector<std::array<int, 3>> m_index;
   std::vector<std::array<int, 3>> m_minus1;  ///< index of k - e_i, or -1
   std::vector<std::array<int, 3>> m_minus2;  ///< index of k - 2 e_i, or -1
+  struct Recurrence {
+    std::uint32_t m1[3], m2[3];  ///< k - e_i, k - 2 e_i, or the zero slot
+    double alpha, beta;          ///< -(2|k| - 1) / |k|, -(|k| - 1) / |k|
+  };
+  std::vector<Recurrence> m_recurrence;
   struct Term {
     int a, b, c;
     double coef;
   };
-  std::vector<Term> m_m2l;  ///< L_a += coef * D_c(R) * M_b with c = a + b
-  std::vector<Term> m_m2m;  ///< M_a(parent) += coef * d^c * M_b(child), c = a - b
-  std::vector<Term> m_l2l;  ///< L_a(child) += coef * d^c * L_b(parent), c = b - a
+  std::vector<Term> m_m2l;               ///< L_a += coef * D_c(R) * M_b with c = a + b, sorted by a
+  std::vector<std::size_t> m_m2l_start;  ///< first term of each a
+  std::vector<Term> m_m2m;               ///< M_a(parent) += coef * d^c * M_b(child), c = a - b
+  std::vector<Term> m_l2l;               ///< L_a(child) += coef * d^c * L_b(parent), c = b - a
   mutable std::vector<double> m_charge;
   mutable std::vector<double> m_moments;  ///< nodes x index count
   mutable std::vector<double> m_local;    ///< nodes x index count
