@@ -19,7 +19,7 @@ struct MeshingOptions {
   double facet_distance = 0.0;          ///< max surface approximation error; >= 0
   double facet_angle = 25.0;            ///< min facet angle, degrees, in (0, 30]
   double cell_radius_edge_ratio = 3.0;  ///< tet quality bound, >= 2
-  bool optimize = true;                 ///< ODT/lloyd off, perturb + exude on
+  bool optimize = true;  ///< sliver exudation to a 10 degree dihedral bound (no ODT/Lloyd/perturb)
 };
 
 /// Procedural shapes made with Mesh_3's implicit domain.

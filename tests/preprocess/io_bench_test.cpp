@@ -1,0 +1,70 @@
+// Hidden benchmark (run with "[.bench]"): tet mesh write/read per format, boundary extraction
+// and validation on a large generated mesh. Prints figures; asserts only correctness.
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <catch2/catch.hpp>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+
+#include "tetseg/preprocess/io.hpp"
+#include "tetseg/preprocess/meshing.hpp"
+#include "tetseg/preprocess/surface.hpp"
+
+using namespace tetseg::preprocess;
+
+namespace {
+
+template <class F>
+double best_of(int runs, F&& f) {
+  double best = 1e300;
+  for (int r = 0; r < runs; ++r) {
+    const auto start = std::chrono::steady_clock::now();
+    f();
+    best = std::min(
+        best, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+  }
+  return best;
+}
+
+}  // namespace
+
+TEST_CASE("Benchmark: tet mesh I/O, extraction and validation", "[.bench][io]") {
+  ShapeOptions o;
+  o.size = 2.5;
+  TetMesh mesh;
+  const double t_mesh = best_of(1, [&] { mesh = generate_shape(Shape::kPawn, o); });
+  std::printf("generate pawn --size 2.5: %.2f s, %zu nodes, %zu tets\n", t_mesh, mesh.nodes.size(),
+              mesh.tets.size());
+  const auto dir =
+      std::filesystem::temp_directory_path() / ("tetseg_io_bench_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  for (const char* name : {"b.mesh", "b.node", "b.msh", "b22.msh"}) {
+    const std::string path = (dir / name).string();
+    const bool v22 = std::string(name) == "b22.msh";
+    const double t_write = best_of(3, [&] {
+      if (v22) {
+        write_gmsh22(path, mesh);
+      } else {
+        write_tet_mesh(path, mesh);
+      }
+    });
+    TetMesh back;
+    const double t_read = best_of(3, [&] { back = read_tet_mesh(path); });
+    CHECK(back.tets == mesh.tets);
+    double bytes = static_cast<double>(std::filesystem::file_size(path));
+    if (std::string(name) == "b.node")
+      bytes += static_cast<double>(std::filesystem::file_size(dir / "b.ele"));
+    const double mb = bytes / 1e6;
+    std::printf("%-8s %6.1f MB  write %.3f s (%.0f MB/s)  read %.3f s (%.0f MB/s)\n", name, mb,
+                t_write, mb / t_write, t_read, mb / t_read);
+  }
+  std::filesystem::remove_all(dir);
+  Surface surface;
+  const double t_extract = best_of(3, [&] { surface = extract_surface(mesh); });
+  const double t_validate = best_of(3, [&] { validate_tet_mesh(mesh, surface, "bench"); });
+  std::printf("extract_surface %.3f s (%zu triangles), validate_tet_mesh %.3f s\n", t_extract,
+              surface.triangles.size(), t_validate);
+}
