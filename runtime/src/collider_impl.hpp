@@ -129,6 +129,8 @@ struct Collider::Impl {
   void process_triangle_pair(std::uint32_t t1, std::uint32_t t2) noexcept;
   void process_vertex_face(std::uint32_t p, std::uint32_t face) noexcept;
   void process_edge_edge(std::uint32_t e1, std::uint32_t e2) noexcept;
+  /// Swept boxes of two edges overlap and not all four nodes are still.
+  bool edge_boxes_overlap(std::uint32_t e1, std::uint32_t e2) const noexcept;
   void record(const Contact& c) noexcept;
   bool traverse_self(const TreeView& tree) noexcept;
   bool traverse_pair(const TreeView& ta, const TreeView& tb, bool same_cluster) noexcept;

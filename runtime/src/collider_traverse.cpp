@@ -86,12 +86,9 @@ void Collider::Impl::process_vertex_face(std::uint32_t p, std::uint32_t face) no
   const auto& f = asset->triangles[face];
   const std::uint32_t ip = surf_index[p];
   if (!vmoved[ip] && !tmov[face]) return;  // still feature pair: only t = 0 contact possible
-  ++stats.feature_pairs;
   const double ms = opt.ccd.min_separation;
-  if (!boxes_overlap(vbox[ip], tbox[face], ms)) {
-    ++stats.feature_pairs_filtered;
-    return;
-  }
+  if (!boxes_overlap(vbox[ip], tbox[face], ms)) return;
+  ++stats.feature_pairs;
   if (ms <= 0) {
     // Coplanarity cubic det[b-a, c-a, p-a] with a proven strict sign: never coplanar.
     const Orientation o = classify_orientation(pos0(f[0]), pos0(f[1]), pos0(f[2]), pos0(p),
@@ -118,21 +115,25 @@ void Collider::Impl::process_vertex_face(std::uint32_t p, std::uint32_t face) no
   record(c);
 }
 
+bool Collider::Impl::edge_boxes_overlap(std::uint32_t e1, std::uint32_t e2) const noexcept {
+  const std::uint32_t ia = surf_index[edges[e1][0]], ib = surf_index[edges[e1][1]];
+  const std::uint32_t ic = surf_index[edges[e2][0]], id = surf_index[edges[e2][1]];
+  if (!vmoved[ia] && !vmoved[ib] && !vmoved[ic] && !vmoved[id]) return false;
+  Box ba = vbox[ia], bc = vbox[ic];
+  box_union(ba, vbox[ib]);
+  box_union(bc, vbox[id]);
+  return boxes_overlap(ba, bc, opt.ccd.min_separation);
+}
+
 void Collider::Impl::process_edge_edge(std::uint32_t e1, std::uint32_t e2) noexcept {
   if (e1 > e2) std::swap(e1, e2);
   const std::uint32_t a = edges[e1][0], b = edges[e1][1], c = edges[e2][0], d = edges[e2][1];
   const std::uint32_t ia = surf_index[a], ib = surf_index[b], ic = surf_index[c],
                       id = surf_index[d];
   if (!vmoved[ia] && !vmoved[ib] && !vmoved[ic] && !vmoved[id]) return;
-  ++stats.feature_pairs;
   const double ms = opt.ccd.min_separation;
-  Box ba = vbox[ia], bc = vbox[ic];
-  box_union(ba, vbox[ib]);
-  box_union(bc, vbox[id]);
-  if (!boxes_overlap(ba, bc, ms)) {
-    ++stats.feature_pairs_filtered;
-    return;
-  }
+  if (!edge_boxes_overlap(e1, e2)) return;
+  ++stats.feature_pairs;
   if (ms <= 0) {
     // det[b-a, d-c, c-a] = det[b-a, d-a, c-a]: orientation of (a; b, d, c).
     const Orientation o = classify_orientation(pos0(a), pos0(b), pos0(d), pos0(c), pos1(a), pos1(b),
@@ -176,6 +177,9 @@ void Collider::Impl::process_triangle_pair(std::uint32_t t1, std::uint32_t t2) n
     for (std::uint32_t p : P) {
       if (p == F[0] || p == F[1] || p == F[2]) continue;
       const std::uint32_t ip = surf_index[p];
+      // Cheap rejections before the ownership scan (repeated inside, harmless).
+      if (!vmoved[ip] && !tmov[face]) continue;
+      if (!boxes_overlap(vbox[ip], tbox[face], opt.ccd.min_separation)) continue;
       bool owner = true;
       for (std::uint32_t k = vt_offset[ip]; k < vt_offset[ip + 1] && owner; ++k) {
         const std::uint32_t t = vt_list[k];
@@ -193,6 +197,7 @@ void Collider::Impl::process_triangle_pair(std::uint32_t t1, std::uint32_t t2) n
       const auto& E1 = edges[e1];
       const auto& E2 = edges[e2];
       if (E1[0] == E2[0] || E1[0] == E2[1] || E1[1] == E2[0] || E1[1] == E2[1]) continue;
+      if (!edge_boxes_overlap(e1, e2)) continue;
       bool owner = true;
       for (std::uint32_t k1 = et_offset[e1]; k1 < et_offset[e1 + 1] && owner; ++k1) {
         for (std::uint32_t k2 = et_offset[e2]; k2 < et_offset[e2 + 1] && owner; ++k2) {

@@ -35,7 +35,7 @@ std::string number(double v) {
 }
 
 int run(const std::string& asset_path, const std::string& frames_path, const std::string& mode_name,
-        const std::string& query, bool json) {
+        const std::string& query, bool json, bool stop_at_contact) {
   tetseg::ColliderOptions options;
   if (!tetseg::parse_collider_mode(mode_name.c_str(), options.mode))
     throw ToolError(kExitUsage, "", "unknown mode '" + mode_name + "' (rvbc, bvh, brute)");
@@ -99,8 +99,9 @@ int run(const std::string& asset_path, const std::string& frames_path, const std
       if (r.has_contacts) std::cout << ", contacts " << r.contacts;
       std::cout << '\n';
     }
+    if (stop_at_contact && r.any) break;
   }
-  const double n = steps > 0 ? double(steps) : 1.0;
+  const double n = results.empty() ? 1.0 : double(results.size());
   if (json) {
     std::cout << "{\"mode\": \"" << mode_name << "\", \"query\": \"" << query
               << "\", \"frames\": [";
@@ -118,7 +119,7 @@ int run(const std::string& asset_path, const std::string& frames_path, const std
               << ", \"tests\": " << number(tests / n) << ", \"total\": " << number(total / n)
               << "}}\n";
   } else {
-    std::cout << "mode " << mode_name << ", query " << query << ", " << steps
+    std::cout << "mode " << mode_name << ", query " << query << ", " << results.size()
               << " steps; mean ms: refit " << refit / n << ", classify " << classify / n
               << ", traversal " << traversal / n << ", tests " << tests / n << ", total "
               << total / n << '\n';
@@ -142,9 +143,12 @@ int main(int argc, char** argv) {
   app.add_option("--query", query, "any, earliest or all (default)")
       ->check(CLI::IsMember({"any", "earliest", "all"}));
   app.add_flag("--json", json, "Machine-readable output on stdout");
+  bool stop_at_contact = false;
+  app.add_flag("--stop-at-contact", stop_at_contact,
+               "Stop after the first step with a contact (as a simulator would respond)");
   try {
     app.parse(argc, argv);
-    return run(asset_path, frames_path, mode, query, json);
+    return run(asset_path, frames_path, mode, query, json, stop_at_contact);
   } catch (const CLI::ParseError& e) {
     const int code = app.exit(e);
     return code == 0 ? kExitOk : kExitUsage;

@@ -104,8 +104,8 @@ struct ColliderStats {
   std::uint64_t node_pairs_visited = 0;  ///< BVH node pairs popped by traversal
   std::uint64_t node_pairs_orientation_culled = 0;
   std::uint64_t triangle_pairs = 0;          ///< non-culled triangle pairs examined
-  std::uint64_t feature_pairs = 0;           ///< distinct feature pairs reaching the filter
-  std::uint64_t feature_pairs_filtered = 0;  ///< rejected by box or coplanarity filter
+  std::uint64_t feature_pairs = 0;           ///< distinct feature pairs whose boxes overlap
+  std::uint64_t feature_pairs_filtered = 0;  ///< of those, rejected by the coplanarity filter
   std::uint64_t feature_tests = 0;           ///< elementary tests run
   std::uint64_t contacts = 0;                ///< elementary tests that reported contact
   bool nothing_moved = false;
