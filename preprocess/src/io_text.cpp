@@ -2,7 +2,7 @@
 
 #include <algorithm>
 #include <cctype>
-#include <cerrno>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -134,41 +134,41 @@ void Tokenizer::fail_at(std::size_t line, const std::string& message) const {
 }
 
 bool parse_double(std::string_view token, double& value) {
-  if (token.empty() || token.size() > 64) return false;
-  char buffer[65];
-  std::copy(token.begin(), token.end(), buffer);
-  buffer[token.size()] = '\0';
-  char* end = nullptr;
-  errno = 0;
-  value = std::strtod(buffer, &end);
-  if (end != buffer + token.size()) return false;
-  return true;  // over/underflow gives inf/0; callers check finiteness
+  if (!token.empty() && token.front() == '+') token.remove_prefix(1);
+  if (token.empty()) return false;
+  const char* end = token.data() + token.size();
+  const auto [ptr, ec] = std::from_chars(token.data(), end, value);
+  if (ec == std::errc::result_out_of_range) {
+    // Over/underflow: fall back to strtod, which gives inf or 0 (callers check finiteness).
+    char buffer[72];
+    if (token.size() >= sizeof buffer) return false;
+    std::copy(token.begin(), token.end(), buffer);
+    buffer[token.size()] = '\0';
+    value = std::strtod(buffer, nullptr);
+    return ptr == end;
+  }
+  return ec == std::errc() && ptr == end;
 }
 
 bool parse_int(std::string_view token, std::int64_t& value) {
-  if (token.empty() || token.size() > 30) return false;
-  char buffer[32];
-  std::copy(token.begin(), token.end(), buffer);
-  buffer[token.size()] = '\0';
-  char* end = nullptr;
-  errno = 0;
-  const long long parsed = std::strtoll(buffer, &end, 10);
-  if (end != buffer + token.size() || errno == ERANGE) return false;
-  value = parsed;
-  return true;
+  if (!token.empty() && token.front() == '+') token.remove_prefix(1);
+  if (token.empty()) return false;
+  const char* end = token.data() + token.size();
+  const auto [ptr, ec] = std::from_chars(token.data(), end, value);
+  return ec == std::errc() && ptr == end;
 }
 
 void append_double(std::string& out, double value) {
+  // Shortest representation that reads back to the same double.
   char buffer[40];
-  const int n = std::snprintf(buffer, sizeof buffer, "%.17g", value);
-  out.append(buffer, static_cast<std::size_t>(n));
+  const auto [ptr, ec] = std::to_chars(buffer, buffer + sizeof buffer, value);
+  out.append(buffer, static_cast<std::size_t>(ptr - buffer));
 }
 
 void append_uint(std::string& out, std::uint64_t value) {
   char buffer[24];
-  const int n =
-      std::snprintf(buffer, sizeof buffer, "%llu", static_cast<unsigned long long>(value));
-  out.append(buffer, static_cast<std::size_t>(n));
+  const auto [ptr, ec] = std::to_chars(buffer, buffer + sizeof buffer, value);
+  out.append(buffer, static_cast<std::size_t>(ptr - buffer));
 }
 
 void write_text_file(const std::string& path, const std::string& text) {

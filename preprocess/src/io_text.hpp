@@ -59,7 +59,7 @@ class Tokenizer {
 bool parse_double(std::string_view token, double& value);
 bool parse_int(std::string_view token, std::int64_t& value);
 
-/// Appends "%.17g" of `value` (round-trips exactly).
+/// Appends the shortest decimal form of `value` that reads back exactly.
 void append_double(std::string& out, double value);
 void append_uint(std::string& out, std::uint64_t value);
 

@@ -151,6 +151,18 @@ TEST_CASE("The MEDIT reader accepts the format's variations", "[format][io]") {
     CHECK_THAT(error_of([&] { read_tet_mesh(path); }),
                Catch::Contains("line 3: a vertex coordinate is not finite"));
   }
+  SECTION("Numbers with a plus sign are read; an overflowing one is not finite.") {
+    const std::string ok =
+        dir.write("plus.mesh",
+                  "Dimension 3\nVertices 4\n+1.5 0 0 +0\n1 0 0 0\n0 1 0 0\n0 0 1e-400 0\n"
+                  "Tetrahedra 1\n1 2 3 4 +7\n");
+    const TetMesh m = read_tet_mesh(ok);
+    CHECK(m.nodes[0][0] == 1.5);
+    CHECK(m.nodes[3][2] == 0.0);
+    const std::string big = dir.write("big.mesh", "Dimension 3\nVertices 1\n0 1e400 0 0\n");
+    CHECK_THAT(error_of([&] { read_tet_mesh(big); }),
+               Catch::Contains("line 3: a vertex coordinate is not finite"));
+  }
   SECTION("A truncated file reports an unexpected end of file.") {
     const std::string path = dir.write("eof.mesh", "Dimension 3\nVertices 3\n0 0 0 0\n1 0 0 0\n");
     CHECK_THAT(error_of([&] { read_tet_mesh(path); }), Catch::Contains("unexpected end of file"));
