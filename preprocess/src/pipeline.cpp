@@ -1,7 +1,6 @@
 #include "tetseg/preprocess/pipeline.hpp"
 
 #include <algorithm>
-#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <numeric>
@@ -12,8 +11,6 @@
 
 namespace tetseg::preprocess {
 namespace {
-
-using Clock = std::chrono::steady_clock;
 
 // Shortest decimal text that reads back as exactly `value` ("0.1", not "0.10000000000000001").
 std::string format_number(double value) {
@@ -52,28 +49,6 @@ std::string base_name(const std::string& path) {
   const auto slash = path.find_last_of('/');
   return slash == std::string::npos ? path : path.substr(slash + 1);
 }
-
-// Times one stage and reports it.
-class StageTimer {
- public:
-  StageTimer(BuildReport& report, const std::function<void(const StageReport&)>& on_stage)
-      : m_report(report), m_on_stage(on_stage) {}
-  template <typename F>
-  auto run(const char* name, F&& work) {
-    const auto start = Clock::now();
-    StageReport stage;
-    stage.name = name;
-    auto result = work(stage.summary);
-    stage.seconds = std::chrono::duration<double>(Clock::now() - start).count();
-    m_report.stages.push_back(stage);
-    if (m_on_stage) m_on_stage(stage);
-    return result;
-  }
-
- private:
-  BuildReport& m_report;
-  const std::function<void(const StageReport&)>& m_on_stage;
-};
 
 }  // namespace
 

@@ -84,34 +84,27 @@ void run_build(const BuildArgs& args) {
   using Clock = std::chrono::steady_clock;
   const auto start = Clock::now();
   BuildReport report;
-  auto on_stage = [&](const StageReport& stage) { print_stage(stage, args.quiet); };
-  auto timed = [&](const char* name, auto&& work) {
-    const auto t0 = Clock::now();
-    StageReport stage;
-    stage.name = name;
-    auto result = work(stage.summary);
-    stage.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
-    report.stages.push_back(stage);
-    on_stage(stage);
-    return result;
+  const std::function<void(const StageReport&)> on_stage = [&](const StageReport& stage) {
+    print_stage(stage, args.quiet);
   };
+  StageTimer timer(report, on_stage);
 
   TetMesh mesh;
   if (is_tet_mesh_path(args.input)) {
-    mesh = timed("read", [&](std::string& summary) {
+    mesh = timer.run("read", [&](std::string& summary) {
       TetMesh m = read_tet_mesh(args.input);
       summary = std::to_string(m.nodes.size()) + " nodes, " + std::to_string(m.tets.size()) + " tets";
       return m;
     });
   } else {
-    const TriangleMesh surface = timed("read", [&](std::string& summary) {
+    const TriangleMesh surface = timer.run("read", [&](std::string& summary) {
       TriangleMesh s = read_triangle_mesh(args.input);
       validate_closed_surface(s, args.input);
       summary = std::to_string(s.vertices.size()) + " vertices, " +
                 std::to_string(s.triangles.size()) + " triangles (surface)";
       return s;
     });
-    mesh = timed("tetrahedralize", [&](std::string& summary) {
+    mesh = timer.run("tetrahedralize", [&](std::string& summary) {
       TetMesh m = tetrahedralize(surface, args.meshing, args.input);
       summary = std::to_string(m.nodes.size()) + " nodes, " + std::to_string(m.tets.size()) + " tets";
       return m;
@@ -121,7 +114,7 @@ void run_build(const BuildArgs& args) {
   BuildOptions options = args.options;
   options.keep_rest_positions = !args.no_rest_positions;
   const format::Asset asset = build_asset(mesh, args.input, options, report, on_stage);
-  const std::vector<std::uint8_t> bytes = timed("write", [&](std::string& summary) {
+  const std::vector<std::uint8_t> bytes = timer.run("write", [&](std::string& summary) {
     std::vector<std::uint8_t> b = format::write_asset(asset);
     write_file_atomic(args.output, b);
     summary = args.output + " (" + std::to_string(b.size()) + " bytes)";

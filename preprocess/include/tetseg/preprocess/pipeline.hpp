@@ -3,6 +3,7 @@
 /// The whole preprocessing pipeline: tet mesh -> surface -> charge -> segmentation -> detector
 /// nodes -> BVH topology -> asset. What `tetseg build` runs.
 
+#include <chrono>
 #include <cstdint>
 #include <functional>
 #include <string>
@@ -47,6 +48,30 @@ struct BuildReport {
   SegmentationCounts segmentation;
   ChargeResult charge;  ///< density left empty; solver figures only
   std::vector<float> rest_positive_fraction;  ///< per cluster
+};
+
+/// Runs stages, timing each, appending it to `report.stages` and passing it to `on_stage`.
+/// `work(summary)` does the stage, may fill the human summary, and returns its result.
+class StageTimer {
+ public:
+  StageTimer(BuildReport& report, const std::function<void(const StageReport&)>& on_stage)
+      : m_report(report), m_on_stage(on_stage) {}
+
+  template <typename Work>
+  auto run(const char* name, Work&& work) {
+    const auto start = std::chrono::steady_clock::now();
+    StageReport stage;
+    stage.name = name;
+    auto result = work(stage.summary);
+    stage.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    m_report.stages.push_back(stage);
+    if (m_on_stage) m_on_stage(stage);
+    return result;
+  }
+
+ private:
+  BuildReport& m_report;
+  const std::function<void(const StageReport&)>& m_on_stage;
 };
 
 /// Options as the key/value pairs recorded in the asset's provenance (sorted by key).
