@@ -61,8 +61,8 @@ Criteria make_criteria(const Mesh3Criteria& c) {
 /// the optimiser gets no time limit (its default limit is the refinement time, which would
 /// make the result depend on the machine's speed). Optimisation is sliver exudation until
 /// every dihedral angle is at least kExudeBoundDegrees (or no tet improves); perturbation
-/// and ODT/Lloyd are off (perturbation without a time limit cost 6x the refinement time on
-/// a 190k-tet pawn for little gain; see docs/benchmarks.md, Meshing).
+/// and ODT/Lloyd are off (perturbation without a time limit was much slower than the
+/// refinement itself on large meshes).
 constexpr double kExudeBoundDegrees = 10.0;
 
 template <class C3t3, class Domain, class Criteria>
