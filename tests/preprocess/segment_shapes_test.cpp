@@ -86,6 +86,27 @@ std::uint32_t cluster_nearest(const Result& r, const Vec3& p) {
   return cluster;
 }
 
+// The visibility strategy never does worse than the paper's node and comes within `slack` of
+// the best interior node found by brute force (every interior node, every triangle).
+void check_visibility_against_brute_force(const Result& r, double slack) {
+  const std::vector<Detector> paper =
+      choose_detectors(r.mesh.nodes, r.surface, r.seg.triangle_cluster, r.seg.cluster_count,
+                       DetectorStrategy::kNearestCentroid);
+  for (std::uint32_t c = 0; c < r.seg.cluster_count; ++c) {
+    std::vector<std::uint32_t> ids;
+    for (std::uint32_t t = 0; t < r.seg.triangle_cluster.size(); ++t)
+      if (r.seg.triangle_cluster[t] == c) ids.push_back(t);
+    std::uint32_t best = 0;
+    for (std::uint32_t v : r.surface.interior_nodes)
+      best = std::max(
+          best, count_positive_triangles(r.mesh.nodes, r.surface.triangles, ids, r.mesh.nodes[v]));
+    const double oracle = static_cast<double>(best) / static_cast<double>(ids.size());
+    CAPTURE(c, oracle, paper[c].rest_positive_fraction, r.detectors[c].rest_positive_fraction);
+    CHECK(r.detectors[c].rest_positive_fraction >= paper[c].rest_positive_fraction);
+    CHECK(r.detectors[c].rest_positive_fraction >= oracle - slack);
+  }
+}
+
 }  // namespace
 
 TEST_CASE("A sphere is one cluster", "[segmentation][shapes]") {
@@ -126,6 +147,7 @@ TEST_CASE("A dumbbell's two necks give two boundaries and three clusters",
   CHECK(middle != right);
   CHECK(left != right);
   check_detectors(r);
+  check_visibility_against_brute_force(r, 0.01);
 }
 
 TEST_CASE("A pawn gets a boundary at its collar and neck", "[segmentation][shapes]") {
@@ -147,4 +169,5 @@ TEST_CASE("A pawn gets a boundary at its collar and neck", "[segmentation][shape
   CHECK(at_collar >= 1);
   CHECK(cluster_nearest(r, {0, 0, 1.65}) != cluster_nearest(r, {0, 0, 0}));  // head vs base
   check_detectors(r);
+  check_visibility_against_brute_force(r, 0.01);
 }
