@@ -283,3 +283,29 @@ TEST_CASE("A self-intersecting start state is reported", "[collider][rest]") {
   REQUIRE(d.step(frames[1].data(), frames[1].data()) == ColliderStatus::kOk);
   CHECK(d.rest_intersection().intersecting);
 }
+
+TEST_CASE("Degenerate chain BVHs as deep as the cluster is large are traversed correctly",
+          "[collider][api]") {
+  const Surface s = dumbbell(12, 16);
+  std::vector<std::uint32_t> cluster_of(s.tris.size());
+  for (std::size_t t = 0; t < s.tris.size(); ++t)
+    cluster_of[t] = s.verts[s.tris[t][0]][2] > 0 ? 1 : 0;
+  const Scene chain = make_scene(s, cluster_of, {{0, 0, -1.6}, {0, 0, 1.6}}, 0);
+  const Scene split = make_scene(s, cluster_of, {{0, 0, -1.6}, {0, 0, 1.6}}, 2);
+  const auto frames =
+      make_frames(chain, 12, [](const P3& p, double t) { return bend(p, t, 2.6, -0.5, 0.5, 0.0); });
+  const SequenceReport rep = compare_with_brute(chain, frames);
+  CHECK(rep.contact_frames == 1);
+  // Same contacts as with well-formed BVHs, step by step.
+  Collider a(chain.asset), b(split.asset);
+  std::vector<Contact> ca(1 << 14), cb(1 << 14);
+  for (std::size_t f = 0; f + 1 < frames.size(); ++f) {
+    REQUIRE(a.step(frames[f].data(), frames[f + 1].data()) == ColliderStatus::kOk);
+    REQUIRE(b.step(frames[f].data(), frames[f + 1].data()) == ColliderStatus::kOk);
+    const ContactsResult ra = a.contacts(ca.data(), ca.size());
+    const ContactsResult rb = b.contacts(cb.data(), cb.size());
+    REQUIRE(ra.status == ColliderStatus::kOk);
+    REQUIRE(ra.found == rb.found);
+    for (std::size_t i = 0; i < ra.written; ++i) CHECK(same_feature(ca[i], cb[i]));
+  }
+}

@@ -59,6 +59,7 @@ int run(const std::string& asset_path, const std::string& frames_path, const std
   std::vector<tetseg::Contact> buffer;  // contacts are counted, not stored
   std::vector<FrameResult> results;
   double refit = 0, classify = 0, traversal = 0, tests = 0, total = 0;
+  double uncertain = 0, feature_tests = 0, skipped = 0;
   using Clock = std::chrono::steady_clock;
   const std::size_t steps = frames.frame_count > 0 ? frames.frame_count - 1 : 0;
   for (std::size_t f = 0; f < steps; ++f) {
@@ -90,6 +91,9 @@ int run(const std::string& asset_path, const std::string& frames_path, const std
     classify += stats.classify_ms;
     traversal += stats.traversal_ms;
     tests += stats.tests_ms;
+    uncertain += double(stats.triangles_uncertain);
+    feature_tests += double(stats.feature_tests);
+    skipped += double(stats.clusters_skipped);
     results.push_back(r);
     if (!json) {
       std::cout << "frame " << f << ": any " << (r.any ? "yes" : "no");
@@ -122,7 +126,9 @@ int run(const std::string& asset_path, const std::string& frames_path, const std
     std::cout << "mode " << mode_name << ", query " << query << ", " << results.size()
               << " steps; mean ms: refit " << refit / n << ", classify " << classify / n
               << ", traversal " << traversal / n << ", tests " << tests / n << ", total "
-              << total / n << '\n';
+              << total / n << "; mean per step: " << uncertain / n << " uncertain triangles of "
+              << asset.triangle_count() << ", " << skipped / n << " clusters skipped, "
+              << feature_tests / n << " elementary tests\n";
   }
   return kExitOk;
 }

@@ -164,6 +164,22 @@ inline void build_bvh(const Surface& s, std::vector<std::uint32_t> tris, std::ui
   order = tris;
 }
 
+/// A valid but degenerate BVH: a chain whose depth equals the triangle count (each inner node
+/// has one single-triangle leaf and the rest of the chain). Stresses traversal stacks.
+inline void build_chain_bvh(const std::vector<std::uint32_t>& tris,
+                            std::vector<std::uint32_t>& order,
+                            std::vector<format::BvhNode>& nodes) {
+  order = tris;
+  nodes.clear();
+  const std::uint32_t n = static_cast<std::uint32_t>(tris.size());
+  for (std::uint32_t k = 0; k + 1 < n; ++k) {
+    const std::uint32_t self = static_cast<std::uint32_t>(nodes.size());
+    nodes.push_back({self + 1, self + 2, 0});
+    nodes.push_back({k, 0, 1});
+  }
+  nodes.push_back({n - 1, 0, 1});
+}
+
 /// A scene: the asset plus rest positions of all nodes (surface vertices, then detectors).
 struct Scene {
   Asset asset;
@@ -172,6 +188,7 @@ struct Scene {
 };
 
 /// Assembles, validates and loads an asset. `cluster_of[t]` in [0, detectors.size()).
+/// `leaf_size` 0 builds chain BVHs (build_chain_bvh) instead of median splits.
 inline Scene make_scene(const Surface& s, const std::vector<std::uint32_t>& cluster_of,
                         const std::vector<P3>& detectors, std::uint32_t leaf_size = 2) {
   format::Asset a;
@@ -188,7 +205,11 @@ inline Scene make_scene(const Surface& s, const std::vector<std::uint32_t>& clus
     if (tris.empty()) throw std::runtime_error("empty cluster in test scene");
     std::vector<std::uint32_t> order;
     std::vector<format::BvhNode> nodes;
-    build_bvh(s, tris, leaf_size, order, nodes);
+    if (leaf_size == 0) {
+      build_chain_bvh(tris, order, nodes);
+    } else {
+      build_bvh(s, tris, leaf_size, order, nodes);
+    }
     format::Cluster cl;
     cl.detector_node = nv + c;
     cl.rest_positive_fraction = 1.0f;

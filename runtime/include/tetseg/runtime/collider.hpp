@@ -141,7 +141,8 @@ class Collider {
   /// Rule for still geometry: a feature pair whose four nodes are all still is never
   /// tested (it can only touch during the whole step, i.e. at t = 0, which the previous step
   /// or `check_rest_intersection` reports); so still clusters, pairs of still clusters and
-  /// a step where nothing moved cost no traversal. Rejects non-finite input (kNonFinite).
+  /// a step where nothing moved cost no traversal. Rejects NaN/inf
+  /// positions of the nodes it reads (surface and detector nodes; no other node is read).
   ColliderStatus step(const double* x0, const double* x1, std::size_t value_count) noexcept;
   /// Same with value_count = node_count * 3 assumed.
   ColliderStatus step(const double* x0, const double* x1) noexcept;
