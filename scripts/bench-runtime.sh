@@ -5,7 +5,8 @@
 # per-step times (refit, classify, traversal, elementary tests, total) and feature tests.
 # Two runs per scene: up to and including the first step with a contact (what a simulator
 # steps through before responding: --stop-at-contact) and the whole sequence (later steps
-# start interpenetrating and report hundreds of contacts).
+# start interpenetrating and report hundreds of contacts). Brute force is skipped on the
+# whole sequence of scenes over 10k triangles (minutes).
 # Usage: scripts/bench-runtime.sh [build-dir]   (default build-bench-runtime)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -35,6 +36,8 @@ for entry in "${scenes[@]}"; do
     extra=()
     [ "$span" = first ] && extra=(--stop-at-contact)
     for mode in rvbc bvh brute; do
+      # brute force over a whole 15k-triangle sequence takes minutes: first-contact span only
+      [ "$mode" = brute ] && [ "$span" = all ] && [ "$tris" -gt 10000 ] && continue
       "$bin/tetseg-run" "$work/$name.tetseg" "$work/$name.tsf" --mode "$mode" --json "${extra[@]}" \
         >"$work/$name-$mode-$span.json"
       python3 - "$work/$name-$mode-$span.json" "$name" "$tris" "$span" <<'PY'
