@@ -31,7 +31,7 @@ double best_of(int runs, F&& f) {
 
 }  // namespace
 
-TEST_CASE("Benchmark: tet mesh I/O, extraction and validation", "[.bench][io]") {
+TEST_CASE("Benchmark: tet mesh I/O, extraction and validation", "[.bench][io-bench]") {
   ShapeOptions o;
   o.size = 2.5;
   TetMesh mesh;

@@ -6,6 +6,8 @@
 #include <catch2/catch.hpp>
 #include <filesystem>
 #include <fstream>
+#include <functional>
+#include <sstream>
 #include <string>
 
 #include "tetseg/preprocess/io.hpp"
@@ -348,5 +350,38 @@ TEST_CASE("Surfaces are imported through assimp with coincident vertices merged"
   SECTION("A missing file is an error naming it.") {
     CHECK_THAT(error_of([&] { read_triangle_mesh(dir.file("nope.obj")); }),
                Catch::Contains("cannot open"));
+  }
+}
+
+TEST_CASE("Every truncated prefix of a valid file reads or fails with InputError", "[format][io]") {
+  const TempDir dir("prefix");
+  const TetMesh mesh = grid_mesh(1);
+  for (const char* name : {"p.mesh", "p.msh", "q.msh", "p.node"}) {
+    CAPTURE(name);
+    const std::string path = dir.file(name);
+    if (std::string(name) == "q.msh") {
+      write_gmsh22(path, mesh);
+    } else {
+      write_tet_mesh(path, mesh);
+    }
+    std::ifstream in(path, std::ios::binary);
+    std::stringstream buffer;
+    buffer << in.rdbuf();
+    const std::string text = buffer.str();
+    std::size_t failures = 0;
+    for (std::size_t n = 0; n < text.size(); ++n) {
+      dir.write(name, text.substr(0, n));
+      try {
+        const TetMesh m = read_tet_mesh(path);
+        // Only a cut inside the last line or the end marker can leave a complete file.
+        CHECK(n + 40 >= text.size());
+        CHECK(m.tets.size() == mesh.tets.size());
+        for (const Tet& t : m.tets)
+          for (std::uint32_t v : t) CHECK(v < m.nodes.size());
+      } catch (const InputError&) {
+        ++failures;
+      }
+    }
+    CHECK(failures + 40 >= text.size());
   }
 }
