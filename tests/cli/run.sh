@@ -63,14 +63,21 @@ PY
 # Frame files from meshes: the .obj frames written by tetseg-scene give the same bytes.
 "$bin/tetseg-frames" fromobj.tsf frame_000*.obj 2>/dev/null
 cmp fromobj.tsf d.tsf || fail "frames from .obj differ from the generated frames"
-# A .ply with the same vertices (ascii) converts to the same positions as the .obj.
+# A .ply (ascii) and a Medit .mesh with the same vertices convert to the same positions.
 python3 - <<'PY'
 v = [l.split()[1:] for l in open("frame_0000.obj") if l.startswith("v ")]
 with open("f0.ply", "w") as out:
     out.write(f"ply\nformat ascii 1.0\nelement vertex {len(v)}\nproperty double x\nproperty double y\nproperty double z\nelement face 0\nproperty list uchar int vertex_indices\nend_header\n")
     for p in v: out.write(" ".join(p) + "\n")
 PY
-"$bin/tetseg-frames" ply.tsf f0.ply frame_0001.obj 2>/dev/null
+python3 - <<'PY'
+v = [l.split()[1:] for l in open("frame_0001.obj") if l.startswith("v ")]
+with open("f1.mesh", "w") as out:
+    out.write(f"MeshVersionFormatted 2\nDimension 3\nVertices\n{len(v)}\n")
+    for p in v: out.write(" ".join(p) + " 0\n")
+    out.write("End\n")
+PY
+"$bin/tetseg-frames" ply.tsf f0.ply f1.mesh 2>/dev/null
 "$bin/tetseg-frames" obj.tsf frame_0000.obj frame_0001.obj 2>/dev/null
 cmp ply.tsf obj.tsf || fail "frames from .ply differ from .obj"
 printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n' > tri.obj
