@@ -78,6 +78,16 @@ with open("f1.mesh", "w") as out:
     out.write("End\n")
 PY
 "$bin/tetseg-frames" ply.tsf f0.ply f1.mesh 2>/dev/null
+# Binary little-endian PLY with an extra float property and a face element.
+python3 - <<'PY'
+import struct
+v = [[float(x) for x in l.split()[1:]] for l in open("frame_0000.obj") if l.startswith("v ")]
+with open("f0b.ply", "wb") as out:
+    out.write(f"ply\nformat binary_little_endian 1.0\nelement vertex {len(v)}\nproperty float q\nproperty double x\nproperty double y\nproperty double z\nelement face 0\nproperty list uchar int vertex_indices\nend_header\n".encode())
+    for p in v: out.write(struct.pack("<f3d", 0.5, *p))
+PY
+"$bin/tetseg-frames" plyb.tsf f0b.ply f1.mesh 2>/dev/null
+cmp plyb.tsf ply.tsf || fail "frames from binary .ply differ"
 "$bin/tetseg-frames" obj.tsf frame_0000.obj frame_0001.obj 2>/dev/null
 cmp ply.tsf obj.tsf || fail "frames from .ply differ from .obj"
 printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n' > tri.obj
