@@ -198,9 +198,9 @@ TEST_CASE("The TetGen reader accepts 0- and 1-based files with attributes", "[fo
     CHECK(m.tets[0] == Tet{0, 1, 2, 3});
     CHECK(m.tets[1] == Tet{1, 4, 2, 3});
   }
-  SECTION("0-based files give the same ids.") {
-    dir.write("z.node", "4 3 0 0\n0 0 0 0\n1 1 0 0\n2 0 1 0\n3 0 0 1\n");
-    dir.write("z.ele", "1 4 0\n0 0 1 2 3\n");
+  SECTION("0-based files with CRLF line ends give the same ids.") {
+    dir.write("z.node", "4 3 0 0\r\n0 0 0 0\r\n1 1 0 0\r\n2 0 1 0\r\n3 0 0 1\r\n");
+    dir.write("z.ele", "1 4 0\r\n0 0 1 2 3\r\n");
     const TetMesh m = read_tet_mesh(dir.file("z.node"));
     CHECK(m.tets[0] == Tet{0, 1, 2, 3});
   }
@@ -342,6 +342,17 @@ TEST_CASE("Surfaces are imported through assimp with coincident vertices merged"
     }
     text += "endsolid cube\n";
     check_cube(read_triangle_mesh(dir.write("cube.stl", text)));
+  }
+  SECTION("ASCII PLY with a face list.") {
+    std::string text =
+        "ply\nformat ascii 1.0\nelement vertex 8\nproperty float x\nproperty float y\n"
+        "property float z\nelement face 12\nproperty list uchar int vertex_indices\nend_header\n";
+    for (const auto& p : c)
+      text += std::to_string(p[0]) + " " + std::to_string(p[1]) + " " + std::to_string(p[2]) + "\n";
+    for (const auto& t : f)
+      text += "3 " + std::to_string(t[0]) + " " + std::to_string(t[1]) + " " +
+              std::to_string(t[2]) + "\n";
+    check_cube(read_triangle_mesh(dir.write("cube.ply", text)));
   }
   SECTION("A file with no triangles is an error.") {
     const std::string path = dir.write("empty.obj", "v 0 0 0\nv 1 0 0\n");

@@ -118,7 +118,8 @@ void finish_tet_mesh(const preprocess::TetMesh& mesh, const std::string& output,
       preprocess::validate_tet_mesh(mesh, surface, output);
     } catch (const preprocess::InputError& e) {
       throw ToolError(kExitProcessingFailed, output,
-                      std::string("meshing produced an invalid mesh: ") + e.what());
+                      std::string("meshing produced an invalid mesh: ") + e.what() +
+                          " (thin parts may need a smaller --facet-size)");
     }
     stage.done(std::to_string(surface.triangles.size()) + " surface triangles, " +
                std::to_string(surface.interior_nodes.size()) + " interior nodes");

@@ -13,8 +13,17 @@ namespace tetseg::preprocess {
 /// file; the other is found beside it), Gmsh `.msh` 2.2 and 4.1 (ASCII).
 bool is_tet_mesh_path(const std::string& path);
 
-/// Reads a tetrahedral mesh; the format follows from the extension. Checks syntax and index
-/// ranges and finite coordinates, not geometry (see validate.hpp). Throws InputError.
+/// Reads a tetrahedral mesh; the format follows from the extension (case-insensitive). Nodes
+/// get 0-based ids in file order (all nodes of the file, also those no tet uses; Gmsh tags
+/// and TetGen's 0/1-based ids are mapped). Only 4-node tets are kept (10-node tets: their
+/// corner nodes); other elements (triangles, edges, ...) are ignored, as are unknown MEDIT
+/// sections and Gmsh `$Sections`. If every tet with nonzero volume is negatively oriented
+/// (a mirrored convention), two vertices of every tet are swapped; mixed orientations are
+/// left for validate_tet_mesh to report. Checks syntax, counts, index ranges and finite
+/// coordinates, not geometry. Throws InputError(path, "line N: ...") for malformed text,
+/// unexpected end of file, indices out of range, NaN/Inf, counts that do not match, binary
+/// Gmsh; "no tetrahedra in file" when there are none. Safe on untrusted input (counts are
+/// checked against the file size before reserving). Thread-safe (no shared state).
 TetMesh read_tet_mesh(const std::string& path);
 
 /// Writes a tetrahedral mesh in the format named by the extension (`.mesh`, `.node`/`.ele`,
@@ -24,8 +33,11 @@ TetMesh read_tet_mesh(const std::string& path);
 void write_tet_mesh(const std::string& path, const TetMesh& mesh);
 void write_gmsh22(const std::string& path, const TetMesh& mesh);
 
-/// Reads a triangle surface through assimp (OBJ, PLY, STL, OFF, glTF, ...), merging
-/// coincident vertices. Throws InputError.
+/// Reads a triangle surface through assimp (OBJ, PLY, STL, OFF, glTF, ...): polygons are
+/// triangulated, node transforms applied, points and lines dropped, and vertices with exactly
+/// the same position merged (numbered in order of first use). Coordinates pass through
+/// assimp's single-precision floats. Throws InputError when the file cannot be read or holds
+/// no triangles. No validation: see validate_closed_surface.
 TriangleMesh read_triangle_mesh(const std::string& path);
 
 }  // namespace tetseg::preprocess
