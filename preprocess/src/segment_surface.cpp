@@ -35,7 +35,8 @@ class Segmenter {
         m_options(options),
         m_mesh(surface.triangles),
         m_n(static_cast<std::uint32_t>(surface.triangles.size())),
-        m_in_set(m_n, 0) {
+        m_in_set(m_n, 0),
+        m_kept_cut(3 * static_cast<std::size_t>(m_n), 0) {
     m_min_cluster = options.min_cluster_triangles > 0 ? options.min_cluster_triangles
                                                       : derived_min_cluster_triangles(m_n);
   }
@@ -67,9 +68,14 @@ class Segmenter {
   HalfEdges m_mesh;
   std::uint32_t m_n;
   std::uint32_t m_min_cluster = 1;
-  std::vector<std::uint8_t> m_in_set;               // the segment being processed
-  std::vector<std::vector<std::uint32_t>> m_loops;  // half-edges of chosen boundaries
-  std::vector<std::uint32_t> m_labels;              // scratch
+  std::vector<std::uint8_t> m_in_set;                  // the segment being processed
+  std::vector<std::uint8_t> m_kept_cut;                // per half-edge: on a kept boundary
+  std::vector<std::vector<std::uint32_t>> m_loops;     // half-edges of chosen boundaries
+  std::vector<std::uint32_t> m_segment_of;             // per triangle: marked segment or kNone
+  std::vector<std::vector<std::uint32_t>> m_segments;  // triangles of each marked segment
+  std::vector<std::uint32_t> m_absorbed;  // per segment: == m_stamp when in the growing set
+  std::uint32_t m_stamp = 0;              // 1 + the segment being processed
+  std::vector<std::uint32_t> m_labels;    // scratch
   SegmentationCounts m_counts;
 };
 
@@ -114,6 +120,18 @@ bool Segmenter::grow(std::vector<std::uint32_t>& set) {
         const std::uint32_t u = m_mesh.neighbor(3 * t + k);
         if (u != kNone && !m_in_set[u]) ring.push_back(u);
       }
+    if (m_options.grow_through_marked) {
+      // A ring that touches another marked segment takes all of it: the low-charge band it
+      // belongs to is one structure, split only by a few triangles above alpha.
+      const std::size_t direct = ring.size();
+      for (std::size_t i = 0; i < direct; ++i) {
+        const std::uint32_t other = m_segment_of[ring[i]];
+        if (other == kNone || m_absorbed[other] == m_stamp) continue;
+        m_absorbed[other] = m_stamp;
+        for (std::uint32_t t : m_segments[other])
+          if (!m_in_set[t]) ring.push_back(t);
+      }
+    }
     std::sort(ring.begin(), ring.end());
     ring.erase(std::unique(ring.begin(), ring.end()), ring.end());
     if (ring.empty()) return false;
@@ -188,6 +206,7 @@ bool Segmenter::pick_boundary(const std::vector<std::uint32_t>& set) {
   const std::vector<std::uint8_t> all(m_n, 1);
   for (const Contour& c : contours) {
     if (!c.closed || c.half_edges.size() < 3) continue;
+    // Alone, the loop must split the surface with its two sides in different pieces.
     std::vector<std::uint8_t> cut(3 * static_cast<std::size_t>(m_n), 0);
     for (std::uint32_t h : c.half_edges) {
       cut[h] = 1;
@@ -195,10 +214,29 @@ bool Segmenter::pick_boundary(const std::vector<std::uint32_t>& set) {
     }
     std::vector<std::uint32_t> labels;
     if (detail::label_components(m_mesh, all, &cut, labels) < 2) continue;
-    // Components of the surface without this loop: count those touching it on each side.
-    std::uint32_t left = labels[c.half_edges.front() / 3];
-    std::uint32_t right = m_mesh.neighbor(c.half_edges.front());
-    if (right == kNone || labels[right] == left) continue;
+    const std::uint32_t right = m_mesh.neighbor(c.half_edges.front());
+    if (right == kNone || labels[right] == labels[c.half_edges.front() / 3]) continue;
+    // With the boundaries kept so far, every edge of the loop must lie between two different
+    // pieces of at least the minimum cluster size: no sliver clusters between nearby loops.
+    for (std::size_t h = 0; h < cut.size(); ++h) cut[h] |= m_kept_cut[h];
+    const std::uint32_t count = detail::label_components(m_mesh, all, &cut, labels);
+    std::vector<std::uint32_t> sizes(count, 0);
+    for (std::uint32_t t = 0; t < m_n; ++t) ++sizes[labels[t]];
+    bool ok = true;
+    for (std::uint32_t h : c.half_edges) {
+      const std::uint32_t u = m_mesh.neighbor(h);
+      const std::uint32_t a = labels[h / 3];
+      if (u == kNone || labels[u] == a || sizes[a] < m_min_cluster ||
+          sizes[labels[u]] < m_min_cluster) {
+        ok = false;
+        break;
+      }
+    }
+    if (!ok) continue;
+    for (std::uint32_t h : c.half_edges) {
+      m_kept_cut[h] = 1;
+      m_kept_cut[m_mesh.twin(h)] = 1;
+    }
     m_loops.push_back(c.half_edges);
     return true;
   }
@@ -324,22 +362,31 @@ Segmentation Segmenter::run() {
   if (m_n == 0) return out;
   std::vector<std::uint8_t> marked(m_n, 0);
   for (std::uint32_t t = 0; t < m_n; ++t) marked[t] = m_density[t] < m_options.alpha ? 1 : 0;
-  std::vector<std::uint32_t> segment_of;
-  const std::uint32_t segments = detail::label_components(m_mesh, marked, nullptr, segment_of);
+  const std::uint32_t segments = detail::label_components(m_mesh, marked, nullptr, m_segment_of);
   m_counts.segments_found = segments;
-  std::vector<std::vector<std::uint32_t>> members(segments);
+  m_segments.assign(segments, {});
   for (std::uint32_t t = 0; t < m_n; ++t)
-    if (segment_of[t] != kNone) members[segment_of[t]].push_back(t);
+    if (m_segment_of[t] != kNone) m_segments[m_segment_of[t]].push_back(t);
+  m_absorbed.assign(segments, 0);
 
   const double beta =
       m_options.beta_divisor > 0.0 ? static_cast<double>(m_n) / m_options.beta_divisor : 0.0;
+  std::vector<std::uint8_t> consumed(segments, 0);
   for (std::uint32_t s = 0; s < segments; ++s) {
-    std::vector<std::uint32_t> set = members[s];
+    // A segment taken whole into an earlier segment's successful growth is done.
+    if (consumed[s]) continue;
+    std::vector<std::uint32_t> set = m_segments[s];
     set_flags(set, 1);
+    m_stamp = s + 1;
+    m_absorbed[s] = m_stamp;
     bool ok = separates(set);
     if (!ok && static_cast<double>(set.size()) > beta) {
       ok = grow(set);
-      if (ok) ++m_counts.segments_grown;
+      if (ok) {
+        ++m_counts.segments_grown;
+        for (std::uint32_t o = 0; o < segments; ++o)
+          if (m_absorbed[o] == m_stamp) consumed[o] = 1;
+      }
     }
     if (ok) {
       shrink(set);

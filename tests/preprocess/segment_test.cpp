@@ -118,14 +118,14 @@ TEST_CASE("Low-density bands at both ends of a dumbbell's neck give three cluste
     CHECK(again.triangle_cluster == seg.triangle_cluster);
     CHECK(again.boundary_loops == seg.boundary_loops);
   }
-  SECTION("A minimum cluster size above the neck's size merges it into a neighbour.") {
+  SECTION("A minimum cluster size above the neck's size keeps only one of the two boundaries.") {
     SegmentationOptions options;
     options.min_cluster_triangles = 300;  // cubes have 736 triangles, the neck at most 256
-    const Segmentation merged = segment_surface(shape.nodes, shape.surface, eq, options);
-    check_segmentation_invariants(shape.surface.triangles, merged);
-    CHECK(merged.cluster_count == 2);
-    CHECK(merged.counts.clusters_merged == 1);
-    CHECK(merged.boundary_loops.size() == 1);
+    const Segmentation fewer = segment_surface(shape.nodes, shape.surface, eq, options);
+    check_segmentation_invariants(shape.surface.triangles, fewer);
+    CHECK(fewer.counts.segments_shrunk == 2);
+    CHECK(fewer.cluster_count == 2);
+    CHECK(fewer.boundary_loops.size() == 1);
   }
 }
 
@@ -159,6 +159,38 @@ TEST_CASE("A band that almost surrounds the neck grows until it separates", "[se
     SegmentationOptions options;
     options.beta_divisor = 10.0;  // beta = 172 triangles > 48
     const Segmentation seg = segment_surface(shape.nodes, shape.surface, eq, options);
+    CHECK(seg.counts.segments_grown == 0);
+    CHECK(seg.cluster_count == 1);
+  }
+}
+
+TEST_CASE("A band broken into pieces is joined by growing through marked triangles",
+          "[segmentation]") {
+  const VoxelShape shape = dumbbell();
+  // A band around the neck at x in (5.5, 6.5), broken at the neck's four long edges.
+  const auto eq = field(shape, [](const Vec3& c) {
+    const bool near_edge = (std::abs(c[1] - 1) < 0.3 || std::abs(c[1] - 3) < 0.3) &&
+                           (std::abs(c[2] - 1) < 0.3 || std::abs(c[2] - 3) < 0.3);
+    return on_neck_band(c, 5.5, 6.5) && !near_edge ? 0.05 : 0.6;
+  });
+  SegmentationOptions options;
+  options.growth_bound = 0.12;  // 207 triangles: too few for one piece to grow around alone
+  SECTION("Growing through the other pieces closes the band within the bound.") {
+    const Segmentation seg = segment_surface(shape.nodes, shape.surface, eq, options);
+    check_segmentation_invariants(shape.surface.triangles, seg);
+    CHECK(seg.counts.segments_found == 4);
+    CHECK(seg.counts.segments_grown == 1);  // the other three were taken into the first
+    REQUIRE(seg.boundary_loops.size() == 1);
+    CHECK(seg.cluster_count == 2);
+    for (std::uint32_t v : seg.boundary_loops[0]) {
+      CHECK(shape.nodes[v][0] > 4.0);
+      CHECK(shape.nodes[v][0] < 8.0);
+    }
+  }
+  SECTION("The paper's growth (neighbours only) hits the bound and finds no boundary.") {
+    options.grow_through_marked = false;
+    const Segmentation seg = segment_surface(shape.nodes, shape.surface, eq, options);
+    check_segmentation_invariants(shape.surface.triangles, seg);
     CHECK(seg.counts.segments_grown == 0);
     CHECK(seg.cluster_count == 1);
   }

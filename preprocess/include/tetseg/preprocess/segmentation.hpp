@@ -28,6 +28,9 @@ struct SegmentationOptions {
   /// segment_surface takes the equalised values).
   Equalization equalization = Equalization::kHistogram;
   double growth_bound = 0.25;  ///< a grown segment is dropped once it exceeds this share of N
+  /// When a growing segment's ring touches another marked segment, take that whole segment
+  /// into the ring (not in the paper; joins a low-charge crease broken into pieces).
+  bool grow_through_marked = true;
   /// Clusters smaller than this are merged into a neighbour, and complement pieces smaller than
   /// this never count as separated (they are filled into the segment). 0 = derived:
   /// derived_min_cluster_triangles(N).
