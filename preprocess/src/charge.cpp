@@ -21,6 +21,7 @@ using namespace charge_detail;
 
 constexpr std::size_t kAutoDirectMax = 400;
 constexpr std::size_t kAutoDenseMax = 3000;
+constexpr std::size_t kAutoHighOrderMin = 10000;
 
 double seconds_since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
@@ -130,7 +131,9 @@ ChargeResult compute_charge(const std::vector<Vec3>& points, const std::vector<T
     (void)it;
   };
   if (solver == ChargeSolver::kFast) {
-    const TreecodeOperator op(panels, tree, near, options.fast_theta, options.fast_order);
+    const int order =
+        options.fast_order >= 0 ? options.fast_order : (n < kAutoHighOrderMin ? 6 : 8);
+    const TreecodeOperator op(panels, tree, near, options.fast_theta, order);
     result.assembly_seconds = seconds_since(t0);
     progress("assembly", 1.0);
     const auto t1 = Clock::now();

@@ -170,13 +170,13 @@ int main(int argc, char** argv) {
   std::string mesh_dir = TETSEG_BENCH_MESH_DIR;
   std::string real = "elephant.off";
   std::vector<std::string> sizes = {"1k", "5k", "20k", "100k"};
-  std::vector<std::string> solvers = {"direct", "gmres", "fast"};
+  std::vector<std::string> solvers = {"direct", "gmres", "fast", "fast@1e-8"};
   double tolerance = 1e-6;
   bool reference = true;
   app.add_option("--mesh-dir", mesh_dir, "Directory with the CGAL demo meshes");
   app.add_option("--real", real, "Real mesh (OFF) subdivided to the sizes");
   app.add_option("--sizes", sizes, "Any of 1k 5k 20k 100k");
-  app.add_option("--solvers", solvers, "Any of direct gmres fast");
+  app.add_option("--solvers", solvers, "Any of direct gmres fast, optionally name@tolerance");
   app.add_option("--tolerance", tolerance, "Relative residual for the timed runs");
   app.add_flag("--no-reference{false}", reference, "Skip the reference solves");
   CLI11_PARSE(app, argc, argv);
@@ -248,16 +248,22 @@ int main(int argc, char** argv) {
         ref_name = std::string("failed: ") + r.error;
       }
     }
-    for (const std::string& s : solvers) {
+    for (const std::string& spec : solvers) {
+      // "name" or "name@tolerance"
+      const std::size_t at = spec.find('@');
+      const std::string s = spec.substr(0, at);
       ChargeOptions o;
-      preprocess::parse_charge_solver(s, o.solver);
-      o.tolerance = tolerance;
+      if (!preprocess::parse_charge_solver(s, o.solver)) {
+        std::fprintf(stderr, "bench: unknown solver %s\n", spec.c_str());
+        return 2;
+      }
+      o.tolerance = at == std::string::npos ? tolerance : std::stod(spec.substr(at + 1));
       if (o.solver == ChargeSolver::kDirect && n > 6000) continue;
       if (o.solver == ChargeSolver::kGmres && n > 25000) continue;
-      std::fprintf(stderr, "bench: %s %zu %s\n", m.name.c_str(), n, s.c_str());
+      std::fprintf(stderr, "bench: %s %zu %s\n", m.name.c_str(), n, spec.c_str());
       const CaseResult r = run_case(m.mesh, o);
       if (!r.ok) {
-        std::printf("| %s | %zu | %s | failed: %s |\n", m.name.c_str(), n, s.c_str(), r.error);
+        std::printf("| %s | %zu | %s | failed: %s |\n", m.name.c_str(), n, spec.c_str(), r.error);
         continue;
       }
       std::string analytic = "-", vs_ref = "-", vs_ref_abs = "-";
@@ -272,7 +278,7 @@ int main(int argc, char** argv) {
       }
       std::printf(
           "| %s | %zu | %s | %.3f | %.3f | %.3f | %.2f | %d | %.1e | %.0f | %s | %s | %s | %s |\n",
-          m.name.c_str(), n, r.solver, r.assembly, r.solve, r.assembly + r.solve, r.cpu,
+          m.name.c_str(), n, spec.c_str(), r.assembly, r.solve, r.assembly + r.solve, r.cpu,
           r.iterations, r.residual, static_cast<double>(r.peak_kb) / 1024.0, analytic.c_str(),
           vs_ref.c_str(), vs_ref_abs.c_str(), ref_name.c_str());
       std::fflush(stdout);

@@ -31,7 +31,7 @@ struct ChargeArgs {
   double tolerance = 1e-6;
   int max_iterations = 500;
   double theta = 0.5;
-  int order = 6;
+  int order = -1;
   int bins = 256;
 };
 
@@ -281,7 +281,9 @@ void add_charge_command(CLI::App& root) {
       ->check(CLI::Range(1, 100000));
   cmd->add_option("--theta", args->theta, "Fast solver opening parameter, (0, 1)")
       ->check(CLI::Range(0.05, 0.95));
-  cmd->add_option("--order", args->order, "Fast solver expansion order")->check(CLI::Range(0, 12));
+  cmd->add_option("--order", args->order,
+                  "Fast solver expansion order (-1 = 6 below 10k triangles, else 8)")
+      ->check(CLI::Range(-1, 16));
   cmd->add_option("--equalize", args->equalization, "histogram (paper) | rank | log")
       ->check(CLI::IsMember({"histogram", "rank", "log"}));
   cmd->add_option("--bins", args->bins, "Histogram bins")->check(CLI::Range(1, 1 << 20));

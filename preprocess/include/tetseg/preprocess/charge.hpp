@@ -42,8 +42,10 @@ struct ChargeOptions {
   /// Treecode opening parameter: a cluster acts through its multipoles on a target leaf when
   /// (r_leaf + r_cluster) < theta * distance. Smaller is more accurate and slower; (0, 1).
   double fast_theta = 0.5;
-  /// Total order of the treecode's Taylor expansions (0..12); error ~ theta^(order + 1).
-  int fast_order = 6;
+  /// Total order of the fast solver's Taylor expansions, 0..16; error ~ theta^(order + 1).
+  /// Negative means automatic: 6 below 10,000 triangles, 8 from there on (the density error
+  /// grows with N for a fixed operator error; docs/charge.md).
+  int fast_order = -1;
   int leaf_size = 32;  ///< cluster-tree leaf size (fast solver)
   /// Largest dense matrix the solver may store, in bytes; 0 means half of the memory the
   /// operating system reports as available. Explicit direct/gmres requests beyond it fail.
