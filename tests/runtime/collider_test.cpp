@@ -309,3 +309,42 @@ TEST_CASE("Degenerate chain BVHs as deep as the cluster is large are traversed c
     for (std::size_t i = 0; i < ra.written; ++i) CHECK(same_feature(ca[i], cb[i]));
   }
 }
+
+TEST_CASE("A minimum separation finds contacts no later and no fewer than exact contact",
+          "[collider][api]") {
+  const Scene scene = dumbbell_scene();
+  const auto frames =
+      make_frames(scene, 12, [](const P3& p, double t) { return bend(p, t, 2.6, -0.5, 0.5, 0.0); });
+  for (ColliderMode mode : {ColliderMode::kBvh, ColliderMode::kBrute}) {
+    CAPTURE(to_string(mode));
+    ColliderOptions exact_options, near_options;
+    exact_options.mode = near_options.mode = mode;
+    near_options.ccd.min_separation = 0.02;
+    Collider exact(scene.asset, exact_options), near(scene.asset, near_options);
+    std::vector<Contact> ce(1 << 15), cn(1 << 15);
+    bool near_earlier = false;
+    for (std::size_t f = 0; f + 1 < frames.size(); ++f) {
+      REQUIRE(exact.step(frames[f].data(), frames[f + 1].data()) == ColliderStatus::kOk);
+      REQUIRE(near.step(frames[f].data(), frames[f + 1].data()) == ColliderStatus::kOk);
+      const ContactsResult re = exact.contacts(ce.data(), ce.size());
+      const ContactsResult rn = near.contacts(cn.data(), cn.size());
+      REQUIRE_FALSE(rn.truncated());
+      for (std::size_t i = 0; i < re.written; ++i) {
+        const bool found = std::any_of(cn.begin(), cn.begin() + rn.written,
+                                       [&](const Contact& c) { return same_feature(c, ce[i]); });
+        CHECK(found);
+      }
+      if (re.found > 0) {
+        CHECK(near.earliest_toi().contact.toi <= exact.earliest_toi().contact.toi);
+        break;
+      }
+      near_earlier = near_earlier || rn.found > 0;
+    }
+    CHECK(near_earlier);  // the near contact shows up at least one step before the exact one
+  }
+  ColliderMode parsed = ColliderMode::kBrute;
+  CHECK(parse_collider_mode("rvbc", parsed));
+  CHECK(parsed == ColliderMode::kRvbc);
+  CHECK_FALSE(parse_collider_mode("fast", parsed));
+  CHECK_FALSE(parse_collider_mode(nullptr, parsed));
+}
