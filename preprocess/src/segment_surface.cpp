@@ -371,10 +371,7 @@ Segmentation Segmenter::run() {
 
   const double beta =
       m_options.beta_divisor > 0.0 ? static_cast<double>(m_n) / m_options.beta_divisor : 0.0;
-  std::vector<std::uint8_t> consumed(segments, 0);
   for (std::uint32_t s = 0; s < segments; ++s) {
-    // A segment taken whole into an earlier segment's successful growth is done.
-    if (consumed[s]) continue;
     std::vector<std::uint32_t> set = m_segments[s];
     set_flags(set, 1);
     m_stamp = s + 1;
@@ -382,11 +379,7 @@ Segmentation Segmenter::run() {
     bool ok = separates(set);
     if (!ok && static_cast<double>(set.size()) > beta) {
       ok = grow(set);
-      if (ok) {
-        ++m_counts.segments_grown;
-        for (std::uint32_t o = 0; o < segments; ++o)
-          if (m_absorbed[o] == m_stamp) consumed[o] = 1;
-      }
+      if (ok) ++m_counts.segments_grown;
     }
     if (ok) {
       shrink(set);
