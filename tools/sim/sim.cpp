@@ -1,0 +1,247 @@
+// XPBD soft body with ground friction and collider-checked self-contact (sim.hpp).
+
+#include "sim.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace tetseg::tools {
+namespace {
+
+using preprocess::InputError;
+
+double tet_volume(const double* a, const double* b, const double* c, const double* d) {
+  const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+  const double v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+  const double w[3] = {d[0] - a[0], d[1] - a[1], d[2] - a[2]};
+  return (u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0]) +
+          u[2] * (v[0] * w[1] - v[1] * w[0])) /
+         6.0;
+}
+
+tetseg::ColliderOptions collider_options(const SimOptions& o) {
+  tetseg::ColliderOptions c;
+  c.mode = o.collider_mode;
+  c.time_tests = false;
+  c.use_openmp = false;
+  return c;
+}
+
+}  // namespace
+
+std::vector<double> place_above_ground(const std::vector<preprocess::Vec3>& nodes, int up_axis,
+                                       double ground, double drop_height, double tilt_x,
+                                       double tilt_y) {
+  std::vector<double> x(nodes.size() * 3);
+  double centre[3] = {0, 0, 0};
+  for (const auto& p : nodes)
+    for (int k = 0; k < 3; ++k) centre[k] += p[k];
+  for (double& c : centre) c /= nodes.empty() ? 1.0 : double(nodes.size());
+  const double a = tilt_x * M_PI / 180.0, ca = std::cos(a), sa = std::sin(a);
+  const double b = tilt_y * M_PI / 180.0, cb = std::cos(b), sb = std::sin(b);
+  double lowest = INFINITY;
+  for (std::size_t i = 0; i < nodes.size(); ++i) {
+    const double px = nodes[i][0] - centre[0], py = nodes[i][1] - centre[1],
+                 pz = nodes[i][2] - centre[2];
+    const double y = ca * py - sa * pz, z1 = sa * py + ca * pz;  // about x
+    x[i * 3 + 0] = centre[0] + cb * px + sb * z1;                // then about y
+    x[i * 3 + 1] = centre[1] + y;
+    x[i * 3 + 2] = centre[2] - sb * px + cb * z1;
+    lowest = std::min(lowest, x[i * 3 + up_axis]);
+  }
+  const double shift = ground + drop_height - lowest;
+  for (std::size_t i = 0; i < nodes.size(); ++i) x[i * 3 + up_axis] += shift;
+  return x;
+}
+
+SoftBody::SoftBody(const preprocess::TetMesh& mesh, const tetseg::Asset& asset,
+                   const std::vector<double>& start, const SimOptions& options,
+                   const std::string& what)
+    : m_opt(options), m_collider(asset, collider_options(options)) {
+  if (!(options.frame_dt > 0) || options.substeps == 0 || options.iterations == 0 ||
+      options.up_axis < 0 || options.up_axis > 2 || !(options.friction >= 0) ||
+      !(options.density > 0) || !(options.edge_compliance >= 0) ||
+      !(options.volume_compliance >= 0) || !(options.damping >= 0))
+    throw InputError(what, "simulation option out of range");
+  m_node_count = mesh.nodes.size();
+  if (asset.node_count() != m_node_count)
+    throw InputError(what, "the asset has " + std::to_string(asset.node_count()) +
+                               " nodes, the tet mesh " + std::to_string(m_node_count));
+  if (start.size() != m_node_count * 3) throw InputError(what, "start position count mismatch");
+  if (m_collider.status() != tetseg::ColliderStatus::kOk)
+    throw InputError(what, "cannot create the collider");
+
+  // Masses (lumped tet volumes), rest volumes, unique edges in sorted order.
+  m_tets = mesh.tets;
+  m_inv_mass.assign(m_node_count, 0.0);
+  m_tet_rest.resize(m_tets.size());
+  std::vector<std::array<std::uint32_t, 2>> edges;
+  edges.reserve(m_tets.size() * 6);
+  for (std::size_t t = 0; t < m_tets.size(); ++t) {
+    const auto& q = m_tets[t];
+    const double v = tet_volume(mesh.nodes[q[0]].data(), mesh.nodes[q[1]].data(),
+                                mesh.nodes[q[2]].data(), mesh.nodes[q[3]].data());
+    if (!(v > 0)) throw InputError(what, "tet " + std::to_string(t) + " is not positive");
+    m_tet_rest[t] = v;
+    for (std::uint32_t n : q) m_inv_mass[n] += v * options.density / 4.0;
+    for (int i = 0; i < 4; ++i)
+      for (int j = i + 1; j < 4; ++j) edges.push_back({std::min(q[i], q[j]), std::max(q[i], q[j])});
+  }
+  for (double& m : m_inv_mass) m = m > 0 ? 1.0 / m : 0.0;
+  std::sort(edges.begin(), edges.end());
+  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+  m_edges = std::move(edges);
+  m_edge_rest.resize(m_edges.size());
+  for (std::size_t e = 0; e < m_edges.size(); ++e) {
+    const auto& a = mesh.nodes[m_edges[e][0]];
+    const auto& b = mesh.nodes[m_edges[e][1]];
+    m_edge_rest[e] = std::sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) +
+                               (a[2] - b[2]) * (a[2] - b[2]));
+  }
+
+  m_x = start;
+  m_x_prev = start;
+  m_v.assign(m_node_count * 3, 0.0);
+  m_frozen.assign(m_node_count, 0);
+  m_contacts.resize(std::max<std::size_t>(1, options.contact_capacity));
+  const tetseg::RestCheck rc = m_collider.check_rest_intersection(m_x.data(), m_x.size());
+  if (rc.status != tetseg::ColliderStatus::kOk)
+    throw InputError(what, std::string("start check failed: ") + tetseg::to_string(rc.status));
+  if (rc.intersecting)
+    throw InputError(what, "the start surface self-intersects (triangles " +
+                               std::to_string(rc.triangle_a) + " and " +
+                               std::to_string(rc.triangle_b) + ")");
+}
+
+void SoftBody::advance_frame() {
+  const double h = m_opt.frame_dt / m_opt.substeps;
+  for (std::uint32_t s = 0; s < m_opt.substeps; ++s) substep(h);
+}
+
+void SoftBody::substep(double h) {
+  ++m_counters.substeps;
+  const int up = m_opt.up_axis;
+  const double damp = std::max(0.0, 1.0 - m_opt.damping * h);
+  m_x_prev = m_x;
+  for (std::size_t i = 0; i < m_node_count; ++i) {
+    if (m_inv_mass[i] == 0) continue;
+    m_v[i * 3 + up] -= m_opt.gravity * h;
+    for (int k = 0; k < 3; ++k) {
+      m_v[i * 3 + k] *= damp;
+      m_x[i * 3 + k] += m_v[i * 3 + k] * h;
+    }
+  }
+  for (std::uint32_t it = 0; it < m_opt.iterations; ++it) solve_constraints(h);
+  apply_ground();
+  resolve_self_contact();
+  for (std::size_t i = 0; i < m_x.size(); ++i) m_v[i] = (m_x[i] - m_x_prev[i]) / h;
+}
+
+void SoftBody::solve_constraints(double h) {
+  double* x = m_x.data();
+  const double* w = m_inv_mass.data();
+  const double ae = m_opt.edge_compliance / (h * h);
+  for (std::size_t e = 0; e < m_edges.size(); ++e) {
+    const std::uint32_t a = m_edges[e][0], b = m_edges[e][1];
+    const double wsum = w[a] + w[b];
+    if (wsum == 0) continue;
+    double d[3] = {x[a * 3] - x[b * 3], x[a * 3 + 1] - x[b * 3 + 1], x[a * 3 + 2] - x[b * 3 + 2]};
+    const double len = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    if (len == 0) continue;
+    const double lambda = -(len - m_edge_rest[e]) / (wsum + ae);
+    for (int k = 0; k < 3; ++k) {
+      const double n = d[k] / len;
+      x[a * 3 + k] += w[a] * lambda * n;
+      x[b * 3 + k] -= w[b] * lambda * n;
+    }
+  }
+  // Volume: C = V - V0 with gradients (x_j - x_i) x (x_k - x_i) / 6 for each opposite face.
+  static constexpr int kFace[4][3] = {{1, 3, 2}, {0, 2, 3}, {0, 3, 1}, {0, 1, 2}};
+  const double av = m_opt.volume_compliance / (h * h);
+  for (std::size_t t = 0; t < m_tets.size(); ++t) {
+    const auto& q = m_tets[t];
+    double g[4][3];
+    double wsum = 0;
+    for (int j = 0; j < 4; ++j) {
+      const double* p0 = x + std::size_t(q[kFace[j][0]]) * 3;
+      const double* p1 = x + std::size_t(q[kFace[j][1]]) * 3;
+      const double* p2 = x + std::size_t(q[kFace[j][2]]) * 3;
+      const double u[3] = {p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]};
+      const double v[3] = {p2[0] - p0[0], p2[1] - p0[1], p2[2] - p0[2]};
+      g[j][0] = (u[1] * v[2] - u[2] * v[1]) / 6.0;
+      g[j][1] = (u[2] * v[0] - u[0] * v[2]) / 6.0;
+      g[j][2] = (u[0] * v[1] - u[1] * v[0]) / 6.0;
+      wsum += w[q[j]] * (g[j][0] * g[j][0] + g[j][1] * g[j][1] + g[j][2] * g[j][2]);
+    }
+    if (wsum + av == 0) continue;
+    const double vol = tet_volume(x + std::size_t(q[0]) * 3, x + std::size_t(q[1]) * 3,
+                                  x + std::size_t(q[2]) * 3, x + std::size_t(q[3]) * 3);
+    const double lambda = -(vol - m_tet_rest[t]) / (wsum + av);
+    for (int j = 0; j < 4; ++j)
+      for (int k = 0; k < 3; ++k) x[std::size_t(q[j]) * 3 + k] += lambda * w[q[j]] * g[j][k];
+  }
+}
+
+void SoftBody::apply_ground() {
+  const int up = m_opt.up_axis;
+  const int t1 = (up + 1) % 3, t2 = (up + 2) % 3;
+  for (std::size_t i = 0; i < m_node_count; ++i) {
+    double* p = m_x.data() + i * 3;
+    const double pen = m_opt.ground - p[up];
+    if (!(pen > 0)) continue;
+    ++m_counters.ground_contacts;
+    p[up] = m_opt.ground;
+    // Coulomb friction on the tangential displacement of the substep (position-based).
+    const double* q = m_x_prev.data() + i * 3;
+    const double d1 = p[t1] - q[t1], d2 = p[t2] - q[t2];
+    const double dl = std::sqrt(d1 * d1 + d2 * d2);
+    const double limit = m_opt.friction * pen;
+    if (dl <= limit) {
+      p[t1] = q[t1];
+      p[t2] = q[t2];
+    } else {
+      const double s = limit / dl;
+      p[t1] -= d1 * s;
+      p[t2] -= d2 * s;
+    }
+  }
+}
+
+void SoftBody::resolve_self_contact() {
+  std::uint32_t rounds = 0;
+  bool first = true;
+  for (;;) {
+    const tetseg::ColliderStatus st = m_collider.step(m_x_prev.data(), m_x.data(), m_x.size());
+    if (st != tetseg::ColliderStatus::kOk)
+      throw std::runtime_error(std::string("collider step failed: ") + tetseg::to_string(st));
+    ++rounds;
+    ++m_counters.query_rounds;
+    if (!m_collider.any_collision()) break;
+    const tetseg::ContactsResult r = m_collider.contacts(m_contacts.data(), m_contacts.size());
+    if (r.status != tetseg::ColliderStatus::kOk)
+      throw std::runtime_error(std::string("collider query failed: ") +
+                               tetseg::to_string(r.status));
+    if (first) ++m_counters.substeps_with_contact;
+    first = false;
+    m_counters.contacts_resolved += r.found;
+    bool progress = false;
+    for (std::size_t c = 0; c < r.written; ++c) {
+      for (std::uint32_t n : m_contacts[c].nodes) {
+        double* p = m_x.data() + std::size_t(n) * 3;
+        const double* q = m_x_prev.data() + std::size_t(n) * 3;
+        if (p[0] == q[0] && p[1] == q[1] && p[2] == q[2]) continue;
+        p[0] = q[0];
+        p[1] = q[1];
+        p[2] = q[2];
+        ++m_counters.nodes_frozen;
+        progress = true;
+      }
+    }
+    // A contact always has a moving node, so progress holds; guard against a broken collider.
+    if (!progress) throw std::runtime_error("self-contact response made no progress");
+  }
+  m_counters.max_rounds = std::max(m_counters.max_rounds, rounds);
+}
+
+}  // namespace tetseg::tools
