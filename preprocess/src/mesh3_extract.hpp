@@ -58,12 +58,11 @@ Criteria make_criteria(const Mesh3Criteria& c) {
 }
 
 /// Runs make_mesh_3 deterministically: the default random generator is reset to seed 0 and
-/// the optimiser gets no time limit (its default limit is the refinement time, which would
-/// make the result depend on the machine's speed). Optimisation is sliver exudation until
-/// every dihedral angle is at least kExudeBoundDegrees (or no tet improves); perturbation
-/// and ODT/Lloyd are off (perturbation without a time limit was much slower than the
-/// refinement itself on large meshes).
-constexpr double kExudeBoundDegrees = 10.0;
+/// the optimisers get no time limit (their default limit is the refinement time, which would
+/// make the result depend on the machine's speed). Optimisation: sliver perturbation until
+/// every dihedral angle is at least kPerturbBoundDegrees (or nothing improves), then sliver
+/// exudation; ODT and Lloyd are off.
+constexpr double kPerturbBoundDegrees = 10.0;
 
 template <class C3t3, class Domain, class Criteria>
 C3t3 run_mesh_3(const Domain& domain, const Criteria& criteria, bool optimize) {
@@ -71,8 +70,9 @@ C3t3 run_mesh_3(const Domain& domain, const Criteria& criteria, bool optimize) {
   CGAL::get_default_random() = CGAL::Random(0);
   if (optimize) {
     return CGAL::make_mesh_3<C3t3>(
-        domain, criteria, params::no_odt(), params::no_lloyd(), params::no_perturb(),
-        params::exude(params::time_limit = 0, params::sliver_bound = kExudeBoundDegrees));
+        domain, criteria, params::no_odt(), params::no_lloyd(),
+        params::perturb(params::time_limit = 0, params::sliver_bound = kPerturbBoundDegrees),
+        params::exude(params::time_limit = 0, params::sliver_bound = 0));
   }
   return CGAL::make_mesh_3<C3t3>(domain, criteria, params::no_odt(), params::no_lloyd(),
                                  params::no_perturb(), params::no_exude());

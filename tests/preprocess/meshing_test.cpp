@@ -142,8 +142,10 @@ TEST_CASE("Meshing is deterministic", "[meshing]") {
 
 TEST_CASE("Default shape densities give the documented surface sizes", "[meshing][slow]") {
   const ShapeOptions o;
+  MeshingOptions fast;
+  fast.optimize = false;  // sliver removal barely changes the boundary; it costs most time
   const auto triangles = [&](Shape s) {
-    return extract_surface(generate_shape(s, o)).triangles.size();
+    return extract_surface(generate_shape(s, o, fast)).triangles.size();
   };
   const std::size_t pawn = triangles(Shape::kPawn);
   CHECK(pawn > 4000);
@@ -197,6 +199,7 @@ TEST_CASE("Real meshes from libcgal-demo import and tetrahedralise", "[meshing][
     return;
   }
   MeshingOptions coarse;
+  coarse.optimize = false;  // keeps the test fast; the optimised path is tested above
   SECTION("Elephant, dino and hand give valid meshes close to the input volume.") {
     for (const char* name : {"elephant", "dino", "hand"}) {
       CAPTURE(name);

@@ -19,7 +19,7 @@ struct MeshingOptions {
   double facet_distance = 0.0;          ///< max surface approximation error; >= 0
   double facet_angle = 25.0;            ///< min facet angle, degrees, in (0, 30]
   double cell_radius_edge_ratio = 3.0;  ///< tet quality bound, >= 2
-  bool optimize = true;  ///< sliver exudation to a 10 degree dihedral bound (no ODT/Lloyd/perturb)
+  bool optimize = true;  ///< sliver perturbation (10 degree bound) + exudation; no ODT/Lloyd
 };
 
 /// Procedural shapes made with Mesh_3's implicit domain.
