@@ -10,6 +10,10 @@
 
 #include "collider_impl.hpp"
 
+#if defined(TETSEG_HAVE_OPENMP)
+#include <omp.h>
+#endif
+
 namespace tetseg {
 namespace {
 
@@ -144,7 +148,12 @@ void Collider::Impl::construct(const Asset& a, const ColliderOptions& o) {
   }
   // The kBvh tree is a median split: depth <= log2(triangles) + 1 < 64.
   const std::size_t stack_size = 4 * (std::size_t(std::max<std::uint32_t>(max_depth, 64)) + 4);
-  stack.resize(stack_size);
+  std::size_t threads = 1;
+#if defined(TETSEG_HAVE_OPENMP)
+  if (opt.use_openmp) threads = static_cast<std::size_t>(std::max(1, omp_get_max_threads()));
+#endif
+  workers.resize(threads);
+  for (Worker& w : workers) w.stack.resize(stack_size);
 
   // Per-step scratch.
   vmoved.assign(nv, 0);
@@ -378,11 +387,9 @@ bool Collider::any_collision() noexcept {
   Impl& s = *m_impl;
   if (s.any_known) return s.any_value;
   s.qkind = QueryKind::kAny;
-  s.out = nullptr;
-  s.out_cap = 0;
-  if (!s.run_query()) return true;  // internal overflow: conservatively "maybe"
+  if (!s.run_query(nullptr, 0)) return true;  // internal overflow: conservatively "maybe"
   s.any_known = true;
-  s.any_value = s.stop;
+  s.any_value = s.query_hit;
   return s.any_value;
 }
 
@@ -392,9 +399,7 @@ EarliestContact Collider::earliest_toi() noexcept {
   Impl& s = *m_impl;
   if (!s.full_done) {
     s.qkind = QueryKind::kFull;
-    s.out = nullptr;
-    s.out_cap = 0;
-    if (!s.run_query()) return r;
+    if (!s.run_query(nullptr, 0)) return r;
   }
   r.found = s.has_best;
   r.contact = s.best;
@@ -414,17 +419,13 @@ ContactsResult Collider::contacts(Contact* buffer, std::size_t capacity) noexcep
     return r;
   }
   s.qkind = QueryKind::kFull;
-  s.out = buffer;
-  s.out_cap = capacity;
-  if (!s.run_query()) {
+  if (!s.run_query(capacity > 0 ? buffer : nullptr, capacity)) {
     r.status = ColliderStatus::kInternal;
     return r;
   }
   r.found = s.full_found;
   r.written = s.out_written;
-  std::sort(buffer, buffer + r.written, contact_less);
-  s.out = nullptr;
-  s.out_cap = 0;
+  if (r.written > 0) std::sort(buffer, buffer + r.written, contact_less);
   return r;
 }
 

@@ -150,24 +150,25 @@ bool segment_meets_triangle(const double* p, const double* q, const double* a, c
 
 }  // namespace
 
-void Collider::Impl::rest_triangle_pair(std::uint32_t t1, std::uint32_t t2) noexcept {
+void Collider::Impl::rest_triangle_pair(Worker& w, std::uint32_t t1,
+                                        std::uint32_t t2) const noexcept {
   const auto& A = asset->triangles[t1];
   const auto& B = asset->triangles[t2];
   int shared = 0;
   for (std::uint32_t u : A)
-    for (std::uint32_t w : B) shared += u == w;
+    for (std::uint32_t v : B) shared += u == v;
   if (shared >= 2) return;  // edge neighbours: only a flat fold could touch; not checked
-  for (int dir = 0; dir < 2 && !stop; ++dir) {
+  for (int dir = 0; dir < 2 && !w.stop; ++dir) {
     const auto& E = dir == 0 ? A : B;
     const auto& F = dir == 0 ? B : A;
     for (int k = 0; k < 3; ++k) {
       const std::uint32_t p = E[k], q = E[(k + 1) % 3];
       if (p == F[0] || p == F[1] || p == F[2] || q == F[0] || q == F[1] || q == F[2]) continue;
       if (segment_meets_triangle(pos0(p), pos0(q), pos0(F[0]), pos0(F[1]), pos0(F[2]))) {
-        rest_hit = true;
-        rest_a = std::min(t1, t2);
-        rest_b = std::max(t1, t2);
-        stop = true;
+        w.rest_hit = true;
+        w.rest_a = std::min(t1, t2);
+        w.rest_b = std::max(t1, t2);
+        w.stop = true;
         return;
       }
     }
@@ -184,10 +185,12 @@ RestCheck Collider::check_rest_intersection(const double* x, std::size_t value_c
   r.status = s.begin_step(x, x, value_count);  // invalidates the current step
   if (r.status != ColliderStatus::kOk) return r;
   s.rest_mode = true;
-  s.rest_hit = false;
   s.refit_and_classify();
   s.qkind = QueryKind::kAny;
-  const bool ok = s.run_query();
+  const bool ok = s.run_query(nullptr, 0);  // rest mode: serial, worker 0
+  s.rest_hit = s.workers[0].rest_hit;
+  s.rest_a = s.workers[0].rest_a;
+  s.rest_b = s.workers[0].rest_b;
   s.rest_mode = false;
   s.have_step = false;
   s.stats = ColliderStats{};

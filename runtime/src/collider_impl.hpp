@@ -52,6 +52,30 @@ struct StackItem {
 
 enum class QueryKind : std::uint8_t { kAny, kFull };
 
+/// Running state of one traversal thread (index 0 is the serial one). Allocated at
+/// construction: one per OpenMP thread when `use_openmp`, else one.
+struct Worker {
+  std::vector<StackItem> stack;
+  ColliderStats stats;  // counters only; merged into the collider's stats after a query
+  bool stop = false;
+  bool overflow = false;
+  std::size_t found = 0;
+  bool has_best = false;
+  Contact best;
+  double tests_seconds = 0;
+  Contact* out = nullptr;
+  std::size_t out_cap = 0, out_written = 0;
+  bool rest_hit = false;
+  std::uint32_t rest_a = 0, rest_b = 0;
+  void reset() noexcept {
+    stats = ColliderStats{};
+    stop = overflow = has_best = rest_hit = false;
+    found = out_written = out_cap = 0;
+    out = nullptr;
+    tests_seconds = 0;
+  }
+};
+
 struct Collider::Impl {
   // --- construction-time data
   const format::Asset* asset = nullptr;
@@ -91,7 +115,7 @@ struct Collider::Impl {
   std::vector<std::uint8_t> tmov;
   std::vector<Box> nbox;  // per asset BVH node
   std::vector<std::uint32_t> nneg, nunc, nmov;
-  std::vector<StackItem> stack;
+  std::vector<Worker> workers;
   ColliderStats stats;
   RestCheck rest;
 
@@ -102,17 +126,11 @@ struct Collider::Impl {
   Contact best;
   std::size_t full_found = 0;
 
-  // running query
+  // running query (shared, read-only during traversal) and its merged outcome
   QueryKind qkind = QueryKind::kFull;
-  bool stop = false;
-  bool overflow = false;
-  Contact* out = nullptr;
-  std::size_t out_cap = 0, out_written = 0, q_found = 0;
-  bool q_has_best = false;
-  Contact q_best;
-  double tests_seconds = 0;
-  // rest check running state
-  bool rest_hit = false;
+  bool query_hit = false;       // kAny: a contact was found
+  std::size_t out_written = 0;  // contacts written to the caller's buffer
+  bool rest_hit = false;        // check_rest_intersection outcome
   std::uint32_t rest_a = 0, rest_b = 0;
 
   // --- collider.cpp
@@ -123,26 +141,32 @@ struct Collider::Impl {
   const double* pos1(std::uint32_t node) const noexcept { return x1 + std::size_t(node) * 3; }
 
   // --- collider_traverse.cpp
-  /// Runs the query over all candidates; honours `stop`. Returns false on stack overflow.
-  bool run_query() noexcept;
+  /// Runs the query over all candidates into workers (merged into stats/results); stops early
+  /// for kAny. `out`/`out_cap`: optional contact buffer (forces the serial path). Returns
+  /// false on stack overflow.
+  bool run_query(Contact* out, std::size_t out_cap) noexcept;
   bool non_culled(std::uint32_t t1, std::uint32_t t2) const noexcept;
-  void process_triangle_pair(std::uint32_t t1, std::uint32_t t2) noexcept;
-  void process_vertex_face(std::uint32_t p, std::uint32_t face) noexcept;
-  void process_edge_edge(std::uint32_t e1, std::uint32_t e2) noexcept;
+  void process_triangle_pair(Worker& w, std::uint32_t t1, std::uint32_t t2) const noexcept;
+  void process_vertex_face(Worker& w, std::uint32_t p, std::uint32_t face) const noexcept;
+  void process_edge_edge(Worker& w, std::uint32_t e1, std::uint32_t e2) const noexcept;
   /// Swept boxes of two edges overlap and not all four nodes are still.
   bool edge_boxes_overlap(std::uint32_t e1, std::uint32_t e2) const noexcept;
-  void record(const Contact& c) noexcept;
-  bool traverse_self(const TreeView& tree) noexcept;
-  bool traverse_pair(const TreeView& ta, const TreeView& tb, bool same_cluster) noexcept;
-  void leaf_pair(const TreeView& ta, std::uint32_t a, const TreeView& tb, std::uint32_t b) noexcept;
-  void run_brute() noexcept;
+  void record(Worker& w, const Contact& c) const noexcept;
+  bool traverse_self(Worker& w, const TreeView& tree) const noexcept;
+  bool traverse_pair(Worker& w, const TreeView& ta, const TreeView& tb) const noexcept;
+  void leaf_pair(Worker& w, const TreeView& ta, std::uint32_t a, const TreeView& tb,
+                 std::uint32_t b) const noexcept;
+  void brute_vertex_faces(Worker& w, std::uint32_t i) const noexcept;
+  void brute_edge_edges(Worker& w, std::uint32_t i) const noexcept;
+  /// Intra-cluster work of cluster c1 and its pairs with every cluster c2 > c1.
+  bool cluster_tasks(Worker& w, std::uint32_t c1, bool count_skips) const noexcept;
   TreeView cluster_view(std::uint32_t c) const noexcept;
   TreeView global_view() const noexcept;
 
   // --- collider_bvh.cpp
   void build_global_bvh(const double* positions) noexcept;
   void refit_global_bvh() noexcept;
-  void rest_triangle_pair(std::uint32_t t1, std::uint32_t t2) noexcept;
+  void rest_triangle_pair(Worker& w, std::uint32_t t1, std::uint32_t t2) const noexcept;
 };
 
 }  // namespace tetseg

@@ -14,6 +14,10 @@
 
 #include "collider_impl.hpp"
 
+#if defined(TETSEG_HAVE_OPENMP)
+#include <omp.h>
+#endif
+
 namespace tetseg {
 namespace {
 
@@ -68,43 +72,44 @@ bool Collider::Impl::non_culled(std::uint32_t t1, std::uint32_t t2) const noexce
   return true;
 }
 
-void Collider::Impl::record(const Contact& c) noexcept {
-  ++stats.contacts;
+void Collider::Impl::record(Worker& w, const Contact& c) const noexcept {
+  ++w.stats.contacts;
   if (qkind == QueryKind::kAny) {
-    stop = true;
+    w.stop = true;
     return;
   }
-  ++q_found;
-  if (!q_has_best || contact_less(c, q_best)) {
-    q_best = c;
-    q_has_best = true;
+  ++w.found;
+  if (!w.has_best || contact_less(c, w.best)) {
+    w.best = c;
+    w.has_best = true;
   }
-  if (out && out_written < out_cap) out[out_written++] = c;
+  if (w.out && w.out_written < w.out_cap) w.out[w.out_written++] = c;
 }
 
-void Collider::Impl::process_vertex_face(std::uint32_t p, std::uint32_t face) noexcept {
+void Collider::Impl::process_vertex_face(Worker& w, std::uint32_t p,
+                                         std::uint32_t face) const noexcept {
   const auto& f = asset->triangles[face];
   const std::uint32_t ip = surf_index[p];
   if (!vmoved[ip] && !tmov[face]) return;  // still feature pair: only t = 0 contact possible
   const double ms = opt.ccd.min_separation;
   if (!boxes_overlap(vbox[ip], tbox[face], ms)) return;
-  ++stats.feature_pairs;
+  ++w.stats.feature_pairs;
   if (ms <= 0) {
     // Coplanarity cubic det[b-a, c-a, p-a] with a proven strict sign: never coplanar.
     const Orientation o = classify_orientation(pos0(f[0]), pos0(f[1]), pos0(f[2]), pos0(p),
                                                pos1(f[0]), pos1(f[1]), pos1(f[2]), pos1(p));
     if (o != Orientation::kUncertain) {
-      ++stats.feature_pairs_filtered;
+      ++w.stats.feature_pairs_filtered;
       return;
     }
   }
-  ++stats.feature_tests;
+  ++w.stats.feature_tests;
   Clock::time_point t0;
   if (opt.time_tests) t0 = Clock::now();
   const CcdResult r =
       vertex_face_ccd(v3(pos0(p)), v3(pos0(f[0])), v3(pos0(f[1])), v3(pos0(f[2])), v3(pos1(p)),
                       v3(pos1(f[0])), v3(pos1(f[1])), v3(pos1(f[2])), opt.ccd);
-  if (opt.time_tests) tests_seconds += std::chrono::duration<double>(Clock::now() - t0).count();
+  if (opt.time_tests) w.tests_seconds += std::chrono::duration<double>(Clock::now() - t0).count();
   if (!r.hit()) return;
   Contact c;
   c.kind = ContactKind::kVertexFace;
@@ -112,7 +117,7 @@ void Collider::Impl::process_vertex_face(std::uint32_t p, std::uint32_t face) no
   c.triangle = face;
   c.at_start = r.outcome == CcdOutcome::kContactAtStart;
   c.toi = c.at_start ? 0.0 : r.toi;
-  record(c);
+  record(w, c);
 }
 
 bool Collider::Impl::edge_boxes_overlap(std::uint32_t e1, std::uint32_t e2) const noexcept {
@@ -125,7 +130,8 @@ bool Collider::Impl::edge_boxes_overlap(std::uint32_t e1, std::uint32_t e2) cons
   return boxes_overlap(ba, bc, opt.ccd.min_separation);
 }
 
-void Collider::Impl::process_edge_edge(std::uint32_t e1, std::uint32_t e2) noexcept {
+void Collider::Impl::process_edge_edge(Worker& w, std::uint32_t e1,
+                                       std::uint32_t e2) const noexcept {
   if (e1 > e2) std::swap(e1, e2);
   const std::uint32_t a = edges[e1][0], b = edges[e1][1], c = edges[e2][0], d = edges[e2][1];
   const std::uint32_t ia = surf_index[a], ib = surf_index[b], ic = surf_index[c],
@@ -133,22 +139,22 @@ void Collider::Impl::process_edge_edge(std::uint32_t e1, std::uint32_t e2) noexc
   if (!vmoved[ia] && !vmoved[ib] && !vmoved[ic] && !vmoved[id]) return;
   const double ms = opt.ccd.min_separation;
   if (!edge_boxes_overlap(e1, e2)) return;
-  ++stats.feature_pairs;
+  ++w.stats.feature_pairs;
   if (ms <= 0) {
     // det[b-a, d-c, c-a] = det[b-a, d-a, c-a]: orientation of (a; b, d, c).
     const Orientation o = classify_orientation(pos0(a), pos0(b), pos0(d), pos0(c), pos1(a), pos1(b),
                                                pos1(d), pos1(c));
     if (o != Orientation::kUncertain) {
-      ++stats.feature_pairs_filtered;
+      ++w.stats.feature_pairs_filtered;
       return;
     }
   }
-  ++stats.feature_tests;
+  ++w.stats.feature_tests;
   Clock::time_point t0;
   if (opt.time_tests) t0 = Clock::now();
   const CcdResult r = edge_edge_ccd(v3(pos0(a)), v3(pos0(b)), v3(pos0(c)), v3(pos0(d)), v3(pos1(a)),
                                     v3(pos1(b)), v3(pos1(c)), v3(pos1(d)), opt.ccd);
-  if (opt.time_tests) tests_seconds += std::chrono::duration<double>(Clock::now() - t0).count();
+  if (opt.time_tests) w.tests_seconds += std::chrono::duration<double>(Clock::now() - t0).count();
   if (!r.hit()) return;
   Contact k;
   k.kind = ContactKind::kEdgeEdge;
@@ -156,21 +162,22 @@ void Collider::Impl::process_edge_edge(std::uint32_t e1, std::uint32_t e2) noexc
   k.triangle = 0;
   k.at_start = r.outcome == CcdOutcome::kContactAtStart;
   k.toi = k.at_start ? 0.0 : r.toi;
-  record(k);
+  record(w, k);
 }
 
-void Collider::Impl::process_triangle_pair(std::uint32_t t1, std::uint32_t t2) noexcept {
+void Collider::Impl::process_triangle_pair(Worker& w, std::uint32_t t1,
+                                           std::uint32_t t2) const noexcept {
   if (!non_culled(t1, t2)) return;
   if (rest_mode) {
-    rest_triangle_pair(t1, t2);
+    rest_triangle_pair(w, t1, t2);
     return;
   }
-  ++stats.triangle_pairs;
+  ++w.stats.triangle_pairs;
   const std::uint64_t key = pair_key(t1, t2);
   const auto& A = asset->triangles[t1];
   const auto& B = asset->triangles[t2];
   // Vertex-face, both directions.
-  for (int dir = 0; dir < 2 && !stop; ++dir) {
+  for (int dir = 0; dir < 2 && !w.stop; ++dir) {
     const auto& P = dir == 0 ? A : B;
     const auto& F = dir == 0 ? B : A;
     const std::uint32_t face = dir == 0 ? t2 : t1;
@@ -185,8 +192,8 @@ void Collider::Impl::process_triangle_pair(std::uint32_t t1, std::uint32_t t2) n
         const std::uint32_t t = vt_list[k];
         if (pair_key(t, face) < key && non_culled(t, face)) owner = false;
       }
-      if (owner) process_vertex_face(p, face);
-      if (stop) return;
+      if (owner) process_vertex_face(w, p, face);
+      if (w.stop) return;
     }
   }
   // Edge-edge.
@@ -201,85 +208,84 @@ void Collider::Impl::process_triangle_pair(std::uint32_t t1, std::uint32_t t2) n
       bool owner = true;
       for (std::uint32_t k1 = et_offset[e1]; k1 < et_offset[e1 + 1] && owner; ++k1) {
         for (std::uint32_t k2 = et_offset[e2]; k2 < et_offset[e2 + 1] && owner; ++k2) {
-          const std::uint32_t u = et_list[k1], w = et_list[k2];
-          if (u != w && pair_key(u, w) < key && non_culled(u, w)) owner = false;
+          const std::uint32_t u = et_list[k1], v = et_list[k2];
+          if (u != v && pair_key(u, v) < key && non_culled(u, v)) owner = false;
         }
       }
-      if (owner) process_edge_edge(e1, e2);
-      if (stop) return;
+      if (owner) process_edge_edge(w, e1, e2);
+      if (w.stop) return;
     }
   }
 }
 
-void Collider::Impl::leaf_pair(const TreeView& ta, std::uint32_t a, const TreeView& tb,
-                               std::uint32_t b) noexcept {
+void Collider::Impl::leaf_pair(Worker& w, const TreeView& ta, std::uint32_t a, const TreeView& tb,
+                               std::uint32_t b) const noexcept {
   const format::BvhNode& na = ta.nodes[a];
   const format::BvhNode& nb = tb.nodes[b];
-  for (std::uint32_t i = 0; i < na.count && !stop; ++i) {
-    for (std::uint32_t j = 0; j < nb.count && !stop; ++j) {
-      process_triangle_pair(ta.leaf_tris[na.first + i], tb.leaf_tris[nb.first + j]);
+  for (std::uint32_t i = 0; i < na.count && !w.stop; ++i) {
+    for (std::uint32_t j = 0; j < nb.count && !w.stop; ++j) {
+      process_triangle_pair(w, ta.leaf_tris[na.first + i], tb.leaf_tris[nb.first + j]);
     }
   }
 }
 
-bool Collider::Impl::traverse_pair(const TreeView& ta, const TreeView& tb,
-                                   bool same_cluster) noexcept {
+bool Collider::Impl::traverse_pair(Worker& w, const TreeView& ta,
+                                   const TreeView& tb) const noexcept {
   // Same-tree pairs come from traverse_self, which pushes them; here the roots of two trees.
   std::size_t top = 0;
-  stack[top++] = {0, 0};
-  while (top > 0 && !stop) {
-    const StackItem it = stack[--top];
-    ++stats.node_pairs_visited;
+  w.stack[top++] = {0, 0};
+  while (top > 0 && !w.stop) {
+    const StackItem it = w.stack[--top];
+    ++w.stats.node_pairs_visited;
     if (!rest_mode && ta.nmov[it.a] == 0 && tb.nmov[it.b] == 0) continue;
     if (!boxes_overlap(ta.box[it.a], tb.box[it.b], opt.ccd.min_separation)) continue;
     const format::BvhNode& na = ta.nodes[it.a];
     const format::BvhNode& nb = tb.nodes[it.b];
     if (na.count > 0 && nb.count > 0) {
-      leaf_pair(ta, it.a, tb, it.b);
+      leaf_pair(w, ta, it.a, tb, it.b);
       continue;
     }
-    if (top + 2 > stack.size()) return false;
+    if (top + 2 > w.stack.size()) return false;
     const bool split_a = nb.count > 0 || (na.count == 0 && ta.ntris[it.a] >= tb.ntris[it.b]);
     if (split_a) {
-      stack[top++] = {na.second, it.b};
-      stack[top++] = {na.first, it.b};
+      w.stack[top++] = {na.second, it.b};
+      w.stack[top++] = {na.first, it.b};
     } else {
-      stack[top++] = {it.a, nb.second};
-      stack[top++] = {it.a, nb.first};
+      w.stack[top++] = {it.a, nb.second};
+      w.stack[top++] = {it.a, nb.first};
     }
   }
-  (void)same_cluster;
   return true;
 }
 
-bool Collider::Impl::traverse_self(const TreeView& t) noexcept {
+bool Collider::Impl::traverse_self(Worker& w, const TreeView& t) const noexcept {
   const bool orient = t.nneg != nullptr;
   auto one_sign = [&](std::uint32_t n) {
     return orient && (t.nunc[n] == 0 && (t.nneg[n] == 0 || t.nneg[n] == t.ntris[n]));
   };
   std::size_t top = 0;
-  stack[top++] = {0, kNone};
-  while (top > 0 && !stop) {
-    const StackItem it = stack[--top];
-    ++stats.node_pairs_visited;
+  w.stack[top++] = {0, kNone};
+  while (top > 0 && !w.stop) {
+    const StackItem it = w.stack[--top];
+    ++w.stats.node_pairs_visited;
     if (it.b == kNone) {
       const std::uint32_t n = it.a;
       if (!rest_mode && t.nmov[n] == 0) continue;
       if (one_sign(n)) {
-        ++stats.node_pairs_orientation_culled;
+        ++w.stats.node_pairs_orientation_culled;
         continue;
       }
       const format::BvhNode& nd = t.nodes[n];
       if (nd.count > 0) {
-        for (std::uint32_t i = 0; i < nd.count && !stop; ++i)
-          for (std::uint32_t j = i + 1; j < nd.count && !stop; ++j)
-            process_triangle_pair(t.leaf_tris[nd.first + i], t.leaf_tris[nd.first + j]);
+        for (std::uint32_t i = 0; i < nd.count && !w.stop; ++i)
+          for (std::uint32_t j = i + 1; j < nd.count && !w.stop; ++j)
+            process_triangle_pair(w, t.leaf_tris[nd.first + i], t.leaf_tris[nd.first + j]);
         continue;
       }
-      if (top + 3 > stack.size()) return false;
-      stack[top++] = {nd.first, nd.second};
-      stack[top++] = {nd.second, kNone};
-      stack[top++] = {nd.first, kNone};
+      if (top + 3 > w.stack.size()) return false;
+      w.stack[top++] = {nd.first, nd.second};
+      w.stack[top++] = {nd.second, kNone};
+      w.stack[top++] = {nd.first, kNone};
       continue;
     }
     if (!rest_mode && t.nmov[it.a] == 0 && t.nmov[it.b] == 0) continue;
@@ -287,107 +293,180 @@ bool Collider::Impl::traverse_self(const TreeView& t) noexcept {
     if (orient && t.nunc[it.a] == 0 && t.nunc[it.b] == 0 &&
         ((t.nneg[it.a] == 0 && t.nneg[it.b] == 0) ||
          (t.nneg[it.a] == t.ntris[it.a] && t.nneg[it.b] == t.ntris[it.b]))) {
-      ++stats.node_pairs_orientation_culled;
+      ++w.stats.node_pairs_orientation_culled;
       continue;
     }
     const format::BvhNode& na = t.nodes[it.a];
     const format::BvhNode& nb = t.nodes[it.b];
     if (na.count > 0 && nb.count > 0) {
-      leaf_pair(t, it.a, t, it.b);
+      leaf_pair(w, t, it.a, t, it.b);
       continue;
     }
-    if (top + 2 > stack.size()) return false;
+    if (top + 2 > w.stack.size()) return false;
     const bool split_a = nb.count > 0 || (na.count == 0 && t.ntris[it.a] >= t.ntris[it.b]);
     if (split_a) {
-      stack[top++] = {na.second, it.b};
-      stack[top++] = {na.first, it.b};
+      w.stack[top++] = {na.second, it.b};
+      w.stack[top++] = {na.first, it.b};
     } else {
-      stack[top++] = {it.a, nb.second};
-      stack[top++] = {it.a, nb.first};
+      w.stack[top++] = {it.a, nb.second};
+      w.stack[top++] = {it.a, nb.first};
     }
   }
   return true;
 }
 
-void Collider::Impl::run_brute() noexcept {
-  // Every vertex against every triangle not containing it, every pair of edges with four
-  // distinct nodes; swept-box overlap is checked inside the feature functions.
-  const std::uint32_t nv = static_cast<std::uint32_t>(surf_nodes.size());
-  for (std::uint32_t i = 0; i < nv && !stop; ++i) {
-    const std::uint32_t p = surf_nodes[i];
-    for (std::uint32_t f = 0; f < tri_count && !stop; ++f) {
-      const auto& F = asset->triangles[f];
-      if (p == F[0] || p == F[1] || p == F[2]) continue;
-      if (rest_mode) continue;
-      process_vertex_face(p, f);
-    }
-  }
-  const std::uint32_t ne = static_cast<std::uint32_t>(edges.size());
-  for (std::uint32_t i = 0; i < ne && !stop; ++i) {
-    for (std::uint32_t j = i + 1; j < ne && !stop; ++j) {
-      const auto& E1 = edges[i];
-      const auto& E2 = edges[j];
-      if (E1[0] == E2[0] || E1[0] == E2[1] || E1[1] == E2[0] || E1[1] == E2[1]) continue;
-      process_edge_edge(i, j);
-    }
+void Collider::Impl::brute_vertex_faces(Worker& w, std::uint32_t i) const noexcept {
+  // Vertex i against every triangle not containing it (swept-box overlap checked inside).
+  const std::uint32_t p = surf_nodes[i];
+  for (std::uint32_t f = 0; f < tri_count && !w.stop; ++f) {
+    const auto& F = asset->triangles[f];
+    if (p == F[0] || p == F[1] || p == F[2]) continue;
+    process_vertex_face(w, p, f);
   }
 }
 
-bool Collider::Impl::run_query() noexcept {
+void Collider::Impl::brute_edge_edges(Worker& w, std::uint32_t i) const noexcept {
+  // Edge i against every later edge with four distinct nodes.
+  const std::uint32_t ne = static_cast<std::uint32_t>(edges.size());
+  const auto& E1 = edges[i];
+  for (std::uint32_t j = i + 1; j < ne && !w.stop; ++j) {
+    const auto& E2 = edges[j];
+    if (E1[0] == E2[0] || E1[0] == E2[1] || E1[1] == E2[0] || E1[1] == E2[1]) continue;
+    process_edge_edge(w, i, j);
+  }
+}
+
+bool Collider::Impl::cluster_tasks(Worker& w, std::uint32_t c1, bool count_skips) const noexcept {
+  const std::uint32_t nc = static_cast<std::uint32_t>(asset->clusters.size());
+  const TreeView v1 = cluster_view(c1);
+  const bool still = !rest_mode && v1.nmov[0] == 0;
+  const bool one_sign =
+      v1.nneg && v1.nunc[0] == 0 && (v1.nneg[0] == 0 || v1.nneg[0] == v1.ntris[0]);
+  if (still || one_sign) {
+    if (count_skips) ++w.stats.clusters_skipped;
+  } else if (!traverse_self(w, v1)) {
+    return false;
+  }
+  for (std::uint32_t c2 = c1 + 1; c2 < nc && !w.stop; ++c2) {
+    const TreeView v2 = cluster_view(c2);
+    if (!rest_mode && v1.nmov[0] == 0 && v2.nmov[0] == 0) continue;
+    if (!boxes_overlap(v1.box[0], v2.box[0], opt.ccd.min_separation)) continue;
+    if (!traverse_pair(w, v1, v2)) return false;
+  }
+  return true;
+}
+
+namespace {
+
+void add_counts(ColliderStats& to, const ColliderStats& from) noexcept {
+  to.clusters_skipped += from.clusters_skipped;
+  to.node_pairs_visited += from.node_pairs_visited;
+  to.node_pairs_orientation_culled += from.node_pairs_orientation_culled;
+  to.triangle_pairs += from.triangle_pairs;
+  to.feature_pairs += from.feature_pairs;
+  to.feature_pairs_filtered += from.feature_pairs_filtered;
+  to.feature_tests += from.feature_tests;
+  to.contacts += from.contacts;
+}
+
+}  // namespace
+
+bool Collider::Impl::run_query(Contact* out, std::size_t out_cap) noexcept {
   const auto t_start = Clock::now();
-  stop = false;
-  q_found = 0;
-  q_has_best = false;
-  out_written = 0;
-  tests_seconds = 0;
-  bool ok = true;
+  for (Worker& w : workers) w.reset();
+  Worker& w0 = workers[0];
+  w0.out = out;
+  w0.out_cap = out ? out_cap : 0;
+  const bool count_skips = !stats.full_traversal && qkind == QueryKind::kFull && !rest_mode;
+  // Parallel traversal: OpenMP threads take whole tasks (a cluster with its pairs, a brute
+  // force vertex or edge); merged in worker order, so counts and the earliest contact equal
+  // the serial ones. A caller buffer keeps the serial path (its truncation is order-bound).
+  const bool parallel = workers.size() > 1 && out == nullptr && !rest_mode;
+  (void)parallel;
   if (!stats.nothing_moved || rest_mode) {
     const format::Asset& fa = *asset;
-    if (opt.mode == ColliderMode::kBrute && !rest_mode) {
-      run_brute();
-    } else if (opt.mode == ColliderMode::kBvh && !rest_mode) {
-      if (tri_count > 0) ok = traverse_self(global_view());
+    const std::uint32_t nc = static_cast<std::uint32_t>(fa.clusters.size());
+    const std::int64_t nv = static_cast<std::int64_t>(surf_nodes.size());
+    const std::int64_t ne = static_cast<std::int64_t>(edges.size());
+    if (opt.mode == ColliderMode::kBvh && !rest_mode) {
+      if (tri_count > 0 && !traverse_self(w0, global_view())) w0.overflow = true;
+    } else if (opt.mode == ColliderMode::kBrute && !rest_mode) {
+#if defined(TETSEG_HAVE_OPENMP)
+      if (parallel) {
+#pragma omp parallel num_threads(static_cast <int>(workers.size()))
+        {
+          Worker& w = workers[static_cast<std::size_t>(omp_get_thread_num())];
+#pragma omp for schedule(dynamic, 16)
+          for (std::int64_t i = 0; i < nv; ++i)
+            if (!w.stop) brute_vertex_faces(w, static_cast<std::uint32_t>(i));
+#pragma omp for schedule(dynamic, 16)
+          for (std::int64_t i = 0; i < ne; ++i)
+            if (!w.stop) brute_edge_edges(w, static_cast<std::uint32_t>(i));
+        }
+      } else
+#endif
+      {
+        for (std::int64_t i = 0; i < nv && !w0.stop; ++i)
+          brute_vertex_faces(w0, static_cast<std::uint32_t>(i));
+        for (std::int64_t i = 0; i < ne && !w0.stop; ++i)
+          brute_edge_edges(w0, static_cast<std::uint32_t>(i));
+      }
     } else {
-      const std::uint32_t nc = static_cast<std::uint32_t>(fa.clusters.size());
-      const bool count_skips = !stats.full_traversal && qkind == QueryKind::kFull;
-      for (std::uint32_t c = 0; c < nc && !stop && ok; ++c) {
-        const TreeView v = cluster_view(c);
-        const bool still = !rest_mode && v.nmov[0] == 0;
-        const bool one_sign =
-            v.nneg && v.nunc[0] == 0 && (v.nneg[0] == 0 || v.nneg[0] == v.ntris[0]);
-        if (still || one_sign) {
-          if (count_skips) ++stats.clusters_skipped;
-          continue;
+#if defined(TETSEG_HAVE_OPENMP)
+      if (parallel) {
+#pragma omp parallel num_threads(static_cast <int>(workers.size()))
+        {
+          Worker& w = workers[static_cast<std::size_t>(omp_get_thread_num())];
+#pragma omp for schedule(dynamic, 1)
+          for (std::int64_t c = 0; c < static_cast<std::int64_t>(nc); ++c)
+            if (!w.stop && !w.overflow &&
+                !cluster_tasks(w, static_cast<std::uint32_t>(c), count_skips))
+              w.overflow = true;
         }
-        ok = traverse_self(v);
-      }
-      for (std::uint32_t c1 = 0; c1 < nc && !stop && ok; ++c1) {
-        const TreeView v1 = cluster_view(c1);
-        for (std::uint32_t c2 = c1 + 1; c2 < nc && !stop && ok; ++c2) {
-          const TreeView v2 = cluster_view(c2);
-          if (!rest_mode && v1.nmov[0] == 0 && v2.nmov[0] == 0) continue;
-          if (!boxes_overlap(v1.box[0], v2.box[0], opt.ccd.min_separation)) continue;
-          ok = traverse_pair(v1, v2, false);
+      } else
+#endif
+      {
+        for (std::uint32_t c = 0; c < nc && !w0.stop; ++c) {
+          if (!cluster_tasks(w0, c, count_skips)) {
+            w0.overflow = true;
+            break;
+          }
         }
       }
+    }
+  }
+  // Merge in worker order.
+  bool overflow = false, hit = false;
+  std::size_t found = 0;
+  bool has = false;
+  Contact first;
+  double tests_seconds = 0;
+  for (const Worker& w : workers) {
+    add_counts(stats, w.stats);
+    overflow = overflow || w.overflow;
+    hit = hit || w.stop;
+    found += w.found;
+    tests_seconds += w.tests_seconds;
+    if (w.has_best && (!has || contact_less(w.best, first))) {
+      first = w.best;
+      has = true;
     }
   }
   const double total_ms = std::chrono::duration<double, std::milli>(Clock::now() - t_start).count();
   const double tests_ms = tests_seconds * 1e3;
   stats.tests_ms += tests_ms;
   stats.traversal_ms += std::max(0.0, total_ms - tests_ms);
-  if (!ok) {
-    overflow = true;
-    return false;
-  }
+  if (overflow) return false;
+  query_hit = hit;
+  out_written = w0.out_written;
   if (qkind == QueryKind::kFull && !rest_mode) {
     stats.full_traversal = true;
     full_done = true;
-    full_found = q_found;
-    has_best = q_has_best;
-    best = q_best;
+    full_found = found;
+    has_best = has;
+    best = first;
     any_known = true;
-    any_value = q_found > 0;
+    any_value = found > 0;
   }
   return true;
 }

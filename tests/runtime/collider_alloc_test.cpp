@@ -100,19 +100,37 @@ TEST_CASE("A step and its queries allocate nothing", "[collider][alloc]") {
   }
 }
 
-TEST_CASE("OpenMP refit and classification give the same results as serial", "[collider][openmp]") {
-  // Large enough (> 4096 surface nodes) for the parallel loops to engage.
+TEST_CASE("OpenMP results are identical to serial results", "[collider][openmp]") {
+  // Large enough (> 4096 surface nodes) for the parallel refit/classification loops to engage;
+  // traversal runs in parallel for queries without a caller buffer.
   const Scene scene = make_axial_scene(sphere(1.0, 96, 60), {-0.3, 0.3}, {-0.6, 0.0, 0.6});
   const auto frames =
-      make_frames(scene, 5, [](const P3& p, double t) { return squash(p, 0.75 * t); });
+      make_frames(scene, 4, [](const P3& p, double t) { return squash(p, 0.75 * t); });
+  const ColliderMode mode = ColliderMode::kRvbc;
+  CAPTURE(to_string(mode));
   std::size_t total = 0;
   ColliderOptions serial_options, parallel_options;
+  serial_options.mode = parallel_options.mode = mode;
   parallel_options.use_openmp = true;
   Collider serial(scene.asset, serial_options), parallel(scene.asset, parallel_options);
   std::vector<Contact> a(1 << 16), b(1 << 16);
   for (std::size_t f = 0; f + 1 < frames.size(); ++f) {
     REQUIRE(serial.step(frames[f].data(), frames[f + 1].data()) == ColliderStatus::kOk);
     REQUIRE(parallel.step(frames[f].data(), frames[f + 1].data()) == ColliderStatus::kOk);
+    CHECK(serial.any_collision() == parallel.any_collision());
+    REQUIRE(serial.step(frames[f].data(), frames[f + 1].data()) == ColliderStatus::kOk);
+    REQUIRE(parallel.step(frames[f].data(), frames[f + 1].data()) == ColliderStatus::kOk);
+    const EarliestContact ea = serial.earliest_toi(), eb = parallel.earliest_toi();
+    REQUIRE(ea.found == eb.found);
+    if (ea.found) {
+      CHECK(ea.contact.nodes == eb.contact.nodes);
+      CHECK(ea.contact.toi == eb.contact.toi);
+    }
+    CHECK(serial.contacts(nullptr, 0).found == parallel.contacts(nullptr, 0).found);
+    CHECK(serial.stats().triangles_positive == parallel.stats().triangles_positive);
+    CHECK(serial.stats().triangles_uncertain == parallel.stats().triangles_uncertain);
+    CHECK(serial.stats().feature_tests == parallel.stats().feature_tests);
+    CHECK(serial.stats().triangle_pairs == parallel.stats().triangle_pairs);
     const ContactsResult ra = serial.contacts(a.data(), a.size());
     const ContactsResult rb = parallel.contacts(b.data(), b.size());
     REQUIRE(ra.found == rb.found);
@@ -121,9 +139,27 @@ TEST_CASE("OpenMP refit and classification give the same results as serial", "[c
       CHECK(a[i].nodes == b[i].nodes);
       CHECK(a[i].toi == b[i].toi);
     }
-    CHECK(serial.stats().triangles_positive == parallel.stats().triangles_positive);
-    CHECK(serial.stats().triangles_uncertain == parallel.stats().triangles_uncertain);
+  }
+  CHECK(total > 0);
+}
+
+TEST_CASE("Parallel brute force equals serial brute force", "[collider][openmp]") {
+  const Scene scene = make_axial_scene(sphere(1.0, 24, 13), {0.0}, {-0.4, 0.4});
+  const auto frames = make_frames(scene, 6, squash);
+  ColliderOptions serial_options, parallel_options;
+  serial_options.mode = parallel_options.mode = ColliderMode::kBrute;
+  parallel_options.use_openmp = true;
+  Collider serial(scene.asset, serial_options), parallel(scene.asset, parallel_options);
+  std::size_t total = 0;
+  for (std::size_t f = 0; f + 1 < frames.size(); ++f) {
+    REQUIRE(serial.step(frames[f].data(), frames[f + 1].data()) == ColliderStatus::kOk);
+    REQUIRE(parallel.step(frames[f].data(), frames[f + 1].data()) == ColliderStatus::kOk);
+    const EarliestContact ea = serial.earliest_toi(), eb = parallel.earliest_toi();
+    REQUIRE(ea.found == eb.found);
+    if (ea.found) CHECK(ea.contact.nodes == eb.contact.nodes);
+    CHECK(serial.contacts(nullptr, 0).found == parallel.contacts(nullptr, 0).found);
     CHECK(serial.stats().feature_tests == parallel.stats().feature_tests);
+    total += serial.contacts(nullptr, 0).found;
   }
   CHECK(total > 0);
 }

@@ -53,8 +53,11 @@ struct ColliderOptions {
   CcdOptions ccd;
   /// Leaf size of the `kBvh` mode's BVH (clamped to [1, 16]).
   std::uint32_t bvh_leaf_size = 4;
-  /// Parallelise refit and classification with OpenMP when built with it. Results are
-  /// bit-identical to serial. Off by default.
+  /// Use OpenMP threads inside a step when built with it: refit and classification loops
+  /// (large meshes), and the traversal of `any_collision`, `earliest_toi` and
+  /// `contacts(nullptr, 0)` in rvbc and brute modes (whole clusters / features per task).
+  /// Results are identical to serial (merged in a fixed order); a contact buffer and the bvh
+  /// mode traverse serially. Scratch per thread is allocated at construction. Off by default.
   bool use_openmp = false;
   /// Run `check_rest_intersection` on the start positions of the first step (cost: one
   /// overlap-only traversal with static triangle tests). Result in `rest_intersection()`.
