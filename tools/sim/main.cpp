@@ -109,6 +109,8 @@ int main(int argc, char** argv) {
       ->check(CLI::NonNegativeNumber);
   app.add_option("--mode", a.mode, "Collider mode for self-contact: rvbc (default), bvh, brute")
       ->check(CLI::IsMember({"rvbc", "bvh", "brute"}));
+  app.add_flag("--no-self-contact{false}", opt.self_contact,
+               "Skip self-contact handling (frames may self-intersect; for comparisons)");
   app.add_flag("--json", a.json, "Print the counters as JSON on stdout");
   try {
     app.parse(argc, argv);

@@ -134,7 +134,7 @@ void SoftBody::substep(double h) {
   }
   for (std::uint32_t it = 0; it < m_opt.iterations; ++it) solve_constraints(h);
   apply_ground();
-  resolve_self_contact();
+  if (m_opt.self_contact) resolve_self_contact();
   for (std::size_t i = 0; i < m_x.size(); ++i) m_v[i] = (m_x[i] - m_x_prev[i]) / h;
 }
 

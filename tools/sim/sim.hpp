@@ -40,6 +40,7 @@ struct SimOptions {
   double damping = 0.5;           ///< linear velocity damping per second, >= 0
   tetseg::ColliderMode collider_mode = tetseg::ColliderMode::kRvbc;
   std::size_t contact_capacity = 1 << 14;  ///< contacts read per query round
+  bool self_contact = true;  ///< false: no self-contact handling (for tests and comparisons)
 };
 
 /// Totals over a run.
