@@ -35,8 +35,9 @@ std::string number(double v) {
 }
 
 int run(const std::string& asset_path, const std::string& frames_path, const std::string& mode_name,
-        const std::string& query, bool json, bool stop_at_contact) {
+        const std::string& query, bool json, bool stop_at_contact, bool openmp) {
   tetseg::ColliderOptions options;
+  options.use_openmp = openmp;
   if (!tetseg::parse_collider_mode(mode_name.c_str(), options.mode))
     throw ToolError(kExitUsage, "", "unknown mode '" + mode_name + "' (rvbc, bvh, brute)");
   tetseg::Asset asset;
@@ -152,9 +153,12 @@ int main(int argc, char** argv) {
   bool stop_at_contact = false;
   app.add_flag("--stop-at-contact", stop_at_contact,
                "Stop after the first step with a contact (as a simulator would respond)");
+  bool openmp = false;
+  app.add_flag("--openmp", openmp,
+               "Use OpenMP threads inside each step (ColliderOptions::use_openmp)");
   try {
     app.parse(argc, argv);
-    return run(asset_path, frames_path, mode, query, json, stop_at_contact);
+    return run(asset_path, frames_path, mode, query, json, stop_at_contact, openmp);
   } catch (const CLI::ParseError& e) {
     const int code = app.exit(e);
     return code == 0 ? kExitOk : kExitUsage;
