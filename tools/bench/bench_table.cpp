@@ -2,6 +2,9 @@
 // mode: mean per-step milliseconds of BVH update, orientation check, traversal, elementary
 // tests and total, the work counts, and the contacts missed against `brute` (every contact of
 // every step is compared, plus the any-collision answer and the earliest time of impact).
+// Comparisons cover the steps whose start frame passes the static intersection check: the
+// collider's culling assumes an intersection-free start (docs/runtime.md); the table shows
+// how many steps were compared.
 // Links the runtime only. Timings: each step is run `--repeat` times and the fastest run of
 // the step is kept (robust to the shared cores of a CI machine); the mean is over steps.
 
@@ -46,9 +49,11 @@ Key key_of(const tetseg::Contact& c) {
 }
 
 struct StepTruth {
+  bool clean_start = true;  ///< start frame passes the static intersection check
   bool any = false;
   double earliest = 1.0;
-  std::vector<Key> contacts;  // sorted
+  std::vector<Key> contacts;           // sorted
+  std::vector<Key> earliest_contacts;  // sorted: contacts with toi == earliest
 };
 
 struct Row {
@@ -57,7 +62,11 @@ struct Row {
   std::size_t steps = 0;
   double refit = 0, classify = 0, cone = 0, traversal = 0, tests = 0, total = 0, cpu = 0;
   double tri_pairs = 0, feature_tests = 0, contacts = 0;
-  std::uint64_t missed = 0, extra = 0, any_mismatch = 0, toi_mismatch = 0;
+  /// missed: brute contacts at the step's earliest toi that the mode did not report (must be
+  /// 0); later_missed: brute contacts after the earliest toi not reported (informative: once
+  /// the surface touches, the culling premise no longer holds for the rest of the step).
+  std::uint64_t missed = 0, later_missed = 0, extra = 0, any_mismatch = 0, toi_mismatch = 0;
+  std::size_t compared = 0;  ///< steps whose start is intersection-free (the collider's premise)
   bool truncated = false;
 };
 
@@ -136,19 +145,35 @@ Row run_mode(const Scene& s, tetseg::ColliderMode mode, bool openmp, std::size_t
     keys.reserve(result.written);
     for (std::size_t k = 0; k < result.written; ++k) keys.push_back(key_of(buffer[k]));
     std::sort(keys.begin(), keys.end());
+    std::vector<Key> first_keys;
+    for (std::size_t k = 0; k < result.written; ++k)
+      if (e.found && buffer[k].toi == e.contact.toi) first_keys.push_back(key_of(buffer[k]));
+    std::sort(first_keys.begin(), first_keys.end());
     if (record) {
+      const tetseg::RestCheck rc =
+          collider.check_rest_intersection(x0, std::size_t(s.frames.node_count) * 3);
+      truth[i].clean_start = rc.status == tetseg::ColliderStatus::kOk && !rc.intersecting;
+      row.compared += truth[i].clean_start ? 1 : 0;
       truth[i].any = result.found > 0;
       truth[i].earliest = e.found ? e.contact.toi : 1.0;
       truth[i].contacts = std::move(keys);
+      truth[i].earliest_contacts = std::move(first_keys);
       continue;
     }
     const StepTruth& t = truth[i];
+    if (!t.clean_start) continue;
+    ++row.compared;
     if (t.any != (result.found > 0)) ++row.any_mismatch;
     if (t.any && e.found && e.contact.toi > t.earliest) ++row.toi_mismatch;
     std::vector<Key> diff;
+    std::set_difference(t.earliest_contacts.begin(), t.earliest_contacts.end(), keys.begin(),
+                        keys.end(), std::back_inserter(diff));
+    const std::size_t missed_first = diff.size();
+    row.missed += missed_first;
+    diff.clear();
     std::set_difference(t.contacts.begin(), t.contacts.end(), keys.begin(), keys.end(),
                         std::back_inserter(diff));
-    row.missed += diff.size();
+    row.later_missed += diff.size() - std::min(diff.size(), missed_first);
     diff.clear();
     std::set_difference(keys.begin(), keys.end(), t.contacts.begin(), t.contacts.end(),
                         std::back_inserter(diff));
@@ -213,24 +238,28 @@ int table(const std::vector<std::string>& scene_args, const std::string& mode_li
       const Row& r = rows[i];
       std::cout << (i ? ", " : "") << "{\"scene\": \"" << r.scene << "\", \"mode\": \"" << r.mode
                 << "\", \"openmp\": " << (r.openmp ? "true" : "false") << ", \"steps\": " << r.steps
-                << ", \"bvh_update_ms\": " << r.refit << ", \"orientation_ms\": " << r.classify
-                << ", \"cone_ms\": " << r.cone << ", \"traversal_ms\": " << r.traversal
-                << ", \"tests_ms\": " << r.tests << ", \"total_ms\": " << r.total
-                << ", \"total_cpu_ms\": " << r.cpu << ", \"triangle_pairs\": " << r.tri_pairs
+                << ", \"compared\": " << r.compared << ", \"bvh_update_ms\": " << r.refit
+                << ", \"orientation_ms\": " << r.classify << ", \"cone_ms\": " << r.cone
+                << ", \"traversal_ms\": " << r.traversal << ", \"tests_ms\": " << r.tests
+                << ", \"total_ms\": " << r.total << ", \"total_cpu_ms\": " << r.cpu
+                << ", \"triangle_pairs\": " << r.tri_pairs
                 << ", \"feature_tests\": " << r.feature_tests << ", \"contacts\": " << r.contacts
-                << ", \"missed\": " << r.missed << ", \"extra\": " << r.extra
-                << ", \"any_mismatch\": " << r.any_mismatch << ", \"toi_later\": " << r.toi_mismatch
+                << ", \"missed\": " << r.missed << ", \"later_missed\": " << r.later_missed
+                << ", \"extra\": " << r.extra << ", \"any_mismatch\": " << r.any_mismatch
+                << ", \"toi_later\": " << r.toi_mismatch
                 << ", \"truncated\": " << (r.truncated ? "true" : "false") << "}";
     }
     std::cout << "], \"all_contacts_found\": " << (all_found ? "true" : "false") << "}\n";
   } else {
     std::cout
-        << "| scene | mode | steps | BVH update | orientation | cone+contour | traversal | "
+        << "| scene | mode | steps (compared) | BVH update | orientation | cone+contour | "
+           "traversal | "
            "elem. tests | total | total CPU | tri pairs | feature tests | contacts | missed | "
-           "extra |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+           "later missed | extra "
+           "|\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
     for (const Row& r : rows) {
       std::cout << "| " << r.scene << " | " << r.mode << (r.openmp ? " (OpenMP)" : "") << " | "
-                << r.steps << " | " << fmt("%.4f", r.refit) << " | "
+                << r.steps << " (" << r.compared << ") | " << fmt("%.4f", r.refit) << " | "
                 << (r.mode == "rvbc" ? fmt("%.4f", r.classify) : "-") << " | - | "
                 << fmt("%.4f", r.traversal) << " | " << fmt("%.4f", r.tests) << " | "
                 << fmt("%.4f", r.total) << " | " << fmt("%.4f", r.cpu) << " | "
@@ -238,6 +267,7 @@ int table(const std::vector<std::string>& scene_args, const std::string& mode_li
                 << fmt("%.2f", r.contacts) << " | "
                 << (r.mode == "brute" ? std::string("(truth)")
                                       : std::to_string(r.missed + r.any_mismatch + r.toi_mismatch))
+                << " | " << (r.mode == "brute" ? std::string("-") : std::to_string(r.later_missed))
                 << " | " << (r.mode == "brute" ? std::string("-") : std::to_string(r.extra))
                 << " |\n";
     }
@@ -255,7 +285,7 @@ int table(const std::vector<std::string>& scene_args, const std::string& mode_li
                 << (r.cpu <= 0.25 ? "meets" : "misses") << " the 0.25 ms target"
                 << (r.cpu <= 0.25 ? "" : " by " + fmt("%.4f", r.cpu - 0.25) + " ms") << ")\n";
     }
-    std::cout << "\nall contacts found by every mode: " << (all_found ? "yes" : "NO") << "\n";
+    std::cout << "\ncontacts at the earliest toi found by every mode: " << (all_found ? "yes" : "NO") << "\n";
   }
   return all_found ? 0 : kExitFailed;
 }
