@@ -57,7 +57,8 @@ void add_meshing_options(CLI::App& cmd, preprocess::MeshingOptions& m, bool& gms
   cmd.add_option("--radius-edge-ratio", m.cell_radius_edge_ratio,
                  "Tet quality bound (circumradius / shortest edge), >= 2")
       ->check(CLI::Range(2.0, 1000.0));
-  cmd.add_flag("--no-optimize{false}", m.optimize, "Skip sliver perturbation and exudation");
+  cmd.add_flag_callback(
+      "--no-optimize", [&m] { m.optimize = false; }, "Skip sliver perturbation and exudation");
   cmd.add_flag("--gmsh22", gmsh22, "Write Gmsh 2.2 instead of 4.1 when the output is .msh");
 }
 
