@@ -62,6 +62,7 @@ std::vector<std::pair<std::string, std::string>> provenance_options(const BuildO
       {"segmentation.beta_divisor", format_number(seg.beta_divisor)},
       {"segmentation.equalization", equalization_name(seg.equalization)},
       {"segmentation.growth_bound", format_number(seg.growth_bound)},
+      {"segmentation.grow_through_marked", seg.grow_through_marked ? "yes" : "no"},
       {"segmentation.min_cluster_triangles", std::to_string(seg.min_cluster_triangles)},
       {"segmentation.detector", detector_name(seg.detector)},
       {"rest_positions", options.keep_rest_positions ? "yes" : "no"},

@@ -167,6 +167,9 @@ void add_build_command(CLI::App& root) {
                   "A segment never grows beyond this fraction of the surface")
       ->check(CLI::Range(0.0, 1.0))
       ->capture_default_str();
+  cmd->add_option("--grow-through-marked", seg.grow_through_marked,
+                  "Growing segments take touched marked segments whole (docs/segmentation.md)")
+      ->capture_default_str();
   cmd->add_option("--min-cluster-triangles", seg.min_cluster_triangles,
                   "Clusters smaller than this are merged into a neighbour (0: derived)")
       ->capture_default_str();
