@@ -18,7 +18,7 @@ write_basic_package_version_file(${PROJECT_BINARY_DIR}/tetsegConfigVersion.cmake
 install(FILES ${PROJECT_BINARY_DIR}/tetsegConfig.cmake ${PROJECT_BINARY_DIR}/tetsegConfigVersion.cmake
               ${PROJECT_SOURCE_DIR}/cmake/TetsegAsset.cmake
         DESTINATION ${TETSEG_CMAKE_DIR})
-foreach(tool tetseg tetseg-dump tetseg-ccd tetseg-run)
+foreach(tool tetseg tetseg-dump tetseg-ccd tetseg-run tetseg-render)
   if(TARGET ${tool})
     install(TARGETS ${tool} RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
   endif()
