@@ -1,0 +1,49 @@
+#!/usr/bin/env bash
+# Regenerates the "Table I" and "segmentation parameters" tables of docs/benchmarks.md.
+#
+#   scripts/bench-table.sh [BUILD_DIR] [SCENE_DIR]    (defaults: ./build, BUILD_DIR/scenes)
+#
+# Needs the scenes of scripts/make-scenes.sh (run first, or pass their directory). Release
+# build; single thread, plus the runtime's OpenMP option (refit and classification only).
+# Every step is run 3 times and its fastest run kept; brute force is the truth (slow: about
+# a minute for the pawn).
+set -euo pipefail
+repo=$(cd "$(dirname "$0")/.." && pwd)
+build=$(cd "${1:-$repo/build}" && pwd)
+scenes=${2:-$build/scenes}
+cmake --build "$build" -j2 --target tetseg tetseg-bench >/dev/null
+bench=$build/tools/tetseg-bench
+tetseg=$build/tools/tetseg
+for s in pawn dumbbell elephant; do
+  [ -f "$scenes/$s.tsf" ] || { echo "bench-table: $scenes/$s.tsf missing: run scripts/make-scenes.sh" >&2; exit 1; }
+done
+
+echo "## Table I (tetseg-bench table, $(date -u +%F))"
+echo
+"$bench" table pawn "$scenes/pawn.tetseg" "$scenes/pawn.tsf" \
+  dumbbell "$scenes/dumbbell.tetseg" "$scenes/dumbbell.tsf" \
+  elephant "$scenes/elephant.tetseg" "$scenes/elephant.tsf" --repeat 3 --openmp
+
+echo
+echo "## Segmentation parameters on the pawn scene (rvbc, single thread)"
+echo
+echo "| alpha | beta divisor | equalisation | clusters | uncertain+negative triangles per step | total CPU ms per step | traversal ms | triangle pairs |"
+echo "|---|---|---|---|---|---|---|---|"
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+row() {  # row ALPHA BETA EQUALIZATION
+  "$tetseg" build "$scenes/pawn.mesh" -o "$work/p.tetseg" -q --report "$work/r.json" \
+    --alpha "$1" --beta-divisor "$2" --equalization "$3"
+  "$bench" table pawn "$work/p.tetseg" "$scenes/pawn.tsf" --modes rvbc --no-truth --repeat 3 \
+    --json > "$work/t.json" 2>/dev/null
+  python3 - "$1" "$2" "$3" "$work/r.json" "$work/t.json" <<'PY'
+import json, sys
+a, b, e, rep, tab = sys.argv[1:]
+r = json.load(open(rep)); t = json.load(open(tab))["rows"][0]
+clusters = t["clusters"]
+print(f"| {a} | {b} | {e} | {clusters} | {t['uncertain_negative']:.0f} | {t['total_cpu_ms']:.4f} | {t['traversal_ms']:.4f} | {t['triangle_pairs']:.0f} |")
+PY
+}
+for alpha in 0.05 0.1 0.2 0.3; do row "$alpha" 400 histogram; done
+for beta in 100 1000; do row 0.1 "$beta" histogram; done
+for eq in rank log-histogram; do row 0.1 400 "$eq"; done
