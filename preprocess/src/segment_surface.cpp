@@ -56,7 +56,10 @@ class Segmenter {
   bool separates(std::vector<std::uint32_t>& set);
   bool grow(std::vector<std::uint32_t>& set);
   void shrink(std::vector<std::uint32_t>& set);
-  bool pick_boundary(const std::vector<std::uint32_t>& set);
+  bool pick_boundary(const std::vector<std::uint32_t>& set, const std::vector<std::uint32_t>& band);
+  std::vector<std::uint32_t> tighten(std::vector<std::uint32_t> loop,
+                                     const std::vector<std::uint32_t>& band) const;
+  bool accept_loop(const std::vector<std::uint32_t>& loop);
   std::vector<std::uint32_t> cluster_labels(const std::vector<std::uint8_t>& active,
                                             std::uint32_t& pieces);
   void make_clusters(Segmentation& out);
@@ -197,48 +200,97 @@ void Segmenter::shrink(std::vector<std::uint32_t>& set) {
   }
 }
 
-// The segment boundary: the shortest closed contour of the shrunk set (ties: smallest first
-// half-edge) whose edges, cut, separate the surface. Returns false when none does.
-bool Segmenter::pick_boundary(const std::vector<std::uint32_t>& set) {
+// Loop tightening: while some triangle of the band has two consecutive loop edges a-b, b-c
+// (an "ear", on either side of the loop) and b occurs once in the loop and edge a-c is not on
+// it, move the triangle to the other side: the loop takes a-c instead, strictly shorter. The
+// zig-zag contour of a shrunk strip becomes a taut loop that stays inside the low-charge band
+// (only band triangles move). Scans in loop order until nothing changes: deterministic.
+std::vector<std::uint32_t> Segmenter::tighten(std::vector<std::uint32_t> loop,
+                                              const std::vector<std::uint32_t>& band) const {
+  auto in_band = [&](std::uint32_t t) { return std::binary_search(band.begin(), band.end(), t); };
+  for (bool changed = true; changed && loop.size() > 3;) {
+    changed = false;
+    std::map<std::uint32_t, std::uint32_t> visits;
+    std::set<std::pair<std::uint32_t, std::uint32_t>> edges;
+    for (std::uint32_t h : loop) {
+      ++visits[m_mesh.from(h)];
+      edges.emplace(std::min(m_mesh.from(h), m_mesh.to(h)), std::max(m_mesh.from(h), m_mesh.to(h)));
+    }
+    for (std::size_t i = 0; i < loop.size() && loop.size() > 3; ++i) {
+      const std::size_t j = (i + 1) % loop.size();
+      const std::uint32_t h1 = loop[i], h2 = loop[j];
+      const std::uint32_t a = m_mesh.from(h1), b = m_mesh.to(h1), c = m_mesh.to(h2);
+      if (visits[b] != 1 || a == c || edges.count({std::min(a, c), std::max(a, c)})) continue;
+      std::uint32_t shortcut = kNone, moved = kNone;
+      if (h1 / 3 == h2 / 3) {  // ear on the loop's left side
+        moved = h1 / 3;
+        shortcut = m_mesh.twin(HalfEdges::next(h2));
+      } else if (m_mesh.twin(h1) != kNone && m_mesh.twin(h2) != kNone &&
+                 m_mesh.twin(h1) / 3 == m_mesh.twin(h2) / 3) {  // ear on the right side
+        moved = m_mesh.twin(h1) / 3;
+        shortcut = HalfEdges::next(m_mesh.twin(h1));
+      }
+      if (shortcut == kNone || !in_band(moved)) continue;
+      --visits[b];
+      edges.erase({std::min(a, b), std::max(a, b)});
+      edges.erase({std::min(b, c), std::max(b, c)});
+      edges.emplace(std::min(a, c), std::max(a, c));
+      loop[i] = shortcut;
+      loop.erase(loop.begin() + static_cast<std::ptrdiff_t>(j));
+      if (j < i) i = loop.size();  // the loop wrapped: rescan from the start
+      changed = true;
+    }
+  }
+  return loop;
+}
+
+// Keeps `loop` as a segment boundary if (a) alone it splits the surface with its two sides in
+// different pieces and (b) with the boundaries kept so far every edge of it lies between two
+// different pieces of at least the minimum cluster size (no sliver clusters between nearby
+// loops).
+bool Segmenter::accept_loop(const std::vector<std::uint32_t>& loop) {
+  if (loop.size() < 3) return false;
+  const std::vector<std::uint8_t> all(m_n, 1);
+  std::vector<std::uint8_t> cut(3 * static_cast<std::size_t>(m_n), 0);
+  for (std::uint32_t h : loop) {
+    cut[h] = 1;
+    if (m_mesh.twin(h) != kNone) cut[m_mesh.twin(h)] = 1;
+  }
+  std::vector<std::uint32_t> labels;
+  if (detail::label_components(m_mesh, all, &cut, labels) < 2) return false;
+  const std::uint32_t right = m_mesh.neighbor(loop.front());
+  if (right == kNone || labels[right] == labels[loop.front() / 3]) return false;
+  for (std::size_t h = 0; h < cut.size(); ++h) cut[h] |= m_kept_cut[h];
+  const std::uint32_t count = detail::label_components(m_mesh, all, &cut, labels);
+  std::vector<std::uint32_t> sizes(count, 0);
+  for (std::uint32_t t = 0; t < m_n; ++t) ++sizes[labels[t]];
+  for (std::uint32_t h : loop) {
+    const std::uint32_t u = m_mesh.neighbor(h);
+    const std::uint32_t a = labels[h / 3];
+    if (u == kNone || labels[u] == a || sizes[a] < m_min_cluster ||
+        sizes[labels[u]] < m_min_cluster)
+      return false;
+  }
+  for (std::uint32_t h : loop) {
+    m_kept_cut[h] = 1;
+    m_kept_cut[m_mesh.twin(h)] = 1;
+  }
+  m_loops.push_back(loop);
+  return true;
+}
+
+// The segment boundary: the closed contours of the shrunk set, shortest first (ties: first
+// traced); each is tightened inside the band and tried, then tried as it is; the first loop
+// accepted is the boundary. Returns false when none is.
+bool Segmenter::pick_boundary(const std::vector<std::uint32_t>& set,
+                              const std::vector<std::uint32_t>& band) {
   std::vector<Contour> contours = detail::trace_contours(m_mesh, m_nodes, m_in_set, set);
   std::stable_sort(contours.begin(), contours.end(),
                    [](const Contour& a, const Contour& b) { return a.length < b.length; });
-  const std::vector<std::uint8_t> all(m_n, 1);
   for (const Contour& c : contours) {
     if (!c.closed || c.half_edges.size() < 3) continue;
-    // Alone, the loop must split the surface with its two sides in different pieces.
-    std::vector<std::uint8_t> cut(3 * static_cast<std::size_t>(m_n), 0);
-    for (std::uint32_t h : c.half_edges) {
-      cut[h] = 1;
-      if (m_mesh.twin(h) != kNone) cut[m_mesh.twin(h)] = 1;
-    }
-    std::vector<std::uint32_t> labels;
-    if (detail::label_components(m_mesh, all, &cut, labels) < 2) continue;
-    const std::uint32_t right = m_mesh.neighbor(c.half_edges.front());
-    if (right == kNone || labels[right] == labels[c.half_edges.front() / 3]) continue;
-    // With the boundaries kept so far, every edge of the loop must lie between two different
-    // pieces of at least the minimum cluster size: no sliver clusters between nearby loops.
-    for (std::size_t h = 0; h < cut.size(); ++h) cut[h] |= m_kept_cut[h];
-    const std::uint32_t count = detail::label_components(m_mesh, all, &cut, labels);
-    std::vector<std::uint32_t> sizes(count, 0);
-    for (std::uint32_t t = 0; t < m_n; ++t) ++sizes[labels[t]];
-    bool ok = true;
-    for (std::uint32_t h : c.half_edges) {
-      const std::uint32_t u = m_mesh.neighbor(h);
-      const std::uint32_t a = labels[h / 3];
-      if (u == kNone || labels[u] == a || sizes[a] < m_min_cluster ||
-          sizes[labels[u]] < m_min_cluster) {
-        ok = false;
-        break;
-      }
-    }
-    if (!ok) continue;
-    for (std::uint32_t h : c.half_edges) {
-      m_kept_cut[h] = 1;
-      m_kept_cut[m_mesh.twin(h)] = 1;
-    }
-    m_loops.push_back(c.half_edges);
-    return true;
+    if (accept_loop(tighten(c.half_edges, band))) return true;
+    if (accept_loop(c.half_edges)) return true;
   }
   return false;
 }
@@ -382,9 +434,10 @@ Segmentation Segmenter::run() {
       if (ok) ++m_counts.segments_grown;
     }
     if (ok) {
+      const std::vector<std::uint32_t> band = set;  // the (grown) segment before shrinking
       shrink(set);
       ++m_counts.segments_shrunk;
-      pick_boundary(set);
+      pick_boundary(set, band);
     }
     set_flags(set, 0);
   }
