@@ -141,6 +141,9 @@ TEST_CASE("A band that almost surrounds the neck grows until it separates", "[se
     CHECK(seg.counts.segments_grown == 1);
     REQUIRE(seg.boundary_loops.size() == 1);
     CHECK(seg.cluster_count == 2);
+    // Tightened inside the grown band: the shortest ring around the 2x2 neck, perimeter 8
+    // (the untightened contour of the shrunk strip zig-zags and is longer).
+    CHECK(seg.boundary_lengths[0] == Approx(8.0));
     for (std::uint32_t v : seg.boundary_loops[0]) {
       CHECK(shape.nodes[v][0] > 4.0);
       CHECK(shape.nodes[v][0] < 8.0);
