@@ -11,7 +11,7 @@ set -euo pipefail
 repo=$(cd "$(dirname "$0")/.." && pwd)
 build=$(cd "${1:-$repo/build}" && pwd)
 scenes=${2:-$build/scenes}
-cmake --build "$build" -j2 --target tetseg tetseg-bench >/dev/null
+for t in tetseg tetseg-bench; do [ -x "$build/tools/$t" ] || { echo "bench-table: build $t first: cmake --build $build --target $t" >&2; exit 1; }; done
 bench=$build/tools/tetseg-bench
 tetseg=$build/tools/tetseg
 for s in pawn dumbbell elephant; do

@@ -5,14 +5,14 @@
 #
 #   scripts/make-scenes.sh [BUILD_DIR] [OUT_DIR]      (BUILD_DIR default: ./build)
 #
-# Builds the tools it needs (tetseg, tetseg-sim) in BUILD_DIR first. A few minutes on 2 cores.
+# Needs tetseg and tetseg-sim built in BUILD_DIR (Release). A few minutes on 2 cores.
 set -euo pipefail
 repo=$(cd "$(dirname "$0")/.." && pwd)
 build=$(cd "${1:-$repo/build}" && pwd)
 out=${2:-$build/scenes}
 mkdir -p "$out"
 out=$(cd "$out" && pwd)
-cmake --build "$build" -j2 --target tetseg tetseg-sim >/dev/null
+for t in tetseg sim/tetseg-sim; do [ -x "$build/tools/$t" ] || { echo "make-scenes: build it first: cmake --build $build --target tetseg tetseg-sim" >&2; exit 1; }; done
 tetseg=$build/tools/tetseg
 sim=$build/tools/sim/tetseg-sim
 cd "$out"

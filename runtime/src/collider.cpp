@@ -33,13 +33,16 @@ const char* to_string(ColliderMode mode) noexcept {
       return "bvh";
     case ColliderMode::kBrute:
       return "brute";
+    case ColliderMode::kCone:
+      return "cone";
   }
   return "unknown";
 }
 
 bool parse_collider_mode(const char* name, ColliderMode& out) noexcept {
   if (!name) return false;
-  for (ColliderMode m : {ColliderMode::kRvbc, ColliderMode::kBvh, ColliderMode::kBrute}) {
+  for (ColliderMode m :
+       {ColliderMode::kRvbc, ColliderMode::kBvh, ColliderMode::kBrute, ColliderMode::kCone}) {
     if (std::strcmp(name, to_string(m)) == 0) {
       out = m;
       return true;
@@ -168,7 +171,7 @@ void Collider::Impl::construct(const Asset& a, const ColliderOptions& o) {
 
   // kBvh topology storage (built from rest positions now when available, else on the first
   // step or rest check, without allocating).
-  if (opt.mode == ColliderMode::kBvh) {
+  if (opt.mode == ColliderMode::kBvh || opt.mode == ColliderMode::kCone) {
     const std::size_t cap = tri_count == 0 ? 1 : 2 * std::size_t(tri_count) - 1;
     gnodes.resize(cap);
     gleaf.resize(tri_count);
@@ -179,6 +182,7 @@ void Collider::Impl::construct(const Asset& a, const ColliderOptions& o) {
     gmov.assign(cap, 0);
     if (fa.rest_positions.size() == node_count && node_count > 0) {
       build_global_bvh(fa.rest_positions[0].data());
+      if (opt.mode == ColliderMode::kCone) build_cone_topology();
     }
   }
   ctor_status = ColliderStatus::kOk;
@@ -282,7 +286,7 @@ void Collider::Impl::refit_and_classify() noexcept {
         }
       }
     }
-  } else if (opt.mode == ColliderMode::kBvh) {
+  } else if (opt.mode == ColliderMode::kBvh || opt.mode == ColliderMode::kCone) {
     if (!gbvh_built) build_global_bvh(x0);
     refit_global_bvh();
   }
@@ -290,6 +294,11 @@ void Collider::Impl::refit_and_classify() noexcept {
   for (std::uint32_t t = 0; t < tri_count; ++t) moving += tmov[t];
   stats.triangles_moving = moving;
   stats.refit_ms = ms_since(t_refit);
+  if (opt.mode == ColliderMode::kCone && !rest_mode) {
+    const auto t_cone = Clock::now();
+    update_cones();  // normal_cone.cpp
+    stats.cone_ms = ms_since(t_cone);
+  }
 
   if (opt.mode != ColliderMode::kRvbc || rest_mode) return;
   const auto t_class = Clock::now();

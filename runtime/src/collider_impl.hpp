@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "tetseg/runtime/classify.hpp"
+#include "normal_cone.hpp"
 #include "tetseg/runtime/collider.hpp"
 
 namespace tetseg {
@@ -162,6 +163,12 @@ struct Collider::Impl {
   bool cluster_tasks(Worker& w, std::uint32_t c1, bool count_skips) const noexcept;
   TreeView cluster_view(std::uint32_t c) const noexcept;
   TreeView global_view() const noexcept;
+
+  // --- normal_cone.cpp (kCone)
+  ConeData cone;
+  void build_cone_topology();
+  void update_cones() noexcept;
+  bool cone_self_free(std::uint32_t node) const noexcept;
 
   // --- collider_bvh.cpp
   void build_global_bvh(const double* positions) noexcept;

@@ -271,7 +271,7 @@ bool Collider::Impl::traverse_self(Worker& w, const TreeView& t) const noexcept 
     if (it.b == kNone) {
       const std::uint32_t n = it.a;
       if (!rest_mode && t.nmov[n] == 0) continue;
-      if (one_sign(n)) {
+      if (one_sign(n) || (opt.mode == ColliderMode::kCone && !rest_mode && cone_self_free(n))) {
         ++w.stats.node_pairs_orientation_culled;
         continue;
       }
@@ -388,7 +388,7 @@ bool Collider::Impl::run_query(Contact* out, std::size_t out_cap) noexcept {
     const std::uint32_t nc = static_cast<std::uint32_t>(fa.clusters.size());
     const std::int64_t nv = static_cast<std::int64_t>(surf_nodes.size());
     const std::int64_t ne = static_cast<std::int64_t>(edges.size());
-    if (opt.mode == ColliderMode::kBvh && !rest_mode) {
+    if ((opt.mode == ColliderMode::kBvh || opt.mode == ColliderMode::kCone) && !rest_mode) {
       if (tri_count > 0 && !traverse_self(w0, global_view())) w0.overflow = true;
     } else if (opt.mode == ColliderMode::kBrute && !rest_mode) {
 #if defined(TETSEG_HAVE_OPENMP)

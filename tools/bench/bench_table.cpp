@@ -137,6 +137,7 @@ Row run_mode(const Scene& s, tetseg::ColliderMode mode, bool openmp, std::size_t
     row.cpu += best_cpu;
     row.refit += best_stats.refit_ms;
     row.classify += best_stats.classify_ms;
+    row.cone += best_stats.cone_ms;
     row.traversal += best_stats.traversal_ms;
     row.tests += best_stats.tests_ms;
     row.tri_pairs += double(best_stats.triangle_pairs);
@@ -184,8 +185,8 @@ Row run_mode(const Scene& s, tetseg::ColliderMode mode, bool openmp, std::size_t
     row.extra += diff.size();
   }
   const double n = steps ? double(steps) : 1.0;
-  for (double* v : {&row.refit, &row.classify, &row.traversal, &row.tests, &row.total, &row.cpu,
-                    &row.tri_pairs, &row.feature_tests, &row.contacts, &row.neg_unc})
+  for (double* v : {&row.refit, &row.classify, &row.cone, &row.traversal, &row.tests, &row.total,
+                    &row.cpu, &row.tri_pairs, &row.feature_tests, &row.contacts, &row.neg_unc})
     *v /= n;
   return row;
 }
@@ -272,7 +273,8 @@ int table(const std::vector<std::string>& scene_args, const std::string& mode_li
     for (const Row& r : rows) {
       std::cout << "| " << r.scene << " | " << r.mode << (r.openmp ? " (OpenMP)" : "") << " | "
                 << r.steps << " (" << r.compared << ") | " << fmt("%.4f", r.refit) << " | "
-                << (r.mode == "rvbc" ? fmt("%.4f", r.classify) : "-") << " | - | "
+                << (r.mode == "rvbc" ? fmt("%.4f", r.classify) : "-") << " | "
+                << (r.mode == "cone" ? fmt("%.4f", r.cone) : "-") << " | "
                 << fmt("%.4f", r.traversal) << " | " << fmt("%.4f", r.tests) << " | "
                 << fmt("%.4f", r.total) << " | " << fmt("%.4f", r.cpu) << " | "
                 << fmt("%.0f", r.tri_pairs) << " | " << fmt("%.0f", r.feature_tests) << " | "
@@ -351,7 +353,7 @@ int main(int argc, char** argv) {
   CLI::App* t = app.add_subcommand(
       "table", "Table I: per-step stage times, work counts and missed contacts per mode");
   std::vector<std::string> scenes;
-  std::string modes = "rvbc,bvh,brute";
+  std::string modes = "rvbc,bvh,cone,brute";
   std::size_t stride = 1, max_steps = 1000000;
   int repeat = 3;
   bool openmp = false, json = false, no_truth = false;

@@ -27,6 +27,7 @@ enum class ColliderMode : std::uint8_t {
   kRvbc = 0,   ///< per-cluster BVHs + radial-view orientation culling (default)
   kBvh = 1,    ///< one BVH over the whole surface, overlap culling only
   kBrute = 2,  ///< every feature pair with 4 distinct nodes and overlapping swept boxes
+  kCone = 3,   ///< baseline: `kBvh` + continuous normal cones and contour tests (ICCD-like)
 };
 
 /// Short stable name: "rvbc", "bvh", "brute".
@@ -100,6 +101,7 @@ struct ContactsResult {
 /// Counts and times of the current step (reset by `step`; queries add to them).
 struct ColliderStats {
   double refit_ms = 0, classify_ms = 0, traversal_ms = 0, tests_ms = 0;
+  double cone_ms = 0;  ///< kCone: normal-cone update (contour tests count as traversal)
   std::uint64_t nodes_moved = 0;
   std::uint64_t triangles_positive = 0, triangles_negative = 0, triangles_uncertain = 0;
   std::uint64_t triangles_moving = 0;
