@@ -176,8 +176,9 @@ TEST_CASE("The fast solver's error against GMRES is bounded at 20k triangles", "
   }
   const double worst = max_relative_difference(f.density, g.density);
   WARN("fast vs gmres at 20480: max " << worst << ", mean " << mean);
-  CHECK(worst < 5e-3);
-  CHECK(mean < 5e-4);
+  // Measured 4.7e-4 / 1.4e-5 with the automatic order 8 (docs/charge.md).
+  CHECK(worst < 2e-3);
+  CHECK(mean < 1e-4);
 }
 
 TEST_CASE("Automatic solver choice follows size and memory", "[charge]") {
