@@ -145,7 +145,7 @@ void add_build_command(CLI::App& root) {
   cmd->add_option("--clusters", args->options.clusters,
                   "single: one cluster; charge: the paper's charge-based segmentation")
       ->transform(CLI::CheckedTransformer(cluster_methods, CLI::ignore_case))
-      ->default_str("charge");
+      ->option_text("single|charge (charge)");
 
   SegmentationOptions& seg = args->options.segmentation;
   cmd->add_option("--alpha", seg.alpha, "Equalised density below which triangles are marked")
@@ -162,7 +162,7 @@ void add_build_command(CLI::App& root) {
   cmd->add_option("--equalization", seg.equalization,
                   "histogram (the paper, 256 bins), rank (exact) or log-histogram")
       ->transform(CLI::CheckedTransformer(equalizations, CLI::ignore_case))
-      ->default_str("histogram");
+      ->option_text("histogram|rank|log-histogram (histogram)");
   cmd->add_option("--growth-bound", seg.growth_bound,
                   "A segment never grows beyond this fraction of the surface")
       ->check(CLI::Range(0.0, 1.0))
@@ -179,7 +179,7 @@ void add_build_command(CLI::App& root) {
   cmd->add_option("--detector", seg.detector,
                   "nearest-centroid (the paper) or visibility (most triangles positive at rest)")
       ->transform(CLI::CheckedTransformer(detectors, CLI::ignore_case))
-      ->default_str("visibility");
+      ->option_text("nearest-centroid|visibility (visibility)");
 
   const std::map<std::string, ChargeSolver> solvers{{"auto", ChargeSolver::kAuto},
                                                     {"direct", ChargeSolver::kDirect},
@@ -187,20 +187,26 @@ void add_build_command(CLI::App& root) {
                                                     {"fast", ChargeSolver::kFast}};
   cmd->add_option("--solver", args->options.charge.solver, "Charge solver: auto, direct, gmres, fast")
       ->transform(CLI::CheckedTransformer(solvers, CLI::ignore_case))
-      ->default_str("auto");
+      ->option_text("auto|direct|gmres|fast (auto)");
   cmd->add_option("--tolerance", args->options.charge.tolerance,
                   "Relative residual of the iterative charge solvers")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
 
   cmd->add_option("--cell-size", args->meshing.cell_size,
-                  "Surface input only: target tet edge length (0: derived, docs/cli.md)")
+                  "Surface input only: max tet circumradius (0: derived, docs/cli.md)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  cmd->add_option("--facet-size", args->meshing.facet_size,
+                  "Surface input only: max surface Delaunay ball radius (0: derived)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   cmd->add_option("--facet-distance", args->meshing.facet_distance,
                   "Surface input only: max surface approximation error (0: derived)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
+  cmd->add_flag("--no-optimize", [args](std::int64_t) { args->meshing.optimize = false; },
+                "Surface input only: skip sliver perturbation and exudation (faster meshing)");
   cmd->add_flag("--no-rest-positions", args->no_rest_positions,
                 "Do not store rest positions in the asset (smaller; tools cannot draw it)");
   cmd->add_flag("-q,--quiet", args->quiet, "No stage lines");
