@@ -25,28 +25,40 @@ inline double norm(const Vec3& a) {
 }  // namespace
 
 double triangle_potential(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& r) {
+  return TriangleKernel(a, b, c).potential(r);
+}
+
+TriangleKernel::TriangleKernel(const Vec3& a, const Vec3& b, const Vec3& c) {
   Vec3 n = cross(sub(b, a), sub(c, a));
   const double twice_area = norm(n);
-  if (!(twice_area > 0.0)) return 0.0;
-  n = {n[0] / twice_area, n[1] / twice_area, n[2] / twice_area};
-  const double d = dot(n, sub(r, a));
-  const double ad = std::abs(d);
-  const Vec3 rho = {r[0] - d * n[0], r[1] - d * n[1], r[2] - d * n[2]};
+  if (!(twice_area > 0.0)) return;
+  m_valid = true;
+  m_normal = {n[0] / twice_area, n[1] / twice_area, n[2] / twice_area};
+  m_corner = a;
   const Vec3* v[3] = {&a, &b, &c};
-  double sum = 0.0;
   for (int i = 0; i < 3; ++i) {
-    const Vec3& pm = *v[i];
-    const Vec3& pp = *v[(i + 1) % 3];
-    const Vec3 e = sub(pp, pm);
-    const double len = norm(e);
-    const Vec3 l = {e[0] / len, e[1] / len, e[2] / len};
-    const Vec3 u = cross(l, n);
-    const Vec3 to_m = sub(pm, rho);
-    const Vec3 to_p = sub(pp, rho);
-    const double lp = dot(to_p, l);
-    const double lm = dot(to_m, l);
-    const double t = dot(to_m, u);
-    if (std::abs(t) < 1e-12 * len) continue;  // point on the edge line: the term vanishes
+    Edge& e = m_edge[i];
+    e.start = *v[i];
+    const Vec3 d = sub(*v[(i + 1) % 3], *v[i]);
+    e.length = norm(d);
+    e.dir = {d[0] / e.length, d[1] / e.length, d[2] / e.length};
+    e.out = cross(e.dir, m_normal);
+  }
+}
+
+double TriangleKernel::potential(const Vec3& r) const {
+  if (!m_valid) return 0.0;
+  const double d = dot(m_normal, sub(r, m_corner));
+  const double ad = std::abs(d);
+  double sum = 0.0;
+  for (const Edge& e : m_edge) {
+    // Edge coordinates of the projection of r: dir and out are orthogonal to the normal, so
+    // the offset from r to its projection drops out of the dot products.
+    const Vec3 to_m = sub(e.start, r);
+    const double lm = dot(to_m, e.dir);
+    const double lp = lm + e.length;
+    const double t = dot(to_m, e.out);
+    if (std::abs(t) < 1e-12 * e.length) continue;  // point on the edge line: the term vanishes
     const double r0sq = t * t + d * d;
     const double rp = std::sqrt(lp * lp + r0sq);
     const double rm = std::sqrt(lm * lm + r0sq);
@@ -54,7 +66,11 @@ double triangle_potential(const Vec3& a, const Vec3& b, const Vec3& c, const Vec
         lm < 0.0 ? std::log((rm - lm) / (rp - lp)) : std::log((rp + lp) / (rm + lm));
     sum += t * log_term;
     if (ad > 0.0) {
-      sum -= ad * (std::atan2(t * lp, r0sq + ad * rp) - std::atan2(t * lm, r0sq + ad * rm));
+      // atan2(y1, x1) - atan2(y2, x2) with x1, x2 > 0: both angles lie in (-pi/2, pi/2), so
+      // the difference lies in (-pi, pi) and equals the angle of (x1 + i y1) conj(x2 + i y2).
+      const double y1 = t * lp, x1 = r0sq + ad * rp;
+      const double y2 = t * lm, x2 = r0sq + ad * rm;
+      sum -= ad * std::atan2(y1 * x2 - x1 * y2, x1 * x2 + y1 * y2);
     }
   }
   return sum;

@@ -17,6 +17,27 @@ namespace tetseg::preprocess::charge_detail {
 /// of the triangle does not matter. A zero-area triangle gives 0.
 double triangle_potential(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& r);
 
+/// triangle_potential with the triangle's geometry (unit normal, edge directions) computed
+/// once, for many evaluation points: the near-field assembly evaluates each triangle ~50
+/// times. Same formula (and results to rounding) as triangle_potential, with one atan2 per
+/// edge instead of two. Immutable after construction; safe to share between threads.
+class TriangleKernel {
+ public:
+  TriangleKernel() = default;
+  TriangleKernel(const Vec3& a, const Vec3& b, const Vec3& c);
+  /// Integral over the triangle of 1 / |r - y| dS_y; 0 for a zero-area triangle.
+  double potential(const Vec3& r) const;
+
+ private:
+  struct Edge {
+    Vec3 start{}, dir{}, out{};  ///< first corner, unit direction, dir x normal
+    double length = 0.0;
+  };
+  Vec3 m_corner{}, m_normal{};
+  Edge m_edge[3];
+  bool m_valid = false;
+};
+
 /// The same integral evaluated at the triangle's own centroid (the collocation diagonal),
 /// sum_i t_i [asinh(l_i+ / t_i) - asinh(l_i- / t_i)].
 double triangle_self_potential(const Vec3& a, const Vec3& b, const Vec3& c);
