@@ -10,7 +10,7 @@ data=${TETSEG_SHARED_DIR:-$PWD/../shared}/data/ccd-queries
 cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DTETSEG_BUILD_PREPROCESS=OFF \
   -DTETSEG_BUILD_TESTS=OFF >/dev/null
 cmake --build "$build" --target tetseg-ccd -j 2 >/dev/null
-tool="$build/tools/ccd/tetseg-ccd"
+tool="$build/tools/tetseg-ccd"
 [ -d "$data/sample-queries" ] || { echo "reference data not found under $data" >&2; exit 1; }
 
 echo "== machine: $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | xargs)"

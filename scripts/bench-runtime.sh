@@ -13,7 +13,7 @@ cd "$(dirname "$0")/.."
 build=${1:-build-bench-runtime}
 cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DTETSEG_BUILD_TESTS=OFF >/dev/null
 cmake --build "$build" -j2 --target tetseg-run tetseg-scene >/dev/null
-bin=$build/tools/run
+bin=$build/tools
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 

@@ -14,7 +14,7 @@ mkdir -p "$out"
 out=$(cd "$out" && pwd)
 for t in tetseg sim/tetseg-sim; do [ -x "$build/tools/$t" ] || { echo "make-scenes: build it first: cmake --build $build --target tetseg tetseg-sim" >&2; exit 1; }; done
 tetseg=$build/tools/tetseg
-sim=$build/tools/sim/tetseg-sim
+sim=$build/tools/tetseg-sim
 cd "$out"
 
 scene() {  # scene NAME SIM-OPTIONS...  (NAME.mesh exists)

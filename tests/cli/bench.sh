@@ -11,10 +11,10 @@ trap 'rm -rf "$work"' EXIT
 cd "$work"
 fail() { echo "FAIL: $*" >&2; exit 1; }
 
-"$bin/run/tetseg-scene" dumbbell d.tetseg d.tsf --segments 16 --rings 20 --frames 12 2>/dev/null
+"$bin/tetseg-scene" dumbbell d.tetseg d.tsf --segments 16 --rings 20 --frames 12 2>/dev/null
 "$bin/tetseg" generate dumbbell --size 0.4 -o s.mesh 2>/dev/null
 "$bin/tetseg" build s.mesh -o s.tetseg -q
-"$bin/sim/tetseg-sim" s.mesh s.tetseg -o s.tsf --frames 30 --substeps 4 --dt 0.02 --drop 0.1 \
+"$bin/tetseg-sim" s.mesh s.tetseg -o s.tsf --frames 30 --substeps 4 --dt 0.02 --drop 0.1 \
   --tilt-y 75 --edge-compliance 5e-3 2>/dev/null
 
 "$bin/tetseg-bench" table scene d.tetseg d.tsf sim s.tetseg s.tsf --repeat 1 --openmp --json \

@@ -2,7 +2,7 @@
 # tetseg-ccd end to end: exit codes and messages, the reference queries (zero false negatives),
 # and whole frames of the scalable-CCD data (every true pair reported).
 set -euo pipefail
-tool="${TETSEG_BIN_DIR:?}/ccd/tetseg-ccd"
+tool="${TETSEG_BIN_DIR:?}/tetseg-ccd"
 data="${TETSEG_SHARED_DIR:-}/data/ccd-queries"
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT

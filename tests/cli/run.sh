@@ -3,7 +3,7 @@
 # modes on "any" and on the earliest time of impact), tetseg-frames from .obj/.ply files,
 # exit codes on bad input.
 set -euo pipefail
-bin=${TETSEG_BIN_DIR:?}/run
+bin=${TETSEG_BIN_DIR:?}
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 cd "$work"

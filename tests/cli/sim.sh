@@ -18,7 +18,7 @@ expect_exit() {  # expect_exit CODE PATTERN -- command...
   grep -q -- "$pattern" err.txt out.txt || { cat err.txt >&2; fail "'$*' did not print '$pattern'"; }
 }
 
-sim="$bin/sim/tetseg-sim"
+sim="$bin/tetseg-sim"
 "$bin/tetseg" generate dumbbell --size 0.4 -o d.mesh 2>/dev/null
 "$bin/tetseg" build d.mesh -o d.tetseg -q
 args=(--substeps 1 --dt 0.005 --drop 0.1 --tilt-y 75 --edge-compliance 5e-3)

@@ -2,4 +2,3 @@
 add_executable(tetseg-bench ${CMAKE_CURRENT_LIST_DIR}/bench_table.cpp)
 target_link_libraries(tetseg-bench PRIVATE tetseg::runtime CLI11::CLI11)
 tetseg_set_warnings(tetseg-bench)
-set_target_properties(tetseg-bench PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${PROJECT_BINARY_DIR}/tools)

@@ -39,7 +39,7 @@ int run(const std::string& asset_path, const std::string& frames_path, const std
   tetseg::ColliderOptions options;
   options.use_openmp = openmp;
   if (!tetseg::parse_collider_mode(mode_name.c_str(), options.mode))
-    throw ToolError(kExitUsage, "", "unknown mode '" + mode_name + "' (rvbc, bvh, brute)");
+    throw ToolError(kExitUsage, "", "unknown mode '" + mode_name + "' (rvbc, bvh, brute, cone)");
   tetseg::Asset asset;
   std::string why;
   const tetseg::Status s = tetseg::load_asset_file(asset_path, asset, &why);
@@ -145,8 +145,8 @@ int main(int argc, char** argv) {
   bool json = false;
   app.add_option("asset", asset_path, "Asset file (.tetseg)")->required();
   app.add_option("frames", frames_path, "Frame-sequence file (docs/format.md)")->required();
-  app.add_option("--mode", mode, "Candidate search: rvbc (default), bvh or brute")
-      ->check(CLI::IsMember({"rvbc", "bvh", "brute"}));
+  app.add_option("--mode", mode, "Candidate search: rvbc (default), bvh, brute or cone (normal cones, ICCD-style)")
+      ->check(CLI::IsMember({"rvbc", "bvh", "brute", "cone"}));
   app.add_option("--query", query, "any, earliest or all (default)")
       ->check(CLI::IsMember({"any", "earliest", "all"}));
   app.add_flag("--json", json, "Machine-readable output on stdout");
