@@ -22,6 +22,9 @@ using namespace charge_detail;
 constexpr std::size_t kAutoDirectMax = 400;
 constexpr std::size_t kAutoDenseMax = 3000;
 constexpr std::size_t kAutoHighOrderMin = 10000;
+constexpr std::size_t kAutoTightToleranceMin = 10000;
+constexpr double kAutoTolerance = 1e-6;
+constexpr double kAutoTightTolerance = 1e-7;
 
 double seconds_since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
@@ -77,9 +80,12 @@ ChargeResult compute_charge(const std::vector<Vec3>& points, const std::vector<T
   };
   const PanelSet panels = make_panels(points, triangles, file);
   const std::size_t n = panels.size();
-  if (!(options.tolerance > 0.0 && options.tolerance < 1.0)) {
-    throw std::invalid_argument("charge tolerance must lie in (0, 1)");
+  if (!(options.tolerance >= 0.0 && options.tolerance < 1.0)) {
+    throw std::invalid_argument("charge tolerance must lie in (0, 1), or be 0 for automatic");
   }
+  const double tolerance =
+      options.tolerance > 0.0 ? options.tolerance
+                              : (n < kAutoTightToleranceMin ? kAutoTolerance : kAutoTightTolerance);
   if (!(options.fast_theta > 0.0 && options.fast_theta < 1.0)) {
     throw std::invalid_argument("charge fast_theta must lie in (0, 1)");
   }
@@ -107,6 +113,7 @@ ChargeResult compute_charge(const std::vector<Vec3>& points, const std::vector<T
 
   ChargeResult result;
   result.solver = to_string(solver);
+  result.tolerance = tolerance;
   progress("assembly", 0.0);
   const ClusterTree tree = build_cluster_tree(panels, options.leaf_size);
   const NearField near = build_near_field(panels, tree);
@@ -126,7 +133,7 @@ ChargeResult compute_charge(const std::vector<Vec3>& points, const std::vector<T
     }
   };
   auto on_iteration = [&](int it, double res) {
-    const double f = res > 0.0 ? std::log(res) / std::log(options.tolerance) : 1.0;
+    const double f = res > 0.0 ? std::log(res) / std::log(tolerance) : 1.0;
     progress("solve", std::min(1.0, std::max(0.0, f)));
     (void)it;
   };
@@ -138,8 +145,8 @@ ChargeResult compute_charge(const std::vector<Vec3>& points, const std::vector<T
     progress("assembly", 1.0);
     const auto t1 = Clock::now();
     const GmresOutcome g = solve_gmres(
-        n, [&](const double* x, double* out) { op.apply(x, out); }, precondition, b, y,
-        options.tolerance, options.max_iterations, options.restart, on_iteration);
+        n, [&](const double* x, double* out) { op.apply(x, out); }, precondition, b, y, tolerance,
+        options.max_iterations, options.restart, on_iteration);
     result.solve_seconds = seconds_since(t1);
     result.iterations = g.iterations;
     result.residual = g.residual;
@@ -163,7 +170,7 @@ ChargeResult compute_charge(const std::vector<Vec3>& points, const std::vector<T
     } else {
       const GmresOutcome g = solve_gmres(
           n, [&](const double* x, double* out) { dense_apply(m, n, x, out); }, precondition, b, y,
-          options.tolerance, options.max_iterations, options.restart, on_iteration);
+          tolerance, options.max_iterations, options.restart, on_iteration);
       result.iterations = g.iterations;
       result.residual = g.residual;
       result.converged = g.converged;

@@ -199,6 +199,29 @@ TEST_CASE("Automatic solver choice follows size and memory", "[charge]") {
     CHECK_THROWS_WITH(compute_charge(mid.vertices, mid.triangles, o),
                       Catch::Contains("--solver fast"));
   }
+  SECTION("The automatic tolerance is 1e-6 below 10k triangles and 1e-7 from there on.") {
+    const ChargeResult r = compute_charge(mid.vertices, mid.triangles, o);
+    CHECK(r.tolerance == 1e-6);
+    CHECK(r.converged);
+    CHECK(r.residual <= 1e-6);
+    const TriangleMesh large = tetseg::test::icosphere(23);  // 10580
+    REQUIRE(large.triangles.size() >= 10000);
+    const ChargeResult l = compute_charge(large.vertices, large.triangles, o);
+    CHECK(l.solver == "fast");
+    CHECK(l.tolerance == 1e-7);
+    CHECK(l.converged);
+    CHECK(l.residual <= 1e-7);
+    // Sphere: the exact density is uniform (faceting leaves a small ripple).
+    for (const double d : l.density) CHECK(std::abs(d - 1.0) < 2e-2);
+  }
+  SECTION("An explicit tolerance is used as given and a negative one is rejected.") {
+    o.tolerance = 1e-4;
+    const ChargeResult r = compute_charge(mid.vertices, mid.triangles, o);
+    CHECK(r.tolerance == 1e-4);
+    CHECK(r.residual <= 1e-4);
+    o.tolerance = -1e-6;
+    CHECK_THROWS_AS(compute_charge(mid.vertices, mid.triangles, o), std::invalid_argument);
+  }
   SECTION("The progress callback reports both stages and ends at 1.") {
     int assembly = 0, solve_calls = 0;
     double last = -1.0;

@@ -176,7 +176,8 @@ int main(int argc, char** argv) {
   app.add_option("--mesh-dir", mesh_dir, "Directory with the CGAL demo meshes");
   app.add_option("--real", real, "Real mesh (OFF) subdivided to the sizes");
   app.add_option("--sizes", sizes, "Any of 1k 5k 20k 100k");
-  app.add_option("--solvers", solvers, "Any of direct gmres fast, optionally name@tolerance");
+  app.add_option("--solvers", solvers,
+                 "Any of direct gmres fast auto, optionally name@tolerance (name@auto: automatic)");
   app.add_option("--tolerance", tolerance, "Relative residual for the timed runs");
   app.add_flag("--no-reference{false}", reference, "Skip the reference solves");
   CLI11_PARSE(app, argc, argv);
@@ -257,7 +258,10 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "bench: unknown solver %s\n", spec.c_str());
         return 2;
       }
-      o.tolerance = at == std::string::npos ? tolerance : std::stod(spec.substr(at + 1));
+      // "@auto" leaves the tolerance to compute_charge (0).
+      o.tolerance = at == std::string::npos
+                        ? tolerance
+                        : (spec.substr(at + 1) == "auto" ? 0.0 : std::stod(spec.substr(at + 1)));
       if (o.solver == ChargeSolver::kDirect && n > 6000) continue;
       if (o.solver == ChargeSolver::kGmres && n > 25000) continue;
       std::fprintf(stderr, "bench: %s %zu %s\n", m.name.c_str(), n, spec.c_str());

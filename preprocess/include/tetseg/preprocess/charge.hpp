@@ -34,8 +34,11 @@ enum class ChargePreconditioner {
 
 struct ChargeOptions {
   ChargeSolver solver = ChargeSolver::kAuto;
-  /// Relative residual ||1 - M y|| / ||1|| at which the iterative solvers stop, in (0, 1).
-  double tolerance = 1e-6;
+  /// Relative residual ||1 - M y|| / ||1|| at which the iterative solvers stop, in (0, 1),
+  /// or 0 for automatic: 1e-6 below 10,000 triangles, 1e-7 from there on. The density error
+  /// left by a given residual grows with N (at 100k triangles 1e-6 leaves ~1 % max error,
+  /// 1e-7 below 0.1 % on an ellipsoid; docs/charge.md). Negative values are rejected.
+  double tolerance = 0.0;
   int max_iterations = 500;  ///< matrix products, iterative solvers only
   int restart = 80;          ///< GMRES restart length
   ChargePreconditioner preconditioner = ChargePreconditioner::kJacobi;
@@ -64,6 +67,7 @@ struct ChargeResult {
   std::string solver;        ///< the solver actually used: "direct", "gmres" or "fast"
   int iterations = 0;        ///< matrix products (0 for direct)
   double residual = 0.0;     ///< final relative residual against the solver's operator
+  double tolerance = 0.0;    ///< the tolerance used (options.tolerance or the automatic one)
   bool converged = false;    ///< residual <= tolerance (always true for a successful direct)
   std::size_t near_entries = 0;   ///< analytic (near-field) matrix entries
   double assembly_seconds = 0.0;  ///< panels, tree, near field, dense matrix or treecode lists
