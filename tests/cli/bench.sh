@@ -5,11 +5,7 @@
 # agree) on every step with an intersection-free start; bvh and cone must find all of them
 # (the cone mode culls only patches proven embedded for the whole step).
 set -euo pipefail
-bin=${TETSEG_BIN_DIR:?}
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-cd "$work"
-fail() { echo "FAIL: $*" >&2; exit 1; }
+source "$(dirname "${BASH_SOURCE[0]}")/common.bash"
 
 "$bin/tetseg-scene" dumbbell d.tetseg d.tsf --segments 16 --rings 20 --frames 12 2>/dev/null
 "$bin/tetseg" generate dumbbell --size 0.4 -o s.mesh 2>/dev/null

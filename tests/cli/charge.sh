@@ -2,18 +2,7 @@
 # End to end: tetseg charge on a generated tet mesh and on a closed OFF surface; output
 # formats, report, exit codes, and the density checked against the sphere's uniform charge.
 set -euo pipefail
-bin=${TETSEG_BIN_DIR:?}
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-cd "$work"
-
-fail() { echo "FAIL: $*" >&2; exit 1; }
-expect_exit() {  # expect_exit CODE PATTERN -- command...
-  local code=$1 pattern=$2; shift 3
-  set +e; "$@" >out.txt 2>err.txt; local got=$?; set -e
-  [ "$got" -eq "$code" ] || { cat err.txt >&2; fail "'$*' exited $got, expected $code"; }
-  grep -q -- "$pattern" err.txt out.txt || { cat err.txt >&2; fail "'$*' did not print '$pattern'"; }
-}
+source "$(dirname "${BASH_SOURCE[0]}")/common.bash"
 
 # A closed octahedron-based sphere as OFF (surface input, used as given).
 python3 - <<'PY'

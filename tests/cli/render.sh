@@ -2,19 +2,8 @@
 # Pictures for people: tetseg-render (PNG) and tetseg-dump --vtu/--ply on the golden asset and
 # on hand-written PLY files; PNGs are decoded independently (python zlib) and checked.
 set -euo pipefail
-bin=${TETSEG_BIN_DIR:?}
 src=${TETSEG_SOURCE_DIR:?}
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-cd "$work"
-
-fail() { echo "FAIL: $*" >&2; exit 1; }
-expect_exit() {  # expect_exit CODE PATTERN -- command...
-  local code=$1 pattern=$2; shift 3
-  set +e; "$@" >out.txt 2>err.txt; local got=$?; set -e
-  [ "$got" -eq "$code" ] || { cat err.txt >&2; fail "'$*' exited $got, expected $code"; }
-  grep -q -- "$pattern" err.txt out.txt || { cat err.txt >&2; fail "'$*' did not print '$pattern'"; }
-}
+source "$(dirname "${BASH_SOURCE[0]}")/common.bash"
 
 golden=$src/tests/golden/asset-v1.0.tetseg
 expect_exit 0 "Usage" -- "$bin/tetseg-render" --help

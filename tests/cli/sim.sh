@@ -5,18 +5,7 @@
 # does intersect (so the check can fail), that contacts were resolved, that two runs are
 # byte-identical, and the exit codes on bad input.
 set -euo pipefail
-bin=${TETSEG_BIN_DIR:?}
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-cd "$work"
-
-fail() { echo "FAIL: $*" >&2; exit 1; }
-expect_exit() {  # expect_exit CODE PATTERN -- command...
-  local code=$1 pattern=$2; shift 3
-  set +e; "$@" >out.txt 2>err.txt; local got=$?; set -e
-  [ "$got" -eq "$code" ] || { cat err.txt >&2; fail "'$*' exited $got, expected $code"; }
-  grep -q -- "$pattern" err.txt out.txt || { cat err.txt >&2; fail "'$*' did not print '$pattern'"; }
-}
+source "$(dirname "${BASH_SOURCE[0]}")/common.bash"
 
 sim="$bin/tetseg-sim"
 "$bin/tetseg" generate dumbbell --size 0.4 -o d.mesh 2>/dev/null
