@@ -5,7 +5,7 @@
 
 #include <memory>
 
-#include "format/allocation_probe.hpp"
+#include "support/allocation_probe.hpp"
 #include "format/test_assets.hpp"
 
 using namespace tetseg::format;

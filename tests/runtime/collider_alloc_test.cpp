@@ -1,68 +1,12 @@
-// A collider step and its queries allocate nothing; OpenMP results equal serial results.
-// This file replaces the global operator new/delete of the runtime test executable with
-// counting versions (counting only while a test enables it).
+// A collider step and its queries allocate nothing (counted by the test executable's
+// replacement operator new, tests/support/allocation_probe.cpp); OpenMP results equal serial.
 
-#include <atomic>
 #include <catch2/catch.hpp>
-#include <cstdlib>
-#include <new>
 #include <random>
 
 #include "runtime/support/scenes.hpp"
+#include "support/allocation_probe.hpp"
 #include "tetseg/runtime/collider.hpp"
-
-namespace {
-std::atomic<bool> g_counting{false};
-std::atomic<std::size_t> g_allocations{0};
-
-void* counted_allocate(std::size_t size) {
-  if (g_counting.load(std::memory_order_relaxed)) g_allocations.fetch_add(1);
-  if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
-  throw std::bad_alloc();
-}
-
-struct CountAllocations {
-  CountAllocations() {
-    g_allocations = 0;
-    g_counting = true;
-  }
-  ~CountAllocations() { g_counting = false; }
-  std::size_t count() const { return g_allocations.load(); }
-};
-}  // namespace
-
-void* operator new(std::size_t size) {
-  return counted_allocate(size);
-}
-void* operator new[](std::size_t size) {
-  return counted_allocate(size);
-}
-void* operator new(std::size_t size, const std::nothrow_t&) noexcept {
-  try {
-    return counted_allocate(size);
-  } catch (...) {
-    return nullptr;
-  }
-}
-void* operator new[](std::size_t size, const std::nothrow_t&) noexcept {
-  try {
-    return counted_allocate(size);
-  } catch (...) {
-    return nullptr;
-  }
-}
-void operator delete(void* p) noexcept {
-  std::free(p);
-}
-void operator delete[](void* p) noexcept {
-  std::free(p);
-}
-void operator delete(void* p, std::size_t) noexcept {
-  std::free(p);
-}
-void operator delete[](void* p, std::size_t) noexcept {
-  std::free(p);
-}
 
 using namespace tetseg;
 using namespace tetseg::test;
@@ -88,7 +32,7 @@ TEST_CASE("A step and its queries allocate nothing", "[collider][alloc]") {
     REQUIRE(c.status() == ColliderStatus::kOk);
     std::size_t contacts = 0;
     for (std::size_t f = 0; f + 1 < frames.size(); ++f) {
-      CountAllocations counter;
+      AllocationProbe counter;
       REQUIRE(c.step(frames[f].data(), frames[f + 1].data()) == ColliderStatus::kOk);
       c.any_collision();
       c.earliest_toi();

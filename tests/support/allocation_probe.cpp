@@ -1,4 +1,4 @@
-#include "allocation_probe.hpp"
+#include "support/allocation_probe.hpp"
 
 #include <atomic>
 #include <cstdlib>
@@ -7,9 +7,11 @@
 namespace {
 std::atomic<bool> g_recording{false};
 std::atomic<std::size_t> g_largest{0};
+std::atomic<std::size_t> g_count{0};
 
 void* allocate(std::size_t size) {
   if (g_recording.load(std::memory_order_relaxed)) {
+    g_count.fetch_add(1, std::memory_order_relaxed);
     std::size_t seen = g_largest.load(std::memory_order_relaxed);
     while (size > seen && !g_largest.compare_exchange_weak(seen, size)) {
     }
@@ -62,6 +64,7 @@ namespace tetseg::test {
 
 AllocationProbe::AllocationProbe() {
   g_largest.store(0);
+  g_count.store(0);
   g_recording.store(true);
 }
 AllocationProbe::~AllocationProbe() {
@@ -69,6 +72,9 @@ AllocationProbe::~AllocationProbe() {
 }
 std::size_t AllocationProbe::largest() const {
   return g_largest.load();
+}
+std::size_t AllocationProbe::count() const {
+  return g_count.load();
 }
 
 }  // namespace tetseg::test

@@ -1,7 +1,8 @@
 #pragma once
-// Records the largest single operator-new request made while a probe is active, so tests can
-// show that hostile sizes are rejected before anything is allocated. The replacement global
-// operator new/delete live in allocation_probe.cpp (this test executable only).
+// Records the operator-new requests made while a probe is active: how many, and the largest,
+// so tests can show that hostile sizes are rejected before anything is allocated and that a
+// collider step allocates nothing. The replacement global operator new/delete live in
+// allocation_probe.cpp, linked into the format and runtime test executables.
 
 #include <cstddef>
 
@@ -15,6 +16,8 @@ class AllocationProbe {
   AllocationProbe& operator=(const AllocationProbe&) = delete;
   /// Largest request in bytes since construction.
   std::size_t largest() const;
+  /// Number of requests since construction.
+  std::size_t count() const;
 };
 
 }  // namespace tetseg::test
