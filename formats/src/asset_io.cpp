@@ -118,6 +118,17 @@ Status read_impl(const std::uint8_t* data, std::size_t size, Asset& out, std::st
 
 }  // namespace
 
+bool peek_version(const std::uint8_t* data, std::size_t size, std::uint16_t& major,
+                  std::uint16_t& minor) noexcept {
+  if (data == nullptr || size < kEnvelopeBytes) return false;
+  for (std::size_t i = 0; i < kMagic.size(); ++i) {
+    if (data[i] != kMagic[i]) return false;
+  }
+  major = static_cast<std::uint16_t>(get_le(data + kOffsetMajor, 2));
+  minor = static_cast<std::uint16_t>(get_le(data + kOffsetMinor, 2));
+  return true;
+}
+
 const char* to_string(Status status) noexcept {
   switch (status) {
     case Status::kOk:

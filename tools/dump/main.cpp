@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <fstream>
+#include <iterator>
 #include <iostream>
 #include <map>
 #include <sstream>
@@ -42,14 +44,26 @@ std::vector<std::uint32_t> boundary_edges_per_cluster(const Asset& asset) {
   return counts;
 }
 
-std::string version_string() {
-  return std::to_string(tetseg::format::kVersionMajor) + "." +
-         std::to_string(tetseg::format::kVersionMinor);
+/// "major.minor" as the file's envelope declares it (the file has loaded, so it is valid).
+std::string version_string(const std::vector<std::uint8_t>& bytes) {
+  std::uint16_t major = 0;
+  std::uint16_t minor = 0;
+  tetseg::format::peek_version(bytes.data(), bytes.size(), major, minor);
+  return std::to_string(major) + "." + std::to_string(minor);
 }
 
-void print_summary(const std::string& path, const Asset& asset) {
+std::vector<std::uint8_t> read_bytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw tetseg::tools::ToolError(tetseg::tools::kExitBadInput, path, "cannot open file");
+  std::vector<std::uint8_t> bytes((std::istreambuf_iterator<char>(in)),
+                                  std::istreambuf_iterator<char>());
+  if (in.bad()) throw tetseg::tools::ToolError(tetseg::tools::kExitBadInput, path, "read error");
+  return bytes;
+}
+
+void print_summary(const std::string& path, const std::string& version, const Asset& asset) {
   const auto edges = boundary_edges_per_cluster(asset);
-  std::printf("%s: tetseg asset, format %s\n", path.c_str(), version_string().c_str());
+  std::printf("%s: tetseg asset, format %s\n", path.c_str(), version.c_str());
   std::printf("  nodes               %u%s\n", asset.node_count,
               asset.rest_positions.empty() ? " (no rest positions)" : "");
   std::printf("  surface triangles   %zu\n", asset.triangles.size());
@@ -71,12 +85,12 @@ void print_summary(const std::string& path, const Asset& asset) {
   }
 }
 
-void print_json(const Asset& asset) {
+void print_json(const std::string& version, const Asset& asset) {
   using tetseg::tools::json_escape;
   const auto edges = boundary_edges_per_cluster(asset);
   std::ostringstream out;
   out.precision(9);
-  out << "{\n  \"format_version\": \"" << version_string() << "\",\n";
+  out << "{\n  \"format_version\": \"" << version << "\",\n";
   out << "  \"nodes\": " << asset.node_count << ",\n";
   out << "  \"rest_positions\": " << (asset.rest_positions.empty() ? "false" : "true") << ",\n";
   out << "  \"surface_triangles\": " << asset.triangles.size() << ",\n";
@@ -132,7 +146,8 @@ int main(int argc, char** argv) {
   try {
     tetseg::Asset asset;
     std::string detail;
-    const tetseg::Status status = tetseg::load_asset_file(path, asset, &detail);
+    const std::vector<std::uint8_t> bytes = read_bytes(path);
+    const tetseg::Status status = tetseg::load_asset(bytes.data(), bytes.size(), asset, &detail);
     if (status != tetseg::Status::kOk) {
       print_error("tetseg-dump", path,
                   std::string(tetseg::to_string(status)) + (detail.empty() ? "" : ": " + detail));
@@ -140,10 +155,11 @@ int main(int argc, char** argv) {
     }
     if (!vtu_path.empty()) write_file_atomic(vtu_path, asset_to_vtu(asset.data(), path));
     if (!ply_path.empty()) write_file_atomic(ply_path, asset_to_ply(asset.data(), path));
+    const std::string version = version_string(bytes);
     if (json) {
-      print_json(asset.data());
+      print_json(version, asset.data());
     } else {
-      print_summary(path, asset.data());
+      print_summary(path, version, asset.data());
     }
     return kExitOk;
   } catch (const ToolError& e) {

@@ -48,6 +48,11 @@ std::vector<std::uint8_t> write_asset(const Asset& asset);
 Status read_asset(const std::uint8_t* data, std::size_t size, Asset& out,
                   std::string* detail = nullptr) noexcept;
 
+/// The format version an asset's envelope declares. Returns false when `size` is shorter than
+/// the envelope or the magic is wrong; checks nothing else (call `read_asset` for that).
+bool peek_version(const std::uint8_t* data, std::size_t size, std::uint16_t& major,
+                  std::uint16_t& minor) noexcept;
+
 /// Reads a whole file and calls `read_asset`. Returns kIoError (and an empty `out`) when the
 /// file cannot be opened or read. Thread-safe; never throws.
 Status read_asset_file(const std::string& path, Asset& out, std::string* detail = nullptr) noexcept;
