@@ -302,6 +302,19 @@ TreecodeOperator::TreecodeOperator(const PanelSet& panels, const ClusterTree& tr
   for (std::size_t a = 0; a < static_cast<std::size_t>(kc); ++a) {
     m_m2l_start[a + 1] += m_m2l_start[a];
   }
+  for (const Term& t : m_m2l) {
+    m_m2l_b.push_back(static_cast<std::uint16_t>(t.b));
+    m_m2l_c.push_back(static_cast<std::uint16_t>(t.c));
+  }
+  for (const auto& k : m_index) {
+    double f = 1.0;
+    for (int i = 0; i < 3; ++i) {
+      for (int q = 2; q <= k[static_cast<std::size_t>(i)]; ++q) f *= q;
+    }
+    m_fact.push_back(f);
+    m_inv_fact.push_back(1.0 / f);
+    m_moment_scale.push_back(((k[0] + k[1] + k[2]) % 2 ? -1.0 : 1.0) / f);
+  }
 
   m_x.resize(m_n);
   m_y.resize(m_n);
@@ -377,6 +390,7 @@ TreecodeOperator::TreecodeOperator(const PanelSet& panels, const ClusterTree& tr
   m_charge.resize(m_n);
   m_moments.assign(node_count * m_index.size(), 0.0);
   m_local.assign(node_count * m_index.size(), 0.0);
+  m_scaled.assign(node_count * m_index.size(), 0.0);
 }
 
 void TreecodeOperator::apply(const double* x, double* y) const {
@@ -443,6 +457,9 @@ void TreecodeOperator::apply(const double* x, double* y) const {
           shift(m_m2m, mono.data(), m_moments.data() + static_cast<std::size_t>(child) * kc, mom);
         }
       }
+      for (std::size_t e = 0; e < m_scaled.size(); ++e) {
+        m_scaled[e] = m_moments[e] * m_moment_scale[e % kc];
+      }
     }
     // Multipole-to-local for every target cluster.
 #if defined(TETSEG_HAVE_OPENMP)
@@ -455,7 +472,7 @@ void TreecodeOperator::apply(const double* x, double* y) const {
       for (std::size_t f = m_far_start[static_cast<std::size_t>(ti)];
            f < m_far_start[static_cast<std::size_t>(ti) + 1]; ++f) {
         const Cluster& s = nodes[static_cast<std::size_t>(m_far[f])];
-        const double* mom = m_moments.data() + static_cast<std::size_t>(m_far[f]) * kc;
+        const double* mom = m_scaled.data() + static_cast<std::size_t>(m_far[f]) * kc;
         const double r[3] = {target.center[0] - s.center[0], target.center[1] - s.center[1],
                              target.center[2] - s.center[2]};
         const double r2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
@@ -471,13 +488,23 @@ void TreecodeOperator::apply(const double* x, double* y) const {
           const double s2 = deriv[rc.m2[0]] + deriv[rc.m2[1]] + deriv[rc.m2[2]];
           deriv[k] = (rc.alpha * s1 + rc.beta * s2) * inv_r2;
         }
-        // m_m2l is sorted by the target index a: accumulate each L_a in a register.
-        const Term* term = m_m2l.data();
+        for (std::size_t k = 0; k < kc; ++k) deriv[k] *= m_fact[k];
+        // Terms are sorted by the target index a: accumulate each L_a in a register.
+        const std::uint16_t* tb = m_m2l_b.data();
+        const std::uint16_t* tc = m_m2l_c.data();
+        std::size_t e = 0;
         for (std::size_t a = 0; a < kc; ++a) {
-          const Term* end = m_m2l.data() + m_m2l_start[a + 1];
-          double acc = 0.0;
-          for (; term < end; ++term) acc += term->coef * deriv[term->c] * mom[term->b];
-          local[a] += acc;
+          const std::size_t end = m_m2l_start[a + 1];
+          // Four partial sums: one chain would wait on the add latency at every term.
+          double acc0 = 0.0, acc1 = 0.0, acc2 = 0.0, acc3 = 0.0;
+          for (; e + 4 <= end; e += 4) {
+            acc0 += deriv[tc[e]] * mom[tb[e]];
+            acc1 += deriv[tc[e + 1]] * mom[tb[e + 1]];
+            acc2 += deriv[tc[e + 2]] * mom[tb[e + 2]];
+            acc3 += deriv[tc[e + 3]] * mom[tb[e + 3]];
+          }
+          for (; e < end; ++e) acc0 += deriv[tc[e]] * mom[tb[e]];
+          local[a] += ((acc0 + acc1) + (acc2 + acc3)) * m_inv_fact[a];
         }
       }
     }

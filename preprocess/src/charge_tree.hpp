@@ -89,11 +89,17 @@ class TreecodeOperator {
   };
   std::vector<Term> m_m2l;               ///< L_a += coef * D_c(R) * M_b with c = a + b, sorted by a
   std::vector<std::size_t> m_m2l_start;  ///< first term of each a
-  std::vector<Term> m_m2m;               ///< M_a(parent) += coef * d^c * M_b(child), c = a - b
-  std::vector<Term> m_l2l;               ///< L_a(child) += coef * d^c * L_b(parent), c = b - a
+  // The same M2L sum in scaled form, without per-term coefficients:
+  // L_a = (1 / a!) sum_b (c! D_c) ((-1)^|b| M_b / b!), c = a + b, k! = k_x! k_y! k_z!.
+  std::vector<std::uint16_t> m_m2l_b, m_m2l_c;  ///< b and c of each m_m2l term
+  std::vector<double> m_fact, m_inv_fact;       ///< k!, 1 / k!
+  std::vector<double> m_moment_scale;           ///< (-1)^|k| / k!
+  std::vector<Term> m_m2m;  ///< M_a(parent) += coef * d^c * M_b(child), c = a - b
+  std::vector<Term> m_l2l;  ///< L_a(child) += coef * d^c * L_b(parent), c = b - a
   mutable std::vector<double> m_charge;
   mutable std::vector<double> m_moments;  ///< nodes x index count
   mutable std::vector<double> m_local;    ///< nodes x index count
+  mutable std::vector<double> m_scaled;   ///< nodes x index count: M_k (-1)^|k| / k!
 };
 
 }  // namespace tetseg::preprocess::charge_detail
