@@ -423,7 +423,8 @@ void TreecodeOperator::apply(const double* x, double* y) const {
 #pragma omp parallel
 #endif
   {
-    std::vector<double> mono(kc), deriv(kc + 1), pot;
+    constexpr std::size_t kBatch = 4;
+    std::vector<double> mono(kc), deriv((kc + 1) * kBatch), pot, zeros(kc, 0.0);
     // Upward pass: leaf moments from the members.
 #if defined(TETSEG_HAVE_OPENMP)
 #pragma omp for schedule(dynamic, 16)
@@ -469,42 +470,61 @@ void TreecodeOperator::apply(const double* x, double* y) const {
       const Cluster& target = nodes[static_cast<std::size_t>(ti)];
       double* local = m_local.data() + static_cast<std::size_t>(ti) * kc;
       std::fill(local, local + kc, 0.0);
-      for (std::size_t f = m_far_start[static_cast<std::size_t>(ti)];
-           f < m_far_start[static_cast<std::size_t>(ti) + 1]; ++f) {
-        const Cluster& s = nodes[static_cast<std::size_t>(m_far[f])];
-        const double* mom = m_scaled.data() + static_cast<std::size_t>(m_far[f]) * kc;
-        const double r[3] = {target.center[0] - s.center[0], target.center[1] - s.center[1],
-                             target.center[2] - s.center[2]};
-        const double r2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+      // Source clusters in batches of kBatch, interleaved so that the recurrence and the
+      // term sums run kBatch independent chains (lane p of deriv[k * kBatch + p]); missing
+      // lanes of the last batch repeat a real source with zero moments.
+      const std::size_t first = m_far_start[static_cast<std::size_t>(ti)];
+      const std::size_t stop = m_far_start[static_cast<std::size_t>(ti) + 1];
+      for (std::size_t f = first; f < stop; f += kBatch) {
+        double rx[kBatch], ry[kBatch], rz[kBatch], inv_r2[kBatch];
+        const double* mom[kBatch];
+        for (std::size_t p = 0; p < kBatch; ++p) {
+          const bool real = f + p < stop;
+          const std::int32_t sid = m_far[real ? f + p : f];
+          const Cluster& s = nodes[static_cast<std::size_t>(sid)];
+          rx[p] = target.center[0] - s.center[0];
+          ry[p] = target.center[1] - s.center[1];
+          rz[p] = target.center[2] - s.center[2];
+          inv_r2[p] = 1.0 / (rx[p] * rx[p] + ry[p] * ry[p] + rz[p] * rz[p]);
+          mom[p] = real ? m_scaled.data() + static_cast<std::size_t>(sid) * kc : zeros.data();
+        }
         // Taylor coefficients of 1 / |R + w| in w (Duan & Krasny recurrence).
-        // Branch-free: missing predecessors point at deriv[kc] = 0.
-        const double inv_r2 = 1.0 / r2;
-        deriv[0] = std::sqrt(inv_r2);
-        deriv[kc] = 0.0;
+        // Branch-free: missing predecessors point at slot kc, which holds 0.
+        for (std::size_t p = 0; p < kBatch; ++p) {
+          deriv[p] = std::sqrt(inv_r2[p]);
+          deriv[kc * kBatch + p] = 0.0;
+        }
         for (std::size_t k = 1; k < kc; ++k) {
           const Recurrence& rc = m_recurrence[k];
-          const double s1 =
-              r[0] * deriv[rc.m1[0]] + r[1] * deriv[rc.m1[1]] + r[2] * deriv[rc.m1[2]];
-          const double s2 = deriv[rc.m2[0]] + deriv[rc.m2[1]] + deriv[rc.m2[2]];
-          deriv[k] = (rc.alpha * s1 + rc.beta * s2) * inv_r2;
+          const double* x0 = deriv.data() + rc.m1[0] * kBatch;
+          const double* x1 = deriv.data() + rc.m1[1] * kBatch;
+          const double* x2 = deriv.data() + rc.m1[2] * kBatch;
+          const double* y0 = deriv.data() + rc.m2[0] * kBatch;
+          const double* y1 = deriv.data() + rc.m2[1] * kBatch;
+          const double* y2 = deriv.data() + rc.m2[2] * kBatch;
+          double* out = deriv.data() + k * kBatch;
+          for (std::size_t p = 0; p < kBatch; ++p) {
+            const double s1 = rx[p] * x0[p] + ry[p] * x1[p] + rz[p] * x2[p];
+            const double s2 = y0[p] + y1[p] + y2[p];
+            out[p] = (rc.alpha * s1 + rc.beta * s2) * inv_r2[p];
+          }
         }
-        for (std::size_t k = 0; k < kc; ++k) deriv[k] *= m_fact[k];
-        // Terms are sorted by the target index a: accumulate each L_a in a register.
+        for (std::size_t k = 0; k < kc; ++k) {
+          for (std::size_t p = 0; p < kBatch; ++p) deriv[k * kBatch + p] *= m_fact[k];
+        }
+        // Terms are sorted by the target index a: accumulate each L_a in registers.
         const std::uint16_t* tb = m_m2l_b.data();
         const std::uint16_t* tc = m_m2l_c.data();
         std::size_t e = 0;
         for (std::size_t a = 0; a < kc; ++a) {
           const std::size_t end = m_m2l_start[a + 1];
-          // Four partial sums: one chain would wait on the add latency at every term.
-          double acc0 = 0.0, acc1 = 0.0, acc2 = 0.0, acc3 = 0.0;
-          for (; e + 4 <= end; e += 4) {
-            acc0 += deriv[tc[e]] * mom[tb[e]];
-            acc1 += deriv[tc[e + 1]] * mom[tb[e + 1]];
-            acc2 += deriv[tc[e + 2]] * mom[tb[e + 2]];
-            acc3 += deriv[tc[e + 3]] * mom[tb[e + 3]];
+          double acc[kBatch] = {};
+          for (; e < end; ++e) {
+            const double* d = deriv.data() + static_cast<std::size_t>(tc[e]) * kBatch;
+            const std::size_t b = tb[e];
+            for (std::size_t p = 0; p < kBatch; ++p) acc[p] += d[p] * mom[p][b];
           }
-          for (; e < end; ++e) acc0 += deriv[tc[e]] * mom[tb[e]];
-          local[a] += ((acc0 + acc1) + (acc2 + acc3)) * m_inv_fact[a];
+          local[a] += ((acc[0] + acc[1]) + (acc[2] + acc[3])) * m_inv_fact[a];
         }
       }
     }
