@@ -6,8 +6,8 @@
 #include <cstdint>
 #include <vector>
 
-#include "tetseg/runtime/classify.hpp"
 #include "normal_cone.hpp"
+#include "tetseg/runtime/classify.hpp"
 #include "tetseg/runtime/collider.hpp"
 
 namespace tetseg {
@@ -44,6 +44,8 @@ struct TreeView {
   const std::uint32_t* nneg = nullptr;  // null: no orientation culling
   const std::uint32_t* nunc = nullptr;
   const std::uint32_t* nmov = nullptr;
+  const ConeData* cone = nullptr;  // non-null: node self-tests may be culled by normal cones
+  std::uint32_t cone_base = 0;     // cone index of node 0
 };
 
 struct StackItem {
@@ -164,11 +166,21 @@ struct Collider::Impl {
   TreeView cluster_view(std::uint32_t c) const noexcept;
   TreeView global_view() const noexcept;
 
-  // --- normal_cone.cpp (kCone)
-  ConeData cone;
-  void build_cone_topology();
+  // --- normal_cone.cpp (kCone: global BVH; kHybrid: cluster BVHs)
+  ConeData cone;                           // kCone, indexed by global BVH node
+  ConeData ccone;                          // kHybrid, indexed by asset BVH node
+  std::vector<std::uint8_t> cluster_cone;  // kHybrid, per cluster: cones used this step
+  void build_cone_topology(ConeData& cd, const ConeTree& tree, std::vector<std::uint32_t>& pos);
+  void build_global_cones();
+  void build_cluster_cones();
+  ConeTree cluster_cone_tree(const format::Cluster& cl) const noexcept;
   void update_cones() noexcept;
-  bool cone_self_free(std::uint32_t node) const noexcept;
+  void update_cone_tree(ConeData& cd, const ConeTree& tree) noexcept;
+  bool cone_self_free(const ConeData& cd, std::uint32_t node) const noexcept;
+  /// rvbc orientation culling is on (kRvbc, kHybrid; never in the rest check).
+  bool orientation_mode() const noexcept {
+    return (opt.mode == ColliderMode::kRvbc || opt.mode == ColliderMode::kHybrid) && !rest_mode;
+  }
 
   // --- collider_bvh.cpp
   void build_global_bvh(const double* positions) noexcept;

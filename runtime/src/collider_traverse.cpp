@@ -43,9 +43,13 @@ TreeView Collider::Impl::cluster_view(std::uint32_t c) const noexcept {
   v.box = nbox.data() + cl.bvh_offset;
   v.ntris = cluster_node_ntris.data() + cl.bvh_offset;
   v.nmov = nmov.data() + cl.bvh_offset;
-  if (opt.mode == ColliderMode::kRvbc && !rest_mode) {
+  if (orientation_mode()) {
     v.nneg = nneg.data() + cl.bvh_offset;
     v.nunc = nunc.data() + cl.bvh_offset;
+  }
+  if (opt.mode == ColliderMode::kHybrid && !rest_mode && cluster_cone[c]) {
+    v.cone = &ccone;
+    v.cone_base = cl.bvh_offset;
   }
   return v;
 }
@@ -57,6 +61,7 @@ TreeView Collider::Impl::global_view() const noexcept {
   v.box = gbox.data();
   v.ntris = gntris.data();
   v.nmov = gmov.data();
+  if (opt.mode == ColliderMode::kCone && !rest_mode) v.cone = &cone;
   return v;
 }
 
@@ -64,8 +69,7 @@ bool Collider::Impl::non_culled(std::uint32_t t1, std::uint32_t t2) const noexce
   if (t1 == t2) return false;
   if (!rest_mode && !tmov[t1] && !tmov[t2]) return false;
   if (!boxes_overlap(tbox[t1], tbox[t2], opt.ccd.min_separation)) return false;
-  if (opt.mode == ColliderMode::kRvbc && !rest_mode &&
-      asset->triangle_cluster[t1] == asset->triangle_cluster[t2]) {
+  if (orientation_mode() && asset->triangle_cluster[t1] == asset->triangle_cluster[t2]) {
     const std::uint8_t c = tcls[t1];
     if (c != kUnc && c == tcls[t2]) return false;
   }
@@ -271,7 +275,7 @@ bool Collider::Impl::traverse_self(Worker& w, const TreeView& t) const noexcept 
     if (it.b == kNone) {
       const std::uint32_t n = it.a;
       if (!rest_mode && t.nmov[n] == 0) continue;
-      if (one_sign(n) || (opt.mode == ColliderMode::kCone && !rest_mode && cone_self_free(n))) {
+      if (one_sign(n) || (t.cone && cone_self_free(*t.cone, t.cone_base + n))) {
         ++w.stats.node_pairs_orientation_culled;
         continue;
       }

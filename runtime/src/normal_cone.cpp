@@ -61,9 +61,9 @@ double cone_of(const V3* v, int n, V3& axis) {
   const double l = norm(s);
   if (!(l > 1e-12)) return kWide;
   axis = {s.x / l, s.y / l, s.z / l};
-  double a = 0;
-  for (int i = 0; i < n; ++i) a = std::max(a, std::acos(std::clamp(dot(axis, v[i]), -1.0, 1.0)));
-  return a + kAnglePad;
+  double d = 1;  // acos is decreasing: one acos of the smallest dot product
+  for (int i = 0; i < n; ++i) d = std::min(d, dot(axis, v[i]));
+  return std::acos(std::clamp(d, -1.0, 1.0)) + kAnglePad;
 }
 
 struct P2 {
@@ -104,12 +104,15 @@ int bernstein_sign(const P2& u0, const P2& u1, const P2& w0, const P2& w1, bool 
 
 }  // namespace
 
-void Collider::Impl::build_cone_topology() {
-  const std::uint32_t n = gnode_count;
-  std::vector<std::uint32_t> begin(n), end(n), pos(tri_count);
-  for (std::uint32_t i = 0; i < tri_count; ++i) pos[gleaf[i]] = i;
+void Collider::Impl::build_cone_topology(ConeData& cd, const ConeTree& tree,
+                                         std::vector<std::uint32_t>& pos) {
+  // pos: tri_count entries, kNone outside this tree; restored to kNone on return.
+  const std::uint32_t n = tree.count;
+  const format::BvhNode* nodes = tree.nodes;
+  std::vector<std::uint32_t> begin(n), end(n);
+  for (std::uint32_t i = 0; i < tree.leaf_count; ++i) pos[tree.leaf[i]] = i;
   for (std::uint32_t i = n; i-- > 0;) {
-    const format::BvhNode& nd = gnodes[i];
+    const format::BvhNode& nd = nodes[i];
     if (nd.count > 0) {
       begin[i] = nd.first;
       end[i] = nd.first + nd.count;
@@ -118,15 +121,12 @@ void Collider::Impl::build_cone_topology() {
       end[i] = std::max(end[nd.first], end[nd.second]);
     }
   }
-  cone.bnd_offset.assign(n + 1, 0);
-  cone.bnd_edges.clear();
-  cone.loop_ok.assign(n, 0);
   std::vector<std::uint32_t> local, verts;
   for (std::uint32_t i = 0; i < n; ++i) {
     local.clear();
     bool manifold = true;
     for (std::uint32_t k = begin[i]; k < end[i] && manifold; ++k) {
-      for (std::uint32_t e : tri_edges[gleaf[k]]) {
+      for (std::uint32_t e : tri_edges[tree.leaf[k]]) {
         std::uint32_t inside = 0;
         for (std::uint32_t j = et_offset[e]; j < et_offset[e + 1]; ++j)
           inside += pos[et_list[j]] >= begin[i] && pos[et_list[j]] < end[i];
@@ -162,35 +162,61 @@ void Collider::Impl::build_cone_topology() {
       }
       ok = at == start && walked == local.size();
     }
-    cone.loop_ok[i] = ok ? 1 : 0;
-    if (ok) cone.bnd_edges.insert(cone.bnd_edges.end(), local.begin(), local.end());
-    cone.bnd_offset[i + 1] = static_cast<std::uint32_t>(cone.bnd_edges.size());
+    const std::uint32_t g = tree.base + i;
+    cd.loop_ok[g] = ok ? 1 : 0;
+    cd.bnd_begin[g] = static_cast<std::uint32_t>(cd.bnd_edges.size());
+    if (ok) cd.bnd_edges.insert(cd.bnd_edges.end(), local.begin(), local.end());
+    cd.bnd_end[g] = static_cast<std::uint32_t>(cd.bnd_edges.size());
   }
-  cone.axis.assign(std::size_t(n) * 3, 0.0);
-  cone.angle.assign(n, kWide);
+  for (std::uint32_t i = 0; i < tree.leaf_count; ++i) pos[tree.leaf[i]] = kNone;
+}
+
+void Collider::Impl::build_global_cones() {
+  cone.init(gnode_count);
+  std::vector<std::uint32_t> pos(tri_count, kNone);
+  build_cone_topology(cone, ConeTree{gnodes.data(), gleaf.data(), gnode_count, tri_count, 0}, pos);
   cone.topology_built = true;
+}
+
+void Collider::Impl::build_cluster_cones() {
+  const format::Asset& fa = *asset;
+  ccone.init(static_cast<std::uint32_t>(fa.bvh_nodes.size()));
+  std::vector<std::uint32_t> pos(tri_count, kNone);
+  for (const format::Cluster& cl : fa.clusters)
+    build_cone_topology(ccone, cluster_cone_tree(cl), pos);
+  ccone.topology_built = true;
+}
+
+ConeTree Collider::Impl::cluster_cone_tree(const format::Cluster& cl) const noexcept {
+  return ConeTree{asset->bvh_nodes.data() + cl.bvh_offset,
+                  asset->cluster_triangles.data() + cl.triangle_offset, cl.bvh_count,
+                  cl.triangle_count, cl.bvh_offset};
 }
 
 void Collider::Impl::update_cones() noexcept {
   if (!cone.topology_built) {
     try {
-      build_cone_topology();  // only when the asset has no rest positions (allocates once)
+      build_global_cones();  // only when the asset has no rest positions (allocates once)
     } catch (...) {
       return;  // angles stay wide: nothing is culled
     }
   }
+  update_cone_tree(cone, ConeTree{gnodes.data(), gleaf.data(), gnode_count, tri_count, 0});
+}
+
+void Collider::Impl::update_cone_tree(ConeData& cd, const ConeTree& tree) noexcept {
   const format::Asset& fa = *asset;
-  for (std::uint32_t i = gnode_count; i-- > 0;) {
-    const format::BvhNode& nd = gnodes[i];
+  for (std::uint32_t i = tree.count; i-- > 0;) {
+    const format::BvhNode& nd = tree.nodes[i];
     V3 axis{0, 0, 1};
     double angle = kWide;
     if (nd.count > 0) {
       // Leaf: cone of all control normals of its triangles.
-      V3 normals[3 * 16];
+      V3 normals[3 * kMaxConeLeaf];
       int m = 0;
-      bool degenerate = false;
+      bool degenerate = nd.count > kMaxConeLeaf;
       for (std::uint32_t k = 0; k < nd.count && !degenerate; ++k) {
-        const auto& t = fa.triangles[gleaf[nd.first + k]];
+        const auto& t = fa.triangles[tree.leaf[nd.first + k]];
         const V3 u0 = sub(pos0(t[1]), pos0(t[0])), w0 = sub(pos0(t[2]), pos0(t[0]));
         const V3 u1 = sub(pos1(t[1]), pos1(t[0])), w1 = sub(pos1(t[2]), pos1(t[0]));
         const V3 a = cross(u0, w1), b = cross(u1, w0);
@@ -208,10 +234,11 @@ void Collider::Impl::update_cones() noexcept {
       }
       if (!degenerate) angle = cone_of(normals, m, axis);
     } else {
-      const double a1 = cone.angle[nd.first], a2 = cone.angle[nd.second];
+      const std::size_t c1 = tree.base + nd.first, c2 = tree.base + nd.second;
+      const double a1 = cd.angle[c1], a2 = cd.angle[c2];
       if (a1 < kHalfPi && a2 < kHalfPi) {
-        const double* p = &cone.axis[std::size_t(nd.first) * 3];
-        const double* q = &cone.axis[std::size_t(nd.second) * 3];
+        const double* p = &cd.axis[c1 * 3];
+        const double* q = &cd.axis[c2 * 3];
         const V3 u1{p[0], p[1], p[2]}, u2{q[0], q[1], q[2]};
         const double phi = std::acos(std::clamp(dot(u1, u2), -1.0, 1.0));
         if (phi + a2 <= a1) {
@@ -242,17 +269,18 @@ void Collider::Impl::update_cones() noexcept {
       }
     }
     if (!(angle < kHalfPi)) angle = kWide;
-    cone.angle[i] = angle;
-    cone.axis[std::size_t(i) * 3 + 0] = axis.x;
-    cone.axis[std::size_t(i) * 3 + 1] = axis.y;
-    cone.axis[std::size_t(i) * 3 + 2] = axis.z;
+    const std::size_t g = tree.base + i;
+    cd.angle[g] = angle;
+    cd.axis[g * 3 + 0] = axis.x;
+    cd.axis[g * 3 + 1] = axis.y;
+    cd.axis[g * 3 + 2] = axis.z;
   }
 }
 
-bool Collider::Impl::cone_self_free(std::uint32_t node) const noexcept {
-  if (!cone.topology_built || node >= gnode_count) return false;
-  if (!(cone.angle[node] < kHalfPi - 1e-6) || !cone.loop_ok[node]) return false;
-  const double* ax = &cone.axis[std::size_t(node) * 3];
+bool Collider::Impl::cone_self_free(const ConeData& cd, std::uint32_t node) const noexcept {
+  if (!cd.topology_built || node >= cd.angle.size()) return false;
+  if (!(cd.angle[node] < kHalfPi - 1e-6) || !cd.loop_ok[node]) return false;
+  const double* ax = &cd.axis[std::size_t(node) * 3];
   const V3 u{ax[0], ax[1], ax[2]};
   // Orthonormal basis of the projection plane.
   const V3 pick = std::fabs(u.x) < 0.6 ? V3{1, 0, 0} : V3{0, 1, 0};
@@ -263,13 +291,13 @@ bool Collider::Impl::cone_self_free(std::uint32_t node) const noexcept {
   auto project = [&](const double* p) {
     return P2{p[0] * e1.x + p[1] * e1.y + p[2] * e1.z, p[0] * e2.x + p[1] * e2.y + p[2] * e2.z};
   };
-  const std::uint32_t first = cone.bnd_offset[node], last = cone.bnd_offset[node + 1];
+  const std::uint32_t first = cd.bnd_begin[node], last = cd.bnd_end[node];
   const std::uint32_t k = last - first;
   // Projected end points at t = 0 and t = 1, and swept 2D boxes, of every boundary edge.
   P2 p0[kMaxContourEdges][2], p1[kMaxContourEdges][2];
   double box[kMaxContourEdges][4];
   for (std::uint32_t i = 0; i < k; ++i) {
-    const auto& e = edges[cone.bnd_edges[first + i]];
+    const auto& e = edges[cd.bnd_edges[first + i]];
     for (int s = 0; s < 2; ++s) {
       p0[i][s] = project(pos0(e[s]));
       p1[i][s] = project(pos1(e[s]));
@@ -285,9 +313,9 @@ bool Collider::Impl::cone_self_free(std::uint32_t node) const noexcept {
     return bernstein_sign(sub2(b0, a0), sub2(b1, a1), sub2(c0, a0), sub2(c1, a1), false);
   };
   for (std::uint32_t i = 0; i < k; ++i) {
-    const auto& ei = edges[cone.bnd_edges[first + i]];
+    const auto& ei = edges[cd.bnd_edges[first + i]];
     for (std::uint32_t j = i + 1; j < k; ++j) {
-      const auto& ej = edges[cone.bnd_edges[first + j]];
+      const auto& ej = edges[cd.bnd_edges[first + j]];
       int si = -1, sj = -1;  // shared vertex slots
       for (int a = 0; a < 2; ++a)
         for (int b = 0; b < 2; ++b)
