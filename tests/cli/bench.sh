@@ -4,6 +4,7 @@
 # force finds at the earliest time of impact of each step (missed 0, any and earliest toi
 # agree) on every step with an intersection-free start; bvh and cone must find all of them
 # (the cone mode culls only patches proven embedded for the whole step).
+# needs: preprocess
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/common.bash"
 

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # End to end: tetseg generate -> build -> tetseg-dump; exit codes, messages, determinism,
 # atomic output.
+# needs: preprocess
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/common.bash"
 

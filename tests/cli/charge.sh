@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # End to end: tetseg charge on a generated tet mesh and on a closed OFF surface; output
 # formats, report, exit codes, and the density checked against the sphere's uniform charge.
+# needs: preprocess
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/common.bash"
 

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # End-to-end: tetseg generate / tetrahedralize. Exit codes (0 ok, 2 usage, 3 bad input,
 # 4 output failed), error message format, outputs, determinism across processes.
+# needs: preprocess
 set -euo pipefail
 
 tetseg="${TETSEG_BIN_DIR:?}/tetseg"

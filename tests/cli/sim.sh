@@ -4,6 +4,7 @@
 # self-intersects and no step has a contact, that the same run without self-contact handling
 # does intersect (so the check can fail), that contacts were resolved, that two runs are
 # byte-identical, and the exit codes on bad input.
+# needs: preprocess
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/common.bash"
 
