@@ -164,6 +164,8 @@ void Collider::Impl::construct(const Asset& a, const ColliderOptions& o) {
   vmoved.assign(nv, 0);
   vbox.resize(nv);
   tbox.resize(tri_count);
+  ebox.resize(edges.size());
+  emov.assign(edges.size(), 0);
   tcls.assign(tri_count, static_cast<std::uint8_t>(Orientation::kUncertain));
   tmov.assign(tri_count, 0);
   nbox.resize(nn);
@@ -266,6 +268,17 @@ void Collider::Impl::refit_and_classify() noexcept {
     box_union(b, vbox[i2]);
     tbox[t] = b;
     tmov[t] = (vmoved[i0] | vmoved[i1] | vmoved[i2]) ? 1 : 0;
+  }
+  const std::int64_t ne = static_cast<std::int64_t>(edges.size());
+#if defined(TETSEG_HAVE_OPENMP)
+#pragma omp parallel for if (opt.use_openmp && ne > 8192)
+#endif
+  for (std::int64_t e = 0; e < ne; ++e) {
+    const std::uint32_t i0 = surf_index[edges[e][0]], i1 = surf_index[edges[e][1]];
+    Box b = vbox[i0];
+    box_union(b, vbox[i1]);
+    ebox[e] = b;
+    emov[e] = vmoved[i0] | vmoved[i1];
   }
   if (opt.mode == ColliderMode::kRvbc || opt.mode == ColliderMode::kHybrid || rest_mode) {
     for (std::size_t c = 0; c < fa.clusters.size(); ++c) {

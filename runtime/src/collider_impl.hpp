@@ -114,6 +114,8 @@ struct Collider::Impl {
   std::vector<std::uint8_t> vmoved;  // per surface vertex
   std::vector<Box> vbox;             // per surface vertex, swept
   std::vector<Box> tbox;
+  std::vector<Box> ebox;           // per edge, swept (refit)
+  std::vector<std::uint8_t> emov;  // per edge: an end node moved
   std::vector<std::uint8_t> tcls;  // Orientation
   std::vector<std::uint8_t> tmov;
   std::vector<Box> nbox;  // per asset BVH node

@@ -125,24 +125,16 @@ void Collider::Impl::process_vertex_face(Worker& w, std::uint32_t p,
 }
 
 bool Collider::Impl::edge_boxes_overlap(std::uint32_t e1, std::uint32_t e2) const noexcept {
-  const std::uint32_t ia = surf_index[edges[e1][0]], ib = surf_index[edges[e1][1]];
-  const std::uint32_t ic = surf_index[edges[e2][0]], id = surf_index[edges[e2][1]];
-  if (!vmoved[ia] && !vmoved[ib] && !vmoved[ic] && !vmoved[id]) return false;
-  Box ba = vbox[ia], bc = vbox[ic];
-  box_union(ba, vbox[ib]);
-  box_union(bc, vbox[id]);
-  return boxes_overlap(ba, bc, opt.ccd.min_separation);
+  if (!emov[e1] && !emov[e2]) return false;
+  return boxes_overlap(ebox[e1], ebox[e2], opt.ccd.min_separation);
 }
 
 void Collider::Impl::process_edge_edge(Worker& w, std::uint32_t e1,
                                        std::uint32_t e2) const noexcept {
   if (e1 > e2) std::swap(e1, e2);
   const std::uint32_t a = edges[e1][0], b = edges[e1][1], c = edges[e2][0], d = edges[e2][1];
-  const std::uint32_t ia = surf_index[a], ib = surf_index[b], ic = surf_index[c],
-                      id = surf_index[d];
-  if (!vmoved[ia] && !vmoved[ib] && !vmoved[ic] && !vmoved[id]) return;
   const double ms = opt.ccd.min_separation;
-  if (!edge_boxes_overlap(e1, e2)) return;
+  if (!edge_boxes_overlap(e1, e2)) return;  // also: all four nodes still
   ++w.stats.feature_pairs;
   if (ms <= 0) {
     // det[b-a, d-c, c-a] = det[b-a, d-a, c-a]: orientation of (a; b, d, c).
@@ -203,6 +195,8 @@ void Collider::Impl::process_triangle_pair(Worker& w, std::uint32_t t1,
   // Edge-edge.
   for (std::uint32_t i = 0; i < 3; ++i) {
     const std::uint32_t e1 = tri_edges[t1][i];
+    // tbox[t2] contains the boxes of t2's edges: one check rejects all three.
+    if (!boxes_overlap(ebox[e1], tbox[t2], opt.ccd.min_separation)) continue;
     for (std::uint32_t j = 0; j < 3; ++j) {
       const std::uint32_t e2 = tri_edges[t2][j];
       const auto& E1 = edges[e1];
