@@ -5,7 +5,8 @@
 # time, CPU seconds, iterations, residual, peak RSS and error against the analytic density and
 # the best reference available. Takes several minutes (the references dominate).
 # Usage: scripts/bench-charge.sh [build-dir] [extra tetseg-bench-charge options]
-#        (default build-bench-charge; e.g. `--sizes 1k 5k --solvers gmres fast`)
+#        (default build-bench-charge; e.g. `--sizes 1k 5k --solvers gmres fast --repeat 5`;
+#        `name@auto` uses the automatic tolerance, `--repeat N` keeps the fastest of N runs)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 build=${1:-build-bench-charge}
