@@ -1,0 +1,71 @@
+// The FMM product of the fast solver against the exact O(N^2) product of the same collocation
+// matrix (point-charge far field plus analytic near field), at two FMM orders and at scales
+// far from 1 (docs/charge.md, "fast").
+
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <vector>
+
+#include "../../preprocess/src/charge_potential.hpp"
+#include "../../preprocess/src/charge_solvers.hpp"
+#include "../../preprocess/src/charge_tree.hpp"
+#include "charge_shapes.hpp"
+
+using namespace tetseg::preprocess::charge_detail;
+
+namespace {
+
+/// Relative 2-norm and max pointwise relative error of the FMM product against the dense
+/// one, for a positive smoothly varying charge vector.
+std::pair<double, double> fmm_error(const tetseg::preprocess::TriangleMesh& m, double theta,
+                                    int order) {
+  const PanelSet panels = make_panels(m.vertices, m.triangles, "");
+  const std::size_t n = panels.size();
+  const ClusterTree tree = build_cluster_tree(panels, 32);
+  const NearField near = build_near_field(panels, tree);
+  const std::vector<double> dense = assemble_dense(panels, near);
+  std::vector<double> x(n), exact(n), fast(n);
+  for (std::size_t i = 0; i < n; ++i) x[i] = 1.0 + 0.3 * std::sin(0.37 * static_cast<double>(i));
+  dense_apply(dense, n, x.data(), exact.data());
+  const TreecodeOperator op(panels, tree, near, theta, order);
+  op.apply(x.data(), fast.data());
+  double num = 0.0, den = 0.0, worst = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    num += (fast[i] - exact[i]) * (fast[i] - exact[i]);
+    den += exact[i] * exact[i];
+    worst = std::max(worst, std::abs(fast[i] / exact[i] - 1.0));
+  }
+  return {std::sqrt(num / den), worst};
+}
+
+tetseg::preprocess::TriangleMesh scaled(tetseg::preprocess::TriangleMesh m, double s) {
+  for (auto& p : m.vertices) p = {p[0] * s, p[1] * s, p[2] * s};
+  return m;
+}
+
+}  // namespace
+
+TEST_CASE("The FMM product matches the exact product of the collocation matrix", "[charge]") {
+  const auto m = tetseg::test::ellipsoid(11, 1.0, 0.6, 0.3);  // 2420 triangles
+  REQUIRE(m.triangles.size() == 2420);
+  SECTION("Order 6 at theta 0.5 is accurate to a few 1e-6 (2-norm).") {
+    const auto e = fmm_error(m, 0.5, 6);
+    CHECK(e.first < 1e-5);
+    CHECK(e.second < 1e-4);
+  }
+  SECTION("Order 8 is more accurate than order 6, and order 2 much less.") {
+    const auto e6 = fmm_error(m, 0.5, 6);
+    const auto e8 = fmm_error(m, 0.5, 8);
+    const auto e2 = fmm_error(m, 0.5, 2);
+    CHECK(e8.first < 0.6 * e6.first);
+    CHECK(e2.first > 10.0 * e6.first);
+  }
+  SECTION("The error does not depend on the length unit (1e-20 and 1e20 scales).") {
+    const auto e = fmm_error(m, 0.5, 6);
+    for (const double s : {1e-20, 1e20}) {
+      const auto es = fmm_error(scaled(m, s), 0.5, 6);
+      CHECK(std::abs(es.first - e.first) < 1e-2 * e.first);
+      CHECK(std::abs(es.second - e.second) < 1e-2 * e.second);
+    }
+  }
+}
