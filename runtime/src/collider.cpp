@@ -35,16 +35,14 @@ const char* to_string(ColliderMode mode) noexcept {
       return "brute";
     case ColliderMode::kCone:
       return "cone";
-    case ColliderMode::kHybrid:
-      return "hybrid";
   }
   return "unknown";
 }
 
 bool parse_collider_mode(const char* name, ColliderMode& out) noexcept {
   if (!name) return false;
-  for (ColliderMode m : {ColliderMode::kRvbc, ColliderMode::kBvh, ColliderMode::kBrute,
-                         ColliderMode::kCone, ColliderMode::kHybrid}) {
+  for (ColliderMode m :
+       {ColliderMode::kRvbc, ColliderMode::kBvh, ColliderMode::kBrute, ColliderMode::kCone}) {
     if (std::strcmp(name, to_string(m)) == 0) {
       out = m;
       return true;
@@ -189,11 +187,6 @@ void Collider::Impl::construct(const Asset& a, const ColliderOptions& o) {
       if (opt.mode == ColliderMode::kCone) build_global_cones();
     }
   }
-  if (opt.mode == ColliderMode::kHybrid) {
-    if (!(opt.hybrid_threshold >= 0)) opt.hybrid_threshold = 0;  // NaN too
-    cluster_cone.assign(fa.clusters.size(), 0);
-    build_cluster_cones();
-  }
   ctor_status = ColliderStatus::kOk;
 }
 
@@ -280,7 +273,7 @@ void Collider::Impl::refit_and_classify() noexcept {
     ebox[e] = b;
     emov[e] = vmoved[i0] | vmoved[i1];
   }
-  if (opt.mode == ColliderMode::kRvbc || opt.mode == ColliderMode::kHybrid || rest_mode) {
+  if (opt.mode == ColliderMode::kRvbc || rest_mode) {
     for (std::size_t c = 0; c < fa.clusters.size(); ++c) {
       const format::Cluster& cl = fa.clusters[c];
       const format::BvhNode* nodes = fa.bvh_nodes.data() + cl.bvh_offset;
@@ -361,21 +354,6 @@ void Collider::Impl::refit_and_classify() noexcept {
     }
   }
   stats.classify_ms = ms_since(t_class);
-  if (opt.mode != ColliderMode::kHybrid) return;
-  // Hybrid: normal cones for the self-test of each moving cluster whose negative + uncertain
-  // share exceeds the threshold (one-sign and still clusters are skipped anyway).
-  const auto t_cone = Clock::now();
-  for (std::size_t c = 0; c < fa.clusters.size(); ++c) {
-    const format::Cluster& cl = fa.clusters[c];
-    const std::uint32_t r = cl.bvh_offset;
-    const double bad = double(nneg[r]) + double(nunc[r]);
-    const bool one_sign = nunc[r] == 0 && (nneg[r] == 0 || nneg[r] == cluster_node_ntris[r]);
-    const bool use =
-        nmov[r] > 0 && !one_sign && bad > opt.hybrid_threshold * double(cluster_node_ntris[r]);
-    cluster_cone[c] = use ? 1 : 0;
-    if (use) update_cone_tree(ccone, cluster_cone_tree(cl));
-  }
-  stats.cone_ms = ms_since(t_cone);
 }
 
 // ---------------------------------------------------------------- public API
@@ -485,7 +463,7 @@ const RestCheck& Collider::rest_intersection() const noexcept {
 
 Orientation Collider::triangle_class(std::size_t t) const noexcept {
   if (!m_impl || !m_impl->have_step || t >= m_impl->tri_count ||
-      (m_impl->opt.mode != ColliderMode::kRvbc && m_impl->opt.mode != ColliderMode::kHybrid))
+      m_impl->opt.mode != ColliderMode::kRvbc)
     return Orientation::kUncertain;
   return static_cast<Orientation>(m_impl->tcls[t]);
 }

@@ -168,21 +168,15 @@ struct Collider::Impl {
   TreeView cluster_view(std::uint32_t c) const noexcept;
   TreeView global_view() const noexcept;
 
-  // --- normal_cone.cpp (kCone: global BVH; kHybrid: cluster BVHs)
-  ConeData cone;                           // kCone, indexed by global BVH node
-  ConeData ccone;                          // kHybrid, indexed by asset BVH node
-  std::vector<std::uint8_t> cluster_cone;  // kHybrid, per cluster: cones used this step
+  // --- normal_cone.cpp (kCone)
+  ConeData cone;  // kCone, indexed by global BVH node
   void build_cone_topology(ConeData& cd, const ConeTree& tree, std::vector<std::uint32_t>& pos);
   void build_global_cones();
-  void build_cluster_cones();
-  ConeTree cluster_cone_tree(const format::Cluster& cl) const noexcept;
   void update_cones() noexcept;
   void update_cone_tree(ConeData& cd, const ConeTree& tree) noexcept;
   bool cone_self_free(const ConeData& cd, std::uint32_t node) const noexcept;
-  /// rvbc orientation culling is on (kRvbc, kHybrid; never in the rest check).
-  bool orientation_mode() const noexcept {
-    return (opt.mode == ColliderMode::kRvbc || opt.mode == ColliderMode::kHybrid) && !rest_mode;
-  }
+  /// rvbc orientation culling is on (kRvbc; never in the rest check).
+  bool orientation_mode() const noexcept { return opt.mode == ColliderMode::kRvbc && !rest_mode; }
 
   // --- collider_bvh.cpp
   void build_global_bvh(const double* positions) noexcept;

@@ -47,10 +47,6 @@ TreeView Collider::Impl::cluster_view(std::uint32_t c) const noexcept {
     v.nneg = nneg.data() + cl.bvh_offset;
     v.nunc = nunc.data() + cl.bvh_offset;
   }
-  if (opt.mode == ColliderMode::kHybrid && !rest_mode && cluster_cone[c]) {
-    v.cone = &ccone;
-    v.cone_base = cl.bvh_offset;
-  }
   return v;
 }
 

@@ -178,21 +178,6 @@ void Collider::Impl::build_global_cones() {
   cone.topology_built = true;
 }
 
-void Collider::Impl::build_cluster_cones() {
-  const format::Asset& fa = *asset;
-  ccone.init(static_cast<std::uint32_t>(fa.bvh_nodes.size()));
-  std::vector<std::uint32_t> pos(tri_count, kNone);
-  for (const format::Cluster& cl : fa.clusters)
-    build_cone_topology(ccone, cluster_cone_tree(cl), pos);
-  ccone.topology_built = true;
-}
-
-ConeTree Collider::Impl::cluster_cone_tree(const format::Cluster& cl) const noexcept {
-  return ConeTree{asset->bvh_nodes.data() + cl.bvh_offset,
-                  asset->cluster_triangles.data() + cl.triangle_offset, cl.bvh_count,
-                  cl.triangle_count, cl.bvh_offset};
-}
-
 void Collider::Impl::update_cones() noexcept {
   if (!cone.topology_built) {
     try {

@@ -1,7 +1,8 @@
 #pragma once
 // Private data of the collider's normal cones (normal_cone.cpp): ColliderMode::kCone, a
-// baseline in the spirit of ICCD (Tang et al. 2009) over the kBvh mode's global BVH, and
-// ColliderMode::kHybrid, the same cones over the asset's per-cluster BVHs. Not installed.
+// baseline in the spirit of ICCD (Tang et al. 2009) over the kBvh mode's global BVH. The
+// functions take any BVH (`ConeTree`); a per-cluster use (a "hybrid" mode) was measured and
+// removed, docs/benchmarks.md. Not installed.
 
 #include <cstdint>
 #include <vector>

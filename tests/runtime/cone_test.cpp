@@ -126,12 +126,4 @@ TEST_CASE("Normal-cone mode has a stable name", "[collider][cone]") {
   CHECK(std::string(to_string(ColliderMode::kCone)) == "cone");
 }
 
-TEST_CASE("Hybrid mode has a stable name", "[collider][hybrid]") {
-  ColliderMode m = ColliderMode::kRvbc;
-  CHECK(parse_collider_mode("hybrid", m));
-  CHECK(m == ColliderMode::kHybrid);
-  CHECK(std::string(to_string(ColliderMode::kHybrid)) == "hybrid");
-  CHECK_FALSE(parse_collider_mode("hybrid2", m));
-}
-
 }  // namespace tetseg::test

@@ -89,9 +89,6 @@ void load_scene(Scene& s, const std::string& asset_path, const std::string& fram
     throw Failure{kExitBadInput, frames_path + ": node count differs from the asset's"};
 }
 
-/// `--hybrid-threshold` (ColliderOptions::hybrid_threshold of the hybrid mode).
-double g_hybrid_threshold = tetseg::ColliderOptions{}.hybrid_threshold;
-
 /// Runs `mode` over the steps (f, f + stride); fills timing and counts; when `truth` is given
 /// and `record` is false, compares; when `record` is true, stores the mode's results in it.
 Row run_mode(const Scene& s, tetseg::ColliderMode mode, bool openmp, std::size_t stride,
@@ -99,7 +96,6 @@ Row run_mode(const Scene& s, tetseg::ColliderMode mode, bool openmp, std::size_t
              std::vector<tetseg::Contact>& buffer) {
   tetseg::ColliderOptions opt;
   opt.mode = mode;
-  opt.hybrid_threshold = g_hybrid_threshold;
   opt.use_openmp = openmp;
   opt.time_tests = true;
   tetseg::Collider collider(s.asset, opt);
@@ -277,8 +273,8 @@ int table(const std::vector<std::string>& scene_args, const std::string& mode_li
     for (const Row& r : rows) {
       std::cout << "| " << r.scene << " | " << r.mode << (r.openmp ? " (OpenMP)" : "") << " | "
                 << r.steps << " (" << r.compared << ") | " << fmt("%.4f", r.refit) << " | "
-                << (r.mode == "rvbc" || r.mode == "hybrid" ? fmt("%.4f", r.classify) : "-") << " | "
-                << (r.mode == "cone" || r.mode == "hybrid" ? fmt("%.4f", r.cone) : "-") << " | "
+                << (r.mode == "rvbc" ? fmt("%.4f", r.classify) : "-") << " | "
+                << (r.mode == "cone" ? fmt("%.4f", r.cone) : "-") << " | "
                 << fmt("%.4f", r.traversal) << " | " << fmt("%.4f", r.tests) << " | "
                 << fmt("%.4f", r.total) << " | " << fmt("%.4f", r.cpu) << " | "
                 << fmt("%.0f", r.tri_pairs) << " | " << fmt("%.0f", r.feature_tests) << " | "
@@ -357,7 +353,7 @@ int main(int argc, char** argv) {
   CLI::App* t = app.add_subcommand(
       "table", "Table I: per-step stage times, work counts and missed contacts per mode");
   std::vector<std::string> scenes;
-  std::string modes = "rvbc,hybrid,bvh,cone,brute";
+  std::string modes = "rvbc,bvh,cone,brute";
   std::size_t stride = 1, max_steps = 1000000;
   int repeat = 3;
   bool openmp = false, json = false, no_truth = false;
@@ -369,9 +365,6 @@ int main(int argc, char** argv) {
       ->check(CLI::PositiveNumber);
   t->add_option("--repeat", repeat, "Runs per step; the fastest is kept (default 3)")
       ->check(CLI::Range(1, 100));
-  t->add_option("--hybrid-threshold", g_hybrid_threshold,
-                "hybrid mode: negative+uncertain share above which a cluster uses cones")
-      ->check(CLI::Range(0.0, 1.0));
   t->add_flag("--openmp", openmp, "Also run each mode with use_openmp (refit, classification)");
   t->add_flag("--no-truth", no_truth,
               "Skip brute force and the comparison (timings only; missed reads 0)");

@@ -59,8 +59,6 @@ struct SequenceReport {
   std::uint64_t orientation_culled = 0;
   std::uint64_t clusters_skipped = 0;
   std::uint64_t rvbc_tests = 0, brute_tests = 0;
-  /// Triangle pairs of rvbc and of hybrid (threshold 0: cones in every mixed-sign cluster).
-  std::uint64_t rvbc_pairs = 0, hybrid_pairs = 0;
   std::vector<Contact> first_contacts;
   /// Earliest contacts whose feature pair also lies in an orientation-culled triangle pair
   /// (same cluster, same definite class): the design note's wedge-tip situation, where the
@@ -68,11 +66,11 @@ struct SequenceReport {
   int wedge_contacts = 0;  // brute contacts at the earliest toi of the first contact frame
 };
 
-/// Compares rvbc, hybrid (threshold 0) and bvh with brute on every step until (and including) the
-/// first step with a contact: after it the surface may start a step self-intersecting, which voids
-/// the culling guarantee (design note), so later steps are not compared. Does a triangle pair
-/// containing the feature pair of `c` have the same definite class in the same cluster (i.e. is it
-/// culled by orientation in the collider's current step)?
+/// Compares rvbc and bvh with brute on every step until (and including) the first step with a
+/// contact: after it the surface may start a step self-intersecting, which voids the culling
+/// guarantee (design note), so later steps are not compared.
+/// Does a triangle pair containing the feature pair of `c` have the same definite class in
+/// the same cluster (i.e. is it culled by orientation in the collider's current step)?
 inline bool in_culled_pair(const Collider& rvbc, const Scene& scene, const Contact& c) {
   const format::Asset& a = scene.asset.data();
   auto has = [&](std::size_t t, std::uint32_t n) {
@@ -108,11 +106,7 @@ inline SequenceReport compare_with_brute(const Scene& scene,
   Collider bvh(scene.asset, o);
   o.mode = ColliderMode::kBrute;
   Collider brute(scene.asset, o);
-  o.mode = ColliderMode::kHybrid;
-  o.hybrid_threshold = 0.0;
-  Collider hybrid(scene.asset, o);
   REQUIRE(rvbc.status() == ColliderStatus::kOk);
-  REQUIRE(hybrid.status() == ColliderStatus::kOk);
   SequenceReport rep;
   constexpr double kTol = 1e-9;
   for (std::size_t f = 0; f + 1 < frames.size(); ++f) {
@@ -120,9 +114,6 @@ inline SequenceReport compare_with_brute(const Scene& scene,
     const StepAnswer b = answer(brute, frames[f].data(), frames[f + 1].data());
     const StepAnswer r = answer(rvbc, frames[f].data(), frames[f + 1].data());
     const StepAnswer g = answer(bvh, frames[f].data(), frames[f + 1].data());
-    const StepAnswer h = answer(hybrid, frames[f].data(), frames[f + 1].data());
-    rep.rvbc_pairs += rvbc.stats().triangle_pairs;
-    rep.hybrid_pairs += hybrid.stats().triangle_pairs;
     rep.orientation_culled += rvbc.stats().node_pairs_orientation_culled;
     rep.clusters_skipped += rvbc.stats().clusters_skipped;
     rep.rvbc_tests += rvbc.stats().feature_tests;
@@ -130,7 +121,6 @@ inline SequenceReport compare_with_brute(const Scene& scene,
     ++rep.frames_compared;
     REQUIRE(r.any == b.any);
     REQUIRE(g.any == b.any);
-    REQUIRE(h.any == b.any);
     // bvh has no orientation culling: exactly the brute-force contact set.
     REQUIRE(g.contacts.size() == b.contacts.size());
     for (std::size_t i = 0; i < b.contacts.size(); ++i) {
@@ -140,17 +130,13 @@ inline SequenceReport compare_with_brute(const Scene& scene,
     if (!b.any) continue;
     ++rep.contact_frames;
     REQUIRE(r.earliest.found);
-    REQUIRE(h.earliest.found);
     CHECK(r.earliest.contact.toi == Approx(b.earliest.contact.toi).margin(kTol));
-    CHECK(h.earliest.contact.toi == Approx(b.earliest.contact.toi).margin(kTol));
     for (const Contact& c : b.contacts) {
       if (c.toi > b.earliest.contact.toi + kTol) continue;
       CAPTURE(describe(c));
       const bool found = std::any_of(r.contacts.begin(), r.contacts.end(),
                                      [&](const Contact& x) { return same_feature(x, c); });
       CHECK(found);
-      CHECK(std::any_of(h.contacts.begin(), h.contacts.end(),
-                        [&](const Contact& x) { return same_feature(x, c); }));
       if (rep.contact_frames == 1) rep.first_contacts.push_back(c);
       if (found && in_culled_pair(rvbc, scene, c)) ++rep.wedge_contacts;
     }

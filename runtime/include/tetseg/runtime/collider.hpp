@@ -28,13 +28,9 @@ enum class ColliderMode : std::uint8_t {
   kBvh = 1,    ///< one BVH over the whole surface, overlap culling only
   kBrute = 2,  ///< every feature pair with 4 distinct nodes and overlapping swept boxes
   kCone = 3,   ///< baseline: `kBvh` + continuous normal cones and contour tests (ICCD-like)
-  /// `kRvbc`, plus normal-cone culling (as `kCone`) of the node self-tests inside each moving
-  /// cluster whose negative + uncertain triangle share this step exceeds
-  /// `ColliderOptions::hybrid_threshold`. Cross-cluster pairs as in `kRvbc`.
-  kHybrid = 4,
 };
 
-/// Short stable name: "rvbc", "bvh", "brute", "cone", "hybrid".
+/// Short stable name: "rvbc", "bvh", "brute", "cone".
 const char* to_string(ColliderMode mode) noexcept;
 /// Parses a name of `to_string`; false when unknown.
 bool parse_collider_mode(const char* name, ColliderMode& out) noexcept;
@@ -56,9 +52,6 @@ struct ColliderOptions {
   /// the coplanarity filter is off, but orientation culling (rvbc) still only guarantees
   /// exact contacts: use `kBvh` when every near contact must be found.
   CcdOptions ccd;
-  /// `kHybrid`: a cluster's self-test also uses normal cones in a step where more than this
-  /// fraction (in [0,1]; negative or NaN = 0) of its triangles is negative or uncertain.
-  double hybrid_threshold = 0.1;
   /// Leaf size of the `kBvh` mode's BVH (clamped to [1, 16]).
   std::uint32_t bvh_leaf_size = 4;
   /// Use OpenMP threads inside a step when built with it: refit and classification loops
@@ -108,7 +101,7 @@ struct ContactsResult {
 /// Counts and times of the current step (reset by `step`; queries add to them).
 struct ColliderStats {
   double refit_ms = 0, classify_ms = 0, traversal_ms = 0, tests_ms = 0;
-  /// kCone, kHybrid: normal-cone update (contour tests count as traversal)
+  /// kCone: normal-cone update (contour tests count as traversal)
   double cone_ms = 0;
   std::uint64_t nodes_moved = 0;
   std::uint64_t triangles_positive = 0, triangles_negative = 0, triangles_uncertain = 0;
