@@ -225,14 +225,19 @@ void Collider::Impl::leaf_pair(Worker& w, const TreeView& ta, std::uint32_t a, c
 
 bool Collider::Impl::traverse_pair(Worker& w, const TreeView& ta,
                                    const TreeView& tb) const noexcept {
-  // Same-tree pairs come from traverse_self, which pushes them; here the roots of two trees.
+  // Same-tree pairs come from traverse_self; here the roots of two trees. A pair is tested
+  // (not both still, boxes overlap) before it is pushed, so popped pairs are live.
+  const double ms = opt.ccd.min_separation;
+  auto live = [&](std::uint32_t a, std::uint32_t b) {
+    return (rest_mode || ta.nmov[a] != 0 || tb.nmov[b] != 0) &&
+           boxes_overlap(ta.box[a], tb.box[b], ms);
+  };
+  if (!live(0, 0)) return true;
   std::size_t top = 0;
   w.stack[top++] = {0, 0};
   while (top > 0 && !w.stop) {
     const StackItem it = w.stack[--top];
     ++w.stats.node_pairs_visited;
-    if (!rest_mode && ta.nmov[it.a] == 0 && tb.nmov[it.b] == 0) continue;
-    if (!boxes_overlap(ta.box[it.a], tb.box[it.b], opt.ccd.min_separation)) continue;
     const format::BvhNode& na = ta.nodes[it.a];
     const format::BvhNode& nb = tb.nodes[it.b];
     if (na.count > 0 && nb.count > 0) {
@@ -242,11 +247,11 @@ bool Collider::Impl::traverse_pair(Worker& w, const TreeView& ta,
     if (top + 2 > w.stack.size()) return false;
     const bool split_a = nb.count > 0 || (na.count == 0 && ta.ntris[it.a] >= tb.ntris[it.b]);
     if (split_a) {
-      w.stack[top++] = {na.second, it.b};
-      w.stack[top++] = {na.first, it.b};
+      if (live(na.second, it.b)) w.stack[top++] = {na.second, it.b};
+      if (live(na.first, it.b)) w.stack[top++] = {na.first, it.b};
     } else {
-      w.stack[top++] = {it.a, nb.second};
-      w.stack[top++] = {it.a, nb.first};
+      if (live(it.a, nb.second)) w.stack[top++] = {it.a, nb.second};
+      if (live(it.a, nb.first)) w.stack[top++] = {it.a, nb.first};
     }
   }
   return true;
@@ -254,8 +259,22 @@ bool Collider::Impl::traverse_pair(Worker& w, const TreeView& ta,
 
 bool Collider::Impl::traverse_self(Worker& w, const TreeView& t) const noexcept {
   const bool orient = t.nneg != nullptr;
+  const double ms = opt.ccd.min_separation;
   auto one_sign = [&](std::uint32_t n) {
     return orient && (t.nunc[n] == 0 && (t.nneg[n] == 0 || t.nneg[n] == t.ntris[n]));
+  };
+  // Pair items are tested (not both still, boxes overlap, not culled by orientation) before
+  // they are pushed, so popped pair items are live.
+  auto live_pair = [&](std::uint32_t a, std::uint32_t b) {
+    if (!rest_mode && t.nmov[a] == 0 && t.nmov[b] == 0) return false;
+    if (!boxes_overlap(t.box[a], t.box[b], ms)) return false;
+    if (orient && t.nunc[a] == 0 && t.nunc[b] == 0 &&
+        ((t.nneg[a] == 0 && t.nneg[b] == 0) ||
+         (t.nneg[a] == t.ntris[a] && t.nneg[b] == t.ntris[b]))) {
+      ++w.stats.node_pairs_orientation_culled;
+      return false;
+    }
+    return true;
   };
   std::size_t top = 0;
   w.stack[top++] = {0, kNone};
@@ -277,17 +296,9 @@ bool Collider::Impl::traverse_self(Worker& w, const TreeView& t) const noexcept 
         continue;
       }
       if (top + 3 > w.stack.size()) return false;
-      w.stack[top++] = {nd.first, nd.second};
+      if (live_pair(nd.first, nd.second)) w.stack[top++] = {nd.first, nd.second};
       w.stack[top++] = {nd.second, kNone};
       w.stack[top++] = {nd.first, kNone};
-      continue;
-    }
-    if (!rest_mode && t.nmov[it.a] == 0 && t.nmov[it.b] == 0) continue;
-    if (!boxes_overlap(t.box[it.a], t.box[it.b], opt.ccd.min_separation)) continue;
-    if (orient && t.nunc[it.a] == 0 && t.nunc[it.b] == 0 &&
-        ((t.nneg[it.a] == 0 && t.nneg[it.b] == 0) ||
-         (t.nneg[it.a] == t.ntris[it.a] && t.nneg[it.b] == t.ntris[it.b]))) {
-      ++w.stats.node_pairs_orientation_culled;
       continue;
     }
     const format::BvhNode& na = t.nodes[it.a];
@@ -299,11 +310,11 @@ bool Collider::Impl::traverse_self(Worker& w, const TreeView& t) const noexcept 
     if (top + 2 > w.stack.size()) return false;
     const bool split_a = nb.count > 0 || (na.count == 0 && t.ntris[it.a] >= t.ntris[it.b]);
     if (split_a) {
-      w.stack[top++] = {na.second, it.b};
-      w.stack[top++] = {na.first, it.b};
+      if (live_pair(na.second, it.b)) w.stack[top++] = {na.second, it.b};
+      if (live_pair(na.first, it.b)) w.stack[top++] = {na.first, it.b};
     } else {
-      w.stack[top++] = {it.a, nb.second};
-      w.stack[top++] = {it.a, nb.first};
+      if (live_pair(it.a, nb.second)) w.stack[top++] = {it.a, nb.second};
+      if (live_pair(it.a, nb.first)) w.stack[top++] = {it.a, nb.first};
     }
   }
   return true;
