@@ -12,7 +12,7 @@ build=$(cd "${1:-$repo/build}" && pwd)
 out=${2:-$build/scenes}
 mkdir -p "$out"
 out=$(cd "$out" && pwd)
-for t in tetseg sim/tetseg-sim; do [ -x "$build/tools/$t" ] || { echo "make-scenes: build it first: cmake --build $build --target tetseg tetseg-sim" >&2; exit 1; }; done
+for t in tetseg tetseg-sim; do [ -x "$build/tools/$t" ] || { echo "make-scenes: build it first: cmake --build $build --target tetseg tetseg-sim" >&2; exit 1; }; done
 tetseg=$build/tools/tetseg
 sim=$build/tools/tetseg-sim
 cd "$out"
