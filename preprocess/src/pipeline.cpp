@@ -1,6 +1,7 @@
 #include "tetseg/preprocess/pipeline.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <numeric>
@@ -15,6 +16,10 @@ namespace {
 // Shortest decimal text that reads back as exactly `value` ("0.1", not "0.10000000000000001").
 std::string format_number(double value) {
   char buffer[64];
+  if (value == std::floor(value) && std::fabs(value) < 1e15) {
+    std::snprintf(buffer, sizeof buffer, "%.0f", value);
+    return buffer;
+  }
   for (int digits = 1; digits <= 17; ++digits) {
     std::snprintf(buffer, sizeof buffer, "%.*g", digits, value);
     if (std::strtod(buffer, nullptr) == value) break;
@@ -57,7 +62,8 @@ std::vector<std::pair<std::string, std::string>> provenance_options(const BuildO
   std::vector<std::pair<std::string, std::string>> out = {
       {"clusters", options.clusters == ClusterMethod::kSingle ? "single" : "charge"},
       {"charge.solver", solver_name(options.charge.solver)},
-      {"charge.tolerance", format_number(options.charge.tolerance)},
+      {"charge.tolerance",
+       options.charge.tolerance == 0.0 ? "auto" : format_number(options.charge.tolerance)},
       {"segmentation.alpha", format_number(seg.alpha)},
       {"segmentation.beta_divisor", format_number(seg.beta_divisor)},
       {"segmentation.equalization", equalization_name(seg.equalization)},
@@ -102,6 +108,7 @@ format::Asset build_asset(const TetMesh& mesh, const std::string& source,
       ChargeResult r = compute_charge(mesh.nodes, surface.triangles, options.charge, source);
       std::ostringstream text;
       text << r.solver << ", " << r.iterations << " iterations, residual " << r.residual
+           << " (tolerance " << r.tolerance << ")"
            << ", capacitance " << r.capacitance;
       summary = text.str();
       return r;

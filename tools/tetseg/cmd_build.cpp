@@ -60,7 +60,9 @@ std::string report_json(const BuildArgs& args, const BuildReport& report,
       << "},\n";
   if (!report.charge.solver.empty()) {
     const ChargeResult& c = report.charge;
-    out << "  \"charge\": {\"solver\": \"" << c.solver << "\", \"iterations\": " << c.iterations
+    out << "  \"charge\": {\"solver\": \"" << c.solver << "\", \"tolerance\": " << c.tolerance
+        << ", \"converged\": " << (c.converged ? "true" : "false")
+        << ", \"iterations\": " << c.iterations
         << ", \"residual\": " << c.residual << ", \"capacitance\": " << c.capacitance
         << ", \"assembly_seconds\": " << c.assembly_seconds
         << ", \"solve_seconds\": " << c.solve_seconds << "},\n";
@@ -189,8 +191,9 @@ void add_build_command(CLI::App& root) {
       ->transform(CLI::CheckedTransformer(solvers, CLI::ignore_case))
       ->option_text("auto|direct|gmres|fast (auto)");
   cmd->add_option("--tolerance", args->options.charge.tolerance,
-                  "Relative residual of the iterative charge solvers")
-      ->check(CLI::PositiveNumber)
+                  "Relative residual of the iterative charge solvers (0: 1e-6 below 10k "
+                  "triangles, 1e-7 above)")
+      ->check(CLI::Range(0.0, 0.5))
       ->capture_default_str();
 
   cmd->add_option("--cell-size", args->meshing.cell_size,

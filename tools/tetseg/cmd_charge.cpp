@@ -28,7 +28,7 @@ struct ChargeArgs {
   std::string report;
   std::string solver = "auto";
   std::string equalization = "histogram";
-  double tolerance = 1e-6;
+  double tolerance = 0.0;  // 0: automatic (charge.hpp)
   int max_iterations = 500;
   double theta = 0.5;
   int order = -1;
@@ -236,7 +236,7 @@ void run_charge(const ChargeArgs& args) {
     std::fprintf(stderr,
                  "tetseg: warning: the solver stopped at residual %.2e above the tolerance %.2e "
                  "after %d iterations (raise --max-iterations)\n",
-                 r.residual, args.tolerance, r.iterations);
+                 r.residual, r.tolerance, r.iterations);
   }
   const std::vector<double> eq = preprocess::equalize(r.density, method, args.bins);
   const Outputs out{points, triangles, r.density, eq};
@@ -252,7 +252,7 @@ void run_charge(const ChargeArgs& args) {
       << "\",\n  \"triangles\": " << triangles.size() << ",\n  \"solver\": \"" << r.solver
       << "\",\n  \"iterations\": " << r.iterations << ",\n  \"residual\": " << r.residual
       << ",\n  \"converged\": " << (r.converged ? "true" : "false")
-      << ",\n  \"tolerance\": " << args.tolerance << ",\n  \"capacitance\": " << r.capacitance
+      << ",\n  \"tolerance\": " << r.tolerance << ",\n  \"capacitance\": " << r.capacitance
       << ",\n  \"total_area\": " << r.total_area << ",\n  \"equalization\": \""
       << preprocess::to_string(method) << "\",\n  \"assembly_seconds\": " << r.assembly_seconds
       << ",\n  \"solve_seconds\": " << r.solve_seconds << "\n}\n";
@@ -275,8 +275,10 @@ void add_charge_command(CLI::App& root) {
       ->required();
   cmd->add_option("--solver", args->solver, "auto | direct | gmres | fast")
       ->check(CLI::IsMember({"auto", "direct", "gmres", "fast"}));
-  cmd->add_option("--tolerance", args->tolerance, "Relative residual of the iterative solvers")
-      ->check(CLI::Range(1e-14, 0.5));
+  cmd->add_option("--tolerance", args->tolerance,
+                  "Relative residual of the iterative solvers (0: 1e-6 below 10k triangles, "
+                  "1e-7 above)")
+      ->check(CLI::Range(0.0, 0.5));
   cmd->add_option("--max-iterations", args->max_iterations, "Iteration cap")
       ->check(CLI::Range(1, 100000));
   cmd->add_option("--theta", args->theta, "Fast solver opening parameter, (0, 1)")
