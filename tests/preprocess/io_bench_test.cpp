@@ -9,8 +9,8 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <map>
 
+#include "preprocess/charge_shapes.hpp"
 #include "tetseg/preprocess/io.hpp"
 #include "tetseg/preprocess/meshing.hpp"
 #include "tetseg/preprocess/surface.hpp"
@@ -31,43 +31,11 @@ double best_of(int runs, F&& f) {
   return best;
 }
 
-/// Octahedron subdivided `levels` times, projected on the unit sphere: 8 * 4^levels triangles.
-TriangleMesh sphere_surface(int levels) {
-  TriangleMesh m{
-      {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}},
-      {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4}, {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}}};
-  for (int l = 0; l < levels; ++l) {
-    std::map<std::pair<std::uint32_t, std::uint32_t>, std::uint32_t> mid;
-    auto midpoint = [&](std::uint32_t a, std::uint32_t b) {
-      const auto key = std::minmax(a, b);
-      const auto it = mid.find(key);
-      if (it != mid.end()) return it->second;
-      Vec3 p;
-      for (int k = 0; k < 3; ++k) p[k] = 0.5 * (m.vertices[a][k] + m.vertices[b][k]);
-      const double n = std::sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
-      for (double& c : p) c /= n;
-      m.vertices.push_back(p);
-      return mid[key] = static_cast<std::uint32_t>(m.vertices.size() - 1);
-    };
-    std::vector<Tri> next;
-    for (const Tri& t : m.triangles) {
-      const std::uint32_t ab = midpoint(t[0], t[1]);
-      const std::uint32_t bc = midpoint(t[1], t[2]);
-      const std::uint32_t ca = midpoint(t[2], t[0]);
-      next.push_back({t[0], ab, ca});
-      next.push_back({ab, t[1], bc});
-      next.push_back({ca, bc, t[2]});
-      next.push_back({ab, bc, ca});
-    }
-    m.triangles = std::move(next);
-  }
-  return m;
-}
 
 }  // namespace
 
 TEST_CASE("Benchmark: closed-surface validation at 131k triangles", "[.bench][io-bench]") {
-  const TriangleMesh s = sphere_surface(7);
+  const TriangleMesh s = tetseg::test::icosphere(81);
   const double t = best_of(3, [&] { validate_closed_surface(s, "sphere"); });
   std::printf("validate_closed_surface: %zu triangles, %.3f s\n", s.triangles.size(), t);
 }

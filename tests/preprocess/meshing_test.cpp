@@ -6,9 +6,9 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
-#include <map>
 #include <stdexcept>
 
+#include "preprocess/charge_shapes.hpp"
 #include "tetseg/preprocess/io.hpp"
 #include "tetseg/preprocess/meshing.hpp"
 #include "tetseg/preprocess/surface.hpp"
@@ -42,38 +42,6 @@ Checked check_valid(const TetMesh& m) {
   return c;
 }
 
-/// Octahedron subdivided `levels` times and projected on the unit sphere (outward).
-TriangleMesh icosphere(int levels) {
-  TriangleMesh m{
-      {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}},
-      {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4}, {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}}};
-  for (int l = 0; l < levels; ++l) {
-    std::map<std::pair<std::uint32_t, std::uint32_t>, std::uint32_t> mid;
-    auto midpoint = [&](std::uint32_t a, std::uint32_t b) {
-      const auto key = std::minmax(a, b);
-      const auto it = mid.find(key);
-      if (it != mid.end()) return it->second;
-      Vec3 p;
-      for (int k = 0; k < 3; ++k) p[k] = 0.5 * (m.vertices[a][k] + m.vertices[b][k]);
-      const double n = std::sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
-      for (double& c : p) c /= n;
-      m.vertices.push_back(p);
-      return mid[key] = static_cast<std::uint32_t>(m.vertices.size() - 1);
-    };
-    std::vector<Tri> next;
-    for (const Tri& t : m.triangles) {
-      const std::uint32_t ab = midpoint(t[0], t[1]);
-      const std::uint32_t bc = midpoint(t[1], t[2]);
-      const std::uint32_t ca = midpoint(t[2], t[0]);
-      next.push_back({t[0], ab, ca});
-      next.push_back({ab, t[1], bc});
-      next.push_back({ca, bc, t[2]});
-      next.push_back({ab, bc, ca});
-    }
-    m.triangles = std::move(next);
-  }
-  return m;
-}
 
 }  // namespace
 
@@ -131,7 +99,7 @@ TEST_CASE("Meshing is deterministic", "[meshing]") {
   const TetMesh b = generate_shape(Shape::kPawn, o);
   CHECK(a.nodes == b.nodes);
   CHECK(a.tets == b.tets);
-  const TriangleMesh s = icosphere(3);
+  const TriangleMesh s = tetseg::test::icosphere(5);
   MeshingOptions m;
   m.facet_size = 0.2;
   const TetMesh c = tetrahedralize(s, m, "sphere");
@@ -171,7 +139,7 @@ TEST_CASE("Bad meshing options are rejected", "[meshing]") {
 }
 
 TEST_CASE("A closed surface is filled with valid tets of the same volume", "[meshing]") {
-  const TriangleMesh s = icosphere(3);
+  const TriangleMesh s = tetseg::test::icosphere(5);
   const double input_volume = enclosed_volume(s.vertices, s.triangles);
   SECTION("An icosphere gives a valid mesh within 2% of the polyhedron's volume.") {
     MeshingOptions m;
