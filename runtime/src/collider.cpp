@@ -278,26 +278,8 @@ void Collider::Impl::refit_and_classify() noexcept {
       const format::Cluster& cl = fa.clusters[c];
       const format::BvhNode* nodes = fa.bvh_nodes.data() + cl.bvh_offset;
       const std::uint32_t* leaf = fa.cluster_triangles.data() + cl.triangle_offset;
-      Box* nb = nbox.data() + cl.bvh_offset;
-      std::uint32_t* nm = nmov.data() + cl.bvh_offset;
-      for (std::uint32_t i = cl.bvh_count; i-- > 0;) {
-        const format::BvhNode& n = nodes[i];
-        if (n.count > 0) {
-          Box b = tbox[leaf[n.first]];
-          std::uint32_t m = 0;
-          for (std::uint32_t k = 0; k < n.count; ++k) {
-            box_union(b, tbox[leaf[n.first + k]]);
-            m += tmov[leaf[n.first + k]];
-          }
-          nb[i] = b;
-          nm[i] = m;
-        } else {
-          Box b = nb[n.first];
-          box_union(b, nb[n.second]);
-          nb[i] = b;
-          nm[i] = nm[n.first] + nm[n.second];
-        }
-      }
+      refit_bvh(nodes, cl.bvh_count, leaf, tbox.data(), tmov.data(), nbox.data() + cl.bvh_offset,
+                nmov.data() + cl.bvh_offset);
     }
   } else if (opt.mode == ColliderMode::kBvh || opt.mode == ColliderMode::kCone) {
     if (!gbvh_built) build_global_bvh(x0);

@@ -70,24 +70,8 @@ void Collider::Impl::build_global_bvh(const double* positions) noexcept {
 }
 
 void Collider::Impl::refit_global_bvh() noexcept {
-  for (std::uint32_t i = gnode_count; i-- > 0;) {
-    const format::BvhNode& n = gnodes[i];
-    if (n.count > 0) {
-      Box b = tbox[gleaf[n.first]];
-      std::uint32_t m = 0;
-      for (std::uint32_t k = 0; k < n.count; ++k) {
-        box_union(b, tbox[gleaf[n.first + k]]);
-        m += tmov[gleaf[n.first + k]];
-      }
-      gbox[i] = b;
-      gmov[i] = m;
-    } else {
-      Box b = gbox[n.first];
-      box_union(b, gbox[n.second]);
-      gbox[i] = b;
-      gmov[i] = gmov[n.first] + gmov[n.second];
-    }
-  }
+  refit_bvh(gnodes.data(), gnode_count, gleaf.data(), tbox.data(), tmov.data(), gbox.data(),
+            gmov.data());
 }
 
 namespace {

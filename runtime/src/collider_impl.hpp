@@ -53,6 +53,50 @@ struct StackItem {
   std::uint32_t b;  // kNone: self item of node a
 };
 
+/// Bottom-up refit of one BVH (children after parents, so reverse order is bottom-up): node
+/// boxes are the union of their triangles' swept boxes `tbox`, node counters `nmov` the sum of
+/// their triangles' moving flags `tmov`. `leaf` maps leaf positions to triangle ids.
+inline void refit_bvh(const format::BvhNode* nodes, std::uint32_t node_count,
+                      const std::uint32_t* leaf, const Box* tbox, const std::uint8_t* tmov,
+                      Box* box, std::uint32_t* nmov) noexcept {
+  for (std::uint32_t i = node_count; i-- > 0;) {
+    const format::BvhNode& n = nodes[i];
+    if (n.count > 0) {
+      Box b = tbox[leaf[n.first]];
+      std::uint32_t m = 0;
+      for (std::uint32_t k = 0; k < n.count; ++k) {
+        box_union(b, tbox[leaf[n.first + k]]);
+        m += tmov[leaf[n.first + k]];
+      }
+      box[i] = b;
+      nmov[i] = m;
+    } else {
+      Box b = box[n.first];
+      box_union(b, box[n.second]);
+      box[i] = b;
+      nmov[i] = nmov[n.first] + nmov[n.second];
+    }
+  }
+}
+
+/// One descent step of a node-pair traversal: splits the inner node of pair `item` with more
+/// triangles (a leaf is never split) and pushes the child pairs that `live` accepts.
+/// `stack` must have room for two more items.
+template <class Live>
+inline void push_child_pairs(const StackItem& item, const TreeView& ta, const TreeView& tb,
+                             Live&& live, StackItem* stack, std::size_t& top) noexcept {
+  const format::BvhNode& na = ta.nodes[item.a];
+  const format::BvhNode& nb = tb.nodes[item.b];
+  const bool split_a = nb.count > 0 || (na.count == 0 && ta.ntris[item.a] >= tb.ntris[item.b]);
+  if (split_a) {
+    if (live(na.second, item.b)) stack[top++] = {na.second, item.b};
+    if (live(na.first, item.b)) stack[top++] = {na.first, item.b};
+  } else {
+    if (live(item.a, nb.second)) stack[top++] = {item.a, nb.second};
+    if (live(item.a, nb.first)) stack[top++] = {item.a, nb.first};
+  }
+}
+
 enum class QueryKind : std::uint8_t { kAny, kFull };
 
 /// Running state of one traversal thread (index 0 is the serial one). Allocated at

@@ -245,14 +245,7 @@ bool Collider::Impl::traverse_pair(Worker& w, const TreeView& ta,
       continue;
     }
     if (top + 2 > w.stack.size()) return false;
-    const bool split_a = nb.count > 0 || (na.count == 0 && ta.ntris[it.a] >= tb.ntris[it.b]);
-    if (split_a) {
-      if (live(na.second, it.b)) w.stack[top++] = {na.second, it.b};
-      if (live(na.first, it.b)) w.stack[top++] = {na.first, it.b};
-    } else {
-      if (live(it.a, nb.second)) w.stack[top++] = {it.a, nb.second};
-      if (live(it.a, nb.first)) w.stack[top++] = {it.a, nb.first};
-    }
+    push_child_pairs(it, ta, tb, live, w.stack.data(), top);
   }
   return true;
 }
@@ -308,14 +301,7 @@ bool Collider::Impl::traverse_self(Worker& w, const TreeView& t) const noexcept 
       continue;
     }
     if (top + 2 > w.stack.size()) return false;
-    const bool split_a = nb.count > 0 || (na.count == 0 && t.ntris[it.a] >= t.ntris[it.b]);
-    if (split_a) {
-      if (live_pair(na.second, it.b)) w.stack[top++] = {na.second, it.b};
-      if (live_pair(na.first, it.b)) w.stack[top++] = {na.first, it.b};
-    } else {
-      if (live_pair(it.a, nb.second)) w.stack[top++] = {it.a, nb.second};
-      if (live_pair(it.a, nb.first)) w.stack[top++] = {it.a, nb.first};
-    }
+    push_child_pairs(it, t, t, live_pair, w.stack.data(), top);
   }
   return true;
 }
