@@ -12,6 +12,7 @@
 #include <sstream>
 #include <string>
 
+#include "preprocess/grid_mesh.hpp"
 #include "tetseg/preprocess/io.hpp"
 #include "tetseg/preprocess/surface.hpp"
 
@@ -40,43 +41,10 @@ struct TempDir {
 /// An n^3 grid of cubes over [0,1]^3 (with an irrational jitter so coordinates need all 17
 /// digits), each cube split into 6 positively oriented tets (Kuhn triangulation).
 TetMesh grid_mesh(int n) {
-  TetMesh m;
-  auto id = [n](int i, int j, int k) {
-    return static_cast<std::uint32_t>((i * (n + 1) + j) * (n + 1) + k);
-  };
-  for (int i = 0; i <= n; ++i)
-    for (int j = 0; j <= n; ++j)
-      for (int k = 0; k <= n; ++k)
-        m.nodes.push_back(
-            {i / double(n) + 1e-3 / 3.0 * j, j / double(n) + 1e-3 / 7.0 * k, k / double(n) * 1.1});
-  const int perms[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
-  for (int i = 0; i < n; ++i)
-    for (int j = 0; j < n; ++j)
-      for (int k = 0; k < n; ++k)
-        for (const auto& p : perms) {
-          int c[3] = {i, j, k};
-          Tet t;
-          t[0] = id(c[0], c[1], c[2]);
-          for (int s = 0; s < 3; ++s) {
-            ++c[p[s]];
-            t[static_cast<std::size_t>(s + 1)] = id(c[0], c[1], c[2]);
-          }
-          m.tets.push_back(t);
-        }
-  // Orient positively.
-  for (Tet& t : m.tets) {
-    const Vec3& a = m.nodes[t[0]];
-    const Vec3& b = m.nodes[t[1]];
-    const Vec3& c = m.nodes[t[2]];
-    const Vec3& d = m.nodes[t[3]];
-    const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
-    const double v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
-    const double w[3] = {d[0] - a[0], d[1] - a[1], d[2] - a[2]};
-    const double det = u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0]) +
-                       u[2] * (v[0] * w[1] - v[1] * w[0]);
-    if (det < 0) std::swap(t[2], t[3]);
-  }
-  return m;
+  return tetseg::test::kuhn_grid(n, n, n, [n](int i, int j, int k) {
+    return Vec3{i / double(n) + 1e-3 / 3.0 * j, j / double(n) + 1e-3 / 7.0 * k,
+                k / double(n) * 1.1};
+  });
 }
 
 bool same_mesh(const TetMesh& a, const TetMesh& b) {

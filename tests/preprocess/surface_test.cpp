@@ -3,49 +3,12 @@
 #include <catch2/catch.hpp>
 #include <cmath>
 
+#include "preprocess/grid_mesh.hpp"
 #include "tetseg/preprocess/surface.hpp"
 
 using namespace tetseg::preprocess;
-
-namespace {
-
-double orient(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
-  const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
-  const double v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
-  const double w[3] = {d[0] - a[0], d[1] - a[1], d[2] - a[2]};
-  return u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0]) +
-         u[2] * (v[0] * w[1] - v[1] * w[0]);
-}
-
-/// An n^3 grid of unit cubes, 6 positively oriented tets per cube (Kuhn triangulation).
-TetMesh cube_grid(int n) {
-  TetMesh m;
-  auto id = [n](int i, int j, int k) {
-    return static_cast<std::uint32_t>((i * (n + 1) + j) * (n + 1) + k);
-  };
-  for (int i = 0; i <= n; ++i)
-    for (int j = 0; j <= n; ++j)
-      for (int k = 0; k <= n; ++k) m.nodes.push_back({double(i), double(j), double(k)});
-  const int perms[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
-  for (int i = 0; i < n; ++i)
-    for (int j = 0; j < n; ++j)
-      for (int k = 0; k < n; ++k)
-        for (const auto& p : perms) {
-          int c[3] = {i, j, k};
-          Tet t;
-          t[0] = id(c[0], c[1], c[2]);
-          for (int s = 0; s < 3; ++s) {
-            ++c[p[s]];
-            t[static_cast<std::size_t>(s + 1)] = id(c[0], c[1], c[2]);
-          }
-          if (orient(m.nodes[t[0]], m.nodes[t[1]], m.nodes[t[2]], m.nodes[t[3]]) < 0)
-            std::swap(t[2], t[3]);
-          m.tets.push_back(t);
-        }
-  return m;
-}
-
-}  // namespace
+using tetseg::test::cube_grid;
+using tetseg::test::orient;
 
 TEST_CASE("The boundary of a single tet is its four outward faces", "[surface]") {
   const TetMesh m{{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}}, {{0, 1, 2, 3}}};

@@ -2,55 +2,16 @@
 
 #include <catch2/catch.hpp>
 #include <cmath>
-#include <functional>
 #include <limits>
 
+#include "preprocess/grid_mesh.hpp"
 #include "tetseg/preprocess/surface.hpp"
 
 using namespace tetseg::preprocess;
 
 namespace {
 
-double orient(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
-  const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
-  const double v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
-  const double w[3] = {d[0] - a[0], d[1] - a[1], d[2] - a[2]};
-  return u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0]) +
-         u[2] * (v[0] * w[1] - v[1] * w[0]);
-}
-
-/// nx x ny x nz cubes, 6 tets each (Kuhn), node (i, j, k) placed at map(i, j, k); tets are
-/// oriented positively after mapping.
-TetMesh grid(int nx, int ny, int nz, const std::function<Vec3(int, int, int)>& map) {
-  TetMesh m;
-  auto id = [=](int i, int j, int k) {
-    return static_cast<std::uint32_t>((i * (ny + 1) + j) * (nz + 1) + k);
-  };
-  for (int i = 0; i <= nx; ++i)
-    for (int j = 0; j <= ny; ++j)
-      for (int k = 0; k <= nz; ++k) m.nodes.push_back(map(i, j, k));
-  const int perms[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
-  for (int i = 0; i < nx; ++i)
-    for (int j = 0; j < ny; ++j)
-      for (int k = 0; k < nz; ++k)
-        for (const auto& p : perms) {
-          int c[3] = {i, j, k};
-          Tet t;
-          t[0] = id(c[0], c[1], c[2]);
-          for (int s = 0; s < 3; ++s) {
-            ++c[p[s]];
-            t[static_cast<std::size_t>(s + 1)] = id(c[0], c[1], c[2]);
-          }
-          if (orient(m.nodes[t[0]], m.nodes[t[1]], m.nodes[t[2]], m.nodes[t[3]]) < 0)
-            std::swap(t[2], t[3]);
-          m.tets.push_back(t);
-        }
-  return m;
-}
-
-TetMesh block(int n) {
-  return grid(n, n, n, [](int i, int j, int k) { return Vec3{double(i), double(j), double(k)}; });
-}
+TetMesh block(int n) { return tetseg::test::cube_grid(n); }
 
 std::string tet_error(const TetMesh& m) {
   try {
@@ -146,7 +107,7 @@ TEST_CASE("Each tet mesh defect is reported with a clear message", "[validate]")
                                "there), first is vertex 0"));
   }
   SECTION("Two separate blocks are two components.") {
-    const TetMesh other = grid(1, 1, 1, [](int i, int j, int k) {
+    const TetMesh other = tetseg::test::kuhn_grid(1, 1, 1, [](int i, int j, int k) {
       return Vec3{double(i) + 5.0, double(j), double(k)};
     });
     CHECK_THAT(tet_error(join(m, other)),
@@ -155,7 +116,7 @@ TEST_CASE("Each tet mesh defect is reported with a clear message", "[validate]")
   SECTION("A bar coiled past a full turn intersects itself at rest.") {
     // 12 cubes around 1.25 turns of a circle of radius 3 in the xz plane: both ends overlap.
     const double kPi = std::acos(-1.0);
-    const TetMesh coil = grid(12, 1, 1, [&](int i, int j, int k) {
+    const TetMesh coil = tetseg::test::kuhn_grid(12, 1, 1, [&](int i, int j, int k) {
       const double angle = 2.5 * kPi * i / 12.0;
       const double r = 3.0 + k;
       return Vec3{r * std::cos(angle), double(j) + 0.1 * angle, r * std::sin(angle)};
