@@ -47,6 +47,20 @@ TetMesh grid_mesh(int n) {
   });
 }
 
+/// Writes `mesh` to `path` (Gmsh 2.2 when `gmsh22`, else the format of the extension) and
+/// returns the file's text.
+std::string written_text(const std::string& path, const TetMesh& mesh, bool gmsh22) {
+  if (gmsh22) {
+    write_gmsh22(path, mesh);
+  } else {
+    write_tet_mesh(path, mesh);
+  }
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  return buffer.str();
+}
+
 bool same_mesh(const TetMesh& a, const TetMesh& b) {
   return a.nodes == b.nodes && a.tets == b.tets;
 }
@@ -340,15 +354,7 @@ TEST_CASE("Every truncated prefix of a valid file reads or fails with InputError
   for (const char* name : {"p.mesh", "p.msh", "q.msh", "p.node"}) {
     CAPTURE(name);
     const std::string path = dir.file(name);
-    if (std::string(name) == "q.msh") {
-      write_gmsh22(path, mesh);
-    } else {
-      write_tet_mesh(path, mesh);
-    }
-    std::ifstream in(path, std::ios::binary);
-    std::stringstream buffer;
-    buffer << in.rdbuf();
-    const std::string text = buffer.str();
+    const std::string text = written_text(path, mesh, std::string(name) == "q.msh");
     std::size_t failures = 0;
     std::size_t tried = 0;
     // Every 5th prefix, and every one of the last 60 (where a cut can leave a full mesh).
@@ -378,15 +384,7 @@ TEST_CASE("Random byte changes never crash a reader", "[format][io]") {
   for (const char* name : {"f.mesh", "f.msh", "g.msh", "f.node"}) {
     CAPTURE(name);
     const std::string path = dir.file(name);
-    if (std::string(name) == "g.msh") {
-      write_gmsh22(path, mesh);
-    } else {
-      write_tet_mesh(path, mesh);
-    }
-    std::ifstream in(path, std::ios::binary);
-    std::stringstream buffer;
-    buffer << in.rdbuf();
-    const std::string text = buffer.str();
+    const std::string text = written_text(path, mesh, std::string(name) == "g.msh");
     for (int trial = 0; trial < 120; ++trial) {
       std::string changed = text;
       for (int k = 0; k < 1 + trial % 3; ++k)
