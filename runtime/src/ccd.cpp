@@ -247,6 +247,17 @@ bool all_finite(const Vec3d* const* points, int count) noexcept {
 
 enum class Depth { kFilter, kFull };
 
+/// The four points of a query at the ends of the time interval [ta, tb]: x[i][0] at ta,
+/// x[i][1] at tb.
+template <class I>
+void positions_at(const Vec3d* const x0[4], const Vec3d* const x1[4], double ta, double tb,
+                  Vec<I> (&x)[4][2]) noexcept {
+  for (int i = 0; i < 4; ++i) {
+    x[i][0] = position<I>(*x0[i], *x1[i], ta);
+    x[i][1] = ta == tb ? x[i][0] : position<I>(*x0[i], *x1[i], tb);
+  }
+}
+
 /// Vertex p against triangle abc. Points: 0 = p, 1 = a, 2 = b, 3 = c.
 struct VertexFaceTest {
   const Vec3d* x0[4];
@@ -256,10 +267,7 @@ struct VertexFaceTest {
   template <class I>
   bool excluded(double ta, double tb, Depth depth) const noexcept {
     Vec<I> x[4][2];
-    for (int i = 0; i < 4; ++i) {
-      x[i][0] = position<I>(*x0[i], *x1[i], ta);
-      x[i][1] = ta == tb ? x[i][0] : position<I>(*x0[i], *x1[i], tb);
-    }
+    positions_at<I>(x0, x1, ta, tb, x);
     if (boxes_disjoint<I>(x, 1, x + 1, 3, sep)) return true;
 
     const Slot<I> u = difference(x[2], x[1]);  // b - a
@@ -297,10 +305,7 @@ struct EdgeEdgeTest {
   template <class I>
   bool excluded(double ta, double tb, Depth depth) const noexcept {
     Vec<I> x[4][2];
-    for (int i = 0; i < 4; ++i) {
-      x[i][0] = position<I>(*x0[i], *x1[i], ta);
-      x[i][1] = ta == tb ? x[i][0] : position<I>(*x0[i], *x1[i], tb);
-    }
+    positions_at<I>(x0, x1, ta, tb, x);
     if (boxes_disjoint<I>(x, 2, x + 2, 2, sep)) return true;
 
     const Slot<I> ba = difference(x[1], x[0]);
