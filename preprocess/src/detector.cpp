@@ -25,13 +25,6 @@ double distance2(const Vec3& a, const Vec3& b) {
   return dot(d, d);
 }
 
-bool is_positive(const std::vector<Vec3>& nodes, const Tri& t, const Vec3& o) {
-  const Vec3 a = sub(nodes[t[0]], o);
-  const Vec3 b = sub(nodes[t[1]], o);
-  const Vec3 c = sub(nodes[t[2]], o);
-  return dot(a, cross(b, c)) > 0.0;
-}
-
 /// The `k` interior nodes nearest `point`, ordered by (distance, id).
 std::vector<std::uint32_t> nearest_nodes(const std::vector<Vec3>& nodes,
                                          const std::vector<std::uint32_t>& interior,
@@ -93,13 +86,108 @@ Vec3 kernel_estimate(const std::vector<Vec3>& nodes, const std::vector<Tri>& tri
 
 }  // namespace
 
+bool triangle_positive_from(const std::vector<Vec3>& nodes, const Tri& t, const Vec3& point) {
+  const Vec3 a = sub(nodes[t[0]], point);
+  const Vec3 b = sub(nodes[t[1]], point);
+  const Vec3 c = sub(nodes[t[2]], point);
+  return dot(a, cross(b, c)) > 0.0;
+}
+
 std::uint32_t count_positive_triangles(const std::vector<Vec3>& nodes,
                                        const std::vector<Tri>& triangles,
                                        const std::vector<std::uint32_t>& triangle_ids,
                                        const Vec3& point) {
   std::uint32_t count = 0;
-  for (std::uint32_t id : triangle_ids) count += is_positive(nodes, triangles[id], point) ? 1 : 0;
+  for (std::uint32_t id : triangle_ids)
+    count += triangle_positive_from(nodes, triangles[id], point) ? 1 : 0;
   return count;
+}
+
+Detector best_detector(const std::vector<Vec3>& nodes, const Surface& surface,
+                       const std::vector<std::uint32_t>& triangle_ids, DetectorStrategy strategy) {
+  const std::vector<std::uint32_t>& ids = triangle_ids;
+  Detector det;
+  det.triangle_count = static_cast<std::uint32_t>(ids.size());
+  if (ids.empty()) {
+    // Fallback point for an empty set: the surface's vertex average.
+    Vec3 center{0.0, 0.0, 0.0};
+    for (std::uint32_t v : surface.surface_nodes)
+      for (int k = 0; k < 3; ++k) center[k] += nodes[v][k];
+    if (!surface.surface_nodes.empty())
+      for (int k = 0; k < 3; ++k) center[k] /= static_cast<double>(surface.surface_nodes.size());
+    det.node = nearest_nodes(nodes, surface.interior_nodes, center, 1).front();
+    det.rest_positive_fraction = 1.0f;
+    return det;
+  }
+  // Area-weighted centroid (vertex average when every triangle is degenerate) and box.
+  Vec3 centroid{0.0, 0.0, 0.0};
+  Vec3 average{0.0, 0.0, 0.0};
+  Vec3 lo = nodes[surface.triangles[ids[0]][0]];
+  Vec3 hi = lo;
+  double area = 0.0;
+  for (std::uint32_t id : ids) {
+    const Tri& t = surface.triangles[id];
+    const Vec3 n = cross(sub(nodes[t[1]], nodes[t[0]]), sub(nodes[t[2]], nodes[t[0]]));
+    const double a = 0.5 * std::sqrt(dot(n, n));
+    for (int k = 0; k < 3; ++k) {
+      const double m = (nodes[t[0]][k] + nodes[t[1]][k] + nodes[t[2]][k]) / 3.0;
+      centroid[k] += a * m;
+      average[k] += m;
+      for (std::uint32_t v : t) {
+        lo[k] = std::min(lo[k], nodes[v][k]);
+        hi[k] = std::max(hi[k], nodes[v][k]);
+      }
+    }
+    area += a;
+  }
+  for (int k = 0; k < 3; ++k)
+    centroid[k] = area > 0.0 ? centroid[k] / area : average[k] / static_cast<double>(ids.size());
+
+  const std::vector<std::uint32_t> near =
+      nearest_nodes(nodes, surface.interior_nodes, centroid,
+                    strategy == DetectorStrategy::kNearestCentroid ? 1 : kDetectorNearCentroid);
+  std::uint32_t best_node = near.front();
+  std::uint32_t best_count =
+      count_positive_triangles(nodes, surface.triangles, ids, nodes[best_node]);
+
+  if (strategy == DetectorStrategy::kVisibility && best_count < ids.size()) {
+    const double diagonal = std::sqrt(distance2(lo, hi));
+    const Vec3 kernel = kernel_estimate(nodes, surface.triangles, ids, centroid, 1e-3 * diagonal);
+    std::vector<std::uint32_t> candidates = near;
+    const std::vector<std::uint32_t> near_kernel =
+        nearest_nodes(nodes, surface.interior_nodes, kernel, kDetectorNearKernel);
+    candidates.insert(candidates.end(), near_kernel.begin(), near_kernel.end());
+    // Interior nodes inside the set's box, evenly spread over their id order.
+    std::vector<std::uint32_t> in_box;
+    for (std::uint32_t id : surface.interior_nodes) {
+      const Vec3& p = nodes[id];
+      if (p[0] >= lo[0] && p[0] <= hi[0] && p[1] >= lo[1] && p[1] <= hi[1] && p[2] >= lo[2] &&
+          p[2] <= hi[2])
+        in_box.push_back(id);
+    }
+    const std::size_t stride = std::max<std::size_t>(1, (in_box.size() + kDetectorInBox - 1) / kDetectorInBox);
+    for (std::size_t i = 0; i < in_box.size(); i += stride) candidates.push_back(in_box[i]);
+    // Order candidates by (distance to the centroid, id) so the first best wins ties.
+    std::vector<std::pair<double, std::uint32_t>> keyed;
+    for (std::uint32_t id : candidates) keyed.emplace_back(distance2(nodes[id], centroid), id);
+    std::sort(keyed.begin(), keyed.end());
+    keyed.erase(std::unique(keyed.begin(), keyed.end()), keyed.end());
+    best_count = 0;
+    best_node = keyed.front().second;
+    for (const auto& [dist, id] : keyed) {
+      const std::uint32_t count =
+          count_positive_triangles(nodes, surface.triangles, ids, nodes[id]);
+      if (count > best_count) {
+        best_count = count;
+        best_node = id;
+        if (count == ids.size()) break;
+      }
+    }
+  }
+  det.node = best_node;
+  det.rest_positive_fraction =
+      static_cast<float>(static_cast<double>(best_count) / static_cast<double>(ids.size()));
+  return det;
 }
 
 std::vector<Detector> choose_detectors(const std::vector<Vec3>& nodes, const Surface& surface,
@@ -121,84 +209,9 @@ std::vector<Detector> choose_detectors(const std::vector<Vec3>& nodes, const Sur
       throw std::invalid_argument("choose_detectors: cluster id out of range");
     members[triangle_cluster[t]].push_back(t);
   }
-
-  // Fallback point for empty clusters: the surface's vertex average.
-  Vec3 surface_center{0.0, 0.0, 0.0};
-  for (std::uint32_t v : surface.surface_nodes)
-    for (int k = 0; k < 3; ++k) surface_center[k] += nodes[v][k];
-  if (!surface.surface_nodes.empty())
-    for (int k = 0; k < 3; ++k)
-      surface_center[k] /= static_cast<double>(surface.surface_nodes.size());
-
   std::vector<Detector> out(cluster_count);
-  for (std::uint32_t c = 0; c < cluster_count; ++c) {
-    const std::vector<std::uint32_t>& ids = members[c];
-    Detector& det = out[c];
-    det.triangle_count = static_cast<std::uint32_t>(ids.size());
-    if (ids.empty()) {
-      det.node = nearest_nodes(nodes, surface.interior_nodes, surface_center, 1).front();
-      det.rest_positive_fraction = 1.0f;
-      continue;
-    }
-    // Area-weighted centroid (vertex average when every triangle is degenerate) and box.
-    Vec3 centroid{0.0, 0.0, 0.0};
-    Vec3 average{0.0, 0.0, 0.0};
-    Vec3 lo = nodes[surface.triangles[ids[0]][0]];
-    Vec3 hi = lo;
-    double area = 0.0;
-    for (std::uint32_t id : ids) {
-      const Tri& t = surface.triangles[id];
-      const Vec3 n = cross(sub(nodes[t[1]], nodes[t[0]]), sub(nodes[t[2]], nodes[t[0]]));
-      const double a = 0.5 * std::sqrt(dot(n, n));
-      for (int k = 0; k < 3; ++k) {
-        const double m = (nodes[t[0]][k] + nodes[t[1]][k] + nodes[t[2]][k]) / 3.0;
-        centroid[k] += a * m;
-        average[k] += m;
-        for (std::uint32_t v : t) {
-          lo[k] = std::min(lo[k], nodes[v][k]);
-          hi[k] = std::max(hi[k], nodes[v][k]);
-        }
-      }
-      area += a;
-    }
-    for (int k = 0; k < 3; ++k)
-      centroid[k] = area > 0.0 ? centroid[k] / area : average[k] / static_cast<double>(ids.size());
-
-    const std::vector<std::uint32_t> near =
-        nearest_nodes(nodes, surface.interior_nodes, centroid,
-                      strategy == DetectorStrategy::kNearestCentroid ? 1 : kDetectorNearCentroid);
-    std::uint32_t best_node = near.front();
-    std::uint32_t best_count =
-        count_positive_triangles(nodes, surface.triangles, ids, nodes[best_node]);
-
-    if (strategy == DetectorStrategy::kVisibility && best_count < ids.size()) {
-      const double diagonal = std::sqrt(distance2(lo, hi));
-      const Vec3 kernel = kernel_estimate(nodes, surface.triangles, ids, centroid, 1e-3 * diagonal);
-      std::vector<std::uint32_t> candidates = near;
-      const std::vector<std::uint32_t> near_kernel =
-          nearest_nodes(nodes, surface.interior_nodes, kernel, kDetectorNearKernel);
-      candidates.insert(candidates.end(), near_kernel.begin(), near_kernel.end());
-      // Order candidates by (distance to the centroid, id) so the first best wins ties.
-      std::vector<std::pair<double, std::uint32_t>> keyed;
-      for (std::uint32_t id : candidates) keyed.emplace_back(distance2(nodes[id], centroid), id);
-      std::sort(keyed.begin(), keyed.end());
-      keyed.erase(std::unique(keyed.begin(), keyed.end()), keyed.end());
-      best_count = 0;
-      best_node = keyed.front().second;
-      for (const auto& [dist, id] : keyed) {
-        const std::uint32_t count =
-            count_positive_triangles(nodes, surface.triangles, ids, nodes[id]);
-        if (count > best_count) {
-          best_count = count;
-          best_node = id;
-          if (count == ids.size()) break;
-        }
-      }
-    }
-    det.node = best_node;
-    det.rest_positive_fraction =
-        static_cast<float>(static_cast<double>(best_count) / static_cast<double>(ids.size()));
-  }
+  for (std::uint32_t c = 0; c < cluster_count; ++c)
+    out[c] = best_detector(nodes, surface, members[c], strategy);
   return out;
 }
 

@@ -50,6 +50,15 @@ const char* detector_name(DetectorStrategy strategy) {
   return strategy == DetectorStrategy::kNearestCentroid ? "nearest-centroid" : "visibility";
 }
 
+const char* cluster_method_name(ClusterMethod method) {
+  switch (method) {
+    case ClusterMethod::kSingle: return "single";
+    case ClusterMethod::kCharge: return "charge";
+    case ClusterMethod::kRefined: return "refined";
+  }
+  return "charge";
+}
+
 std::string base_name(const std::string& path) {
   const auto slash = path.find_last_of('/');
   return slash == std::string::npos ? path : path.substr(slash + 1);
@@ -60,7 +69,7 @@ std::string base_name(const std::string& path) {
 std::vector<std::pair<std::string, std::string>> provenance_options(const BuildOptions& options) {
   const SegmentationOptions& seg = options.segmentation;
   std::vector<std::pair<std::string, std::string>> out = {
-      {"clusters", options.clusters == ClusterMethod::kSingle ? "single" : "charge"},
+      {"clusters", cluster_method_name(options.clusters)},
       {"charge.solver", solver_name(options.charge.solver)},
       {"charge.tolerance",
        options.charge.tolerance == 0.0 ? "auto" : format_number(options.charge.tolerance)},
@@ -73,6 +82,16 @@ std::vector<std::pair<std::string, std::string>> provenance_options(const BuildO
       {"segmentation.detector", detector_name(seg.detector)},
       {"rest_positions", options.keep_rest_positions ? "yes" : "no"},
   };
+  if (options.clusters == ClusterMethod::kRefined) {
+    const RefinementOptions& ref = options.refinement;
+    out.insert(out.end(), {{"refine.min_visibility", format_number(ref.min_visibility)},
+                           {"refine.gain_per_cut_edge", format_number(ref.gain_per_cut_edge)},
+                           {"refine.invisibility_cost", format_number(ref.invisibility_cost)},
+                           {"refine.max_clusters", std::to_string(ref.max_clusters)},
+                           {"refine.min_cluster_triangles",
+                            std::to_string(ref.min_cluster_triangles)},
+                           {"refine.merge", ref.merge ? "yes" : "no"}});
+  }
   std::sort(out.begin(), out.end());
   return out;
 }
@@ -126,6 +145,16 @@ format::Asset build_asset(const TetMesh& mesh, const std::string& source,
                 std::to_string(s.cluster_count) + " clusters";
       return s;
     });
+    if (options.clusters == ClusterMethod::kRefined) {
+      segmentation = timer.run("refinement", [&](std::string& summary) {
+        Segmentation s = refine_clusters(mesh.nodes, surface, equalized, segmentation,
+                                         options.refinement, &report.refinement);
+        summary = std::to_string(report.refinement.splits) + " splits, " +
+                  std::to_string(report.refinement.merges) + " merges, " +
+                  std::to_string(s.cluster_count) + " clusters";
+        return s;
+      });
+    }
   }
   report.segmentation = segmentation.counts;
   report.clusters = segmentation.cluster_count;

@@ -58,6 +58,9 @@ std::string report_json(const BuildArgs& args, const BuildReport& report,
       << ", \"segments_shrunk\": " << seg.segments_shrunk << ", \"boundaries\": " << seg.boundaries
       << ", \"clusters\": " << seg.clusters << ", \"clusters_merged\": " << seg.clusters_merged
       << "},\n";
+  out << "  \"refinement\": {\"clusters_before\": " << report.refinement.clusters_before
+      << ", \"splits\": " << report.refinement.splits
+      << ", \"merges\": " << report.refinement.merges << "},\n";
   if (!report.charge.solver.empty()) {
     const ChargeResult& c = report.charge;
     out << "  \"charge\": {\"solver\": \"" << c.solver << "\", \"tolerance\": " << c.tolerance
@@ -143,11 +146,29 @@ void add_build_command(CLI::App& root) {
   cmd->add_option("--report", args->report_path, "Write a JSON report: per-stage seconds, counts");
 
   const std::map<std::string, ClusterMethod> cluster_methods{{"single", ClusterMethod::kSingle},
-                                                             {"charge", ClusterMethod::kCharge}};
+                                                             {"charge", ClusterMethod::kCharge},
+                                                             {"refined", ClusterMethod::kRefined}};
   cmd->add_option("--clusters", args->options.clusters,
-                  "single: one cluster; charge: the paper's charge-based segmentation")
+                  "single: one cluster; charge: the paper's charge-based segmentation; "
+                  "refined: charge, then split clusters no node sees whole and merge neighbours "
+                  "one node sees whole (docs/segmentation.md)")
       ->transform(CLI::CheckedTransformer(cluster_methods, CLI::ignore_case))
-      ->option_text("single|charge (charge)");
+      ->option_text("single|charge|refined (charge)");
+  RefinementOptions& ref = args->options.refinement;
+  cmd->add_option("--refine-visibility", ref.min_visibility,
+                  "refined: split clusters seen positive below this share at rest; merge "
+                  "neighbours seen at least this well")
+      ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str();
+  cmd->add_option("--refine-max-clusters", ref.max_clusters, "refined: no split beyond this many clusters")
+      ->check(CLI::Range(1u, 100000u))
+      ->capture_default_str();
+  cmd->add_option("--refine-gain", ref.gain_per_cut_edge,
+                  "refined: non-positive triangles a split must remove per cut edge")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  cmd->add_option("--refine-merge", ref.merge, "refined: merge neighbours seen whole from one node")
+      ->capture_default_str();
 
   SegmentationOptions& seg = args->options.segmentation;
   cmd->add_option("--alpha", seg.alpha, "Equalised density below which triangles are marked")

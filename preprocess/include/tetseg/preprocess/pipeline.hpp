@@ -19,13 +19,15 @@ namespace tetseg::preprocess {
 /// How the surface is cut into clusters.
 enum class ClusterMethod {
   kSingle,  ///< one cluster (no charge, no segmentation)
-  kCharge,  ///< the paper: charge density, segment boundaries, clusters
+  kCharge,   ///< the paper: charge density, segment boundaries, clusters
+  kRefined,  ///< kCharge, then refine_clusters (split by rest visibility, merge)
 };
 
 struct BuildOptions {
   ClusterMethod clusters = ClusterMethod::kCharge;
   ChargeOptions charge;
   SegmentationOptions segmentation;
+  RefinementOptions refinement;  ///< used by kRefined
   bool keep_rest_positions = true;  ///< store rest positions in the asset (docs/format.md)
 };
 
@@ -46,6 +48,7 @@ struct BuildReport {
   std::uint32_t clusters = 0;
   std::uint32_t boundaries = 0;
   SegmentationCounts segmentation;
+  RefinementCounts refinement;  ///< zero unless kRefined
   ChargeResult charge;  ///< density left empty; solver figures only
   std::vector<float> rest_positive_fraction;  ///< per cluster
 };

@@ -82,6 +82,12 @@ struct Detector {
 /// Candidate counts of the visibility strategy (docs/segmentation.md, "Detector nodes").
 inline constexpr std::uint32_t kDetectorNearCentroid = 24;  ///< nodes nearest the centroid
 inline constexpr std::uint32_t kDetectorNearKernel = 24;    ///< nodes nearest the kernel estimate
+inline constexpr std::uint32_t kDetectorInBox = 64;  ///< interior nodes sampled in the cluster's box
+
+/// True when `point` lies strictly on the inner side of the outward triangle's plane:
+/// det[a-o, b-o, c-o] > 0 (the triangle is "positive" from the point). Plain double arithmetic.
+bool triangle_positive_from(const std::vector<Vec3>& nodes, const Tri& triangle,
+                            const Vec3& point);
 
 /// Number of the cluster's triangles (ids in `triangle_ids`) that are positive from `point`:
 /// det[a-o, b-o, c-o] > 0 for outward triangles (the point lies strictly on the inner side of
@@ -95,10 +101,11 @@ std::uint32_t count_positive_triangles(const std::vector<Vec3>& nodes,
 /// `surface.interior_nodes` from rest positions `nodes`.
 /// - kNearestCentroid: the interior node nearest the cluster's area-weighted centroid (the
 ///   paper).
-/// - kVisibility: among the kDetectorNearCentroid interior nodes nearest the centroid and the
+/// - kVisibility: among the kDetectorNearCentroid interior nodes nearest the centroid, the
 ///   kDetectorNearKernel nearest an estimate of the cluster's rest kernel (the region from which
-///   all its triangles are positive), the node with the largest share of positive triangles;
-///   ties go to the node nearer the centroid, then to the lower id.
+///   all its triangles are positive) and up to kDetectorInBox interior nodes inside the
+///   cluster's bounding box (evenly spread in id order), the node with the largest share of
+///   positive triangles; ties go to the node nearer the centroid, then to the lower id.
 /// Every cluster gets a node even when none sees all its triangles positive (the runtime stays
 /// correct, only slower). A cluster without triangles gets the node nearest the surface's
 /// centroid and fraction 1. Deterministic; O(clusters x interior nodes + candidates x N).
@@ -107,6 +114,46 @@ std::uint32_t count_positive_triangles(const std::vector<Vec3>& nodes,
 std::vector<Detector> choose_detectors(const std::vector<Vec3>& nodes, const Surface& surface,
                                        const std::vector<std::uint32_t>& triangle_cluster,
                                        std::uint32_t cluster_count, DetectorStrategy strategy);
+
+/// The detector choose_detectors picks for one set of surface triangles (`triangle_ids`, any
+/// order). Preconditions (unchecked): at least one interior node, every id in range.
+Detector best_detector(const std::vector<Vec3>& nodes, const Surface& surface,
+                       const std::vector<std::uint32_t>& triangle_ids, DetectorStrategy strategy);
+
+/// Visibility-driven refinement of a segmentation (beyond the paper; docs/segmentation.md,
+/// "Refinement"). Thresholds were picked by measurement (docs/benchmarks.md).
+struct RefinementOptions {
+  /// A cluster whose best detector sees a smaller share of its triangles positive at rest is
+  /// split; two neighbouring clusters whose union is seen at least this well are merged.
+  double min_visibility = 0.97;
+  /// A split is kept only if it removes at least this many non-positive triangles per edge of
+  /// the new cut (a longer cut adds more cross-cluster triangle pairs at run time).
+  double gain_per_cut_edge = 1.0;
+  /// Cost of a triangle not positive from its part's node, in mean edge lengths of cut (the
+  /// cut's edges cost length x (0.05 + equalised density) x concavity factor <= 1).
+  double invisibility_cost = 1.0;
+  std::uint32_t max_clusters = 32;          ///< no split beyond this many clusters
+  std::uint32_t min_cluster_triangles = 0;  ///< 0 = the segmentation's minimum
+  bool merge = true;                        ///< merge neighbours seen whole from one node
+};
+
+struct RefinementCounts {
+  std::uint32_t clusters_before = 0;
+  std::uint32_t splits = 0;
+  std::uint32_t merges = 0;
+};
+
+/// Splits clusters that no interior node sees well at rest into parts that are (nearly)
+/// star-shaped from a node of their own, along a minimum cut that prefers short, concave,
+/// low-charge edges; then (when `merge`) greedily merges neighbours whose union is seen at
+/// least `min_visibility` positive without losing visibility. Uses the kVisibility detector
+/// search. Returns the new segmentation: clusters renumbered by smallest triangle id, every
+/// cluster edge-connected when its input cluster was, boundary loops recomputed as the
+/// distinct contours of the clusters, `counts.clusters` updated. Deterministic.
+/// Preconditions as segment_surface, plus at least one interior node (InputError otherwise).
+Segmentation refine_clusters(const std::vector<Vec3>& nodes, const Surface& surface,
+                             const std::vector<double>& equalized, const Segmentation& charge,
+                             const RefinementOptions& options, RefinementCounts* counts = nullptr);
 
 struct ClusterBvh {
   std::vector<std::uint32_t> triangles;  ///< the cluster's surface triangle ids, leaf order
