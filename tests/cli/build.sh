@@ -16,7 +16,7 @@ expect_exit 0 "Usage" -- "$bin/tetseg-dump" --help
 expect_exit 3 "tetseg-dump: error: missing.tetseg: " -- "$bin/tetseg-dump" missing.tetseg
 
 "$bin/tetseg" generate sphere -o sphere.mesh --size 0.5 2>gen.txt
-for clusters in single charge; do
+for clusters in single charge refined; do
   "$bin/tetseg" build sphere.mesh -o "$clusters.tetseg" --clusters "$clusters" \
     --report "$clusters.json" 2>build.txt
   for stage in surface detectors bvh write; do
@@ -34,6 +34,9 @@ assert all(0.0 <= c["rest_positive_fraction"] <= 1.0 for c in dump["clusters"])
 assert dump["provenance"]["source"] == "sphere.mesh"
 assert dump["provenance"]["options"]["clusters"] == mode
 assert all(k in report["seconds"] for k in ("surface", "detectors", "bvh", "write", "total"))
+assert report["refinement"]["clusters_before"] == (len(dump["clusters"]) - report["refinement"]["splits"]
+                                                  + report["refinement"]["merges"] if mode == "refined" else 0)
+assert ("refine.min_visibility" in dump["provenance"]["options"]) == (mode == "refined")
 if mode == "single":
     assert len(dump["clusters"]) == 1
     # The only cluster of a sphere sees every triangle positive from its detector node.

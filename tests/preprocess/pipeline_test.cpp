@@ -32,7 +32,7 @@ TEST_CASE("The pipeline turns a dumbbell into a valid, loadable asset", "[pipeli
                   [&](const StageReport& stage) { stages.push_back(stage.name); });
 
   REQUIRE(stages == std::vector<std::string>{"surface", "charge", "equalize", "segmentation",
-                                             "detectors", "bvh"});
+                                             "refinement", "detectors", "bvh"});
   const Surface surface = extract_surface(mesh);
   REQUIRE(asset.node_count == mesh.nodes.size());
   REQUIRE(asset.triangles == surface.triangles);
@@ -84,6 +84,27 @@ TEST_CASE("Two builds with the same input and options give byte-identical assets
   BuildReport third_report;
   const auto third = tetseg::format::write_asset(build_asset(mesh, "a.mesh", options, third_report));
   REQUIRE(third != first);  // at least the provenance differs
+}
+
+TEST_CASE("Refined clusters are seen at least as well as the paper's, with fewer non-positive "
+          "triangles in all", "[pipeline]") {
+  BuildOptions options;
+  options.clusters = ClusterMethod::kCharge;
+  BuildReport charge_report, refined_report;
+  const auto charge = build_asset(coarse_dumbbell(), "d.mesh", options, charge_report);
+  options.clusters = ClusterMethod::kRefined;
+  const auto refined = build_asset(coarse_dumbbell(), "d.mesh", options, refined_report);
+  auto non_positive = [](const tetseg::format::Asset& asset) {
+    double sum = 0.0;
+    for (const auto& c : asset.clusters)
+      sum += static_cast<double>(c.triangle_count) * (1.0 - c.rest_positive_fraction);
+    return sum;
+  };
+  CHECK(non_positive(refined) <= non_positive(charge) + 1e-3);
+  CHECK(refined_report.refinement.clusters_before == charge.clusters.size());
+  CHECK(refined.clusters.size() == charge.clusters.size() + refined_report.refinement.splits -
+                                       refined_report.refinement.merges);
+  REQUIRE(tetseg::format::validate(refined) == tetseg::format::Status::kOk);
 }
 
 TEST_CASE("A single-cluster build skips charge and segmentation", "[pipeline]") {

@@ -153,7 +153,7 @@ void add_build_command(CLI::App& root) {
                   "refined: charge, then split clusters no node sees whole and merge neighbours "
                   "one node sees whole (docs/segmentation.md)")
       ->transform(CLI::CheckedTransformer(cluster_methods, CLI::ignore_case))
-      ->option_text("single|charge|refined (charge)");
+      ->option_text("single|charge|refined (refined)");
   RefinementOptions& ref = args->options.refinement;
   cmd->add_option("--refine-visibility", ref.min_visibility,
                   "refined: split clusters seen positive below this share at rest; merge "

@@ -24,7 +24,9 @@ enum class ClusterMethod {
 };
 
 struct BuildOptions {
-  ClusterMethod clusters = ClusterMethod::kCharge;
+  /// kRefined measured faster per frame than kCharge on every benchmark scene
+  /// (docs/benchmarks.md, "Cluster refinement").
+  ClusterMethod clusters = ClusterMethod::kRefined;
   ChargeOptions charge;
   SegmentationOptions segmentation;
   RefinementOptions refinement;  ///< used by kRefined

@@ -57,6 +57,8 @@ struct Segmentation {
   std::uint32_t cluster_count = 0;              ///< clusters numbered by their smallest triangle id
   /// Closed loops of node ids: consecutive nodes (and last -> first) share a surface edge; a
   /// node may repeat at a pinch. Every edge of a loop has different clusters on its two sides.
+  /// segment_surface's loops each split the surface; refine_clusters' loops are the distinct
+  /// contours of the clusters, which on a surface with handles separate only together.
   std::vector<std::vector<std::uint32_t>> boundary_loops;
   std::vector<double> boundary_lengths;     ///< per loop, sum of edge lengths at rest
   std::uint32_t min_cluster_triangles = 0;  ///< the minimum actually used
