@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Regenerates the "Table I" and "segmentation parameters" tables of docs/benchmarks.md.
+# Regenerates the "Table I", "cluster refinement" and "segmentation parameters" tables of
+# docs/benchmarks.md.
 #
 #   scripts/bench-table.sh [BUILD_DIR] [SCENE_DIR]    (defaults: ./build, BUILD_DIR/scenes)
 #
@@ -25,6 +26,38 @@ echo
   elephant "$scenes/elephant.tetseg" "$scenes/elephant.tsf" --repeat 3 --openmp
 
 echo
+echo "## Cluster methods (rvbc, single thread; brute force is the truth)"
+echo
+for s in armadillo dino; do
+  [ -f "$scenes/$s.tsf" ] || { echo "bench-table: $scenes/$s.tsf missing: run scripts/make-scenes.sh" >&2; exit 1; }
+done
+args=()
+for s in pawn dumbbell elephant armadillo dino; do
+  for c in refined charge single; do
+    asset="$scenes/$s-$c.tetseg"; [ "$c" = refined ] && asset="$scenes/$s.tetseg"
+    args+=("$s/$c" "$asset" "$scenes/$s.tsf")
+  done
+done
+cluster_json=$(mktemp)
+"$bench" table "${args[@]}" --modes rvbc --repeat 3 --json > "$cluster_json"
+python3 - "$cluster_json" "$scenes" <<'PY'
+import json, sys
+rows = [r for r in json.load(open(sys.argv[1]))["rows"] if r["mode"] == "rvbc"]
+print("| scene | clusters | count | rest non-positive triangles | negative+uncertain per step | triangle pairs per step | total CPU ms per step | vs charge | missed |")
+print("|---|---|---|---|---|---|---|---|---|")
+cpu = {r["scene"]: r["total_cpu_ms"] for r in rows}
+for r in rows:
+    scene, method = r["scene"].split("/")
+    suffix = "" if method == "refined" else "-" + method
+    report = json.load(open(f"{sys.argv[2]}/{scene}{suffix}.build.json"))
+    rest = sum(c["triangles"] * (1 - c["rest_positive_fraction"]) for c in report["clusters"])
+    ratio = cpu[f"{scene}/charge"] / r["total_cpu_ms"]
+    print(f"| {scene} | {method} | {r['clusters']} | {rest:.0f} | {r['uncertain_negative']:.0f} | "
+          f"{r['triangle_pairs']:.0f} | {r['total_cpu_ms']:.4f} | {ratio:.2f}x | {r['missed'] + r['any_mismatch'] + r['toi_later']} |")
+PY
+rm -f "$cluster_json"
+
+echo
 echo "## Segmentation parameters on the pawn scene (rvbc, single thread)"
 echo
 echo "| alpha | beta divisor | equalisation | clusters | uncertain+negative triangles per step | total CPU ms per step | traversal ms | triangle pairs |"
@@ -33,7 +66,7 @@ work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 row() {  # row ALPHA BETA EQUALIZATION
   "$tetseg" build "$scenes/pawn.mesh" -o "$work/p.tetseg" -q --report "$work/r.json" \
-    --alpha "$1" --beta-divisor "$2" --equalization "$3"
+    --clusters charge --alpha "$1" --beta-divisor "$2" --equalization "$3"
   "$bench" table pawn "$work/p.tetseg" "$scenes/pawn.tsf" --modes rvbc --no-truth --repeat 3 \
     --json > "$work/t.json" 2>/dev/null
   python3 - "$1" "$2" "$3" "$work/r.json" "$work/t.json" <<'PY'

@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
-# Generates the three benchmark scenes of docs/benchmarks.md ("Table I"): pawn, dumbbell and
-# elephant (libcgal-demo), each an asset plus a tetseg-sim frame sequence of a soft drop onto
-# the ground. Outputs go to OUT_DIR (default BUILD_DIR/scenes), never into the repository.
+# Generates the benchmark scenes of docs/benchmarks.md ("Table I", "Cluster refinement"): pawn,
+# dumbbell, and the libcgal-demo elephant, armadillo and dino, each an asset (default options)
+# plus a tetseg-sim frame sequence of a soft drop onto the ground, and the same mesh's assets
+# with the other cluster methods (NAME-charge.tetseg, NAME-single.tetseg). Outputs go to
+# OUT_DIR (default BUILD_DIR/scenes), never into the repository.
 #
 #   scripts/make-scenes.sh [BUILD_DIR] [OUT_DIR]      (BUILD_DIR default: ./build)
 #
@@ -20,6 +22,10 @@ cd "$out"
 scene() {  # scene NAME SIM-OPTIONS...  (NAME.mesh exists)
   local name=$1; shift
   "$tetseg" build "$name.mesh" -o "$name.tetseg" -q --report "$name.build.json"
+  for clusters in charge single; do
+    "$tetseg" build "$name.mesh" -o "$name-$clusters.tetseg" -q --clusters "$clusters" \
+      --report "$name-$clusters.build.json"
+  done
   echo "make-scenes: $name: simulating" >&2
   "$sim" "$name.mesh" "$name.tetseg" -o "$name.tsf" --json "$@" > "$name.sim.json"
   echo "make-scenes: $name: $(cat "$name.sim.json")" >&2
@@ -42,4 +48,21 @@ tar xzf /usr/share/doc/libcgal-dev/data.tar.gz -O data/meshes/elephant.off > ele
 scene elephant --frames 200 --drop 0.3 --tilt-x 90 --tilt-y 30 --edge-compliance 2e-5 \
   --iterations 3
 
-echo "make-scenes: done: $out/{pawn,dumbbell,elephant}.{tetseg,tsf}" >&2
+# Two more libcgal-demo characters for the cluster-refinement comparison (issue 7). The
+# armadillo is about 150 units tall: scaled to about 1 so the drop and stiffness match.
+tar xzf /usr/share/doc/libcgal-dev/data.tar.gz -O data/meshes/armadillo.off |
+  python3 -c '
+import sys
+lines = [l for l in sys.stdin.read().split("\n") if l.strip() and not l.startswith("#")]
+nv = int(lines[1].split()[0])
+scaled = [" ".join(repr(float(x) * 0.0066) for x in l.split()[:3]) for l in lines[2:2 + nv]]
+print("\n".join(lines[:2] + scaled + lines[2 + nv:]))' > armadillo.off
+"$tetseg" tetrahedralize armadillo.off -o armadillo.mesh 2>/dev/null
+scene armadillo --frames 200 --drop 0.3 --tilt-x 90 --tilt-y 30 --edge-compliance 2e-5 \
+  --iterations 3
+tar xzf /usr/share/doc/libcgal-dev/data.tar.gz -O data/meshes/dino.off > dino.off
+"$tetseg" tetrahedralize dino.off -o dino.mesh 2>/dev/null
+scene dino --frames 200 --drop 0.3 --tilt-x 90 --tilt-y 30 --edge-compliance 2e-5 \
+  --iterations 3
+
+echo "make-scenes: done: $out/{pawn,dumbbell,elephant,armadillo,dino}{,-charge,-single}.tetseg and .tsf" >&2

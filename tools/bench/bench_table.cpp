@@ -217,12 +217,15 @@ int table(const std::vector<std::string>& scene_args, const std::string& mode_li
   }
   std::vector<Row> rows;
   std::vector<tetseg::Contact> buffer(1 << 20);
+  std::map<std::string, std::vector<StepTruth>> truths;  // by frames path
   for (std::size_t i = 0; i < scene_args.size(); i += 3) {
     Scene s;
     s.name = scene_args[i];
     load_scene(s, scene_args[i + 1], scene_args[i + 2]);
-    std::vector<StepTruth> truth;
-    if (with_truth) {
+    // A scene on the same frames as an earlier one (another asset of the same mesh, e.g.
+    // another cluster method) reuses that scene's brute-force truth.
+    std::vector<StepTruth>& truth = truths[scene_args[i + 2]];
+    if (with_truth && truth.empty()) {
       rows.push_back(run_mode(s, tetseg::ColliderMode::kBrute, false, stride, max_steps, 1, truth,
                               true, buffer));
       std::fprintf(stderr, "tetseg-bench: %s: brute done (%.1f ms/step)\n", s.name.c_str(),
@@ -357,7 +360,10 @@ int main(int argc, char** argv) {
   std::size_t stride = 1, max_steps = 1000000;
   int repeat = 3;
   bool openmp = false, json = false, no_truth = false;
-  t->add_option("scenes", scenes, "NAME ASSET FRAMES, repeated per scene")->required();
+  t->add_option("scenes", scenes,
+                 "NAME ASSET FRAMES, repeated per scene (scenes on the same FRAMES file share "
+                 "one brute-force truth)")
+      ->required();
   t->add_option("--modes", modes, "Comma-separated modes (brute always runs as the truth)");
   t->add_option("--stride", stride, "Step from frame f to f + stride (default 1)")
       ->check(CLI::Range(std::size_t(1), std::size_t(1000)));
