@@ -25,6 +25,10 @@ constexpr std::size_t kAutoHighOrderMin = 10000;
 constexpr std::size_t kAutoTightToleranceMin = 10000;
 constexpr double kAutoTolerance = 1e-6;
 constexpr double kAutoTightTolerance = 1e-7;
+/// Near-field Schwarz: at most this many triangles per leaf problem (the leaf's own and its
+/// nearest near-field neighbours). Measured 64 / 96 / 128 / 160 on the ellipsoid and the
+/// elephant at 5k and 100k (docs/charge.md, "Preconditioner").
+constexpr std::size_t kSchwarzSet = 128;
 
 double seconds_since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
@@ -122,12 +126,19 @@ ChargeResult compute_charge(const std::vector<Vec3>& points, const std::vector<T
 
   std::vector<double> b(n, 1.0), y(n, 0.0);
   std::unique_ptr<BlockJacobi> block;
+  std::unique_ptr<NearFieldSchwarz> schwarz;
   if (options.preconditioner == ChargePreconditioner::kBlock && solver != ChargeSolver::kDirect) {
     block = std::make_unique<BlockJacobi>(panels, tree);
+  }
+  if (options.preconditioner == ChargePreconditioner::kNearField &&
+      solver != ChargeSolver::kDirect) {
+    schwarz = std::make_unique<NearFieldSchwarz>(panels, tree, near, kSchwarzSet);
   }
   const ApplyFn precondition = [&](const double* in, double* out) {
     if (block) {
       block->apply(in, out);
+    } else if (schwarz) {
+      schwarz->apply(in, out);
     } else {
       for (std::size_t i = 0; i < n; ++i) out[i] = in[i] / near.diagonal[i];
     }
@@ -139,7 +150,7 @@ ChargeResult compute_charge(const std::vector<Vec3>& points, const std::vector<T
   };
   if (solver == ChargeSolver::kFast) {
     const int order =
-        options.fast_order >= 0 ? options.fast_order : (n < kAutoHighOrderMin ? 6 : 8);
+        options.fast_order >= 0 ? options.fast_order : (n < kAutoHighOrderMin ? 7 : 8);
     const TreecodeOperator op(panels, tree, near, options.fast_theta, order);
     result.assembly_seconds = seconds_since(t0);
     progress("assembly", 1.0);

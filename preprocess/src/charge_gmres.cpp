@@ -34,9 +34,16 @@ GmresOutcome solve_gmres(std::size_t n, const ApplyFn& apply, const ApplyFn& pre
   const std::size_t m = static_cast<std::size_t>(restart);
   std::vector<double> h((m + 1) * m), cs(m), sn(m), g(m + 1), y(m);
   auto hh = [&](std::size_t i, std::size_t j) -> double& { return h[i * m + j]; };
+  // A zero start needs no product for its residual.
+  bool zero_start = std::all_of(x.begin(), x.end(), [](double v) { return v == 0.0; });
   for (;;) {
-    apply(x.data(), r.data());
-    for (std::size_t i = 0; i < n; ++i) r[i] = b[i] - r[i];
+    if (zero_start) {
+      r = b;
+      zero_start = false;
+    } else {
+      apply(x.data(), r.data());
+      for (std::size_t i = 0; i < n; ++i) r[i] = b[i] - r[i];
+    }
     const double beta = norm2(r);
     out.residual = beta / bnorm;
     if (!std::isfinite(out.residual)) return out;
@@ -221,6 +228,176 @@ void BlockJacobi::apply(const double* in, double* out) const {
       out[m_tree.order[c.begin + a]] = s;
     }
   }
+}
+
+}  // namespace tetseg::preprocess::charge_detail
+
+namespace tetseg::preprocess::charge_detail {
+
+NearFieldSchwarz::NearFieldSchwarz(const PanelSet& panels, const ClusterTree& tree,
+                                   const NearField& near, std::size_t max_set)
+    : m_tree(tree) {
+  const std::size_t n = panels.size();
+  const std::size_t leaves = tree.leaves.size();
+  // Pass 1: the extended set of every leaf.
+  std::vector<std::vector<std::uint32_t>> sets(leaves);
+#if defined(TETSEG_HAVE_OPENMP)
+#pragma omp parallel
+#endif
+  {
+    std::vector<char> mark(n, 0);
+    std::vector<std::pair<double, std::uint32_t>> extra;
+#if defined(TETSEG_HAVE_OPENMP)
+#pragma omp for schedule(dynamic, 8)
+#endif
+    for (std::ptrdiff_t ll = 0; ll < static_cast<std::ptrdiff_t>(leaves); ++ll) {
+      const std::size_t l = static_cast<std::size_t>(ll);
+      const Cluster& c = tree.nodes[static_cast<std::size_t>(tree.leaves[l])];
+      auto& set = sets[l];
+      for (std::uint32_t k = c.begin; k < c.end; ++k) {
+        set.push_back(tree.order[k]);
+        mark[tree.order[k]] = 1;
+      }
+      extra.clear();
+      for (std::uint32_t k = c.begin; k < c.end; ++k) {
+        const std::size_t i = tree.order[k];
+        for (std::size_t e = near.row_start[i]; e < near.row_start[i + 1]; ++e) {
+          const std::uint32_t j = near.column[e];
+          if (mark[j]) continue;
+          mark[j] = 1;
+          const Vec3& q = panels.centroid[j];
+          const double dx = q[0] - c.center[0], dy = q[1] - c.center[1], dz = q[2] - c.center[2];
+          extra.push_back({dx * dx + dy * dy + dz * dz, j});
+        }
+      }
+      for (const std::uint32_t j : set) mark[j] = 0;
+      for (const auto& e : extra) mark[e.second] = 0;
+      const std::size_t room = max_set > set.size() ? max_set - set.size() : 0;
+      if (extra.size() > room) {
+        std::nth_element(extra.begin(), extra.begin() + static_cast<std::ptrdiff_t>(room),
+                         extra.end());
+        extra.resize(room);
+      }
+      std::sort(extra.begin(), extra.end());
+      for (const auto& e : extra) set.push_back(e.second);
+    }
+  }
+  m_set_start.assign(leaves + 1, 0);
+  m_rows_start.assign(leaves + 1, 0);
+  for (std::size_t l = 0; l < leaves; ++l) {
+    const Cluster& c = tree.nodes[static_cast<std::size_t>(tree.leaves[l])];
+    m_set_start[l + 1] = m_set_start[l] + sets[l].size();
+    m_rows_start[l + 1] = m_rows_start[l] + sets[l].size() * (c.end - c.begin);
+  }
+  m_set.resize(m_set_start[leaves]);
+  m_rows.resize(m_rows_start[leaves]);
+  m_mean_set = static_cast<double>(m_set.size()) / static_cast<double>(std::max<std::size_t>(leaves, 1));
+  // Pass 2: factorise M_SS and keep the members' rows of its inverse.
+#if defined(TETSEG_HAVE_OPENMP)
+#pragma omp parallel
+#endif
+  {
+    std::vector<std::int32_t> pos(n, -1);
+#if defined(TETSEG_HAVE_OPENMP)
+#pragma omp for schedule(dynamic, 4)
+#endif
+    for (std::ptrdiff_t ll = 0; ll < static_cast<std::ptrdiff_t>(leaves); ++ll) {
+      const std::size_t l = static_cast<std::size_t>(ll);
+      const Cluster& c = tree.nodes[static_cast<std::size_t>(tree.leaves[l])];
+      const auto& set = sets[l];
+      std::copy(set.begin(), set.end(), m_set.begin() + static_cast<std::ptrdiff_t>(m_set_start[l]));
+      const Eigen::Index s = static_cast<Eigen::Index>(set.size());
+      const Eigen::Index members = static_cast<Eigen::Index>(c.end - c.begin);
+      for (Eigen::Index a = 0; a < s; ++a) pos[set[static_cast<std::size_t>(a)]] = static_cast<std::int32_t>(a);
+      // The transpose of M_SS, so that the solve below yields rows of M_SS^-1. Single
+      // precision: a preconditioner needs a few digits, and the LU is twice as fast.
+      Eigen::MatrixXf at(s, s);
+      for (Eigen::Index a = 0; a < s; ++a) {
+        const std::size_t i = set[static_cast<std::size_t>(a)];
+        const Vec3& p = panels.centroid[i];
+        for (Eigen::Index b = 0; b < s; ++b) {
+          const std::size_t j = set[static_cast<std::size_t>(b)];
+          const Vec3& q = panels.centroid[j];
+          const double dx = p[0] - q[0], dy = p[1] - q[1], dz = p[2] - q[2];
+          const double r2 = dx * dx + dy * dy + dz * dz;
+          at(b, a) = static_cast<float>(r2 > 0.0 ? panels.area[j] / std::sqrt(r2) : 0.0);
+        }
+        for (std::size_t e = near.row_start[i]; e < near.row_start[i + 1]; ++e) {
+          const std::int32_t b = pos[near.column[e]];
+          if (b >= 0) at(b, a) = static_cast<float>(near.value[e]);
+        }
+      }
+      for (const std::uint32_t j : set) pos[j] = -1;
+      const Eigen::MatrixXf rows =
+          at.partialPivLu().solve(Eigen::MatrixXf::Identity(s, members));  // s x members
+      Eigen::Map<Eigen::MatrixXf>(m_rows.data() + m_rows_start[l], s, members) = rows;
+    }
+  }
+}
+
+void NearFieldSchwarz::apply(const double* in, double* out) const {
+  const std::size_t leaves = m_tree.leaves.size();
+#if defined(TETSEG_HAVE_OPENMP)
+#pragma omp parallel
+#endif
+  {
+    std::vector<double> gathered;
+#if defined(TETSEG_HAVE_OPENMP)
+#pragma omp for schedule(static)
+#endif
+    for (std::ptrdiff_t ll = 0; ll < static_cast<std::ptrdiff_t>(leaves); ++ll) {
+      const std::size_t l = static_cast<std::size_t>(ll);
+      const Cluster& c = m_tree.nodes[static_cast<std::size_t>(m_tree.leaves[l])];
+      const std::size_t s = m_set_start[l + 1] - m_set_start[l];
+      const std::uint32_t* set = m_set.data() + m_set_start[l];
+      gathered.resize(s);
+      for (std::size_t b = 0; b < s; ++b) gathered[b] = in[set[b]];
+      const float* rows = m_rows.data() + m_rows_start[l];
+      for (std::size_t a = 0; a < c.end - c.begin; ++a) {
+        const float* row = rows + a * s;
+        double s0 = 0.0, s1 = 0.0;
+        std::size_t b = 0;
+        for (; b + 2 <= s; b += 2) {
+          s0 += row[b] * gathered[b];
+          s1 += row[b + 1] * gathered[b + 1];
+        }
+        if (b < s) s0 += row[b] * gathered[b];
+        out[set[a]] = s0 + s1;
+      }
+    }
+  }
+}
+
+double exact_residual(const PanelSet& panels, const NearField& near, const std::vector<double>& b,
+                      const std::vector<double>& y) {
+  const std::size_t n = panels.size();
+  std::vector<double> cx(n), cy(n), cz(n), q(n);
+  for (std::size_t j = 0; j < n; ++j) {
+    cx[j] = panels.centroid[j][0];
+    cy[j] = panels.centroid[j][1];
+    cz[j] = panels.centroid[j][2];
+    q[j] = panels.area[j] * y[j];
+  }
+  double rr = 0.0, bb = 0.0;
+#if defined(TETSEG_HAVE_OPENMP)
+#pragma omp parallel for schedule(dynamic, 64) reduction(+ : rr, bb)
+#endif
+  for (std::ptrdiff_t ii = 0; ii < static_cast<std::ptrdiff_t>(n); ++ii) {
+    const std::size_t i = static_cast<std::size_t>(ii);
+    const double x = cx[i], yy = cy[i], z = cz[i];
+    double s = 0.0;
+    for (std::size_t j = 0; j < n; ++j) {
+      const double dx = x - cx[j], dy = yy - cy[j], dz = z - cz[j];
+      const double r2 = dx * dx + dy * dy + dz * dz;
+      if (r2 > 0.0) s += q[j] / std::sqrt(r2);
+    }
+    for (std::size_t e = near.row_start[i]; e < near.row_start[i + 1]; ++e) {
+      s += near.correction[e] * y[near.column[e]];
+    }
+    rr += (b[i] - s) * (b[i] - s);
+    bb += b[i] * b[i];
+  }
+  return bb > 0.0 ? std::sqrt(rr / bb) : 0.0;
 }
 
 }  // namespace tetseg::preprocess::charge_detail

@@ -1,6 +1,6 @@
 #pragma once
-// Internal: the linear solvers behind compute_charge (dense LU, restarted GMRES with Jacobi
-// preconditioning) and the dense collocation matrix.
+// Internal: the linear solvers behind compute_charge (dense LU, restarted GMRES with right
+// preconditioning: Jacobi, block Jacobi, near-field Schwarz) and the dense collocation matrix.
 
 #include <functional>
 #include <vector>
@@ -40,6 +40,32 @@ class BlockJacobi {
   std::vector<std::size_t> m_offset;
   std::vector<double> m_inverse;
 };
+
+/// Restricted additive Schwarz preconditioner on the exact near field: for each cluster-tree
+/// leaf L, the set S = L plus the near-field columns of L's rows (nearest to the leaf first,
+/// at most `max_set` in all); M_SS (analytic near entries, point charges elsewhere) is
+/// factorised once and the preconditioner returns, on L only, (M_SS^-1 r_S)|_L. Storage:
+/// |L| x |S| doubles per leaf.
+class NearFieldSchwarz {
+ public:
+  NearFieldSchwarz(const PanelSet& panels, const ClusterTree& tree, const NearField& near,
+                   std::size_t max_set);
+  void apply(const double* in, double* out) const;
+  double mean_set() const { return m_mean_set; }
+
+ private:
+  const ClusterTree& m_tree;
+  std::vector<std::size_t> m_set_start;  ///< per leaf (CSR) into m_set
+  std::vector<std::uint32_t> m_set;      ///< global ids, the leaf's members first
+  std::vector<std::size_t> m_rows_start;  ///< per leaf into m_rows
+  std::vector<float> m_rows;  ///< per leaf, member a: row a of M_SS^-1 (|S| floats)
+  double m_mean_set = 0.0;
+};
+
+/// ||b - M y|| / ||b|| with the exact collocation matrix (point charges plus the analytic
+/// near field), matrix-free: O(N^2) time, OpenMP over rows.
+double exact_residual(const PanelSet& panels, const NearField& near, const std::vector<double>& b,
+                      const std::vector<double>& y);
 
 /// Dense row-major collocation matrix: far entries A_j / r_ij, near entries and the diagonal
 /// from `near`. n * n doubles.
