@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Regenerates the "Table I", "cluster refinement" and "segmentation parameters" tables of
+# Regenerates the "Table I", "cluster refinement", "refinement parameters" and "segmentation
+# parameters" tables of
 # docs/benchmarks.md.
 #
 #   scripts/bench-table.sh [BUILD_DIR] [SCENE_DIR]    (defaults: ./build, BUILD_DIR/scenes)
@@ -80,3 +81,28 @@ PY
 for alpha in 0.05 0.1 0.2 0.3; do row "$alpha" 400 histogram; done
 for beta in 100 1000; do row 0.1 "$beta" histogram; done
 for eq in rank log-histogram; do row 0.1 400 "$eq"; done
+
+echo
+echo "## Refinement parameters (rvbc, single thread, timings only)"
+echo
+echo "| scene | variant | clusters | negative+uncertain triangles per step | triangle pairs | total CPU ms per step |"
+echo "|---|---|---|---|---|---|"
+refine_row() {  # refine_row SCENE LABEL OPTIONS...
+  local scene=$1 label=$2; shift 2
+  "$tetseg" build "$scenes/$scene.mesh" -o "$work/r.tetseg" -q "$@"
+  "$bench" table "$scene" "$work/r.tetseg" "$scenes/$scene.tsf" --modes rvbc --no-truth \
+    --repeat 3 --json > "$work/t.json" 2>/dev/null
+  python3 - "$scene" "$label" "$work/t.json" <<'PY'
+import json, sys
+scene, label, tab = sys.argv[1:]
+t = json.load(open(tab))["rows"][0]
+print(f"| {scene} | {label} | {t['clusters']} | {t['uncertain_negative']:.0f} | {t['triangle_pairs']:.0f} | {t['total_cpu_ms']:.4f} |")
+PY
+}
+for s in pawn elephant armadillo dino; do
+  refine_row "$s" "charge" --clusters charge
+  refine_row "$s" "refined (defaults)" --clusters refined
+  for g in 0.25 0.5 2 4; do refine_row "$s" "gain $g" --clusters refined --refine-gain "$g"; done
+  for v in 0.9 0.95 0.99; do refine_row "$s" "visibility $v" --clusters refined --refine-visibility "$v"; done
+  refine_row "$s" "no merge" --clusters refined --refine-merge false
+done
