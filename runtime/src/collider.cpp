@@ -166,6 +166,8 @@ void Collider::Impl::construct(const Asset& a, const ColliderOptions& o) {
   emov.assign(edges.size(), 0);
   tcls.assign(tri_count, static_cast<std::uint8_t>(Orientation::kUncertain));
   tmov.assign(tri_count, 0);
+  closure_ring.reserve(tri_count);
+  closure_mark.assign(tri_count, 0);
   nbox.resize(nn);
   nneg.assign(nn, 0);
   nunc.assign(nn, 0);

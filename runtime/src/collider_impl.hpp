@@ -165,6 +165,9 @@ struct Collider::Impl {
   std::vector<Box> nbox;  // per asset BVH node
   std::vector<std::uint32_t> nneg, nunc, nmov;
   std::vector<Worker> workers;
+  // Contact closure scratch (capacity tri_count, reserved at construction).
+  std::vector<std::uint32_t> closure_ring;
+  std::vector<std::uint8_t> closure_mark;
   ColliderStats stats;
   RestCheck rest;
 
@@ -221,6 +224,9 @@ struct Collider::Impl {
   bool cone_self_free(const ConeData& cd, std::uint32_t node) const noexcept;
   /// rvbc orientation culling is on (kRvbc; never in the rest check).
   bool orientation_mode() const noexcept { return opt.mode == ColliderMode::kRvbc && !rest_mode; }
+  bool orientation_culled(std::uint32_t t1, std::uint32_t t2) const noexcept;
+  bool in_closure_pair(std::uint32_t t1, std::uint32_t t2, std::uint64_t key) const noexcept;
+  void close_contacts(Worker& w, double toi) noexcept;
 
   // --- collider_bvh.cpp
   void build_global_bvh(const double* positions) noexcept;

@@ -58,6 +58,7 @@ struct SequenceReport {
   int contact_frames = 0;
   std::uint64_t orientation_culled = 0;
   std::uint64_t clusters_skipped = 0;
+  std::uint64_t closure_pairs = 0;  // rvbc contact-closure pairs over the compared steps
   std::uint64_t rvbc_tests = 0, brute_tests = 0;
   std::vector<Contact> first_contacts;
   /// Earliest contacts whose feature pair also lies in an orientation-culled triangle pair
@@ -116,6 +117,7 @@ inline SequenceReport compare_with_brute(const Scene& scene,
     const StepAnswer g = answer(bvh, frames[f].data(), frames[f + 1].data());
     rep.orientation_culled += rvbc.stats().node_pairs_orientation_culled;
     rep.clusters_skipped += rvbc.stats().clusters_skipped;
+    rep.closure_pairs += rvbc.stats().closure_pairs;
     rep.rvbc_tests += rvbc.stats().feature_tests;
     rep.brute_tests += brute.stats().feature_tests;
     ++rep.frames_compared;

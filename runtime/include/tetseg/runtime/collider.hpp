@@ -107,6 +107,9 @@ struct ColliderStats {
   std::uint64_t triangles_positive = 0, triangles_negative = 0, triangles_uncertain = 0;
   std::uint64_t triangles_moving = 0;
   std::uint64_t clusters_skipped = 0;    ///< intra-cluster work skipped (one sign / static)
+  /// kRvbc: orientation-culled triangle pairs around the earliest contacts re-examined by the
+  /// contact closure (docs/runtime.md)
+  std::uint64_t closure_pairs = 0;
   std::uint64_t node_pairs_visited = 0;  ///< BVH node pairs popped by traversal
   std::uint64_t node_pairs_orientation_culled = 0;
   std::uint64_t triangle_pairs = 0;          ///< non-culled triangle pairs examined
