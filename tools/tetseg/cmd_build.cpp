@@ -85,6 +85,9 @@ std::string report_json(const BuildArgs& args, const BuildReport& report,
   return out.str();
 }
 
+/// Rest visibility below which `tetseg build` names the cluster in a note.
+constexpr double kPoorVisibility = 0.8;
+
 void run_build(const BuildArgs& args) {
   using Clock = std::chrono::steady_clock;
   const auto start = Clock::now();
@@ -129,7 +132,25 @@ void run_build(const BuildArgs& args) {
   if (!args.report_path.empty()) {
     write_file_atomic(args.report_path, report_json(args, report, asset, bytes.size(), total));
   }
-  if (!args.quiet) std::fprintf(stderr, "tetseg: done in %.3f s\n", total);
+  if (!args.quiet) {
+    // Clusters no interior node sees well cost run time in every frame: say which, and why.
+    std::size_t poor = 0, worst = 0;
+    for (std::size_t c = 0; c < asset.clusters.size(); ++c) {
+      if (asset.clusters[c].rest_positive_fraction < kPoorVisibility) ++poor;
+      if (asset.clusters[c].rest_positive_fraction < asset.clusters[worst].rest_positive_fraction)
+        worst = c;
+    }
+    if (poor > 0) {
+      std::fprintf(stderr,
+                   "tetseg: note: %zu of %zu clusters are seen less than %.0f%% positive at rest "
+                   "from their detector node (lowest: cluster %zu, %.1f%%); thin parts without "
+                   "interior nodes cause this: a finer interior (--cell-size) gives more "
+                   "candidates (docs/segmentation.md, step 7)\n",
+                   poor, asset.clusters.size(), 100.0 * kPoorVisibility, worst,
+                   100.0 * asset.clusters[worst].rest_positive_fraction);
+    }
+    std::fprintf(stderr, "tetseg: done in %.3f s\n", total);
+  }
 }
 
 }  // namespace
