@@ -209,15 +209,15 @@ int main(int argc, char** argv) {
   int repeat = 1;
   std::size_t exact_max = 25000;
   int order = -1;
-  double theta = 0.5;
+  double theta = 0.0;
   app.add_option("--mesh-dir", mesh_dir, "Directory with the CGAL demo meshes");
   app.add_option("--real", real, "Real mesh (OFF) subdivided to the sizes");
   app.add_option("--sizes", sizes, "Any of 1k 5k 20k 100k");
   app.add_option("--solvers", solvers,
                  "Any of direct gmres fast auto, optionally name/preconditioner (jacobi, block, "
-                 "near) and @tolerance (name@auto: automatic)");
+                 "near), @tolerance (name@auto: automatic) and :order[:theta] of the FMM");
   app.add_option("--order", order, "FMM order of the timed fast runs (default automatic)");
-  app.add_option("--theta", theta, "FMM opening parameter of the timed fast runs");
+  app.add_option("--theta", theta, "FMM opening parameter of the timed fast runs (0: automatic)");
   app.add_option("--exact-residual-max", exact_max,
                  "Largest N for the residual against the exact matrix (O(N^2) product)");
   app.add_option("--tolerance", tolerance, "Relative residual for the timed runs");
@@ -266,7 +266,8 @@ int main(int argc, char** argv) {
     std::vector<double> exact;
     if (m.analytic) exact = ellipsoid_exact(m.mesh, 1.0, 0.6, 0.3);
     // Best reference available: dense LU up to 5k, GMRES at 1e-10 on the stored matrix up to
-    // 25k, else the FMM at theta 0.4 / order 8 to 1e-10.
+    // 25k, else the FMM at theta 0.35 / order 10 to 1e-10 (operator error ~ 0.35^11, about
+    // 1/500 of the timed runs' theta 0.5 / order 8).
     std::vector<double> ref;
     std::string ref_name = "-";
     if (reference) {
@@ -281,9 +282,9 @@ int main(int argc, char** argv) {
         ref_name = "gmres 1e-10";
       } else {
         o.solver = ChargeSolver::kFast;
-        o.fast_theta = 0.4;
-        o.fast_order = 8;
-        ref_name = "fast theta 0.4 order 8, 1e-10";
+        o.fast_theta = 0.35;
+        o.fast_order = 10;
+        ref_name = "fast theta 0.35 order 10, 1e-10";
       }
       std::fprintf(stderr, "bench: %s %zu reference (%s)\n", m.name.c_str(), n, ref_name.c_str());
       const CaseResult r = run_case(m.mesh, o);
@@ -294,9 +295,11 @@ int main(int argc, char** argv) {
       }
     }
     for (const std::string& spec : solvers) {
-      // "name[/preconditioner][@tolerance]"
-      const std::size_t at = spec.find('@');
-      const std::string head = spec.substr(0, at);
+      // "name[/preconditioner][@tolerance][:order[:theta]]"
+      const std::size_t colon = spec.find(':');
+      const std::string main_spec = spec.substr(0, colon);
+      const std::size_t at = main_spec.find('@');
+      const std::string head = main_spec.substr(0, at);
       const std::size_t slash = head.find('/');
       const std::string s = head.substr(0, slash);
       const std::string pre = slash == std::string::npos ? "" : head.substr(slash + 1);
@@ -316,11 +319,18 @@ int main(int argc, char** argv) {
         return 2;
       }
       // "@auto" leaves the tolerance to compute_charge (0).
-      o.tolerance = at == std::string::npos
-                        ? tolerance
-                        : (spec.substr(at + 1) == "auto" ? 0.0 : std::stod(spec.substr(at + 1)));
+      o.tolerance =
+          at == std::string::npos
+              ? tolerance
+              : (main_spec.substr(at + 1) == "auto" ? 0.0 : std::stod(main_spec.substr(at + 1)));
       o.fast_order = order;
       o.fast_theta = theta;
+      if (colon != std::string::npos) {
+        const std::string rest = spec.substr(colon + 1);
+        const std::size_t colon2 = rest.find(':');
+        o.fast_order = std::stoi(rest.substr(0, colon2));
+        if (colon2 != std::string::npos) o.fast_theta = std::stod(rest.substr(colon2 + 1));
+      }
       if (o.solver == ChargeSolver::kDirect && n > 6000) continue;
       if (o.solver == ChargeSolver::kGmres && n > 25000) continue;
       std::fprintf(stderr, "bench: %s %zu %s\n", m.name.c_str(), n, spec.c_str());

@@ -45,9 +45,10 @@ struct ChargeOptions {
   int max_iterations = 500;  ///< matrix products, iterative solvers only
   int restart = 80;          ///< GMRES restart length
   ChargePreconditioner preconditioner = ChargePreconditioner::kNearField;
-  /// Treecode opening parameter: a cluster acts through its multipoles on a target leaf when
-  /// (r_leaf + r_cluster) < theta * distance. Smaller is more accurate and slower; (0, 1).
-  double fast_theta = 0.5;
+  /// FMM opening parameter: two clusters interact through expansions when
+  /// (r_target + r_source) < theta * distance. Smaller is more accurate and slower; (0, 1),
+  /// or 0 for automatic: 0.5 below 10,000 triangles, 0.45 from there on (docs/charge.md).
+  double fast_theta = 0.0;
   /// Total order of the fast solver's Taylor expansions, 0..16; error ~ theta^(order + 1).
   /// Negative means automatic: 7 below 10,000 triangles (operator error ~8e-7, so the residual
   /// against the exact matrix stays near the automatic 1e-6), 8 from there on (the density
