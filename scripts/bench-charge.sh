@@ -2,11 +2,13 @@
 # Benchmark of the charge-density solvers (docs/benchmarks.md, "Charge density"): builds
 # tetseg-bench-charge in Release and prints, for ~1k, 5k, 20k and 100k triangles (ellipsoid
 # 1:0.6:0.3 and the CGAL demo elephant, 1-to-4 subdivided), each solver's assembly and solve
-# time, CPU seconds, iterations, residual, peak RSS and error against the analytic density and
-# the best reference available. Takes several minutes (the references dominate).
+# time, CPU seconds, iterations, residual (against its own operator and, up to 25k triangles,
+# against the exact matrix), peak RSS and error against the analytic density and the best
+# reference available. Takes several minutes (the references dominate).
 # Usage: scripts/bench-charge.sh [build-dir] [extra tetseg-bench-charge options]
 #        (default build-bench-charge; e.g. `--sizes 1k 5k --solvers gmres fast --repeat 5`;
-#        `name@auto` uses the automatic tolerance, `--repeat N` keeps the fastest of N runs)
+#        solver specs name[/jacobi|block|near][@tolerance|@auto][:order[:theta]];
+#        `--repeat N` keeps the fastest of N runs)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 build=${1:-build-bench-charge}
