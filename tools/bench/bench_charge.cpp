@@ -210,6 +210,7 @@ int main(int argc, char** argv) {
   std::size_t exact_max = 25000;
   int order = -1;
   double theta = 0.0;
+  int leaf_size = ChargeOptions{}.leaf_size;
   app.add_option("--mesh-dir", mesh_dir, "Directory with the CGAL demo meshes");
   app.add_option("--real", real, "Real mesh (OFF) subdivided to the sizes");
   app.add_option("--sizes", sizes, "Any of 1k 5k 20k 100k");
@@ -217,6 +218,7 @@ int main(int argc, char** argv) {
                  "Any of direct gmres fast auto, optionally name/preconditioner (jacobi, block, "
                  "near), @tolerance (name@auto: automatic) and :order[:theta] of the FMM");
   app.add_option("--order", order, "FMM order of the timed fast runs (default automatic)");
+  app.add_option("--leaf-size", leaf_size, "Cluster-tree leaf size of the timed runs");
   app.add_option("--theta", theta, "FMM opening parameter of the timed fast runs (0: automatic)");
   app.add_option("--exact-residual-max", exact_max,
                  "Largest N for the residual against the exact matrix (O(N^2) product)");
@@ -325,6 +327,7 @@ int main(int argc, char** argv) {
               : (main_spec.substr(at + 1) == "auto" ? 0.0 : std::stod(main_spec.substr(at + 1)));
       o.fast_order = order;
       o.fast_theta = theta;
+      o.leaf_size = leaf_size;
       if (colon != std::string::npos) {
         const std::string rest = spec.substr(colon + 1);
         const std::size_t colon2 = rest.find(':');
