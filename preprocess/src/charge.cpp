@@ -1,5 +1,6 @@
 // compute_charge: panels, near field, solver choice and read-out (docs/charge.md).
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <fstream>
@@ -33,6 +34,9 @@ constexpr double kAutoLargeTheta = 0.45;
 /// nearest near-field neighbours). Measured 64 / 96 / 128 / 160 on the ellipsoid and the
 /// elephant at 5k and 100k (docs/charge.md, "Preconditioner").
 constexpr std::size_t kSchwarzSet = 128;
+/// Two-level: at most this many coarse clusters and N x K coarse-operator entries.
+constexpr std::size_t kCoarseMax = 256;
+constexpr std::size_t kCoarseEntries = 25'000'000;
 
 double seconds_since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
@@ -131,6 +135,7 @@ ChargeResult compute_charge(const std::vector<Vec3>& points, const std::vector<T
   std::vector<double> b(n, 1.0), y(n, 0.0);
   std::unique_ptr<BlockJacobi> block;
   std::unique_ptr<NearFieldSchwarz> schwarz;
+  std::unique_ptr<TwoLevelSchwarz> two_level;
   if (options.preconditioner == ChargePreconditioner::kBlock && solver != ChargeSolver::kDirect) {
     block = std::make_unique<BlockJacobi>(panels, tree);
   }
@@ -138,11 +143,19 @@ ChargeResult compute_charge(const std::vector<Vec3>& points, const std::vector<T
       solver != ChargeSolver::kDirect) {
     schwarz = std::make_unique<NearFieldSchwarz>(panels, tree, near, kSchwarzSet);
   }
+  if (options.preconditioner == ChargePreconditioner::kTwoLevel &&
+      solver != ChargeSolver::kDirect) {
+    // K: at most 256, clusters of at least ~64 triangles, and N x K floats <= 100 MB.
+    const std::size_t k = std::min({kCoarseMax, n / 64, kCoarseEntries / std::max<std::size_t>(n, 1)});
+    two_level = std::make_unique<TwoLevelSchwarz>(panels, tree, near, kSchwarzSet, k);
+  }
   const ApplyFn precondition = [&](const double* in, double* out) {
     if (block) {
       block->apply(in, out);
     } else if (schwarz) {
       schwarz->apply(in, out);
+    } else if (two_level) {
+      two_level->apply(in, out);
     } else {
       for (std::size_t i = 0; i < n; ++i) out[i] = in[i] / near.diagonal[i];
     }

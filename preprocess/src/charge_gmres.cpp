@@ -401,3 +401,154 @@ double exact_residual(const PanelSet& panels, const NearField& near, const std::
 }
 
 }  // namespace tetseg::preprocess::charge_detail
+
+namespace tetseg::preprocess::charge_detail {
+
+TwoLevelSchwarz::TwoLevelSchwarz(const PanelSet& panels, const ClusterTree& tree,
+                                 const NearField& near, std::size_t max_set,
+                                 std::size_t max_coarse)
+    : m_local(panels, tree, near, max_set), m_n(panels.size()) {
+  const std::size_t n = m_n;
+  // Coarse clusters: the nodes at depth d (or leaves reached before), 2^d <= max_coarse.
+  int depth = 0;
+  while ((std::size_t{2} << depth) <= std::max<std::size_t>(max_coarse, 1)) ++depth;
+  std::vector<std::int32_t> roots;
+  {
+    std::vector<std::pair<std::int32_t, int>> stack = {{0, 0}};
+    while (!stack.empty()) {
+      const auto [id, d] = stack.back();
+      stack.pop_back();
+      const Cluster& c = tree.nodes[static_cast<std::size_t>(id)];
+      if (d == depth || c.left < 0) {
+        roots.push_back(id);
+      } else {
+        stack.push_back({c.right, d + 1});
+        stack.push_back({c.left, d + 1});
+      }
+    }
+  }
+  m_k = roots.size();
+  const std::size_t k = m_k;
+  m_cluster.resize(n);
+  for (std::size_t J = 0; J < k; ++J) {
+    const Cluster& c = tree.nodes[static_cast<std::size_t>(roots[J])];
+    for (std::uint32_t e = c.begin; e < c.end; ++e) {
+      m_cluster[tree.order[e]] = static_cast<std::uint32_t>(J);
+    }
+  }
+  // Per node: total area, area centroid, and a radius about it that covers the triangles.
+  const std::size_t nodes = tree.nodes.size();
+  std::vector<double> area(nodes), cx(nodes), cy(nodes), cz(nodes), radius(nodes);
+  for (std::size_t id = nodes; id-- > 0;) {
+    const Cluster& c = tree.nodes[id];
+    double a = 0.0, x = 0.0, y = 0.0, z = 0.0;
+    for (std::uint32_t e = c.begin; e < c.end; ++e) {
+      const std::uint32_t j = tree.order[e];
+      const double aj = panels.area[j];
+      a += aj;
+      x += aj * panels.centroid[j][0];
+      y += aj * panels.centroid[j][1];
+      z += aj * panels.centroid[j][2];
+    }
+    area[id] = a;
+    cx[id] = x / a;
+    cy[id] = y / a;
+    cz[id] = z / a;
+    double r2 = 0.0;
+    for (std::uint32_t e = c.begin; e < c.end; ++e) {
+      const std::uint32_t j = tree.order[e];
+      const Vec3& q = panels.centroid[j];
+      const double dx = q[0] - cx[id], dy = q[1] - cy[id], dz = q[2] - cz[id];
+      const double h = 0.5 * panels.diameter[j];
+      r2 = std::max(r2, dx * dx + dy * dy + dz * dz + h * h);
+    }
+    radius[id] = std::sqrt(r2);
+  }
+  constexpr double kOpening = 0.5;
+  m_mz.assign(n * k, 0.0f);
+#if defined(TETSEG_HAVE_OPENMP)
+#pragma omp parallel
+#endif
+  {
+    std::vector<std::int32_t> stack;
+    std::vector<double> row(k);
+#if defined(TETSEG_HAVE_OPENMP)
+#pragma omp for schedule(dynamic, 64)
+#endif
+    for (std::ptrdiff_t ii = 0; ii < static_cast<std::ptrdiff_t>(n); ++ii) {
+      const std::size_t i = static_cast<std::size_t>(ii);
+      const Vec3& p = panels.centroid[i];
+      for (std::size_t J = 0; J < k; ++J) {
+        double s = 0.0;
+        stack.assign(1, roots[J]);
+        while (!stack.empty()) {
+          const std::size_t id = static_cast<std::size_t>(stack.back());
+          stack.pop_back();
+          const Cluster& c = tree.nodes[id];
+          const double dx = p[0] - cx[id], dy = p[1] - cy[id], dz = p[2] - cz[id];
+          const double d2 = dx * dx + dy * dy + dz * dz;
+          if (radius[id] * radius[id] < kOpening * kOpening * d2) {
+            s += area[id] / std::sqrt(d2);
+          } else if (c.left >= 0) {
+            stack.push_back(c.left);
+            stack.push_back(c.right);
+          } else {
+            for (std::uint32_t e = c.begin; e < c.end; ++e) {
+              const std::uint32_t j = tree.order[e];
+              const Vec3& q = panels.centroid[j];
+              const double ex = p[0] - q[0], ey = p[1] - q[1], ez = p[2] - q[2];
+              const double r2 = ex * ex + ey * ey + ez * ez;
+              if (r2 > 0.0) s += panels.area[j] / std::sqrt(r2);
+            }
+          }
+        }
+        row[J] = s;
+      }
+      for (std::size_t e = near.row_start[i]; e < near.row_start[i + 1]; ++e) {
+        row[m_cluster[near.column[e]]] += near.correction[e];
+      }
+      float* out = m_mz.data() + i * k;
+      for (std::size_t J = 0; J < k; ++J) out[J] = static_cast<float>(row[J]);
+    }
+  }
+  Eigen::MatrixXd coarse = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(k),
+                                                 static_cast<Eigen::Index>(k));
+  for (std::size_t i = 0; i < n; ++i) {
+    const float* row = m_mz.data() + i * k;
+    for (std::size_t J = 0; J < k; ++J) {
+      coarse(static_cast<Eigen::Index>(m_cluster[i]), static_cast<Eigen::Index>(J)) += row[J];
+    }
+  }
+  const Eigen::MatrixXd inv = coarse.partialPivLu().inverse();
+  m_coarse_inverse.resize(k * k);
+  Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(
+      m_coarse_inverse.data(), static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(k)) = inv;
+  m_residual.resize(n);
+}
+
+void TwoLevelSchwarz::apply(const double* in, double* out) const {
+  const std::size_t n = m_n, k = m_k;
+  std::vector<double> t(k, 0.0), u(k, 0.0);
+  for (std::size_t i = 0; i < n; ++i) t[m_cluster[i]] += in[i];
+  for (std::size_t a = 0; a < k; ++a) {
+    double s = 0.0;
+    const double* row = m_coarse_inverse.data() + a * k;
+    for (std::size_t b = 0; b < k; ++b) s += row[b] * t[b];
+    u[a] = s;
+  }
+  double* r = m_residual.data();
+#if defined(TETSEG_HAVE_OPENMP)
+#pragma omp parallel for schedule(static)
+#endif
+  for (std::ptrdiff_t ii = 0; ii < static_cast<std::ptrdiff_t>(n); ++ii) {
+    const std::size_t i = static_cast<std::size_t>(ii);
+    const float* row = m_mz.data() + i * k;
+    double s = 0.0;
+    for (std::size_t J = 0; J < k; ++J) s += static_cast<double>(row[J]) * u[J];
+    r[i] = in[i] - s;
+  }
+  m_local.apply(r, out);
+  for (std::size_t i = 0; i < n; ++i) out[i] += u[m_cluster[i]];
+}
+
+}  // namespace tetseg::preprocess::charge_detail

@@ -62,6 +62,30 @@ class NearFieldSchwarz {
   double m_mean_set = 0.0;
 };
 
+/// Two-level preconditioner: a coarse correction on K tree clusters (the nodes at one depth,
+/// K <= max_coarse), applied first, then the near-field Schwarz on the remaining residual:
+///   u = C^-1 Z^T r,  out = Z u + Schwarz(r - (M Z) u),
+/// with Z the cluster indicators (piecewise-constant densities) and C = Z^T M Z. M Z (N x K,
+/// single precision) comes from a Barnes-Hut sum per target (cluster subtrees, monopoles at
+/// area centroids when radius < 0.5 distance, point charges in leaves otherwise, plus the
+/// analytic near-field corrections): an approximation of the coarse operator, which only
+/// makes the preconditioner less exact, never the solution.
+class TwoLevelSchwarz {
+ public:
+  TwoLevelSchwarz(const PanelSet& panels, const ClusterTree& tree, const NearField& near,
+                  std::size_t max_set, std::size_t max_coarse);
+  void apply(const double* in, double* out) const;
+  std::size_t coarse_size() const { return m_k; }
+
+ private:
+  NearFieldSchwarz m_local;
+  std::size_t m_n = 0, m_k = 0;
+  std::vector<std::uint32_t> m_cluster;  ///< per triangle: its coarse cluster
+  std::vector<float> m_mz;               ///< n x k, row-major: (M Z)_iJ
+  std::vector<double> m_coarse_inverse;  ///< k x k, row-major: C^-1
+  mutable std::vector<double> m_residual;
+};
+
 /// ||b - M y|| / ||b|| with the exact collocation matrix (point charges plus the analytic
 /// near field), matrix-free: O(N^2) time, OpenMP over rows.
 double exact_residual(const PanelSet& panels, const NearField& near, const std::vector<double>& b,

@@ -165,7 +165,7 @@ TEST_CASE("Every preconditioner converges to the dense solution", "[charge]") {
   const ChargeResult direct = compute_charge(m.vertices, m.triangles, o);
   for (const ChargePreconditioner pre :
        {ChargePreconditioner::kJacobi, ChargePreconditioner::kBlock,
-        ChargePreconditioner::kNearField}) {
+        ChargePreconditioner::kNearField, ChargePreconditioner::kTwoLevel}) {
     o.preconditioner = pre;
     for (const ChargeSolver solver : {ChargeSolver::kGmres, ChargeSolver::kFast}) {
       o.solver = solver;
@@ -178,10 +178,11 @@ TEST_CASE("Every preconditioner converges to the dense solution", "[charge]") {
   }
 }
 
-TEST_CASE("The near-field preconditioner needs far fewer iterations than Jacobi", "[charge]") {
+TEST_CASE("The near-field and two-level preconditioners need far fewer iterations than Jacobi",
+          "[charge]") {
   // Iteration counts are deterministic (fixed mesh, tree and arithmetic order), so this is
-  // not a timing test. Measured at 1e-10 (docs/charge.md): pawn 2920 triangles 42 -> 10,
-  // dumbbell 2820 35 -> 9, for gmres and fast alike.
+  // not a timing test. Measured at 1e-10 (docs/charge.md), Jacobi / near-field / two-level:
+  // pawn 2920 triangles 42 / 10 / 7, dumbbell 2820 35 / 9 / 7, for gmres and fast alike.
   const TriangleMesh pawn = tetseg::test::pawn(0.05);
   const TriangleMesh dumbbell = tetseg::test::dumbbell(0.07);
   for (const TriangleMesh* m : {&pawn, &dumbbell}) {
@@ -195,21 +196,29 @@ TEST_CASE("The near-field preconditioner needs far fewer iterations than Jacobi"
       const ChargeResult jacobi = compute_charge(m->vertices, m->triangles, o);
       o.preconditioner = ChargePreconditioner::kNearField;
       const ChargeResult near = compute_charge(m->vertices, m->triangles, o);
-      CAPTURE(m->triangles.size(), near.solver, jacobi.iterations, near.iterations);
+      o.preconditioner = ChargePreconditioner::kTwoLevel;
+      const ChargeResult two = compute_charge(m->vertices, m->triangles, o);
+      CAPTURE(m->triangles.size(), near.solver, jacobi.iterations, near.iterations,
+              two.iterations);
       CHECK(jacobi.converged);
       CHECK(near.converged);
+      CHECK(two.converged);
       CHECK(near.residual <= 1e-10);
+      CHECK(two.residual <= 1e-10);
       CHECK(3 * near.iterations <= jacobi.iterations);
+      CHECK(two.iterations < near.iterations);
       // Pointwise relative for gmres; for fast in units of the mean density (the creases
       // carry small densities, whose relative error the FMM's operator error inflates).
-      if (solver == ChargeSolver::kGmres) {
-        CHECK(max_relative_difference(near.density, direct.density) < 1e-6);
-      } else {
-        CHECK(max_abs_difference(near.density, direct.density) < 5e-3);
+      for (const ChargeResult* r : {&near, &two}) {
+        if (solver == ChargeSolver::kGmres) {
+          CHECK(max_relative_difference(r->density, direct.density) < 1e-6);
+        } else {
+          CHECK(max_abs_difference(r->density, direct.density) < 5e-3);
+        }
       }
     }
   }
-  CHECK(ChargeOptions{}.preconditioner == ChargePreconditioner::kNearField);  // the default
+  CHECK(ChargeOptions{}.preconditioner == ChargePreconditioner::kTwoLevel);  // the default
 }
 
 TEST_CASE("The fast solver's error against GMRES is bounded at 20k triangles", "[charge][slow]") {

@@ -216,7 +216,7 @@ int main(int argc, char** argv) {
   app.add_option("--sizes", sizes, "Any of 1k 5k 20k 100k");
   app.add_option("--solvers", solvers,
                  "Any of direct gmres fast auto, optionally name/preconditioner (jacobi, block, "
-                 "near), @tolerance (name@auto: automatic) and :order[:theta] of the FMM");
+                 "near, two), @tolerance (name@auto: automatic) and :order[:theta] of the FMM");
   app.add_option("--order", order, "FMM order of the timed fast runs (default automatic)");
   app.add_option("--leaf-size", leaf_size, "Cluster-tree leaf size of the timed runs");
   app.add_option("--theta", theta, "FMM opening parameter of the timed fast runs (0: automatic)");
@@ -313,6 +313,8 @@ int main(int argc, char** argv) {
         o.preconditioner = preprocess::ChargePreconditioner::kBlock;
       } else if (pre == "near") {
         o.preconditioner = preprocess::ChargePreconditioner::kNearField;
+      } else if (pre == "two") {
+        o.preconditioner = preprocess::ChargePreconditioner::kTwoLevel;
       } else if (!pre.empty()) {
         known = false;
       }

@@ -33,6 +33,9 @@ enum class ChargePreconditioner {
   /// Restricted additive Schwarz on the exact near field: per leaf, a dense LU of the matrix
   /// on the leaf plus its nearest near-field neighbours (docs/charge.md, "Preconditioner").
   kNearField,
+  /// kNearField plus a coarse correction on up to 256 tree clusters (piecewise-constant
+  /// densities, Galerkin coarse matrix): removes the smooth error the local solves leave.
+  kTwoLevel,
 };
 
 struct ChargeOptions {
@@ -44,7 +47,7 @@ struct ChargeOptions {
   double tolerance = 0.0;
   int max_iterations = 500;  ///< matrix products, iterative solvers only
   int restart = 80;          ///< GMRES restart length
-  ChargePreconditioner preconditioner = ChargePreconditioner::kNearField;
+  ChargePreconditioner preconditioner = ChargePreconditioner::kTwoLevel;
   /// FMM opening parameter: two clusters interact through expansions when
   /// (r_target + r_source) < theta * distance. Smaller is more accurate and slower; (0, 1),
   /// or 0 for automatic: 0.5 below 10,000 triangles, 0.45 from there on (docs/charge.md).
