@@ -199,6 +199,9 @@ struct Collider::Impl {
   bool run_query(Contact* out, std::size_t out_cap) noexcept;
   bool non_culled(std::uint32_t t1, std::uint32_t t2) const noexcept;
   void process_triangle_pair(Worker& w, std::uint32_t t1, std::uint32_t t2) const noexcept;
+  template <typename Claimed>
+  void test_features(Worker& w, std::uint32_t t1, std::uint32_t t2,
+                     Claimed&& claimed) const noexcept;
   void process_vertex_face(Worker& w, std::uint32_t p, std::uint32_t face) const noexcept;
   void process_edge_edge(Worker& w, std::uint32_t e1, std::uint32_t e2) const noexcept;
   /// Swept boxes of two edges overlap and not all four nodes are still.
@@ -225,7 +228,6 @@ struct Collider::Impl {
   /// rvbc orientation culling is on (kRvbc; never in the rest check).
   bool orientation_mode() const noexcept { return opt.mode == ColliderMode::kRvbc && !rest_mode; }
   bool orientation_culled(std::uint32_t t1, std::uint32_t t2) const noexcept;
-  bool in_closure_pair(std::uint32_t t1, std::uint32_t t2, std::uint64_t key) const noexcept;
   void close_contacts(Worker& w, double toi) noexcept;
 
   // --- collider_bvh.cpp

@@ -81,79 +81,6 @@ bool Collider::Impl::orientation_culled(std::uint32_t t1, std::uint32_t t2) cons
   return boxes_overlap(tbox[t1], tbox[t2], opt.ccd.min_separation);
 }
 
-// The closure pair of key `key` owns a feature pair unless a triangle pair (t1, t2) that
-// contains it was tested by the traversal (non-culled) or comes earlier in the closure.
-bool Collider::Impl::in_closure_pair(std::uint32_t t1, std::uint32_t t2,
-                                     std::uint64_t key) const noexcept {
-  if (non_culled(t1, t2)) return true;
-  return pair_key(t1, t2) < key && closure_mark[t1] && closure_mark[t2] &&
-         orientation_culled(t1, t2);
-}
-
-// Contact closure (rvbc): orientation culling is exact for penetration, but when several
-// features touch one point at the earliest time (two vertices meeting head on), feature pairs
-// in culled triangle pairs can touch at that same time. Re-examines every orientation-culled
-// pair of triangles around the nodes of the contacts at `toi` (seeds: the caller's buffer and
-// each worker's best), testing each feature pair that no tested triangle pair holds, once.
-void Collider::Impl::close_contacts(Worker& w, double toi) noexcept {
-  closure_ring.clear();
-  auto add_ring = [&](const Contact& c) {
-    if (c.toi != toi) return;
-    for (std::uint32_t node : c.nodes) {
-      const std::uint32_t iv = surf_index[node];
-      for (std::uint32_t k = vt_offset[iv]; k < vt_offset[iv + 1]; ++k) {
-        const std::uint32_t t = vt_list[k];
-        if (!closure_mark[t]) {
-          closure_mark[t] = 1;
-          closure_ring.push_back(t);
-        }
-      }
-    }
-  };
-  for (std::size_t i = 0; i < w.out_written; ++i) add_ring(w.out[i]);
-  for (const Worker& other : workers)
-    if (other.has_best) add_ring(other.best);
-  const std::size_t ring = closure_ring.size();  // contacts found below add no seeds
-  for (std::size_t i = 0; i < ring; ++i) {
-    for (std::size_t j = i + 1; j < ring; ++j) {
-      const std::uint32_t t1 = closure_ring[i], t2 = closure_ring[j];
-      if (!orientation_culled(t1, t2)) continue;
-      ++w.stats.closure_pairs;
-      const std::uint64_t key = pair_key(t1, t2);
-      const auto& A = asset->triangles[t1];
-      const auto& B = asset->triangles[t2];
-      for (int dir = 0; dir < 2; ++dir) {
-        const auto& P = dir == 0 ? A : B;
-        const auto& F = dir == 0 ? B : A;
-        const std::uint32_t face = dir == 0 ? t2 : t1;
-        for (std::uint32_t p : P) {
-          if (p == F[0] || p == F[1] || p == F[2]) continue;
-          const std::uint32_t ip = surf_index[p];
-          bool owner = true;
-          for (std::uint32_t k = vt_offset[ip]; k < vt_offset[ip + 1] && owner; ++k)
-            if (in_closure_pair(vt_list[k], face, key)) owner = false;
-          if (owner) process_vertex_face(w, p, face);
-        }
-      }
-      for (std::uint32_t e1 : tri_edges[t1]) {
-        for (std::uint32_t e2 : tri_edges[t2]) {
-          const auto& E1 = edges[e1];
-          const auto& E2 = edges[e2];
-          if (E1[0] == E2[0] || E1[0] == E2[1] || E1[1] == E2[0] || E1[1] == E2[1]) continue;
-          bool owner = true;
-          for (std::uint32_t k1 = et_offset[e1]; k1 < et_offset[e1 + 1] && owner; ++k1)
-            for (std::uint32_t k2 = et_offset[e2]; k2 < et_offset[e2 + 1] && owner; ++k2) {
-              const std::uint32_t u = et_list[k1], v = et_list[k2];
-              if (u != v && in_closure_pair(u, v, key)) owner = false;
-            }
-          if (owner) process_edge_edge(w, e1, e2);
-        }
-      }
-    }
-  }
-  for (std::uint32_t t : closure_ring) closure_mark[t] = 0;
-}
-
 void Collider::Impl::record(Worker& w, const Contact& c) const noexcept {
   ++w.stats.contacts;
   if (qkind == QueryKind::kAny) {
@@ -239,15 +166,12 @@ void Collider::Impl::process_edge_edge(Worker& w, std::uint32_t e1,
   record(w, k);
 }
 
-void Collider::Impl::process_triangle_pair(Worker& w, std::uint32_t t1,
-                                           std::uint32_t t2) const noexcept {
-  if (!non_culled(t1, t2)) return;
-  if (rest_mode) {
-    rest_triangle_pair(w, t1, t2);
-    return;
-  }
-  ++w.stats.triangle_pairs;
-  const std::uint64_t key = pair_key(t1, t2);
+// Tests the feature pairs of triangles t1 != t2 (vertex-face both ways, edge-edge; features
+// with four distinct nodes) that no other triangle pair claims: `claimed(u, v)` is true when
+// the pair (u, v) tests a shared feature pair instead of this one (exact deduplication).
+template <typename Claimed>
+void Collider::Impl::test_features(Worker& w, std::uint32_t t1, std::uint32_t t2,
+                                   Claimed&& claimed) const noexcept {
   const auto& A = asset->triangles[t1];
   const auto& B = asset->triangles[t2];
   // Vertex-face, both directions.
@@ -262,10 +186,8 @@ void Collider::Impl::process_triangle_pair(Worker& w, std::uint32_t t1,
       if (!vmoved[ip] && !tmov[face]) continue;
       if (!boxes_overlap(vbox[ip], tbox[face], opt.ccd.min_separation)) continue;
       bool owner = true;
-      for (std::uint32_t k = vt_offset[ip]; k < vt_offset[ip + 1] && owner; ++k) {
-        const std::uint32_t t = vt_list[k];
-        if (pair_key(t, face) < key && non_culled(t, face)) owner = false;
-      }
+      for (std::uint32_t k = vt_offset[ip]; k < vt_offset[ip + 1] && owner; ++k)
+        if (claimed(vt_list[k], face)) owner = false;
       if (owner) process_vertex_face(w, p, face);
       if (w.stop) return;
     }
@@ -285,13 +207,67 @@ void Collider::Impl::process_triangle_pair(Worker& w, std::uint32_t t1,
       for (std::uint32_t k1 = et_offset[e1]; k1 < et_offset[e1 + 1] && owner; ++k1) {
         for (std::uint32_t k2 = et_offset[e2]; k2 < et_offset[e2 + 1] && owner; ++k2) {
           const std::uint32_t u = et_list[k1], v = et_list[k2];
-          if (u != v && pair_key(u, v) < key && non_culled(u, v)) owner = false;
+          if (u != v && claimed(u, v)) owner = false;
         }
       }
       if (owner) process_edge_edge(w, e1, e2);
       if (w.stop) return;
     }
   }
+}
+
+void Collider::Impl::process_triangle_pair(Worker& w, std::uint32_t t1,
+                                           std::uint32_t t2) const noexcept {
+  if (!non_culled(t1, t2)) return;
+  if (rest_mode) {
+    rest_triangle_pair(w, t1, t2);
+    return;
+  }
+  ++w.stats.triangle_pairs;
+  const std::uint64_t key = pair_key(t1, t2);
+  test_features(w, t1, t2, [&](std::uint32_t u, std::uint32_t v) {
+    return pair_key(u, v) < key && non_culled(u, v);
+  });
+}
+
+// Contact closure (rvbc): orientation culling is exact for penetration, but when several
+// features touch one point at the earliest time (two vertices meeting head on), feature pairs
+// in culled triangle pairs can touch at that same time. Re-examines every orientation-culled
+// pair of triangles around the nodes of the contacts at `toi` (seeds: the caller's buffer and
+// each worker's best), testing each feature pair that no tested triangle pair holds, once.
+void Collider::Impl::close_contacts(Worker& w, double toi) noexcept {
+  closure_ring.clear();
+  auto add_ring = [&](const Contact& c) {
+    if (c.toi != toi) return;
+    for (std::uint32_t node : c.nodes) {
+      const std::uint32_t iv = surf_index[node];
+      for (std::uint32_t k = vt_offset[iv]; k < vt_offset[iv + 1]; ++k) {
+        const std::uint32_t t = vt_list[k];
+        if (!closure_mark[t]) {
+          closure_mark[t] = 1;
+          closure_ring.push_back(t);
+        }
+      }
+    }
+  };
+  for (std::size_t i = 0; i < w.out_written; ++i) add_ring(w.out[i]);
+  for (const Worker& other : workers)
+    if (other.has_best) add_ring(other.best);
+  const std::size_t ring = closure_ring.size();  // contacts found below add no seeds
+  for (std::size_t i = 0; i < ring; ++i) {
+    for (std::size_t j = i + 1; j < ring; ++j) {
+      const std::uint32_t t1 = closure_ring[i], t2 = closure_ring[j];
+      if (!orientation_culled(t1, t2)) continue;
+      ++w.stats.closure_pairs;
+      const std::uint64_t key = pair_key(t1, t2);
+      // Claimed: tested by the traversal (non-culled), or earlier in this closure.
+      test_features(w, t1, t2, [&](std::uint32_t u, std::uint32_t v) {
+        return non_culled(u, v) || (pair_key(u, v) < key && closure_mark[u] && closure_mark[v] &&
+                                    orientation_culled(u, v));
+      });
+    }
+  }
+  for (std::uint32_t t : closure_ring) closure_mark[t] = 0;
 }
 
 void Collider::Impl::leaf_pair(Worker& w, const TreeView& ta, std::uint32_t a, const TreeView& tb,
