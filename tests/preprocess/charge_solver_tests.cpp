@@ -256,7 +256,7 @@ TEST_CASE("Automatic solver choice follows size and memory", "[charge]") {
     CHECK_THROWS_WITH(compute_charge(mid.vertices, mid.triangles, o),
                       Catch::Contains("--solver fast"));
   }
-  SECTION("The automatic tolerance is 1e-6 below 10k triangles and 1e-7 from there on.") {
+  SECTION("The automatic tolerance is 1e-6 below 10k triangles and 1e-8 from there on.") {
     const ChargeResult r = compute_charge(mid.vertices, mid.triangles, o);
     CHECK(r.tolerance == 1e-6);
     CHECK(r.converged);
@@ -265,9 +265,9 @@ TEST_CASE("Automatic solver choice follows size and memory", "[charge]") {
     REQUIRE(large.triangles.size() >= 10000);
     const ChargeResult l = compute_charge(large.vertices, large.triangles, o);
     CHECK(l.solver == "fast");
-    CHECK(l.tolerance == 1e-7);
+    CHECK(l.tolerance == 1e-8);
     CHECK(l.converged);
-    CHECK(l.residual <= 1e-7);
+    CHECK(l.residual <= 1e-8);
     // Sphere: the exact density is uniform (faceting leaves a small ripple).
     for (const double d : l.density) CHECK(std::abs(d - 1.0) < 2e-2);
   }

@@ -41,9 +41,10 @@ enum class ChargePreconditioner {
 struct ChargeOptions {
   ChargeSolver solver = ChargeSolver::kAuto;
   /// Relative residual ||1 - M y|| / ||1|| at which the iterative solvers stop, in (0, 1),
-  /// or 0 for automatic: 1e-6 below 10,000 triangles, 1e-7 from there on. The density error
+  /// or 0 for automatic: 1e-6 below 10,000 triangles, 1e-8 from there on. The density error
   /// left by a given residual grows with N (at 100k triangles 1e-6 leaves ~1 % max error,
-  /// 1e-7 below 0.1 % on an ellipsoid; docs/charge.md). Negative values are rejected.
+  /// 1e-8 below 0.1 % on an ellipsoid and the CGAL elephant; docs/charge.md). Negative values
+  /// are rejected.
   double tolerance = 0.0;
   int max_iterations = 500;  ///< matrix products, iterative solvers only
   int restart = 80;          ///< GMRES restart length
