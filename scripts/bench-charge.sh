@@ -7,7 +7,7 @@
 # reference available. Takes several minutes (the references dominate).
 # Usage: scripts/bench-charge.sh [build-dir] [extra tetseg-bench-charge options]
 #        (default build-bench-charge; e.g. `--sizes 1k 5k --solvers gmres fast --repeat 5`;
-#        solver specs name[/jacobi|block|near][@tolerance|@auto][:order[:theta]];
+#        solver specs name[/jacobi|block|near|two][@tolerance|@auto][:order[:theta]];
 #        `--repeat N` keeps the fastest of N runs)
 set -euo pipefail
 cd "$(dirname "$0")/.."
