@@ -234,7 +234,7 @@ void add_build_command(CLI::App& root) {
       ->option_text("auto|direct|gmres|fast (auto)");
   cmd->add_option("--tolerance", args->options.charge.tolerance,
                   "Relative residual of the iterative charge solvers (0: 1e-6 below 10k "
-                  "triangles, 1e-7 above)")
+                  "triangles, 1e-8 above)")
       ->check(CLI::Range(0.0, 0.5))
       ->capture_default_str();
 

@@ -30,7 +30,7 @@ struct ChargeArgs {
   std::string equalization = "histogram";
   double tolerance = 0.0;  // 0: automatic (charge.hpp)
   int max_iterations = 500;
-  double theta = 0.5;
+  double theta = 0.0;  // 0: automatic (charge.hpp)
   int order = -1;
   int bins = 256;
 };
@@ -277,14 +277,15 @@ void add_charge_command(CLI::App& root) {
       ->check(CLI::IsMember({"auto", "direct", "gmres", "fast"}));
   cmd->add_option("--tolerance", args->tolerance,
                   "Relative residual of the iterative solvers (0: 1e-6 below 10k triangles, "
-                  "1e-7 above)")
+                  "1e-8 above)")
       ->check(CLI::Range(0.0, 0.5));
   cmd->add_option("--max-iterations", args->max_iterations, "Iteration cap")
       ->check(CLI::Range(1, 100000));
-  cmd->add_option("--theta", args->theta, "Fast solver opening parameter, (0, 1)")
-      ->check(CLI::Range(0.05, 0.95));
+  cmd->add_option("--theta", args->theta,
+                  "Fast solver opening parameter, (0, 1) (0: 0.5 below 10k triangles, 0.45 above)")
+      ->check(CLI::Range(0.0, 0.95));
   cmd->add_option("--order", args->order,
-                  "Fast solver expansion order (-1 = 6 below 10k triangles, else 8)")
+                  "Fast solver expansion order (-1 = 7 below 10k triangles, else 8)")
       ->check(CLI::Range(-1, 16));
   cmd->add_option("--equalize", args->equalization, "histogram (paper) | rank | log")
       ->check(CLI::IsMember({"histogram", "rank", "log"}));
