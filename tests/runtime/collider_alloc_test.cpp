@@ -4,7 +4,7 @@
 #include <catch2/catch.hpp>
 #include <random>
 
-#include "runtime/support/scenes.hpp"
+#include "common/synthetic_scenes.hpp"
 #include "support/allocation_probe.hpp"
 #include "tetseg/runtime/collider.hpp"
 

@@ -5,7 +5,7 @@
 #include <random>
 
 #include "runtime/support/compare.hpp"
-#include "runtime/support/scenes.hpp"
+#include "common/synthetic_scenes.hpp"
 #include "tetseg/runtime/collider.hpp"
 
 using namespace tetseg;

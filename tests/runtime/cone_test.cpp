@@ -9,7 +9,7 @@
 #include <catch2/catch.hpp>
 
 #include "support/compare.hpp"
-#include "support/scenes.hpp"
+#include "common/synthetic_scenes.hpp"
 #include "tetseg/runtime/collider.hpp"
 
 namespace tetseg::test {

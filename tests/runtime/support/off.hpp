@@ -6,7 +6,7 @@
 #include <string>
 #include <utility>
 
-#include "runtime/support/scenes.hpp"
+#include "common/synthetic_scenes.hpp"
 
 namespace tetseg::test {
 
