@@ -1,8 +1,8 @@
 #pragma once
-// Test support for the collider: closed surfaces over tet-node ids (surfaces of revolution:
+// Synthetic collider scenes without the preprocessor: closed surfaces over tet-node ids (surfaces of revolution:
 // sphere, dumbbell, pawn, mushroom), clusters cut along z with detector nodes on the axis,
 // per-cluster median-split BVHs, assets validated through tetseg::format, and deforming
-// frame sequences. Header-only; used by tests/runtime/collider*_test.cpp.
+// frame sequences. Header-only, runtime only; used by tetseg-scene and the collider tests.
 
 #include <algorithm>
 #include <array>
