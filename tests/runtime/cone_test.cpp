@@ -85,7 +85,7 @@ TEST_CASE("Normal-cone mode finds every contact of a bent dumbbell", "[collider]
 TEST_CASE("Normal-cone mode finds every contact of a twisted pawn folding onto itself",
           "[collider][cone]") {
   const Scene scene = make_axial_scene(pawn(16, 30), {1.0, 2.6}, {0.4, 1.6, 3.3});
-  const auto frames = make_frames(scene, 16, [](const P3& p, double t) {
+  const auto frames = make_frames(scene, 16, [](const tetseg::test::P3& p, double t) {
     const double tw = t * 2.5 * cone_smooth(p[2], 0.5, 3.5);
     const P3 q = {p[0] * std::cos(tw) - p[1] * std::sin(tw),
                   p[0] * std::sin(tw) + p[1] * std::cos(tw), p[2]};
@@ -124,6 +124,21 @@ TEST_CASE("Normal-cone mode has a stable name", "[collider][cone]") {
   CHECK(parse_collider_mode("cone", m));
   CHECK(m == ColliderMode::kCone);
   CHECK(std::string(to_string(ColliderMode::kCone)) == "cone");
+}
+
+TEST_CASE("Normal-cone mode lists every contact of two poles meeting head on",
+          "[collider][cone][closure]") {
+  // The degenerate meeting of docs/runtime.md (many feature pairs touch at one point at once).
+  const Surface s = sphere(1.0, 20, 11);
+  const Scene scene =
+      make_scene(s, std::vector<std::uint32_t>(s.tris.size(), 0), {{0.3, 0.1, 0.05}});
+  const auto frames = make_frames(scene, 16, [](const P3& p, double t) {
+    const double w = std::exp(-(p[0] * p[0] + p[1] * p[1]) / 0.3);
+    const double dz = (p[2] > 0 ? -1.0 : 1.0) * 1.3 * t * w * std::min(1.0, std::fabs(p[2]) * 4);
+    return P3{p[0], p[1], p[2] + dz};
+  });
+  const ConeReport r = compare_cone(scene, frames);
+  CHECK(r.contact_steps == 1);
 }
 
 }  // namespace tetseg::test
