@@ -357,11 +357,7 @@ TEST_CASE("Poles meeting head on: every brute-force contact at the earliest toi 
   for (int clusters : {1, 2}) {
     CAPTURE(clusters);
     const Scene scene = sphere_scene(clusters);
-    const auto frames = make_frames(scene, 16, [](const P3& p, double t) {
-      const double w = std::exp(-(p[0] * p[0] + p[1] * p[1]) / 0.3);
-      const double dz = (p[2] > 0 ? -1.0 : 1.0) * 1.3 * t * w * std::min(1.0, std::fabs(p[2]) * 4);
-      return P3{p[0], p[1], p[2] + dz};
-    });
+    const auto frames = make_frames(scene, 16, press_poles_head_on);
     const SequenceReport rep = compare_with_brute(scene, frames);
     REQUIRE(rep.contact_frames == 1);
     CHECK(rep.first_contacts.size() > 8);

@@ -132,11 +132,7 @@ TEST_CASE("Normal-cone mode lists every contact of two poles meeting head on",
   const Surface s = sphere(1.0, 20, 11);
   const Scene scene =
       make_scene(s, std::vector<std::uint32_t>(s.tris.size(), 0), {{0.3, 0.1, 0.05}});
-  const auto frames = make_frames(scene, 16, [](const P3& p, double t) {
-    const double w = std::exp(-(p[0] * p[0] + p[1] * p[1]) / 0.3);
-    const double dz = (p[2] > 0 ? -1.0 : 1.0) * 1.3 * t * w * std::min(1.0, std::fabs(p[2]) * 4);
-    return P3{p[0], p[1], p[2] + dz};
-  });
+  const auto frames = make_frames(scene, 16, press_poles_head_on);
   const ConeReport r = compare_cone(scene, frames);
   CHECK(r.contact_steps == 1);
 }

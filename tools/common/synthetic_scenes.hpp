@@ -266,6 +266,15 @@ inline std::vector<std::vector<double>> make_frames(const Scene& scene, int fram
   return out;
 }
 
+/// Pushes both poles of a unit sphere about the z axis straight towards the centre (a Gaussian
+/// dent of width 0.3 each): the poles meet head on at one point (t ~ 0.54 on sphere(1, 20, 11)),
+/// the degenerate meeting where many feature pairs touch at once (docs/runtime.md).
+inline P3 press_poles_head_on(const P3& p, double t) {
+  const double w = std::exp(-(p[0] * p[0] + p[1] * p[1]) / 0.3);
+  const double dz = (p[2] > 0 ? -1.0 : 1.0) * 1.3 * t * w * std::min(1.0, std::fabs(p[2]) * 4);
+  return P3{p[0], p[1], p[2] + dz};
+}
+
 /// Applies x -> scale * x + offset to every frame.
 inline std::vector<std::vector<double>> transformed(std::vector<std::vector<double>> frames,
                                                     double scale, const P3& offset) {
