@@ -267,7 +267,7 @@ inline std::vector<std::vector<double>> make_frames(const Scene& scene, int fram
 }
 
 /// Pushes both poles of a unit sphere about the z axis straight towards the centre (a Gaussian
-/// dent of width 0.3 each): the poles meet head on at one point (t ~ 0.54 on sphere(1, 20, 11)),
+/// dent of width 0.3 each): the poles meet head on at one point (t ~ 0.77 on sphere(1, 20, 11)),
 /// the degenerate meeting where many feature pairs touch at once (docs/runtime.md).
 inline P3 press_poles_head_on(const P3& p, double t) {
   const double w = std::exp(-(p[0] * p[0] + p[1] * p[1]) / 0.3);
