@@ -256,14 +256,10 @@ void write_gmsh41(const std::string& path, const TetMesh& mesh) {
   std::string out;
   out.reserve(256 + mesh.nodes.size() * 64 + mesh.tets.size() * 48);
   out += "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Entities\n0 0 0 1\n1";
-  for (double c : lo) {
-    out += ' ';
-    append_double(out, c);
-  }
-  for (double c : hi) {
-    out += ' ';
-    append_double(out, c);
-  }
+  out += ' ';
+  append_point(out, lo);
+  out += ' ';
+  append_point(out, hi);
   out += " 0 0\n$EndEntities\n$Nodes\n";
   const std::size_t n = mesh.nodes.size();
   out += "1 ";
@@ -278,11 +274,7 @@ void write_gmsh41(const std::string& path, const TetMesh& mesh) {
     out += '\n';
   }
   for (const Vec3& p : mesh.nodes) {
-    append_double(out, p[0]);
-    out += ' ';
-    append_double(out, p[1]);
-    out += ' ';
-    append_double(out, p[2]);
+    append_point(out, p);
     out += '\n';
   }
   out += "$EndNodes\n$Elements\n1 ";
@@ -313,10 +305,8 @@ void write_gmsh22_impl(const std::string& path, const TetMesh& mesh) {
   out += '\n';
   for (std::size_t i = 0; i < mesh.nodes.size(); ++i) {
     append_uint(out, i + 1);
-    for (double c : mesh.nodes[i]) {
-      out += ' ';
-      append_double(out, c);
-    }
+    out += ' ';
+    append_point(out, mesh.nodes[i]);
     out += '\n';
   }
   out += "$EndNodes\n$Elements\n";

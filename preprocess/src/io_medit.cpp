@@ -140,11 +140,7 @@ void write_medit(const std::string& path, const TetMesh& mesh) {
   append_uint(out, mesh.nodes.size());
   out += '\n';
   for (const Vec3& p : mesh.nodes) {
-    append_double(out, p[0]);
-    out += ' ';
-    append_double(out, p[1]);
-    out += ' ';
-    append_double(out, p[2]);
+    append_point(out, p);
     out += " 0\n";
   }
   out += "Tetrahedra\n";

@@ -141,10 +141,8 @@ void write_tetgen(const std::string& path, const TetMesh& mesh) {
   out += " 3 0 0\n";
   for (std::size_t i = 0; i < mesh.nodes.size(); ++i) {
     append_uint(out, i);
-    for (double c : mesh.nodes[i]) {
-      out += ' ';
-      append_double(out, c);
-    }
+    out += ' ';
+    append_point(out, mesh.nodes[i]);
     out += '\n';
   }
   write_text_file(stem + ".node", out);

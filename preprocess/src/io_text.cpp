@@ -165,6 +165,14 @@ void append_double(std::string& out, double value) {
   out.append(buffer, static_cast<std::size_t>(ptr - buffer));
 }
 
+void append_point(std::string& out, const Vec3& p) {
+  append_double(out, p[0]);
+  out += ' ';
+  append_double(out, p[1]);
+  out += ' ';
+  append_double(out, p[2]);
+}
+
 void append_uint(std::string& out, std::uint64_t value) {
   char buffer[24];
   const auto [ptr, ec] = std::to_chars(buffer, buffer + sizeof buffer, value);

@@ -62,6 +62,8 @@ bool parse_int(std::string_view token, std::int64_t& value);
 /// Appends the shortest decimal form of `value` that reads back exactly.
 void append_double(std::string& out, double value);
 void append_uint(std::string& out, std::uint64_t value);
+/// Appends "x y z" (append_double each, single spaces, nothing before or after).
+void append_point(std::string& out, const Vec3& p);
 
 /// Writes `text` to `path`; throws OutputError.
 void write_text_file(const std::string& path, const std::string& text);
