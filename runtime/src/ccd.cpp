@@ -441,6 +441,14 @@ CcdResult run_bisection(const Test& test, const CcdOptions& options) noexcept {
   return result;
 }
 
+/// The cheap interval filter over the whole step: false only when contact is excluded.
+/// Non-finite input may hit.
+template <typename Test>
+bool filter_may_hit(const Test& test) noexcept {
+  if (!all_finite(test.x0, 4) || !all_finite(test.x1, 4)) return true;
+  return !test.template excluded<Iv>(0.0, 1.0, Depth::kFilter);
+}
+
 }  // namespace
 
 CcdResult vertex_face_ccd(const Vec3d& p0, const Vec3d& a0, const Vec3d& b0, const Vec3d& c0,
@@ -464,8 +472,7 @@ bool vertex_face_ccd_filter(const Vec3d& p0, const Vec3d& a0, const Vec3d& b0, c
                             const CcdOptions& options) noexcept {
   const VertexFaceTest test{
       {&p0, &a0, &b0, &c0}, {&p1, &a1, &b1, &c1}, Separation(options.min_separation)};
-  if (!all_finite(test.x0, 4) || !all_finite(test.x1, 4)) return true;
-  return !test.excluded<Iv>(0.0, 1.0, Depth::kFilter);
+  return filter_may_hit(test);
 }
 
 bool edge_edge_ccd_filter(const Vec3d& a0, const Vec3d& b0, const Vec3d& c0, const Vec3d& d0,
@@ -473,8 +480,7 @@ bool edge_edge_ccd_filter(const Vec3d& a0, const Vec3d& b0, const Vec3d& c0, con
                           const CcdOptions& options) noexcept {
   const EdgeEdgeTest test{
       {&a0, &b0, &c0, &d0}, {&a1, &b1, &c1, &d1}, Separation(options.min_separation)};
-  if (!all_finite(test.x0, 4) || !all_finite(test.x1, 4)) return true;
-  return !test.excluded<Iv>(0.0, 1.0, Depth::kFilter);
+  return filter_may_hit(test);
 }
 
 }  // namespace tetseg
