@@ -209,6 +209,9 @@ struct Collider::Impl {
   void record(Worker& w, const Contact& c) const noexcept;
   bool traverse_self(Worker& w, const TreeView& tree) const noexcept;
   bool traverse_pair(Worker& w, const TreeView& ta, const TreeView& tb) const noexcept;
+  template <typename Live>
+  bool descend_pair(Worker& w, const TreeView& ta, const TreeView& tb, const StackItem& it,
+                    Live&& live, std::size_t& top) const noexcept;
   void leaf_pair(Worker& w, const TreeView& ta, std::uint32_t a, const TreeView& tb,
                  std::uint32_t b) const noexcept;
   void brute_vertex_faces(Worker& w, std::uint32_t i) const noexcept;

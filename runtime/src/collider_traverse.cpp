@@ -281,6 +281,21 @@ void Collider::Impl::leaf_pair(Worker& w, const TreeView& ta, std::uint32_t a, c
   }
 }
 
+// One step of a pair descent: a pair of leaves is processed, otherwise the live child pairs
+// are pushed. False when the stack has no room.
+template <typename Live>
+bool Collider::Impl::descend_pair(Worker& w, const TreeView& ta, const TreeView& tb,
+                                  const StackItem& it, Live&& live,
+                                  std::size_t& top) const noexcept {
+  if (ta.nodes[it.a].count > 0 && tb.nodes[it.b].count > 0) {
+    leaf_pair(w, ta, it.a, tb, it.b);
+    return true;
+  }
+  if (top + 2 > w.stack.size()) return false;
+  push_child_pairs(it, ta, tb, live, w.stack.data(), top);
+  return true;
+}
+
 bool Collider::Impl::traverse_pair(Worker& w, const TreeView& ta,
                                    const TreeView& tb) const noexcept {
   // Same-tree pairs come from traverse_self; here the roots of two trees. A pair is tested
@@ -296,14 +311,7 @@ bool Collider::Impl::traverse_pair(Worker& w, const TreeView& ta,
   while (top > 0 && !w.stop) {
     const StackItem it = w.stack[--top];
     ++w.stats.node_pairs_visited;
-    const format::BvhNode& na = ta.nodes[it.a];
-    const format::BvhNode& nb = tb.nodes[it.b];
-    if (na.count > 0 && nb.count > 0) {
-      leaf_pair(w, ta, it.a, tb, it.b);
-      continue;
-    }
-    if (top + 2 > w.stack.size()) return false;
-    push_child_pairs(it, ta, tb, live, w.stack.data(), top);
+    if (!descend_pair(w, ta, tb, it, live, top)) return false;
   }
   return true;
 }
@@ -352,14 +360,7 @@ bool Collider::Impl::traverse_self(Worker& w, const TreeView& t) const noexcept 
       w.stack[top++] = {nd.first, kNone};
       continue;
     }
-    const format::BvhNode& na = t.nodes[it.a];
-    const format::BvhNode& nb = t.nodes[it.b];
-    if (na.count > 0 && nb.count > 0) {
-      leaf_pair(w, t, it.a, t, it.b);
-      continue;
-    }
-    if (top + 2 > w.stack.size()) return false;
-    push_child_pairs(it, t, t, live_pair, w.stack.data(), top);
+    if (!descend_pair(w, t, t, it, live_pair, top)) return false;
   }
   return true;
 }
