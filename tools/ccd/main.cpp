@@ -295,8 +295,7 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    const int code = app.exit(e);
-    return code == 0 ? kExitOk : kExitUsage;
+    return parse_error_exit(app, e);  // help, version or usage error
   }
   try {
     if (queries->parsed()) return command_queries(dir, json, method, options);

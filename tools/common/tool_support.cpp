@@ -8,6 +8,8 @@
 
 #include <unistd.h>
 
+#include <CLI/CLI.hpp>
+
 namespace tetseg::tools {
 
 void print_error(const std::string& tool, const std::string& file, const std::string& message) {
@@ -70,6 +72,10 @@ std::string json_escape(const std::string& text) {
     }
   }
   return out;
+}
+
+int parse_error_exit(const CLI::App& app, const CLI::ParseError& error) {
+  return app.exit(error) == 0 ? kExitOk : kExitUsage;
 }
 
 }  // namespace tetseg::tools

@@ -7,6 +7,11 @@
 #include <string>
 #include <vector>
 
+namespace CLI {
+class App;
+class ParseError;
+}  // namespace CLI
+
 namespace tetseg::tools {
 
 /// Exit codes of every tetseg tool (docs/cli.md).
@@ -44,6 +49,10 @@ inline void write_file_atomic(const std::string& path, const std::string& text) 
 inline void write_file_atomic(const std::string& path, const std::vector<std::uint8_t>& bytes) {
   write_file_atomic(path, bytes.data(), bytes.size());
 }
+
+/// After a CLI11 parse error: prints help, the version or the usage error through `app`, and
+/// returns the tool's exit code (kExitOk for --help / --version, else kExitUsage).
+int parse_error_exit(const CLI::App& app, const CLI::ParseError& error);
 
 /// File name without directories ("a/b/c.mesh" -> "c.mesh").
 std::string base_name(const std::string& path);

@@ -40,8 +40,7 @@ int main(int argc, char** argv) {
               << " nodes -> " << out << '\n';
     return kExitOk;
   } catch (const CLI::ParseError& e) {
-    const int code = app.exit(e);
-    return code == 0 ? kExitOk : kExitUsage;
+    return parse_error_exit(app, e);  // help, version or usage error
   } catch (const ToolError& e) {
     print_error("tetseg-frames", e.file(), e.what());
     return e.code();

@@ -160,8 +160,7 @@ int main(int argc, char** argv) {
     app.parse(argc, argv);
     return run(asset_path, frames_path, mode, query, json, stop_at_contact, openmp);
   } catch (const CLI::ParseError& e) {
-    const int code = app.exit(e);
-    return code == 0 ? kExitOk : kExitUsage;
+    return parse_error_exit(app, e);  // help, version or usage error
   } catch (const ToolError& e) {
     print_error(kTool, e.file(), e.what());
     return e.code();

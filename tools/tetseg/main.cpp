@@ -24,8 +24,7 @@ int main(int argc, char** argv) {
     app.parse(argc, argv);
     return kExitOk;
   } catch (const CLI::ParseError& e) {
-    const int code = app.exit(e);  // prints help/version or the usage error
-    return code == 0 ? kExitOk : kExitUsage;
+    return parse_error_exit(app, e);  // help, version or usage error
   } catch (const ToolError& e) {
     print_error("tetseg", e.file(), e.what());
     return e.code();
