@@ -6,21 +6,15 @@
 #include <cmath>
 #include <sstream>
 
+#include "vec3_math.hpp"
+
 namespace tetseg::preprocess::charge_detail {
 namespace {
 
-inline Vec3 sub(const Vec3& a, const Vec3& b) {
-  return {a[0] - b[0], a[1] - b[1], a[2] - b[2]};
-}
-inline double dot(const Vec3& a, const Vec3& b) {
-  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-inline Vec3 cross(const Vec3& a, const Vec3& b) {
-  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-}
-inline double norm(const Vec3& a) {
-  return std::sqrt(dot(a, a));
-}
+using detail::cross;
+using detail::dot;
+using detail::norm;
+using detail::sub;
 
 }  // namespace
 

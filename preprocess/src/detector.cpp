@@ -7,23 +7,15 @@
 #include <utility>
 
 #include "tetseg/preprocess/segmentation.hpp"
+#include "vec3_math.hpp"
 
 namespace tetseg::preprocess {
 namespace {
 
-Vec3 sub(const Vec3& a, const Vec3& b) {
-  return {a[0] - b[0], a[1] - b[1], a[2] - b[2]};
-}
-Vec3 cross(const Vec3& a, const Vec3& b) {
-  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-}
-double dot(const Vec3& a, const Vec3& b) {
-  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-double distance2(const Vec3& a, const Vec3& b) {
-  const Vec3 d = sub(a, b);
-  return dot(d, d);
-}
+using detail::cross;
+using detail::distance2;
+using detail::dot;
+using detail::sub;
 
 /// The `k` interior nodes nearest `point`, ordered by (distance, id).
 std::vector<std::uint32_t> nearest_nodes(const std::vector<Vec3>& nodes,

@@ -20,12 +20,10 @@ using detail::kNone;
 
 namespace {
 
-Vec3 sub(const Vec3& a, const Vec3& b) {
-  return {a[0] - b[0], a[1] - b[1], a[2] - b[2]};
-}
-double dot(const Vec3& a, const Vec3& b) {
-  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
+using detail::cross;
+using detail::dot;
+using detail::norm;
+using detail::sub;
 
 /// A cluster under refinement: its triangles (ascending), its best detector and how many of its
 /// triangles that node sees positive.
@@ -63,16 +61,15 @@ class Refiner {
     double length_sum = 0.0;
     for (std::size_t t = 0; t < n; ++t) {
       const Tri& tri = surface.triangles[t];
-      const Vec3 u = sub(nodes[tri[1]], nodes[tri[0]]);
-      const Vec3 v = sub(nodes[tri[2]], nodes[tri[0]]);
-      Vec3 normal{u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
-      const double len = std::sqrt(dot(normal, normal));
+      Vec3 normal = cross(sub(nodes[tri[1]], nodes[tri[0]]), sub(nodes[tri[2]], nodes[tri[0]]));
+      const double len = norm(normal);
       if (len > 0.0)
         for (double& x : normal) x /= len;
       m_normal[t] = normal;
       for (int k = 0; k < 3; ++k)
         m_centroid[t][k] = (nodes[tri[0]][k] + nodes[tri[1]][k] + nodes[tri[2]][k]) / 3.0;
-      for (std::uint32_t k = 0; k < 3; ++k) length_sum += edge_length(3 * static_cast<std::uint32_t>(t) + k);
+      for (std::uint32_t k = 0; k < 3; ++k)
+        length_sum += m_mesh.length(nodes, 3 * static_cast<std::uint32_t>(t) + k);
     }
     m_mean_edge = n > 0 ? length_sum / static_cast<double>(3 * n) : 1.0;
   }
@@ -80,10 +77,6 @@ class Refiner {
   Segmentation run(const Segmentation& charge, RefinementCounts& counts);
 
  private:
-  double edge_length(std::uint32_t h) const {
-    const Vec3 d = sub(m_nodes[m_mesh.to(h)], m_nodes[m_mesh.from(h)]);
-    return std::sqrt(dot(d, d));
-  }
   /// Cut cost of the edge of half-edge h: length x (0.05 + mean equalised density) x concavity
   /// factor (1 on convex or flat edges, 1 / (1 + 8 bend) on concave ones, bend = (1 - n1.n2)/2).
   double cut_weight(std::uint32_t h) const {
@@ -97,7 +90,7 @@ class Refiner {
     const bool concave = dot(m_normal[a], sub(m_centroid[b], m_centroid[a])) > 0.0;
     const double bend = 0.5 * (1.0 - dot(m_normal[a], m_normal[b]));
     const double shape = concave ? 1.0 / (1.0 + 8.0 * bend) : 1.0;
-    return edge_length(h) * charge * shape;
+    return m_mesh.length(m_nodes, h) * charge * shape;
   }
 
   Part make_part(std::vector<std::uint32_t> triangles) {

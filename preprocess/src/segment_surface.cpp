@@ -44,12 +44,7 @@ class Segmenter {
   Segmentation run();
 
  private:
-  double edge_length(std::uint32_t h) const {
-    const Vec3& a = m_nodes[m_mesh.from(h)];
-    const Vec3& b = m_nodes[m_mesh.to(h)];
-    return std::sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) +
-                     (a[2] - b[2]) * (a[2] - b[2]));
-  }
+  double edge_length(std::uint32_t h) const { return m_mesh.length(m_nodes, h); }
   void set_flags(const std::vector<std::uint32_t>& tris, std::uint8_t value) {
     for (std::uint32_t t : tris) m_in_set[t] = value;
   }

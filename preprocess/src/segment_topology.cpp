@@ -42,12 +42,6 @@ std::vector<Contour> trace_contours(const HalfEdges& mesh, const std::vector<Vec
     const std::uint32_t t = mesh.neighbor(h);
     return t == kNone || !in_set[t];
   };
-  auto length_of = [&](std::uint32_t h) {
-    const Vec3& a = nodes[mesh.from(h)];
-    const Vec3& b = nodes[mesh.to(h)];
-    return std::sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) +
-                     (a[2] - b[2]) * (a[2] - b[2]));
-  };
   // The border half-edge that follows h: rotate around its head through the triangles
   // outside the set until the first triangle inside it.
   auto follow = [&](std::uint32_t h) -> std::uint32_t {
@@ -82,7 +76,7 @@ std::vector<Contour> trace_contours(const HalfEdges& mesh, const std::vector<Vec
     while (true) {
       visited[s] = 1;
       c.half_edges.push_back(h);
-      c.length += length_of(h);
+      c.length += mesh.length(nodes, h);
       const std::uint32_t nh = follow(h);
       if (nh == start) break;
       s = nh == kNone ? border.size() : slot(nh);

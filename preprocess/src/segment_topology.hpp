@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "tetseg/preprocess/mesh.hpp"
+#include "vec3_math.hpp"
 
 namespace tetseg::preprocess::detail {
 
@@ -27,6 +28,10 @@ class HalfEdges {
   std::uint32_t to(std::uint32_t h) const { return (*m_tris)[h / 3][(h % 3 + 1) % 3]; }
   static std::uint32_t next(std::uint32_t h) { return h - h % 3 + (h % 3 + 1) % 3; }
   static std::uint32_t prev(std::uint32_t h) { return h - h % 3 + (h % 3 + 2) % 3; }
+  /// Length of the edge of half-edge h at positions `nodes`.
+  double length(const std::vector<Vec3>& nodes, std::uint32_t h) const {
+    return distance_between(nodes[from(h)], nodes[to(h)]);
+  }
   /// Triangle across half-edge h, or kNone.
   std::uint32_t neighbor(std::uint32_t h) const {
     return m_twin[h] == kNone ? kNone : m_twin[h] / 3;

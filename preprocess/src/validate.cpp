@@ -10,6 +10,7 @@
 
 #include "tetseg/preprocess/surface.hpp"
 #include "validate_internal.hpp"
+#include "vec3_math.hpp"
 
 namespace tetseg::preprocess {
 namespace {
@@ -37,11 +38,6 @@ struct UnionFind {
   }
   std::vector<std::uint32_t> parent;
 };
-
-double dist(const Vec3& a, const Vec3& b) {
-  return std::sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) +
-                   (a[2] - b[2]) * (a[2] - b[2]));
-}
 
 void check_finite(const std::vector<Vec3>& points, const std::string& file, const char* noun) {
   for (std::size_t i = 0; i < points.size(); ++i)
@@ -244,7 +240,7 @@ void validate_tet_mesh(const TetMesh& mesh, const Surface& surface, const std::s
     const double det = u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0]) +
                        u[2] * (v[0] * w[1] - v[1] * w[0]);
     const double edge =
-        std::max({dist(a, b), dist(a, c), dist(a, d), dist(b, c), dist(b, d), dist(c, d)});
+        std::max({detail::distance_between(a, b), detail::distance_between(a, c), detail::distance_between(a, d), detail::distance_between(b, c), detail::distance_between(b, d), detail::distance_between(c, d)});
     if (!(std::abs(det) > kDegenerateVolume * edge * edge * edge)) {
       if (degenerate++ == 0) first_degenerate = t;
     } else if (det < 0) {
@@ -315,7 +311,7 @@ void detail::validate_closed_surface(const TriangleMesh& mesh, const std::string
     const double x = u[1] * v[2] - u[2] * v[1];
     const double y = u[2] * v[0] - u[0] * v[2];
     const double z = u[0] * v[1] - u[1] * v[0];
-    const double edge = std::max({dist(a, b), dist(a, c), dist(b, c)});
+    const double edge = std::max({detail::distance_between(a, b), detail::distance_between(a, c), detail::distance_between(b, c)});
     if (tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2] ||
         !(std::sqrt(x * x + y * y + z * z) > kDegenerateArea * edge * edge)) {
       if (zero_area++ == 0) first_zero = t;
