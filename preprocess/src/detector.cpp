@@ -177,6 +177,7 @@ Detector best_detector(const std::vector<Vec3>& nodes, const Surface& surface,
     }
   }
   det.node = best_node;
+  det.positive_triangles = best_count;
   det.rest_positive_fraction =
       static_cast<float>(static_cast<double>(best_count) / static_cast<double>(ids.size()));
   return det;

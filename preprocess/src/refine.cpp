@@ -25,21 +25,20 @@ using detail::dot;
 using detail::norm;
 using detail::sub;
 
-/// A cluster under refinement: its triangles (ascending), its best detector and how many of its
-/// triangles that node sees positive.
+/// A cluster under refinement: its triangles (ascending) and its best detector.
 struct Part {
   std::vector<std::uint32_t> triangles;
   Detector detector;
-  std::uint32_t positive = 0;
   std::uint32_t serial = 0;  ///< unique per part contents (merge cache key)
   bool settled = false;      ///< a split was tried and rejected
 
   std::uint32_t non_positive() const {
-    return static_cast<std::uint32_t>(triangles.size()) - positive;
+    return static_cast<std::uint32_t>(triangles.size()) - detector.positive_triangles;
   }
   double visibility() const {
     return triangles.empty() ? 1.0
-                             : static_cast<double>(positive) / static_cast<double>(triangles.size());
+                             : static_cast<double>(detector.positive_triangles) /
+                                   static_cast<double>(triangles.size());
   }
 };
 
@@ -98,8 +97,6 @@ class Refiner {
     Part part;
     part.triangles = std::move(triangles);
     part.detector = best_detector(m_nodes, m_surface, part.triangles, DetectorStrategy::kVisibility);
-    part.positive = count_positive_triangles(m_nodes, m_surface.triangles, part.triangles,
-                                             m_nodes[part.detector.node]);
     part.serial = m_next_serial++;
     return part;
   }

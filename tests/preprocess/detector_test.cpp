@@ -109,6 +109,8 @@ TEST_CASE("On an L-shaped solid the visibility strategy finds a node that sees e
     CHECK(d[0].rest_positive_fraction ==
           Approx(double(brute_positive(ell, ids, ell.nodes[paper_node])) / ids.size()));
     CHECK(d[0].rest_positive_fraction < 1.0f);
+    CHECK(d[0].positive_triangles == brute_positive(ell, ids, ell.nodes[paper_node]));
+    CHECK(d[0].triangle_count == ids.size());
   }
   SECTION("The visibility strategy returns an interior node that sees all triangles positive.") {
     const auto d =
@@ -117,6 +119,7 @@ TEST_CASE("On an L-shaped solid the visibility strategy finds a node that sees e
                              d[0].node));
     CHECK(brute_positive(ell, ids, ell.nodes[d[0].node]) == ids.size());
     CHECK(d[0].rest_positive_fraction == 1.0f);
+    CHECK(d[0].positive_triangles == ids.size());
   }
 }
 

@@ -79,6 +79,7 @@ struct Detector {
   std::uint32_t node = 0;               ///< interior tet-mesh node id
   float rest_positive_fraction = 0.0f;  ///< share of the cluster's triangles positive at rest
   std::uint32_t triangle_count = 0;     ///< triangles of the cluster
+  std::uint32_t positive_triangles = 0;  ///< of those, positive from `node` at rest
 };
 
 /// Candidate counts of the visibility strategy (docs/segmentation.md, "Detector nodes").
