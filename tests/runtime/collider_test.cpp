@@ -4,43 +4,14 @@
 #include <cmath>
 #include <random>
 
-#include "runtime/support/compare.hpp"
 #include "common/synthetic_scenes.hpp"
+#include "runtime/support/compare.hpp"
 #include "tetseg/runtime/collider.hpp"
 
 using namespace tetseg;
 using namespace tetseg::test;
 
 namespace {
-
-double smoothstep(double x, double a, double b) {
-  const double s = std::clamp((x - a) / (b - a), 0.0, 1.0);
-  return s * s * (3 - 2 * s);
-}
-
-/// Pushes both poles of a sphere towards the centre until the dents meet (t ~ 0.77). The dents
-/// are off-centre so that the first contact is generic (the head-on meeting of the poles is
-/// its own test below).
-P3 press(const P3& p, double t) {
-  const double cx = p[2] > 0 ? 0.15 : -0.1, cy = p[2] > 0 ? 0.1 : -0.05;
-  const double w = std::exp(-((p[0] - cx) * (p[0] - cx) + (p[1] - cy) * (p[1] - cy)) / 0.3);
-  const double dz = (p[2] > 0 ? -1.0 : 1.0) * 1.3 * t * w * std::min(1.0, std::fabs(p[2]) * 4);
-  return {p[0] + 0.15 * dz, p[1] + 0.05 * dz, p[2] + dz};
-}
-
-/// Rotates everything above the dumbbell's neck about the x axis, blended over the neck.
-P3 bend(const P3& p, double t, double max_angle, double z0, double z1, double pivot_z) {
-  const double a = t * max_angle * smoothstep(p[2], z0, z1);
-  const double y = p[1], z = p[2] - pivot_z;
-  return {p[0], y * std::cos(a) - z * std::sin(a), pivot_z + y * std::sin(a) + z * std::cos(a)};
-}
-
-P3 twist_bend(const P3& p, double t) {
-  const double tw = t * 2.5 * smoothstep(p[2], 0.5, 3.5);
-  const P3 q = {p[0] * std::cos(tw) - p[1] * std::sin(tw),
-                p[0] * std::sin(tw) + p[1] * std::cos(tw), p[2]};
-  return bend(q, t, 3.0, 0.8, 2.6, 1.0);
-}
 
 struct Waves {
   std::vector<std::array<double, 7>> w;  // k (3), phase, direction (3)
@@ -81,7 +52,7 @@ TEST_CASE("Radial-view culling finds the first contact of a pressed sphere", "[c
   for (int clusters : {1, 2}) {
     CAPTURE(clusters);
     const Scene scene = sphere_scene(clusters);
-    const auto frames = make_frames(scene, 16, press);
+    const auto frames = make_frames(scene, 16, press_poles);
     const SequenceReport rep = compare_with_brute(scene, frames);
     REQUIRE(rep.contact_frames == 1);
     CHECK(rep.rvbc_tests < rep.brute_tests);
@@ -91,8 +62,8 @@ TEST_CASE("Radial-view culling finds the first contact of a pressed sphere", "[c
 TEST_CASE("Radial-view culling finds the bells of a bent dumbbell touching, wedge tip included",
           "[collider][rvbc][wedge]") {
   const Scene scene = dumbbell_scene();
-  const auto frames =
-      make_frames(scene, 16, [](const P3& p, double t) { return bend(p, t, 2.6, -0.5, 0.5, 0.0); });
+  const auto frames = make_frames(
+      scene, 16, [](const P3& p, double t) { return bend_about_x(p, t, 2.6, -0.5, 0.5, 0.0); });
   const SequenceReport rep = compare_with_brute(scene, frames);
   REQUIRE(rep.contact_frames == 1);
   CHECK(rep.orientation_culled > 0);
@@ -158,8 +129,8 @@ TEST_CASE("A drooping mushroom rim touching its base agrees with brute force",
 TEST_CASE("Results do not depend on translation far from the origin or on scale",
           "[collider][numerics]") {
   const Scene scene = dumbbell_scene();
-  const auto base =
-      make_frames(scene, 12, [](const P3& p, double t) { return bend(p, t, 2.6, -0.5, 0.5, 0.0); });
+  const auto base = make_frames(
+      scene, 12, [](const P3& p, double t) { return bend_about_x(p, t, 2.6, -0.5, 0.5, 0.0); });
   const auto offset = GENERATE(P3{0, 0, 0}, P3{1e6, -1e6, 1e6});
   const double scale = GENERATE(1e-4, 1.0, 1e4);
   CAPTURE(offset[0], scale);
@@ -200,8 +171,8 @@ TEST_CASE("Rigid motions and zero motion report no contact", "[collider][numeric
   SECTION("A still cluster skips its intra-cluster work but contacts with it are still found.") {
     const Scene db = dumbbell_scene();
     // Only the top bell moves (bend pivot above the neck): bottom bell cluster is still.
-    const auto frames =
-        make_frames(db, 16, [](const P3& p, double t) { return bend(p, t, 2.6, 0.6, 0.9, 0.6); });
+    const auto frames = make_frames(
+        db, 16, [](const P3& p, double t) { return bend_about_x(p, t, 2.6, 0.6, 0.9, 0.6); });
     Collider c(db.asset);
     REQUIRE(c.step(frames[0].data(), frames[1].data()) == ColliderStatus::kOk);
     c.earliest_toi();
@@ -248,7 +219,7 @@ TEST_CASE("Invalid step input is rejected with a status", "[collider][api]") {
 TEST_CASE("Contacts are truncated to the caller's capacity and the count is reported",
           "[collider][api]") {
   const Scene scene = sphere_scene(1);
-  const auto frames = make_frames(scene, 3, press);  // one big step through the centre
+  const auto frames = make_frames(scene, 3, press_poles);  // one big step through the centre
   Collider c(scene.asset);
   REQUIRE(c.step(frames[0].data(), frames[2].data()) == ColliderStatus::kOk);
   const ContactsResult all = c.contacts(nullptr, 0);
@@ -273,7 +244,7 @@ TEST_CASE("A self-intersecting start state is reported", "[collider][rest]") {
   const RestCheck clean = c.check_rest_intersection(scene.rest.data(), scene.rest.size());
   REQUIRE(clean.status == ColliderStatus::kOk);
   CHECK_FALSE(clean.intersecting);
-  const auto frames = make_frames(scene, 2, press);  // poles pushed through each other
+  const auto frames = make_frames(scene, 2, press_poles);  // poles pushed through each other
   const RestCheck bad = c.check_rest_intersection(frames[1].data(), frames[1].size());
   REQUIRE(bad.status == ColliderStatus::kOk);
   CHECK(bad.intersecting);
@@ -292,8 +263,8 @@ TEST_CASE("Degenerate chain BVHs as deep as the cluster is large are traversed c
     cluster_of[t] = s.verts[s.tris[t][0]][2] > 0 ? 1 : 0;
   const Scene chain = make_scene(s, cluster_of, {{0, 0, -1.6}, {0, 0, 1.6}}, 0);
   const Scene split = make_scene(s, cluster_of, {{0, 0, -1.6}, {0, 0, 1.6}}, 2);
-  const auto frames =
-      make_frames(chain, 12, [](const P3& p, double t) { return bend(p, t, 2.6, -0.5, 0.5, 0.0); });
+  const auto frames = make_frames(
+      chain, 12, [](const P3& p, double t) { return bend_about_x(p, t, 2.6, -0.5, 0.5, 0.0); });
   const SequenceReport rep = compare_with_brute(chain, frames);
   CHECK(rep.contact_frames == 1);
   // Same contacts as with well-formed BVHs, step by step.
@@ -313,8 +284,8 @@ TEST_CASE("Degenerate chain BVHs as deep as the cluster is large are traversed c
 TEST_CASE("A minimum separation finds contacts no later and no fewer than exact contact",
           "[collider][api]") {
   const Scene scene = dumbbell_scene();
-  const auto frames =
-      make_frames(scene, 12, [](const P3& p, double t) { return bend(p, t, 2.6, -0.5, 0.5, 0.0); });
+  const auto frames = make_frames(
+      scene, 12, [](const P3& p, double t) { return bend_about_x(p, t, 2.6, -0.5, 0.5, 0.0); });
   for (ColliderMode mode : {ColliderMode::kBvh, ColliderMode::kBrute}) {
     CAPTURE(to_string(mode));
     ColliderOptions exact_options, near_options;

@@ -8,24 +8,12 @@
 
 #include <catch2/catch.hpp>
 
-#include "support/compare.hpp"
 #include "common/synthetic_scenes.hpp"
+#include "support/compare.hpp"
 #include "tetseg/runtime/collider.hpp"
 
 namespace tetseg::test {
 namespace {
-
-double cone_smooth(double x, double a, double b) {
-  const double s = std::clamp((x - a) / (b - a), 0.0, 1.0);
-  return s * s * (3 - 2 * s);
-}
-
-/// Bends everything above z0..z1 about the x axis through pivot_z, up to `max_angle`.
-P3 cone_bend(const P3& p, double t, double max_angle, double z0, double z1, double pivot_z) {
-  const double a = t * max_angle * cone_smooth(p[2], z0, z1);
-  const double y = p[1], z = p[2] - pivot_z;
-  return {p[0], y * std::cos(a) - z * std::sin(a), pivot_z + y * std::sin(a) + z * std::cos(a)};
-}
 
 struct ConeReport {
   int steps = 0, contact_steps = 0;
@@ -75,7 +63,7 @@ ConeReport compare_cone(const Scene& scene, const std::vector<std::vector<double
 TEST_CASE("Normal-cone mode finds every contact of a bent dumbbell", "[collider][cone]") {
   const Scene scene = make_axial_scene(dumbbell(16, 26), {-0.6, 0.6}, {-1.6, 0.0, 1.6});
   const auto frames = make_frames(
-      scene, 16, [](const P3& p, double t) { return cone_bend(p, t, 2.6, -0.5, 0.5, 0.0); });
+      scene, 16, [](const P3& p, double t) { return bend_about_x(p, t, 2.6, -0.5, 0.5, 0.0); });
   const ConeReport r = compare_cone(scene, frames);
   CHECK(r.contact_steps == 1);  // the bells meet within the sequence
   CHECK(r.cone_culled > 0);     // patches were proven free and skipped
@@ -85,12 +73,7 @@ TEST_CASE("Normal-cone mode finds every contact of a bent dumbbell", "[collider]
 TEST_CASE("Normal-cone mode finds every contact of a twisted pawn folding onto itself",
           "[collider][cone]") {
   const Scene scene = make_axial_scene(pawn(16, 30), {1.0, 2.6}, {0.4, 1.6, 3.3});
-  const auto frames = make_frames(scene, 16, [](const tetseg::test::P3& p, double t) {
-    const double tw = t * 2.5 * cone_smooth(p[2], 0.5, 3.5);
-    const P3 q = {p[0] * std::cos(tw) - p[1] * std::sin(tw),
-                  p[0] * std::sin(tw) + p[1] * std::cos(tw), p[2]};
-    return cone_bend(q, t, 3.0, 0.8, 2.6, 1.0);
-  });
+  const auto frames = make_frames(scene, 16, twist_bend);
   const ConeReport r = compare_cone(scene, frames);
   CHECK(r.contact_steps == 1);
   CHECK(r.cone_culled > 0);

@@ -1,8 +1,8 @@
 #pragma once
-// Synthetic collider scenes without the preprocessor: closed surfaces over tet-node ids (surfaces of revolution:
-// sphere, dumbbell, pawn, mushroom), clusters cut along z with detector nodes on the axis,
-// per-cluster median-split BVHs, assets validated through tetseg::format, and deforming
-// frame sequences. Header-only, runtime only; used by tetseg-scene and the collider tests.
+// Synthetic collider scenes without the preprocessor: closed surfaces over tet-node ids (surfaces
+// of revolution: sphere, dumbbell, pawn, mushroom), clusters cut along z with detector nodes on the
+// axis, per-cluster median-split BVHs, assets validated through tetseg::format, and deforming frame
+// sequences. Header-only, runtime only; used by tetseg-scene and the collider tests.
 
 #include <algorithm>
 #include <array>
@@ -26,6 +26,18 @@ struct Surface {
   std::vector<P3> verts;
   std::vector<format::Triangle> tris;
 };
+
+/// Makes the signed volume positive (outward winding).
+inline void orient_outward(Surface& s) {
+  double vol = 0;
+  for (const auto& t : s.tris) {
+    const P3 &a = s.verts[t[0]], &b = s.verts[t[1]], &c = s.verts[t[2]];
+    vol += a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
+           a[2] * (b[0] * c[1] - b[1] * c[0]);
+  }
+  if (vol < 0)
+    for (auto& t : s.tris) std::swap(t[1], t[2]);
+}
 
 /// Closed surface of revolution about the z axis. `profile` = (r, z) from the bottom pole
 /// (r = 0) to the top pole (r = 0); `segments` vertices per ring; ring i is rotated by
@@ -55,15 +67,7 @@ inline Surface revolve(const std::vector<std::array<double, 2>>& profile, int se
     }
   }
   for (int j = 0; j < segments; ++j) s.tris.push_back({top, ring(m - 2, j), ring(m - 2, j + 1)});
-  // Orientation: make the signed volume positive.
-  double vol = 0;
-  for (const auto& t : s.tris) {
-    const P3 &a = s.verts[t[0]], &b = s.verts[t[1]], &c = s.verts[t[2]];
-    vol += a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
-           a[2] * (b[0] * c[1] - b[1] * c[0]);
-  }
-  if (vol < 0)
-    for (auto& t : s.tris) std::swap(t[1], t[2]);
+  orient_outward(s);
   return s;
 }
 
@@ -264,6 +268,39 @@ inline std::vector<std::vector<double>> make_frames(const Scene& scene, int fram
     }
   }
   return out;
+}
+
+/// 0 below a, 1 above b, cubic Hermite blend between.
+inline double smoothstep(double x, double a, double b) {
+  const double s = std::clamp((x - a) / (b - a), 0.0, 1.0);
+  return s * s * (3 - 2 * s);
+}
+
+/// Rotates everything above z0..z1 about the x axis through pivot_z, up to `max_angle` radians
+/// at t = 1, blended over z0..z1.
+inline P3 bend_about_x(const P3& p, double t, double max_angle, double z0, double z1,
+                       double pivot_z) {
+  const double a = t * max_angle * smoothstep(p[2], z0, z1);
+  const double y = p[1], z = p[2] - pivot_z;
+  return {p[0], y * std::cos(a) - z * std::sin(a), pivot_z + y * std::sin(a) + z * std::cos(a)};
+}
+
+/// Pushes both poles of a sphere towards the centre until the dents meet (t ~ 0.77). The dents
+/// are off-centre so that the first contact is generic (press_poles_head_on is the degenerate
+/// variant).
+inline P3 press_poles(const P3& p, double t) {
+  const double cx = p[2] > 0 ? 0.15 : -0.1, cy = p[2] > 0 ? 0.1 : -0.05;
+  const double w = std::exp(-((p[0] - cx) * (p[0] - cx) + (p[1] - cy) * (p[1] - cy)) / 0.3);
+  const double dz = (p[2] > 0 ? -1.0 : 1.0) * 1.3 * t * w * std::min(1.0, std::fabs(p[2]) * 4);
+  return {p[0] + 0.15 * dz, p[1] + 0.05 * dz, p[2] + dz};
+}
+
+/// Twists a pawn of height ~4 about z (2.5 rad at the top) and bends its upper part over.
+inline P3 twist_bend(const P3& p, double t) {
+  const double tw = t * 2.5 * smoothstep(p[2], 0.5, 3.5);
+  const P3 q = {p[0] * std::cos(tw) - p[1] * std::sin(tw),
+                p[0] * std::sin(tw) + p[1] * std::cos(tw), p[2]};
+  return bend_about_x(q, t, 3.0, 0.8, 2.6, 1.0);
 }
 
 /// Pushes both poles of a unit sphere about the z axis straight towards the centre (a Gaussian

@@ -20,31 +20,6 @@ namespace {
 using namespace tetseg::test;
 using namespace tetseg::tools;
 
-double smoothstep(double x, double a, double b) {
-  const double s = std::clamp((x - a) / (b - a), 0.0, 1.0);
-  return s * s * (3 - 2 * s);
-}
-
-P3 bend(const P3& p, double t, double max_angle, double z0, double z1, double pivot_z) {
-  const double a = t * max_angle * smoothstep(p[2], z0, z1);
-  const double y = p[1], z = p[2] - pivot_z;
-  return {p[0], y * std::cos(a) - z * std::sin(a), pivot_z + y * std::sin(a) + z * std::cos(a)};
-}
-
-P3 press(const P3& p, double t) {
-  const double cx = p[2] > 0 ? 0.15 : -0.1, cy = p[2] > 0 ? 0.1 : -0.05;
-  const double w = std::exp(-((p[0] - cx) * (p[0] - cx) + (p[1] - cy) * (p[1] - cy)) / 0.3);
-  const double dz = (p[2] > 0 ? -1.0 : 1.0) * 1.3 * t * w * std::min(1.0, std::fabs(p[2]) * 4);
-  return {p[0] + 0.15 * dz, p[1] + 0.05 * dz, p[2] + dz};
-}
-
-P3 twist_bend(const P3& p, double t) {
-  const double tw = t * 2.5 * smoothstep(p[2], 0.5, 3.5);
-  const P3 q = {p[0] * std::cos(tw) - p[1] * std::sin(tw),
-                p[0] * std::sin(tw) + p[1] * std::cos(tw), p[2]};
-  return bend(q, t, 3.0, 0.8, 2.6, 1.0);
-}
-
 P3 waves(const P3& p, double t) {
   // Four fixed sinusoidal displacement fields (seedless, reproducible everywhere).
   static const double w[4][7] = {{2.1, -1.3, 0.7, 0.3, 0.6, -0.2, 0.5},
@@ -109,12 +84,12 @@ int main(int argc, char** argv) {
       scene = make_axial_scene(s, {1.0, 2.6}, {0.4, 1.6, 3.3});
       if (motion.empty()) motion = "twist";
     }
-    Deformation map =
-        motion == "press"   ? Deformation(press)
-        : motion == "twist" ? Deformation(twist_bend)
-        : motion == "waves"
-            ? Deformation(waves)
-            : Deformation([](const P3& p, double t) { return bend(p, t, 2.6, -0.5, 0.5, 0.0); });
+    Deformation map = motion == "press"   ? Deformation(press_poles)
+                      : motion == "twist" ? Deformation(twist_bend)
+                      : motion == "waves" ? Deformation(waves)
+                                          : Deformation([](const P3& p, double t) {
+                                              return bend_about_x(p, t, 2.6, -0.5, 0.5, 0.0);
+                                            });
     const auto frames = make_frames(scene, frame_count, map);
     tetseg::FrameSequence seq;
     seq.node_count = scene.asset.node_count();

@@ -45,18 +45,6 @@ inline bool closed_and_consistent(const Surface& s) {
   return true;
 }
 
-/// Makes the signed volume positive (outward winding).
-inline void orient_outward(Surface& s) {
-  double vol = 0;
-  for (const auto& t : s.tris) {
-    const P3 &a = s.verts[t[0]], &b = s.verts[t[1]], &c = s.verts[t[2]];
-    vol += a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
-           a[2] * (b[0] * c[1] - b[1] * c[0]);
-  }
-  if (vol < 0)
-    for (auto& t : s.tris) std::swap(t[1], t[2]);
-}
-
 /// `k` clusters as slabs of equal triangle count along the longest axis (by centroid); each
 /// detector is the mean of its slab's centroids (any point off the surface is sound).
 inline Scene slab_scene(const Surface& s, std::uint32_t k) {
