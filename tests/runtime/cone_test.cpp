@@ -23,13 +23,9 @@ struct ConeReport {
 /// Steps until (and including) the first contact: cone equals brute (any, earliest, every
 /// contact); later steps may start self-intersecting and are not compared.
 ConeReport compare_cone(const Scene& scene, const std::vector<std::vector<double>>& frames) {
-  ColliderOptions o;
-  o.mode = ColliderMode::kCone;
-  Collider cone(scene.asset, o);
-  o.mode = ColliderMode::kBvh;
-  Collider bvh(scene.asset, o);
-  o.mode = ColliderMode::kBrute;
-  Collider brute(scene.asset, o);
+  Collider cone = collider_for(scene, ColliderMode::kCone);
+  Collider bvh = collider_for(scene, ColliderMode::kBvh);
+  Collider brute = collider_for(scene, ColliderMode::kBrute);
   REQUIRE(cone.status() == ColliderStatus::kOk);
   ConeReport rep;
   for (std::size_t f = 0; f + 1 < frames.size(); ++f) {

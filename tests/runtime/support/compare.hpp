@@ -24,6 +24,13 @@ inline std::string describe(const Contact& c) {
   return s + "toi " + std::to_string(c.toi);
 }
 
+/// A collider in `mode` with default options over the scene's asset (which must outlive it).
+inline Collider collider_for(const Scene& scene, ColliderMode mode) {
+  ColliderOptions options;
+  options.mode = mode;
+  return Collider(scene.asset, options);
+}
+
 struct StepAnswer {
   bool any = false;
   EarliestContact earliest;
@@ -100,13 +107,9 @@ inline bool in_culled_pair(const Collider& rvbc, const Scene& scene, const Conta
 inline SequenceReport compare_with_brute(const Scene& scene,
                                          const std::vector<std::vector<double>>& frames,
                                          bool stop_at_first_contact = true) {
-  ColliderOptions o;
-  o.mode = ColliderMode::kRvbc;
-  Collider rvbc(scene.asset, o);
-  o.mode = ColliderMode::kBvh;
-  Collider bvh(scene.asset, o);
-  o.mode = ColliderMode::kBrute;
-  Collider brute(scene.asset, o);
+  Collider rvbc = collider_for(scene, ColliderMode::kRvbc);
+  Collider bvh = collider_for(scene, ColliderMode::kBvh);
+  Collider brute = collider_for(scene, ColliderMode::kBrute);
   REQUIRE(rvbc.status() == ColliderStatus::kOk);
   SequenceReport rep;
   constexpr double kTol = 1e-9;
