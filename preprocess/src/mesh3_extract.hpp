@@ -9,6 +9,7 @@
 #include <unordered_map>
 
 #include "meshing_internal.hpp"
+#include "vec3_math.hpp"
 
 namespace tetseg::preprocess::detail {
 
@@ -36,11 +37,7 @@ TetMesh c3t3_to_tet_mesh(const C3t3& c3t3) {
     const Vec3& b = mesh.nodes[tet[1]];
     const Vec3& c2 = mesh.nodes[tet[2]];
     const Vec3& d = mesh.nodes[tet[3]];
-    const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
-    const double v[3] = {c2[0] - a[0], c2[1] - a[1], c2[2] - a[2]};
-    const double w[3] = {d[0] - a[0], d[1] - a[1], d[2] - a[2]};
-    const double det = u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0]) +
-                       u[2] * (v[0] * w[1] - v[1] * w[0]);
+    const double det = detail::tet_det(a, b, c2, d);
     if (det < 0) std::swap(tet[2], tet[3]);
     mesh.tets.push_back(tet);
   }

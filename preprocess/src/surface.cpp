@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "tetseg/preprocess/surface.hpp"
+#include "vec3_math.hpp"
 
 namespace tetseg::preprocess {
 namespace {
@@ -94,11 +95,7 @@ double total_tet_volume(const TetMesh& mesh) {
     const Vec3& b = mesh.nodes[t[1]];
     const Vec3& c = mesh.nodes[t[2]];
     const Vec3& d = mesh.nodes[t[3]];
-    const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
-    const double v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
-    const double w[3] = {d[0] - a[0], d[1] - a[1], d[2] - a[2]};
-    sum += u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0]) +
-           u[2] * (v[0] * w[1] - v[1] * w[0]);
+    sum += detail::tet_det(a, b, c, d);
   }
   return sum / 6.0;
 }

@@ -234,13 +234,10 @@ void validate_tet_mesh(const TetMesh& mesh, const Surface& surface, const std::s
     const Vec3& b = mesh.nodes[tet[1]];
     const Vec3& c = mesh.nodes[tet[2]];
     const Vec3& d = mesh.nodes[tet[3]];
-    const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
-    const double v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
-    const double w[3] = {d[0] - a[0], d[1] - a[1], d[2] - a[2]};
-    const double det = u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0]) +
-                       u[2] * (v[0] * w[1] - v[1] * w[0]);
-    const double edge =
-        std::max({detail::distance_between(a, b), detail::distance_between(a, c), detail::distance_between(a, d), detail::distance_between(b, c), detail::distance_between(b, d), detail::distance_between(c, d)});
+    const double det = detail::tet_det(a, b, c, d);
+    const double edge = std::max({detail::distance_between(a, b), detail::distance_between(a, c),
+                                  detail::distance_between(a, d), detail::distance_between(b, c),
+                                  detail::distance_between(b, d), detail::distance_between(c, d)});
     if (!(std::abs(det) > kDegenerateVolume * edge * edge * edge)) {
       if (degenerate++ == 0) first_degenerate = t;
     } else if (det < 0) {
@@ -311,7 +308,8 @@ void detail::validate_closed_surface(const TriangleMesh& mesh, const std::string
     const double x = u[1] * v[2] - u[2] * v[1];
     const double y = u[2] * v[0] - u[0] * v[2];
     const double z = u[0] * v[1] - u[1] * v[0];
-    const double edge = std::max({detail::distance_between(a, b), detail::distance_between(a, c), detail::distance_between(b, c)});
+    const double edge = std::max({detail::distance_between(a, b), detail::distance_between(a, c),
+                                  detail::distance_between(b, c)});
     if (tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2] ||
         !(std::sqrt(x * x + y * y + z * z) > kDegenerateArea * edge * edge)) {
       if (zero_area++ == 0) first_zero = t;

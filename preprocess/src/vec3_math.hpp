@@ -29,4 +29,10 @@ inline double distance_between(const Vec3& a, const Vec3& b) {
   return std::sqrt(distance2(a, b));
 }
 
+/// det[b - a, c - a, d - a]: six times the signed volume of tet (a, b, c, d), positive when
+/// d lies on the side of triangle (a, b, c) that its counter-clockwise normal points to.
+inline double tet_det(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
+  return dot(sub(b, a), cross(sub(c, a), sub(d, a)));
+}
+
 }  // namespace tetseg::preprocess::detail
