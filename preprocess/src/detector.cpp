@@ -157,7 +157,8 @@ Detector best_detector(const std::vector<Vec3>& nodes, const Surface& surface,
           p[2] <= hi[2])
         in_box.push_back(id);
     }
-    const std::size_t stride = std::max<std::size_t>(1, (in_box.size() + kDetectorInBox - 1) / kDetectorInBox);
+    const std::size_t stride =
+        std::max<std::size_t>(1, (in_box.size() + kDetectorInBox - 1) / kDetectorInBox);
     for (std::size_t i = 0; i < in_box.size(); i += stride) candidates.push_back(in_box[i]);
     // Order candidates by (distance to the centroid, id) so the first best wins ties.
     std::vector<std::pair<double, std::uint32_t>> keyed;

@@ -96,7 +96,8 @@ class Refiner {
     std::sort(triangles.begin(), triangles.end());
     Part part;
     part.triangles = std::move(triangles);
-    part.detector = best_detector(m_nodes, m_surface, part.triangles, DetectorStrategy::kVisibility);
+    part.detector =
+        best_detector(m_nodes, m_surface, part.triangles, DetectorStrategy::kVisibility);
     part.serial = m_next_serial++;
     return part;
   }
@@ -184,8 +185,7 @@ bool Refiner::try_split(const Part& part, Part& first, Part& second) {
     positive_first[i] = triangle_positive_from(m_nodes, m_surface.triangles[tris[i]], seen_from);
     if (!positive_first[i]) unseen.push_back(tris[i]);
   }
-  const Detector other =
-      best_detector(m_nodes, m_surface, unseen, DetectorStrategy::kVisibility);
+  const Detector other = best_detector(m_nodes, m_surface, unseen, DetectorStrategy::kVisibility);
   if (other.node == part.detector.node) return false;
   for (std::uint32_t i = 0; i < m; ++i)
     positive_second[i] =
@@ -305,9 +305,8 @@ Segmentation Refiner::run(const Segmentation& charge, RefinementCounts& counts) 
   if (m_options.merge) merge(parts, counts);
 
   // Clusters numbered by smallest triangle id; loops: the distinct closed contours.
-  std::sort(parts.begin(), parts.end(), [](const Part& a, const Part& b) {
-    return a.triangles.front() < b.triangles.front();
-  });
+  std::sort(parts.begin(), parts.end(),
+            [](const Part& a, const Part& b) { return a.triangles.front() < b.triangles.front(); });
   Segmentation out;
   out.cluster_count = static_cast<std::uint32_t>(parts.size());
   out.triangle_cluster.assign(n, 0);
@@ -351,7 +350,8 @@ Segmentation refine_clusters(const std::vector<Vec3>& nodes, const Surface& surf
     throw InputError("", "the tet mesh has no interior node: clusters cannot be refined");
   const std::size_t n = surface.triangles.size();
   if (equalized.size() != n || charge.triangle_cluster.size() != n)
-    throw std::invalid_argument("refine_clusters: one density and cluster id per triangle expected");
+    throw std::invalid_argument(
+        "refine_clusters: one density and cluster id per triangle expected");
   for (std::uint32_t c : charge.triangle_cluster)
     if (c >= charge.cluster_count) throw std::invalid_argument("refine_clusters: bad cluster id");
   for (const Tri& t : surface.triangles)

@@ -67,9 +67,8 @@ Segmentation one_cluster(const VoxelShape& shape) {
 /// A U in the x-y plane, one unit thick: base x in [0,5], y in [0,1]; arms x in [0,1] and
 /// [4,5], y in [1,6]. No point sees both arms' inner faces (x = 1 facing +x, x = 4 facing -x).
 VoxelShape u_shape() {
-  return make_voxel_shape(5, 6, 1, 2, [](double x, double y, double) {
-    return y < 1.0 || x < 1.0 || x > 4.0;
-  });
+  return make_voxel_shape(5, 6, 1, 2,
+                          [](double x, double y, double) { return y < 1.0 || x < 1.0 || x > 4.0; });
 }
 
 }  // namespace
@@ -114,8 +113,7 @@ TEST_CASE("A U-shaped cluster is split into parts its own nodes see whole", "[re
   REQUIRE(visibility_before < options.min_visibility);  // the premise: no node sees it whole
   options.min_cluster_triangles = 8;
   RefinementCounts counts;
-  const Segmentation after =
-      refine_clusters(u.nodes, u.surface, density, before, options, &counts);
+  const Segmentation after = refine_clusters(u.nodes, u.surface, density, before, options, &counts);
   check_segmentation_invariants(u.surface.triangles, after);
   CHECK(counts.clusters_before == 1);
   CHECK(counts.splits >= 1);
@@ -123,8 +121,9 @@ TEST_CASE("A U-shaped cluster is split into parts its own nodes see whole", "[re
   // Every part is seen at least as well as the threshold, by brute force over all nodes, and
   // the detector search finds it.
   const auto parts = members(after);
-  const std::vector<Detector> detectors = choose_detectors(
-      u.nodes, u.surface, after.triangle_cluster, after.cluster_count, DetectorStrategy::kVisibility);
+  const std::vector<Detector> detectors =
+      choose_detectors(u.nodes, u.surface, after.triangle_cluster, after.cluster_count,
+                       DetectorStrategy::kVisibility);
   for (std::uint32_t c = 0; c < after.cluster_count; ++c) {
     CAPTURE(c, parts[c].size());
     CHECK(brute_visibility(u, parts[c]) >= options.min_visibility);
@@ -187,8 +186,7 @@ TEST_CASE("Refinement rejects inputs that do not match the surface", "[refine]")
   const std::vector<double> density(box.surface.triangles.size(), 0.5);
   Segmentation bad = one_cluster(box);
   bad.triangle_cluster[0] = 3;
-  CHECK_THROWS_AS(refine_clusters(box.nodes, box.surface, density, bad, {}),
-                  std::invalid_argument);
+  CHECK_THROWS_AS(refine_clusters(box.nodes, box.surface, density, bad, {}), std::invalid_argument);
   CHECK_THROWS_AS(refine_clusters(box.nodes, box.surface, {0.5}, one_cluster(box), {}),
                   std::invalid_argument);
   Surface no_interior = box.surface;
