@@ -44,6 +44,20 @@ if mode == "single":
 PY
 done
 
+# Refinement options are range-checked; unknown cluster methods are usage errors.
+expect_exit 2 "refine-visibility" -- "$bin/tetseg" build sphere.mesh -o x.tetseg --refine-visibility 2
+expect_exit 2 "clusters" -- "$bin/tetseg" build sphere.mesh -o x.tetseg --clusters bogus
+[ ! -e x.tetseg ] || fail "a usage error left an asset"
+# A sphere's cluster is seen whole: no visibility note.
+if grep -q "note: .* clusters are seen less than" build.txt; then fail "visibility note on a sphere"; fi
+# A character whose thin parts have no interior node: the build names the poorly seen clusters.
+if [[ -f "${TETSEG_CGAL_MESH_DIR:-/nonexistent}/dino.off" ]]; then
+  expect_exit 0 "tetseg: note: [0-9]* of [0-9]* clusters are seen less than 80% positive" -- \
+    "$bin/tetseg" build "$TETSEG_CGAL_MESH_DIR/dino.off" -o dino.tetseg
+else
+  echo "WARN: CGAL demo meshes not found; skipping the visibility note" >&2
+fi
+
 # Same input and options give byte-identical assets.
 "$bin/tetseg" build sphere.mesh -o again.tetseg --clusters single -q
 cmp single.tetseg again.tetseg || fail "assets differ between two identical runs"
