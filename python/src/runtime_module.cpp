@@ -487,7 +487,7 @@ PYBIND11_MODULE(_runtime, m) {
 
   errors().asset = add_status_exception(
       m, "AssetError", PyExc_ValueError,
-      "An asset could not be loaded. Attributes: status (e.g. 'payload checksum', 'io error') "
+      "An asset could not be loaded. Attributes: status (e.g. 'payload checksum', 'i/o error') "
       "and detail (one line).");
   errors().collider = add_status_exception(
       m, "ColliderError", PyExc_RuntimeError,
