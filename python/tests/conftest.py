@@ -45,6 +45,13 @@ def bin_dir():
     return Path(path)
 
 
+def python_env():
+    """Environment for a child Python that imports the same tetseg as this process."""
+    package_parent = str(Path(tetseg.__file__).resolve().parents[1])
+    path = os.environ.get("PYTHONPATH")
+    return dict(os.environ, PYTHONPATH=package_parent + (os.pathsep + path if path else ""))
+
+
 def run_tool(bin_dir, *args, cwd=None):
     result = subprocess.run([str(bin_dir / args[0]), *map(str, args[1:])], cwd=cwd,
                             capture_output=True, text=True)

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import tetseg
-from conftest import make_scene, read_frames_numpy, tetseg_run_json
+from conftest import make_scene, python_env, read_frames_numpy, tetseg_run_json
 
 
 def python_frames(collider, frames):
@@ -140,7 +140,7 @@ def test_runtime_package_does_not_load_preprocess(dumbbell):
         f"a = tetseg.load_asset({str(asset_path)!r}); f = tetseg.read_frames({str(frames_path)!r})\n"
         "c = tetseg.Collider(a); c.step(f[0], f[1]); c.contacts()\n"
         "assert 'tetseg.preprocess' not in sys.modules, sorted(sys.modules)\n")
-    subprocess.run([sys.executable, "-c", code], check=True)
+    subprocess.run([sys.executable, "-c", code], check=True, env=python_env())
     # Static linking: the runtime extension carries no CGAL code at all.
     assert b"CGAL" not in open(tetseg._runtime.__file__, "rb").read()
 
