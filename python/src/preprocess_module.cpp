@@ -11,6 +11,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <mutex>
 #include <string>
@@ -66,19 +67,22 @@ std::string name_of(const NameTable<Enum>& table, Enum value) {
   return "";
 }
 
+std::string number(double value) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.17g", value);
+  return text;
+}
+
 /// The CLI's range checks (CLI::Range, NonNegativeNumber, PositiveNumber); NaN is refused.
 void check_range(const char* option, double value, double low, double high) {
   if (!(value >= low && value <= high)) {
-    throw py::value_error(std::string(option) + " must be in [" +
-                          py::str(py::float_(low)).cast<std::string>() + ", " +
-                          py::str(py::float_(high)).cast<std::string>() + "], got " +
-                          py::str(py::float_(value)).cast<std::string>());
+    throw py::value_error(std::string(option) + " must be in [" + number(low) + ", " +
+                          number(high) + "], got " + number(value));
   }
 }
 void check_positive(const char* option, double value) {
   if (!(value > 0) || std::isinf(value))
-    throw py::value_error(std::string(option) + " must be positive, got " +
-                          py::str(py::float_(value)).cast<std::string>());
+    throw py::value_error(std::string(option) + " must be positive, got " + number(value));
 }
 constexpr double kUnbounded = HUGE_VAL;
 
@@ -453,6 +457,12 @@ py::tuple generate(const std::string& shape_name, double size, double radius,
   return py::make_tuple(nodes_array(mesh.nodes), cells_array(mesh.tets));
 }
 
+/// `tetseg.preprocess.InputError`; never destroyed (outlives module teardown).
+py::object& input_error_type() {
+  static auto* type = new py::object();
+  return *type;
+}
+
 }  // namespace
 }  // namespace tetseg::python
 
@@ -466,18 +476,19 @@ PYBIND11_MODULE(preprocess, m) {
       "written '_'.";
   m.attr("__version__") = TETSEG_VERSION_STRING;
 
-  static py::object input_error = add_status_exception(
-      m, "InputError", PyExc_ValueError,
+  input_error_type() = add_status_exception(
+      m, "tetseg.preprocess", "InputError", PyExc_ValueError,
       "Bad input mesh: unreadable, malformed or invalid. Attributes: file, detail.");
   py::register_exception_translator([](std::exception_ptr p) {
     try {
       if (p) std::rethrow_exception(p);
     } catch (const InputError& e) {
       const std::string message = (e.file().empty() ? std::string() : e.file() + ": ") + e.what();
-      py::object error = input_error(message);
+      const py::object& type = input_error_type();
+      py::object error = type(message);
       error.attr("file") = e.file();
       error.attr("detail") = std::string(e.what());
-      PyErr_SetObject(input_error.ptr(), error.ptr());
+      PyErr_SetObject(type.ptr(), error.ptr());
     }
   });
 

@@ -12,10 +12,10 @@ namespace tetseg::python {
 
 namespace py = pybind11;
 
-/// Creates exception class `tetseg.<name>` deriving from `base`, adds it to `module`.
-inline py::object add_status_exception(py::module_& module, const char* name, PyObject* base,
-                                       const char* doc) {
-  const std::string qualified = std::string("tetseg.") + name;
+/// Creates exception class `<package>.<name>` deriving from `base`, adds it to `module`.
+inline py::object add_status_exception(py::module_& module, const char* package, const char* name,
+                                       PyObject* base, const char* doc) {
+  const std::string qualified = std::string(package) + "." + name;
   PyObject* type = PyErr_NewExceptionWithDoc(qualified.c_str(), doc, base, nullptr);
   if (type == nullptr) throw py::error_already_set();
   py::object cls = py::reinterpret_steal<py::object>(type);

@@ -486,15 +486,15 @@ PYBIND11_MODULE(_runtime, m) {
   m.attr("__version__") = TETSEG_VERSION_STRING;
 
   errors().asset = add_status_exception(
-      m, "AssetError", PyExc_ValueError,
+      m, "tetseg", "AssetError", PyExc_ValueError,
       "An asset could not be loaded. Attributes: status (e.g. 'payload checksum', 'i/o error') "
       "and detail (one line).");
   errors().collider = add_status_exception(
-      m, "ColliderError", PyExc_RuntimeError,
+      m, "tetseg", "ColliderError", PyExc_RuntimeError,
       "A collider call failed. Attributes: status (e.g. 'non-finite position', 'not ready') and "
       "detail. Queries never answer without a valid step.");
   errors().frames = add_status_exception(
-      m, "FramesError", PyExc_ValueError,
+      m, "tetseg", "FramesError", PyExc_ValueError,
       "A frame-sequence file could not be read. Attributes: status and detail.");
 
   m.attr("CONTACT_DTYPE") = contact_dtype();

@@ -96,6 +96,7 @@ def test_other_bad_assets(tmp_path, dumbbell):
     with pytest.raises(tetseg.AssetError, match="missing.tetseg: i/o error") as error:
         tetseg.load_asset(missing)
     assert error.value.status == "i/o error" and isinstance(error.value, ValueError)
+    assert tetseg.AssetError.__module__ == "tetseg"
     with pytest.raises(TypeError, match="path .* or bytes"):
         tetseg.load_asset(42)
     with pytest.raises(TypeError):
