@@ -511,7 +511,7 @@ PYBIND11_MODULE(preprocess, m) {
         py::arg("facet_size") = meshing.facet_size,
         py::arg("facet_distance") = meshing.facet_distance, py::arg("optimize") = meshing.optimize,
         py::arg("rest_positions") = b.keep_rest_positions, py::arg("on_stage") = py::none(),
-        "build(mesh, **options) -> (asset bytes, report dict)\n\n"
+        "Returns (asset bytes, report dict). "
         "Runs the whole pipeline as `tetseg build` does. mesh: a tet mesh file (.mesh, "
         ".node/.ele, .msh), a closed surface file (.obj, .ply, .stl, .off, ...; tetrahedralised "
         "first with cell_size, facet_size, facet_distance, optimize), or a pair of arrays "
@@ -530,7 +530,7 @@ PYBIND11_MODULE(preprocess, m) {
         py::arg("order") = c.fast_order,
         py::arg("equalize") = std::string(to_string(Equalization::kHistogram)),
         py::arg("bins") = 256,
-        "charge(mesh, **options) -> dict\n\n"
+        "Returns a dict. "
         "Relative charge density of a tet mesh's boundary or of a closed surface, as "
         "`tetseg charge` computes it (docs/charge.md). mesh as for build. Returns density and "
         "equalized (per triangle), points and triangles (the surface they refer to), and the "
@@ -546,7 +546,7 @@ PYBIND11_MODULE(preprocess, m) {
         py::arg("facet_angle") = meshing.facet_angle,
         py::arg("radius_edge_ratio") = meshing.cell_radius_edge_ratio,
         py::arg("optimize") = meshing.optimize,
-        "generate(shape, **options) -> (nodes (N, 3) float64, tets (M, 4) uint32)\n\n"
+        "Returns (nodes (N, 3) float64, tets (M, 4) uint32). "
         "Meshes a procedural shape as `tetseg generate` does: 'sphere', 'ellipsoid', "
         "'dumbbell' or 'pawn'. Deterministic.");
 }

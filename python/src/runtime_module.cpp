@@ -598,12 +598,12 @@ PYBIND11_MODULE(_runtime, m) {
       });
 
   m.def("load_asset", &load_any, py::arg("source"),
-        "load_asset(source) -> Asset\n\n"
+        "Returns an Asset. "
         "Loads and validates an asset from a path (str or os.PathLike) or from bytes. Raises "
         "AssetError (with .status and .detail) when it is unreadable, corrupt or invalid.");
 
   m.def("read_frames", &read_frames_array, py::arg("path"),
-        "read_frames(path) -> ndarray of shape (frames, nodes, 3), float64\n\n"
+        "Returns a (frames, nodes, 3) float64 array. "
         "Reads a frame-sequence file (docs/format.md). Each frames[i] is C-contiguous and can "
         "be passed to Collider.step without a copy. Raises FramesError.");
 
@@ -637,25 +637,25 @@ PYBIND11_MODULE(_runtime, m) {
            "time_tolerance and max_intervals go to the elementary tests. The collider holds a "
            "reference to the asset, so it keeps working when the caller drops the Asset.")
       .def("step", &PyCollider::step, py::arg("x0"), py::arg("x1"),
-           "step(x0, x1)\n\nStarts a step from positions x0 (t = 0) to x1 (t = 1): "
+           "Starts a step from positions x0 (t = 0) to x1 (t = 1): "
            "(node_count, 3) C-contiguous float64 arrays, used in place (not copied) and "
            "referenced by the collider until the next step; do not modify them in between. "
            "TypeError for a non-array or another dtype, ValueError for a wrong shape or a "
            "non-contiguous array, ColliderError ('non-finite position') for NaN/inf.")
       .def("any_collision", &PyCollider::any_collision,
-           "any_collision() -> bool\n\nWhether any feature pair is in contact during the step. "
+           "Whether any feature pair is in contact during the step. "
            "Raises ColliderError without a valid step.")
       .def("earliest_toi", &PyCollider::earliest_toi,
-           "earliest_toi() -> numpy.void record of CONTACT_DTYPE, or None\n\nThe earliest "
-           "contact of the step (fields kind, nodes, triangle, toi, at_start), None when there "
-           "is none. Raises ColliderError without a valid step.")
+           "The earliest contact of the step as a numpy.void record of CONTACT_DTYPE (fields "
+           "kind, nodes, triangle, toi, at_start), or None when there is none. "
+           "Raises ColliderError without a valid step.")
       .def("contacts", &PyCollider::contacts,
-           "contacts() -> ndarray of CONTACT_DTYPE\n\nAll contacts of the step, sorted by toi, "
+           "An ndarray of CONTACT_DTYPE: all contacts of the step, sorted by toi, "
            "kind, nodes. kind is VERTEX_FACE (nodes = p, a, b, c) or EDGE_EDGE (edge a-b "
            "against c-d); toi is a lower bound of the first contact time in [0, 1]. Raises "
            "ColliderError without a valid step.")
       .def("check_rest_intersection", &PyCollider::check_rest_intersection, py::arg("x"),
-           "check_rest_intersection(x) -> dict(intersecting, triangle_a, triangle_b)\n\n"
+           "Returns dict(intersecting, triangle_a, triangle_b). "
            "Static check of positions x ((node_count, 3) float64): do two non-adjacent parts of "
            "the surface intersect or touch? Conservative.")
       .def_property_readonly("stats", &PyCollider::stats,
