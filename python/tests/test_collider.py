@@ -149,3 +149,41 @@ def test_help_shows_docstrings():
     assert "C-contiguous" in tetseg.Collider.step.__doc__
     assert "min_separation" in tetseg.Collider.__init__.__doc__
     assert "AssetError" in tetseg.load_asset.__doc__
+
+
+def contact_map(contacts):
+    return {(int(c["kind"]), tuple(c["nodes"].tolist())): float(c["toi"]) for c in contacts}
+
+
+@pytest.mark.parametrize("shape,options", [
+    ("dumbbell", ["--segments", 16, "--rings", 20, "--frames", 10]),
+    ("sphere", ["--segments", 12, "--rings", 8, "--frames", 6]),
+    ("pawn", ["--segments", 16, "--rings", 24, "--frames", 12]),
+])
+def test_modes_agree_with_brute_force_up_to_the_first_contact(bin_dir, tmp_path, shape, options):
+    # docs/runtime.md, "Guarantees and limits": every mode finds the first contact with
+    # brute force's earliest toi, bvh finds exactly its contact set, and rvbc every
+    # brute-force contact at the earliest toi. Comparisons stop at the first contact step.
+    asset_path, frames_path = make_scene(bin_dir, tmp_path, shape, *options)
+    asset = tetseg.load_asset(asset_path)
+    frames = tetseg.read_frames(frames_path)
+    colliders = {mode: tetseg.Collider(asset, mode=mode) for mode in tetseg.MODES}
+    for step in range(frames.shape[0] - 1):
+        found = {}
+        for mode, collider in colliders.items():
+            collider.step(frames[step], frames[step + 1])
+            found[mode] = (collider.any_collision(), collider.earliest_toi(),
+                           contact_map(collider.contacts()))
+        brute_any, brute_earliest, brute = found["brute"]
+        for mode, (any_hit, earliest, contacts) in found.items():
+            assert any_hit == brute_any, (mode, step)
+            assert (earliest is None) == (brute_earliest is None), (mode, step)
+            if earliest is not None:
+                assert earliest["toi"] == brute_earliest["toi"], (mode, step)
+        assert found["bvh"][2] == brute, step
+        if brute_any:
+            first = brute_earliest["toi"]
+            at_first = {k: t for k, t in brute.items() if t == first}
+            assert at_first.items() <= found["rvbc"][2].items(), step
+            return
+    pytest.fail("the scene must reach a contact")
