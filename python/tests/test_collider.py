@@ -19,12 +19,19 @@ def python_frames(collider, frames):
     return results
 
 
+SCENES = {
+    "dumbbell": ["--segments", 16, "--rings", 20, "--frames", 10],
+    "sphere": ["--segments", 12, "--rings", 8, "--frames", 6],
+    # Over 256 contacts per step: contacts() grows its buffer and traverses again.
+    "dumbbell-fine": ["--segments", 24, "--rings", 30, "--frames", 10],
+}
+
+
 @pytest.mark.parametrize("mode", ["rvbc", "bvh", "brute", "cone"])
-@pytest.mark.parametrize("shape", ["dumbbell", "sphere"])
-def test_contacts_equal_tetseg_run_step_by_step(bin_dir, tmp_path, mode, shape):
-    options = {"dumbbell": ["--segments", 16, "--rings", 20, "--frames", 10],
-               "sphere": ["--segments", 12, "--rings", 8, "--frames", 6]}[shape]
-    asset_path, frames_path = make_scene(bin_dir, tmp_path, shape, *options)
+@pytest.mark.parametrize("scene", sorted(SCENES))
+def test_contacts_equal_tetseg_run_step_by_step(bin_dir, tmp_path, mode, scene):
+    shape = scene.split("-")[0]
+    asset_path, frames_path = make_scene(bin_dir, tmp_path, shape, *SCENES[scene])
     expected = tetseg_run_json(bin_dir, asset_path, frames_path, mode)["frames"]
     frames = read_frames_numpy(frames_path)
     assert np.array_equal(frames, tetseg.read_frames(frames_path))
@@ -32,6 +39,8 @@ def test_contacts_equal_tetseg_run_step_by_step(bin_dir, tmp_path, mode, shape):
     got = python_frames(collider, frames)
     assert len(got) == len(expected) == frames.shape[0] - 1
     assert any(e["any"] for e in expected), "the scene must reach a contact"
+    if scene == "dumbbell-fine":
+        assert max(e["contacts"] for e in expected) > 256
     for step, ((any_hit, earliest, contacts), e) in enumerate(zip(got, expected)):
         assert any_hit == e["any"], step
         assert len(contacts) == e["contacts"], step
