@@ -59,6 +59,8 @@ def test_build_equals_cli(pp, bin_dir, sphere_mesh, tmp_path, options, flags):
     asset = tetseg.load_asset(data)
     assert asset.triangle_count == report["counts"]["surface_triangles"]
     assert (asset.rest_positions is None) == (options.get("rest_positions") is False)
+    assert len(asset.boundaries) == report["counts"]["boundaries"]
+    assert len(asset.clusters) == len(report["clusters"])
 
 
 def test_build_from_generated_arrays_equals_cli(pp, bin_dir, sphere_mesh, tmp_path):
