@@ -74,6 +74,7 @@ setup(
     version=project_version(),
     packages=["tetseg"],
     package_dir={"tetseg": "tetseg"},
+    package_data={"tetseg": ["py.typed", "_runtime.pyi"] + (["preprocess.pyi"] if PREPROCESS else [])},
     ext_modules=extensions,
     cmdclass={"build_ext": CMakeBuild},
     zip_safe=False,
