@@ -16,7 +16,8 @@ def stub_of(module):
 
 
 def public(obj):
-    return {n for n in dir(obj) if not n.startswith("_") or n in ("__init__", "__version__")}
+    names = {n for n in dir(obj) if not n.startswith("_") or n == "__version__"}
+    return names | ({"__init__"} if "__init__" in vars(obj) else set())  # own constructor
 
 
 def pybind_params(function):
