@@ -17,7 +17,10 @@ def stub_of(module):
 
 def public(obj):
     names = {n for n in dir(obj) if not n.startswith("_") or n == "__version__"}
-    return names | ({"__init__"} if "__init__" in vars(obj) else set())  # own constructor
+    constructor = getattr(obj, "__init__", None)
+    if (constructor.__doc__ or "").startswith("__init__("):  # a pybind11 constructor
+        names.add("__init__")
+    return names
 
 
 def pybind_params(function):
