@@ -12,6 +12,8 @@ packages=(
   catch2                                                           # tests
   clang libclang-rt-14-dev                                         # libFuzzer target
   python3                                                          # test helpers
+  pybind11-dev python3-dev python3-numpy                           # Python package (python/)
+  python3-pytest python3-venv python3-pip python3-setuptools python3-wheel  # its tests, pip install
 )
 
 missing=()

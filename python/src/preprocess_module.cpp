@@ -1,0 +1,552 @@
+// tetseg.preprocess: build assets and charge densities from Python (docs/python.md). Links
+// tetseg::preprocess, hence CGAL (GPL); tetseg's runtime package never imports this module.
+// Options and defaults are those of `tetseg build` and `tetseg charge` (docs/cli.md): the
+// defaults come from the library's option structs, the checks below mirror the CLI's.
+
+#include <pybind11/functional.h>
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+#include <mutex>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "python_errors.hpp"
+#include "tetseg/format/asset_io.hpp"
+#include "tetseg/preprocess/charge.hpp"
+#include "tetseg/preprocess/io.hpp"
+#include "tetseg/preprocess/meshing.hpp"
+#include "tetseg/preprocess/pipeline.hpp"
+#include "tetseg/preprocess/surface.hpp"
+
+namespace tetseg::python {
+namespace {
+
+using namespace tetseg::preprocess;
+
+// ---------------------------------------------------------------------------------------
+// Option names. The names of `tetseg build` for the enums that have no name table in the
+// library yet (ClusterMethod, DetectorStrategy, and Equalization's "log-histogram" spelling);
+// replace with the library's tables when they exist.
+
+template <typename Enum>
+using NameTable = std::vector<std::pair<const char*, Enum>>;
+
+const NameTable<ClusterMethod> kClusterMethods{{"single", ClusterMethod::kSingle},
+                                               {"charge", ClusterMethod::kCharge},
+                                               {"refined", ClusterMethod::kRefined}};
+const NameTable<DetectorStrategy> kDetectors{
+    {"nearest-centroid", DetectorStrategy::kNearestCentroid},
+    {"visibility", DetectorStrategy::kVisibility}};
+const NameTable<Equalization> kBuildEqualizations{{"histogram", Equalization::kHistogram},
+                                                  {"rank", Equalization::kRank},
+                                                  {"log-histogram", Equalization::kLogHistogram}};
+
+template <typename Enum>
+Enum enum_from_name(const NameTable<Enum>& table, const char* option, const std::string& name) {
+  std::string names;
+  for (const auto& [n, value] : table) {
+    if (name == n) return value;
+    names += (names.empty() ? "" : ", ") + std::string(n);
+  }
+  throw py::value_error(std::string(option) + ": unknown value '" + name + "' (" + names + ")");
+}
+
+template <typename Enum>
+std::string name_of(const NameTable<Enum>& table, Enum value) {
+  for (const auto& [n, v] : table) {
+    if (v == value) return n;
+  }
+  return "";
+}
+
+std::string number(double value) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.17g", value);
+  return text;
+}
+
+/// The CLI's range checks (CLI::Range, NonNegativeNumber, PositiveNumber); NaN is refused.
+void check_range(const char* option, double value, double low, double high) {
+  if (!(value >= low && value <= high)) {
+    throw py::value_error(std::string(option) + " must be in [" + number(low) + ", " +
+                          number(high) + "], got " + number(value));
+  }
+}
+void check_positive(const char* option, double value) {
+  if (!(value > 0) || std::isinf(value))
+    throw py::value_error(std::string(option) + " must be positive, got " + number(value));
+}
+constexpr double kUnbounded = HUGE_VAL;
+
+// ---------------------------------------------------------------------------------------
+// Input: a mesh file, or (nodes, tets) / (points, triangles) arrays.
+
+py::object numpy() {
+  return py::module_::import("numpy");
+}
+
+std::vector<Vec3> points_from(const py::handle& object) {
+  const py::array a = numpy().attr("ascontiguousarray")(object, py::arg("dtype") = "float64");
+  if (a.ndim() != 2 || a.shape(1) != 3 || a.shape(0) == 0)
+    throw py::value_error("nodes must be an (N, 3) array of coordinates, got shape " +
+                          py::str(a.attr("shape")).cast<std::string>());
+  std::vector<Vec3> points(static_cast<std::size_t>(a.shape(0)));
+  std::memcpy(points.data(), a.data(), points.size() * sizeof(Vec3));
+  return points;
+}
+
+/// (M, columns) integer array of node ids, each in [0, 2^32).
+template <std::size_t Columns>
+std::vector<std::array<std::uint32_t, Columns>> cells_from(const char* what, const py::array& a) {
+  const char kind = a.dtype().kind();
+  if (kind != 'i' && kind != 'u')
+    throw py::type_error(std::string(what) + " must be an integer array, got dtype " +
+                         py::str(a.dtype()).cast<std::string>());
+  if (a.size() > 0) {
+    const py::int_ low = a.attr("min")(), high = a.attr("max")();
+    if (low.cast<long long>() < 0 || high.cast<unsigned long long>() > 0xffffffffull)
+      throw py::value_error(std::string(what) + " hold node ids outside [0, 2^32)");
+  }
+  const py::array ids = numpy().attr("ascontiguousarray")(a, py::arg("dtype") = "uint32");
+  std::vector<std::array<std::uint32_t, Columns>> cells(static_cast<std::size_t>(ids.shape(0)));
+  std::memcpy(cells.data(), ids.data(), cells.size() * sizeof(cells[0]));
+  return cells;
+}
+
+/// What the caller passed: a path, or arrays of a tet mesh or of a closed surface.
+struct Input {
+  std::string path;  // empty for arrays
+  std::string source;
+  bool is_tet_mesh = false;
+  TetMesh tet_mesh;
+  TriangleMesh surface;
+};
+
+Input input_from(const py::object& mesh, const py::object& source) {
+  Input in;
+  if (py::isinstance<py::str>(mesh) || py::hasattr(mesh, "__fspath__")) {
+    const py::object p = py::module_::import("os").attr("fspath")(mesh);
+    if (!py::isinstance<py::str>(p))
+      throw py::type_error("mesh path must be str or os.PathLike[str]");
+    in.path = p.cast<std::string>();
+    in.source = source.is_none() ? in.path : source.cast<std::string>();
+    in.is_tet_mesh = is_tet_mesh_path(in.path);
+    return in;
+  }
+  if (!py::isinstance<py::sequence>(mesh) || py::len(mesh) != 2)
+    throw py::type_error(
+        "mesh must be a file path or a pair of arrays: (nodes (N, 3), tets (M, 4)) or "
+        "(points (N, 3), triangles (M, 3))");
+  const py::sequence pair = mesh;
+  in.source = source.is_none() ? std::string("arrays") : source.cast<std::string>();
+  const py::array cells = numpy().attr("asarray")(pair[1]);
+  if (cells.ndim() != 2 || (cells.shape(1) != 4 && cells.shape(1) != 3))
+    throw py::value_error(
+        "the second array must have shape (M, 4) (tets) or (M, 3) "
+        "(surface triangles), got " +
+        py::str(cells.attr("shape")).cast<std::string>());
+  in.is_tet_mesh = cells.shape(1) == 4;
+  if (in.is_tet_mesh) {
+    in.tet_mesh.nodes = points_from(pair[0]);
+    in.tet_mesh.tets = cells_from<4>("tets", cells);
+  } else {
+    in.surface.vertices = points_from(pair[0]);
+    in.surface.triangles = cells_from<3>("triangles", cells);
+  }
+  return in;
+}
+
+/// Reads the file named by `in.path` (no-op for arrays). Runs without the GIL.
+void read_input(Input& in) {
+  if (in.path.empty()) return;
+  if (in.is_tet_mesh) {
+    in.tet_mesh = read_tet_mesh(in.path);
+  } else {
+    in.surface = read_triangle_mesh(in.path);
+  }
+}
+
+/// CGAL's meshing resets a global random generator and Eigen's thread count is global: one
+/// preprocess call at a time. Lock it only after releasing the GIL (a stage callback takes
+/// the GIL while the lock is held).
+std::mutex& preprocess_mutex() {
+  static std::mutex m;
+  return m;
+}
+
+py::array_t<double> nodes_array(const std::vector<Vec3>& nodes) {
+  py::array_t<double> a({static_cast<py::ssize_t>(nodes.size()), py::ssize_t{3}});
+  std::memcpy(a.mutable_data(), nodes.data(), nodes.size() * sizeof(Vec3));
+  return a;
+}
+
+template <std::size_t Columns>
+py::array_t<std::uint32_t> cells_array(const std::vector<std::array<std::uint32_t, Columns>>& c) {
+  py::array_t<std::uint32_t> a(
+      {static_cast<py::ssize_t>(c.size()), static_cast<py::ssize_t>(Columns)});
+  std::memcpy(a.mutable_data(), c.data(), c.size() * sizeof(c[0]));
+  return a;
+}
+
+py::array_t<double> doubles_array(const std::vector<double>& v) {
+  py::array_t<double> a(static_cast<py::ssize_t>(v.size()));
+  std::memcpy(a.mutable_data(), v.data(), v.size() * sizeof(double));
+  return a;
+}
+
+// ---------------------------------------------------------------------------------------
+// build
+
+py::dict report_dict(const std::string& source, const BuildReport& report,
+                     const format::Asset& asset, std::size_t asset_bytes, double total) {
+  py::dict seconds;
+  py::list stages;
+  for (const StageReport& s : report.stages) {
+    seconds[py::str(s.name)] = s.seconds;
+    stages.append(py::make_tuple(s.name, s.seconds, s.summary));
+  }
+  seconds["total"] = total;
+  py::dict counts;
+  counts["nodes"] = report.nodes;
+  counts["tets"] = report.tets;
+  counts["surface_triangles"] = report.surface_triangles;
+  counts["interior_nodes"] = report.interior_nodes;
+  counts["clusters"] = report.clusters;
+  counts["boundaries"] = report.boundaries;
+  const SegmentationCounts& seg = report.segmentation;
+  py::dict segmentation;
+  segmentation["segments_found"] = seg.segments_found;
+  segmentation["segments_grown"] = seg.segments_grown;
+  segmentation["segments_shrunk"] = seg.segments_shrunk;
+  segmentation["boundaries"] = seg.boundaries;
+  segmentation["clusters"] = seg.clusters;
+  segmentation["clusters_merged"] = seg.clusters_merged;
+  py::dict refinement;
+  refinement["clusters_before"] = report.refinement.clusters_before;
+  refinement["splits"] = report.refinement.splits;
+  refinement["merges"] = report.refinement.merges;
+  py::list clusters;
+  for (const format::Cluster& c : asset.clusters) {
+    py::dict d;
+    d["triangles"] = c.triangle_count;
+    d["detector_node"] = c.detector_node;
+    d["rest_positive_fraction"] = c.rest_positive_fraction;
+    clusters.append(d);
+  }
+  py::dict options;
+  for (const auto& [key, value] : asset.provenance.options) options[py::str(key)] = value;
+
+  py::dict d;
+  d["input"] = source;
+  d["asset_bytes"] = asset_bytes;
+  d["seconds"] = seconds;
+  d["stages"] = stages;
+  d["counts"] = counts;
+  d["segmentation"] = segmentation;
+  d["refinement"] = refinement;
+  if (!report.charge.solver.empty()) {
+    const ChargeResult& c = report.charge;
+    py::dict charge;
+    charge["solver"] = c.solver;
+    charge["tolerance"] = c.tolerance;
+    charge["converged"] = c.converged;
+    charge["iterations"] = c.iterations;
+    charge["residual"] = c.residual;
+    charge["capacitance"] = c.capacitance;
+    charge["assembly_seconds"] = c.assembly_seconds;
+    charge["solve_seconds"] = c.solve_seconds;
+    d["charge"] = charge;
+  }
+  d["clusters"] = clusters;
+  d["options"] = options;
+  return d;
+}
+
+py::tuple build(const py::object& mesh, const py::object& source, const std::string& clusters,
+                double refine_visibility, std::uint32_t refine_max_clusters, double refine_gain,
+                bool refine_merge, double alpha, double beta_divisor,
+                const std::string& equalization, double growth_bound, bool grow_through_marked,
+                std::uint32_t min_cluster_triangles, const std::string& detector,
+                const std::string& solver, double tolerance, double cell_size, double facet_size,
+                double facet_distance, bool optimize, bool rest_positions,
+                const py::object& on_stage) {
+  BuildOptions options;
+  options.clusters = enum_from_name(kClusterMethods, "clusters", clusters);
+  check_range("refine_visibility", refine_visibility, 0.0, 1.0);
+  check_range("refine_max_clusters", refine_max_clusters, 1, 100000);
+  check_range("refine_gain", refine_gain, 0.0, kUnbounded);
+  options.refinement.min_visibility = refine_visibility;
+  options.refinement.max_clusters = refine_max_clusters;
+  options.refinement.gain_per_cut_edge = refine_gain;
+  options.refinement.merge = refine_merge;
+  check_range("alpha", alpha, 0.0, 1.0);
+  check_positive("beta_divisor", beta_divisor);
+  check_range("growth_bound", growth_bound, 0.0, 1.0);
+  options.segmentation.alpha = alpha;
+  options.segmentation.beta_divisor = beta_divisor;
+  options.segmentation.equalization =
+      enum_from_name(kBuildEqualizations, "equalization", equalization);
+  options.segmentation.growth_bound = growth_bound;
+  options.segmentation.grow_through_marked = grow_through_marked;
+  options.segmentation.min_cluster_triangles = min_cluster_triangles;
+  options.segmentation.detector = enum_from_name(kDetectors, "detector", detector);
+  if (!parse_charge_solver(solver, options.charge.solver))
+    throw py::value_error("solver: unknown value '" + solver + "' (auto, direct, gmres, fast)");
+  check_range("tolerance", tolerance, 0.0, 0.5);
+  options.charge.tolerance = tolerance;
+  options.keep_rest_positions = rest_positions;
+  MeshingOptions meshing;
+  check_range("cell_size", cell_size, 0.0, kUnbounded);
+  check_range("facet_size", facet_size, 0.0, kUnbounded);
+  check_range("facet_distance", facet_distance, 0.0, kUnbounded);
+  meshing.cell_size = cell_size;
+  meshing.facet_size = facet_size;
+  meshing.facet_distance = facet_distance;
+  meshing.optimize = optimize;
+
+  Input in = input_from(mesh, source);
+  std::function<void(const StageReport&)> stage_callback;
+  if (!on_stage.is_none()) {
+    stage_callback = [&on_stage](const StageReport& stage) {
+      py::gil_scoped_acquire gil;
+      on_stage(stage.name, stage.seconds, stage.summary);
+    };
+  }
+
+  using Clock = std::chrono::steady_clock;
+  BuildReport report;
+  format::Asset asset;
+  std::vector<std::uint8_t> bytes;
+  double total = 0;
+  {
+    py::gil_scoped_release release;
+    std::lock_guard<std::mutex> lock(preprocess_mutex());
+    const auto start = Clock::now();
+    StageTimer timer(report, stage_callback);
+    // As `tetseg build`: a tet mesh is used as is, a closed surface is tetrahedralised.
+    if (in.is_tet_mesh) {
+      timer.run("read", [&](std::string& summary) {
+        read_input(in);
+        summary = std::to_string(in.tet_mesh.nodes.size()) + " nodes, " +
+                  std::to_string(in.tet_mesh.tets.size()) + " tets";
+        return 0;
+      });
+    } else {
+      timer.run("read", [&](std::string& summary) {
+        read_input(in);
+        validate_closed_surface(in.surface, in.source);
+        summary = std::to_string(in.surface.vertices.size()) + " vertices, " +
+                  std::to_string(in.surface.triangles.size()) + " triangles (surface)";
+        return 0;
+      });
+      in.tet_mesh = timer.run("tetrahedralize", [&](std::string& summary) {
+        TetMesh m = tetrahedralize(in.surface, meshing, in.source);
+        summary =
+            std::to_string(m.nodes.size()) + " nodes, " + std::to_string(m.tets.size()) + " tets";
+        return m;
+      });
+    }
+    asset = build_asset(in.tet_mesh, in.source, options, report, stage_callback);
+    bytes = timer.run("write", [&](std::string& summary) {
+      std::vector<std::uint8_t> b = format::write_asset(asset);
+      summary = std::to_string(b.size()) + " bytes";
+      return b;
+    });
+    total = std::chrono::duration<double>(Clock::now() - start).count();
+  }
+  py::bytes data(reinterpret_cast<const char*>(bytes.data()), bytes.size());
+  return py::make_tuple(data, report_dict(in.source, report, asset, bytes.size(), total));
+}
+
+// ---------------------------------------------------------------------------------------
+// charge
+
+py::dict charge(const py::object& mesh, const py::object& source, const std::string& solver,
+                double tolerance, int max_iterations, double theta, int order,
+                const std::string& equalize_name, int bins) {
+  ChargeOptions options;
+  if (!parse_charge_solver(solver, options.solver))
+    throw py::value_error("solver: unknown value '" + solver + "' (auto, direct, gmres, fast)");
+  Equalization method;
+  if (!parse_equalization(equalize_name, method))
+    throw py::value_error("equalize: unknown value '" + equalize_name + "' (histogram, rank, log)");
+  check_range("tolerance", tolerance, 0.0, 0.5);
+  check_range("max_iterations", max_iterations, 1, 100000);
+  check_range("theta", theta, 0.0, 0.95);
+  check_range("order", order, -1, 16);
+  check_range("bins", bins, 1, 1 << 20);
+  options.tolerance = tolerance;
+  options.max_iterations = max_iterations;
+  options.fast_theta = theta;
+  options.fast_order = order;
+
+  Input in = input_from(mesh, source);
+  std::vector<Vec3> points;
+  std::vector<Tri> triangles;
+  ChargeResult result;
+  std::vector<double> equalized;
+  {
+    py::gil_scoped_release release;
+    std::lock_guard<std::mutex> lock(preprocess_mutex());
+    // As `tetseg charge`: a tet mesh's boundary, or a closed surface as given.
+    read_input(in);
+    if (in.is_tet_mesh) {
+      const Surface surface = extract_surface(in.tet_mesh);
+      validate_tet_mesh(in.tet_mesh, surface, in.source);
+      points = std::move(in.tet_mesh.nodes);
+      triangles = surface.triangles;
+    } else {
+      validate_closed_surface(in.surface, in.source);
+      points = std::move(in.surface.vertices);
+      triangles = std::move(in.surface.triangles);
+    }
+    result = compute_charge(points, triangles, options, in.source);
+    equalized = equalize(result.density, method, bins);
+  }
+  py::dict d;
+  d["density"] = doubles_array(result.density);
+  d["equalized"] = doubles_array(equalized);
+  d["points"] = nodes_array(points);
+  d["triangles"] = cells_array(triangles);
+  d["solver"] = result.solver;
+  d["iterations"] = result.iterations;
+  d["residual"] = result.residual;
+  d["converged"] = result.converged;
+  d["tolerance"] = result.tolerance;
+  d["capacitance"] = result.capacitance;
+  d["total_area"] = result.total_area;
+  d["equalization"] = to_string(method);
+  d["assembly_seconds"] = result.assembly_seconds;
+  d["solve_seconds"] = result.solve_seconds;
+  return d;
+}
+
+// ---------------------------------------------------------------------------------------
+// generate
+
+py::tuple generate(const std::string& shape_name, double size, double radius,
+                   const std::array<double, 3>& axes, double cell_size, double facet_size,
+                   double facet_distance, double facet_angle, double radius_edge_ratio,
+                   bool optimize) {
+  const Shape shape = shape_from_name(shape_name);
+  ShapeOptions shape_options;
+  shape_options.size = size;
+  shape_options.radius = radius;
+  for (int k = 0; k < 3; ++k) shape_options.axes[k] = axes[static_cast<std::size_t>(k)];
+  MeshingOptions meshing;
+  meshing.cell_size = cell_size;
+  meshing.facet_size = facet_size;
+  meshing.facet_distance = facet_distance;
+  meshing.facet_angle = facet_angle;
+  meshing.cell_radius_edge_ratio = radius_edge_ratio;
+  meshing.optimize = optimize;
+  TetMesh mesh;
+  {
+    py::gil_scoped_release release;
+    std::lock_guard<std::mutex> lock(preprocess_mutex());
+    mesh = generate_shape(shape, shape_options, meshing);
+  }
+  return py::make_tuple(nodes_array(mesh.nodes), cells_array(mesh.tets));
+}
+
+/// `tetseg.preprocess.InputError`; never destroyed (outlives module teardown).
+py::object& input_error_type() {
+  static auto* type = new py::object();
+  return *type;
+}
+
+}  // namespace
+}  // namespace tetseg::python
+
+PYBIND11_MODULE(preprocess, m) {
+  using namespace tetseg::python;
+  using namespace tetseg::preprocess;
+  m.doc() =
+      "tetseg.preprocess: build assets and charge densities (docs/python.md). Links CGAL "
+      "(GPL-3.0-or-later); the runtime package `tetseg` does not import it. Options and "
+      "defaults are those of `tetseg build` and `tetseg charge` (docs/cli.md), with '-' "
+      "written '_'.";
+  m.attr("__version__") = TETSEG_VERSION_STRING;
+
+  input_error_type() = add_status_exception(
+      m, "tetseg.preprocess", "InputError", PyExc_ValueError,
+      "Bad input mesh: unreadable, malformed or invalid. Attributes: file, detail.");
+  py::register_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const InputError& e) {
+      const std::string message = (e.file().empty() ? std::string() : e.file() + ": ") + e.what();
+      const py::object& type = input_error_type();
+      py::object error = type(message);
+      error.attr("file") = e.file();
+      error.attr("detail") = std::string(e.what());
+      PyErr_SetObject(type.ptr(), error.ptr());
+    }
+  });
+
+  const BuildOptions b;
+  const MeshingOptions meshing;
+  m.def("build", &build, py::arg("mesh"), py::kw_only(), py::arg("source") = py::none(),
+        py::arg("clusters") = name_of(kClusterMethods, b.clusters),
+        py::arg("refine_visibility") = b.refinement.min_visibility,
+        py::arg("refine_max_clusters") = b.refinement.max_clusters,
+        py::arg("refine_gain") = b.refinement.gain_per_cut_edge,
+        py::arg("refine_merge") = b.refinement.merge, py::arg("alpha") = b.segmentation.alpha,
+        py::arg("beta_divisor") = b.segmentation.beta_divisor,
+        py::arg("equalization") = name_of(kBuildEqualizations, b.segmentation.equalization),
+        py::arg("growth_bound") = b.segmentation.growth_bound,
+        py::arg("grow_through_marked") = b.segmentation.grow_through_marked,
+        py::arg("min_cluster_triangles") = b.segmentation.min_cluster_triangles,
+        py::arg("detector") = name_of(kDetectors, b.segmentation.detector),
+        py::arg("solver") = std::string(to_string(b.charge.solver)),
+        py::arg("tolerance") = b.charge.tolerance, py::arg("cell_size") = meshing.cell_size,
+        py::arg("facet_size") = meshing.facet_size,
+        py::arg("facet_distance") = meshing.facet_distance, py::arg("optimize") = meshing.optimize,
+        py::arg("rest_positions") = b.keep_rest_positions, py::arg("on_stage") = py::none(),
+        "Returns (asset bytes, report dict). "
+        "Runs the whole pipeline as `tetseg build` does. mesh: a tet mesh file (.mesh, "
+        ".node/.ele, .msh), a closed surface file (.obj, .ply, .stl, .off, ...; tetrahedralised "
+        "first with cell_size, facet_size, facet_distance, optimize), or a pair of arrays "
+        "(nodes (N, 3), tets (M, 4)) or (points (N, 3), triangles (M, 3)). source: the name "
+        "recorded in the asset's provenance and used in messages (default: the path, or "
+        "'arrays'). Every other option is the `tetseg build` option of the same name "
+        "(--no-optimize is optimize=False, --no-rest-positions is rest_positions=False). "
+        "on_stage(name, seconds, summary) is called after each stage. The report dict has the "
+        "keys of `tetseg build --report` plus 'stages'. Load the bytes with "
+        "tetseg.load_asset. Raises InputError for a bad mesh, ValueError for a bad option.");
+
+  const ChargeOptions c;
+  m.def("charge", &charge, py::arg("mesh"), py::kw_only(), py::arg("source") = py::none(),
+        py::arg("solver") = std::string(to_string(c.solver)), py::arg("tolerance") = c.tolerance,
+        py::arg("max_iterations") = c.max_iterations, py::arg("theta") = c.fast_theta,
+        py::arg("order") = c.fast_order,
+        py::arg("equalize") = std::string(to_string(Equalization::kHistogram)),
+        py::arg("bins") = 256,
+        "Returns a dict. "
+        "Relative charge density of a tet mesh's boundary or of a closed surface, as "
+        "`tetseg charge` computes it (docs/charge.md). mesh as for build. Returns density and "
+        "equalized (per triangle), points and triangles (the surface they refer to), and the "
+        "solver figures (solver, iterations, residual, converged, tolerance, capacitance, "
+        "total_area, equalization, assembly_seconds, solve_seconds).");
+
+  const ShapeOptions s;
+  m.def("generate", &generate, py::arg("shape"), py::kw_only(), py::arg("size") = s.size,
+        py::arg("radius") = s.radius,
+        py::arg("axes") = std::array<double, 3>{s.axes[0], s.axes[1], s.axes[2]},
+        py::arg("cell_size") = meshing.cell_size, py::arg("facet_size") = meshing.facet_size,
+        py::arg("facet_distance") = meshing.facet_distance,
+        py::arg("facet_angle") = meshing.facet_angle,
+        py::arg("radius_edge_ratio") = meshing.cell_radius_edge_ratio,
+        py::arg("optimize") = meshing.optimize,
+        "Returns (nodes (N, 3) float64, tets (M, 4) uint32). "
+        "Meshes a procedural shape as `tetseg generate` does: 'sphere', 'ellipsoid', "
+        "'dumbbell' or 'pawn'. Deterministic.");
+}

@@ -1,0 +1,671 @@
+// tetseg._runtime: assets, colliders and frame files from Python (docs/python.md). Links the
+// tetseg runtime only (no GPL code). Arrays handed to `Collider.step` are used in place.
+
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <cstddef>
+#include <cstdint>
+#include <cstring>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <type_traits>
+#include <utility>
+#include <vector>
+
+#include "collider_calls.hpp"
+#include "python_errors.hpp"
+#include "tetseg/runtime/asset.hpp"
+#include "tetseg/runtime/collider.hpp"
+#include "tetseg/runtime/frames.hpp"
+
+namespace tetseg::python {
+namespace {
+
+using AssetPtr = std::shared_ptr<const Asset>;
+
+struct Errors {
+  py::object asset, collider, frames;
+};
+Errors& errors() {
+  static Errors* e = new Errors();  // never destroyed: outlives module teardown
+  return *e;
+}
+
+// ---------------------------------------------------------------------------------------
+// NumPy helpers
+
+/// A read-only array over `data`, kept valid by `owner` (which must keep `data` alive).
+py::array read_only_view(const py::dtype& dtype, std::vector<py::ssize_t> shape,
+                         std::vector<py::ssize_t> strides, const void* data, py::handle owner) {
+  py::array array(dtype, std::move(shape), std::move(strides), data, owner);
+  array.attr("setflags")(py::arg("write") = false);
+  return array;
+}
+
+/// Keeps an asset alive for as long as any array viewing it exists.
+py::capsule asset_owner(const AssetPtr& asset) {
+  return py::capsule(new AssetPtr(asset), [](void* p) { delete static_cast<AssetPtr*>(p); });
+}
+
+py::dtype record_dtype(const std::vector<std::pair<const char*, const char*>>& fields,
+                       const std::vector<std::size_t>& offsets, std::size_t itemsize) {
+  py::list names, formats, offs;
+  for (std::size_t i = 0; i < fields.size(); ++i) {
+    names.append(fields[i].first);
+    formats.append(fields[i].second);
+    offs.append(offsets[i]);
+  }
+  return py::dtype(names, formats, offs, static_cast<py::ssize_t>(itemsize));
+}
+
+/// The dtype of `tetseg::Contact`, so the collider writes contacts straight into NumPy memory.
+py::dtype contact_dtype() {
+  static_assert(std::is_standard_layout_v<Contact>);
+  static_assert(sizeof(ContactKind) == 1 && sizeof(bool) == 1);
+  return record_dtype(
+      {{"kind", "u1"}, {"nodes", "(4,)u4"}, {"triangle", "u4"}, {"toi", "f8"}, {"at_start", "?"}},
+      {offsetof(Contact, kind), offsetof(Contact, nodes), offsetof(Contact, triangle),
+       offsetof(Contact, toi), offsetof(Contact, at_start)},
+      sizeof(Contact));
+}
+
+py::dtype cluster_dtype() {
+  using format::Cluster;
+  static_assert(std::is_standard_layout_v<Cluster>);
+  return record_dtype({{"detector_node", "u4"},
+                       {"rest_positive_fraction", "f4"},
+                       {"triangle_offset", "u4"},
+                       {"triangle_count", "u4"},
+                       {"bvh_offset", "u4"},
+                       {"bvh_count", "u4"}},
+                      {offsetof(Cluster, detector_node), offsetof(Cluster, rest_positive_fraction),
+                       offsetof(Cluster, triangle_offset), offsetof(Cluster, triangle_count),
+                       offsetof(Cluster, bvh_offset), offsetof(Cluster, bvh_count)},
+                      sizeof(Cluster));
+}
+
+py::dtype bvh_node_dtype() {
+  using format::BvhNode;
+  return record_dtype(
+      {{"first", "u4"}, {"second", "u4"}, {"count", "u4"}},
+      {offsetof(BvhNode, first), offsetof(BvhNode, second), offsetof(BvhNode, count)},
+      sizeof(BvhNode));
+}
+
+py::dtype boundary_dtype() {
+  using format::BoundaryLoop;
+  return record_dtype({{"node_offset", "u4"}, {"node_count", "u4"}},
+                      {offsetof(BoundaryLoop, node_offset), offsetof(BoundaryLoop, node_count)},
+                      sizeof(BoundaryLoop));
+}
+
+/// A (count, columns) or (count,) read-only view of a vector of records / fixed arrays.
+template <typename T>
+py::array vector_view(const std::vector<T>& values, const py::dtype& dtype, py::ssize_t columns,
+                      const AssetPtr& asset) {
+  const py::ssize_t count = static_cast<py::ssize_t>(values.size());
+  if (columns == 0) {
+    return read_only_view(dtype, {count}, {static_cast<py::ssize_t>(sizeof(T))}, values.data(),
+                          asset_owner(asset));
+  }
+  return read_only_view(dtype, {count, columns},
+                        {static_cast<py::ssize_t>(sizeof(T)), dtype.itemsize()}, values.data(),
+                        asset_owner(asset));
+}
+
+/// Checks that `object` is an (node_count, 3) C-contiguous float64 array and returns its data.
+/// Raises TypeError (not an array, wrong dtype) or ValueError (shape, layout).
+const double* positions_of(const char* name, const py::handle& object, std::size_t node_count) {
+  if (!py::isinstance<py::array>(object)) {
+    throw py::type_error(std::string(name) + " must be a numpy.ndarray of float64 with shape (" +
+                         std::to_string(node_count) + ", 3), got " +
+                         std::string(py::str(py::type::handle_of(object).attr("__name__"))));
+  }
+  const auto array = py::reinterpret_borrow<py::array>(object);
+  if (!array.dtype().equal(py::dtype::of<double>())) {
+    throw py::type_error(std::string(name) + " must have dtype float64 (native byte order), got " +
+                         std::string(py::str(array.dtype())) +
+                         " (convert with numpy.ascontiguousarray(x, dtype=numpy.float64))");
+  }
+  if (array.ndim() != 2 || array.shape(0) != static_cast<py::ssize_t>(node_count) ||
+      array.shape(1) != 3) {
+    throw py::value_error(std::string(name) + " must have shape (" + std::to_string(node_count) +
+                          ", 3) (the asset's node count), got " +
+                          std::string(py::str(array.attr("shape"))));
+  }
+  const int flags = py::detail::array_proxy(array.ptr())->flags;
+  if (!(flags & py::detail::npy_api::NPY_ARRAY_C_CONTIGUOUS_) ||
+      !(flags & py::detail::npy_api::NPY_ARRAY_ALIGNED_)) {
+    throw py::value_error(std::string(name) +
+                          " must be C-contiguous and aligned (it is used in place, not copied); "
+                          "use numpy.ascontiguousarray(x)");
+  }
+  return static_cast<const double*>(array.data());
+}
+
+// ---------------------------------------------------------------------------------------
+// Assets
+
+struct PyAsset {
+  AssetPtr asset;
+};
+
+AssetPtr load_from_bytes(const py::buffer& data) {
+  const py::buffer_info info = data.request();
+  if (info.ndim != 1 || info.itemsize != 1) {
+    throw py::type_error(
+        "asset bytes must be a 1-D buffer of bytes (bytes, bytearray, memoryview)");
+  }
+  auto asset = std::make_shared<Asset>();
+  std::string detail;
+  Status status;
+  {
+    py::gil_scoped_release release;
+    status = load_asset(static_cast<const std::uint8_t*>(info.ptr),
+                        static_cast<std::size_t>(info.size), *asset, &detail);
+  }
+  if (status != Status::kOk) raise_status(errors().asset, "asset bytes", to_string(status), detail);
+  return asset;
+}
+
+AssetPtr load_from_path(const std::string& path) {
+  auto asset = std::make_shared<Asset>();
+  std::string detail;
+  Status status;
+  {
+    py::gil_scoped_release release;
+    status = load_asset_file(path, *asset, &detail);
+  }
+  if (status != Status::kOk) raise_status(errors().asset, path, to_string(status), detail);
+  return asset;
+}
+
+/// str / os.PathLike -> file; bytes-like -> memory.
+PyAsset load_any(const py::object& source) {
+  if (py::isinstance<py::str>(source) || py::hasattr(source, "__fspath__")) {
+    const py::object path = py::module_::import("os").attr("fspath")(source);
+    if (!py::isinstance<py::str>(path))
+      throw py::type_error("asset path must be str or os.PathLike[str]");
+    return PyAsset{load_from_path(path.cast<std::string>())};
+  }
+  if (PyObject_CheckBuffer(source.ptr())) {
+    return PyAsset{load_from_bytes(py::reinterpret_borrow<py::buffer>(source))};
+  }
+  throw py::type_error("load_asset expects a path (str or os.PathLike) or bytes, got " +
+                       std::string(py::str(py::type::handle_of(source).attr("__name__"))));
+}
+
+py::dict provenance_dict(const format::Provenance& p) {
+  py::dict options;
+  for (const auto& [key, value] : p.options) options[py::str(key)] = value;
+  py::dict d;
+  d["tool_version"] = p.tool_version;
+  d["source"] = p.source;
+  d["options"] = options;
+  return d;
+}
+
+// ---------------------------------------------------------------------------------------
+// Collider
+
+/// Refuses concurrent use of one collider from several Python threads (the GIL is released
+/// during steps and queries; a C++ Collider is single-threaded).
+class Busy {
+ public:
+  explicit Busy(std::mutex& m) : m_lock(m, std::try_to_lock) {
+    if (!m_lock.owns_lock())
+      throw std::runtime_error(
+          "this Collider is in use by another thread; use one Collider per thread");
+  }
+
+ private:
+  std::unique_lock<std::mutex> m_lock;
+};
+
+py::dict options_dict(const ColliderOptions& o) {
+  py::dict d;
+  d["mode"] = to_string(o.mode);
+  d["min_separation"] = o.ccd.min_separation;
+  d["time_tolerance"] = o.ccd.time_tolerance;
+  d["max_intervals"] = o.ccd.max_intervals;
+  d["bvh_leaf_size"] = o.bvh_leaf_size;
+  d["use_openmp"] = o.use_openmp;
+  d["check_first_step"] = o.check_first_step;
+  d["time_tests"] = o.time_tests;
+  return d;
+}
+
+py::dict stats_dict(const ColliderStats& s) {
+  py::dict d;
+  d["refit_ms"] = s.refit_ms;
+  d["classify_ms"] = s.classify_ms;
+  d["traversal_ms"] = s.traversal_ms;
+  d["tests_ms"] = s.tests_ms;
+  d["cone_ms"] = s.cone_ms;
+  d["nodes_moved"] = s.nodes_moved;
+  d["triangles_positive"] = s.triangles_positive;
+  d["triangles_negative"] = s.triangles_negative;
+  d["triangles_uncertain"] = s.triangles_uncertain;
+  d["triangles_moving"] = s.triangles_moving;
+  d["clusters_skipped"] = s.clusters_skipped;
+  d["closure_pairs"] = s.closure_pairs;
+  d["node_pairs_visited"] = s.node_pairs_visited;
+  d["node_pairs_orientation_culled"] = s.node_pairs_orientation_culled;
+  d["triangle_pairs"] = s.triangle_pairs;
+  d["feature_pairs"] = s.feature_pairs;
+  d["feature_pairs_filtered"] = s.feature_pairs_filtered;
+  d["feature_tests"] = s.feature_tests;
+  d["contacts"] = s.contacts;
+  d["nothing_moved"] = s.nothing_moved;
+  d["full_traversal"] = s.full_traversal;
+  return d;
+}
+
+py::dict rest_check_dict(const RestCheck& r) {
+  py::dict d;
+  d["intersecting"] = r.intersecting;
+  d["triangle_a"] = r.triangle_a;
+  d["triangle_b"] = r.triangle_b;
+  return d;
+}
+
+class PyCollider {
+ public:
+  PyCollider(py::object asset_object, const ColliderOptions& options)
+      : m_asset_object(std::move(asset_object)),
+        m_asset(m_asset_object.cast<const PyAsset&>().asset) {
+    {
+      py::gil_scoped_release release;
+      m_collider = std::make_unique<Collider>(*m_asset, options);
+    }
+    if (m_collider->status() != ColliderStatus::kOk)
+      raise_status(errors().collider, "Collider", to_string(m_collider->status()),
+                   "cannot create the collider (out of memory)");
+  }
+
+  void step(const py::object& x0, const py::object& x1) {
+    const std::size_t nodes = m_asset->node_count();
+    const double* p0 = positions_of("x0", x0, nodes);
+    const double* p1 = positions_of("x1", x1, nodes);
+    Busy busy(m_mutex);
+    // The C++ collider keeps the pointers until the next step: drop the old arrays only
+    // after it stopped using them, and keep the new ones while it may read them.
+    ColliderStatus status;
+    {
+      py::gil_scoped_release release;
+      status = call_step(*m_collider, p0, p1, nodes * 3);
+    }
+    m_last_step = status;
+    if (status != ColliderStatus::kOk) {
+      m_x0 = py::none();
+      m_x1 = py::none();
+      raise_status(errors().collider, "step", to_string(status), step_failure_detail(status));
+    }
+    m_x0 = x0;
+    m_x1 = x1;
+  }
+
+  bool any_collision() {
+    Busy busy(m_mutex);
+    bool any = false;
+    ColliderStatus status;
+    {
+      py::gil_scoped_release release;
+      status = call_any_collision(*m_collider, m_last_step, any);
+    }
+    check_query("any_collision", status);
+    return any;
+  }
+
+  py::object earliest_toi() {
+    Busy busy(m_mutex);
+    EarliestContact earliest;
+    ColliderStatus status;
+    {
+      py::gil_scoped_release release;
+      status = call_earliest_toi(*m_collider, m_last_step, earliest);
+    }
+    check_query("earliest_toi", status);
+    if (!earliest.found) return py::none();
+    py::array one(contact_dtype(), std::vector<py::ssize_t>{1});
+    std::memcpy(one.mutable_data(), &earliest.contact, sizeof(Contact));
+    return one[py::int_(0)];
+  }
+
+  py::array contacts() {
+    Busy busy(m_mutex);
+    std::size_t capacity = m_contacts_capacity;
+    for (int attempt = 0; attempt < 3; ++attempt) {
+      py::array out(contact_dtype(), std::vector<py::ssize_t>{static_cast<py::ssize_t>(capacity)});
+      auto* buffer = static_cast<Contact*>(out.mutable_data());
+      ContactsResult result;
+      ColliderStatus status;
+      {
+        py::gil_scoped_release release;
+        status = call_contacts(*m_collider, m_last_step, buffer, capacity, result);
+      }
+      check_query("contacts", status);
+      if (!result.truncated()) {
+        out.resize({static_cast<py::ssize_t>(result.written)});
+        return out;
+      }
+      capacity = result.found;  // a deterministic step finds the same contacts again
+      m_contacts_capacity = capacity;
+    }
+    raise_status(errors().collider, "contacts", to_string(ColliderStatus::kInternal),
+                 "the contact count changed between two traversals of one step");
+  }
+
+  py::dict check_rest_intersection(const py::object& x) {
+    const std::size_t nodes = m_asset->node_count();
+    const double* p = positions_of("x", x, nodes);
+    Busy busy(m_mutex);
+    RestCheck result;
+    ColliderStatus status;
+    {
+      py::gil_scoped_release release;
+      status = call_check_rest_intersection(*m_collider, p, nodes * 3, result);
+    }
+    if (status != ColliderStatus::kOk)
+      raise_status(errors().collider, "check_rest_intersection", to_string(status),
+                   step_failure_detail(status));
+    return rest_check_dict(result);
+  }
+
+  py::dict stats() {
+    Busy busy(m_mutex);
+    return stats_dict(m_collider->stats());
+  }
+  py::dict rest_intersection() {
+    Busy busy(m_mutex);
+    return rest_check_dict(m_collider->rest_intersection());
+  }
+  py::dict options() const { return options_dict(m_collider->options()); }
+  std::size_t node_count() const { return m_asset->node_count(); }
+  const py::object& asset() const { return m_asset_object; }
+
+  const char* triangle_class(std::size_t triangle) {
+    Busy busy(m_mutex);
+    if (triangle >= m_asset->triangle_count())
+      throw py::index_error("triangle " + std::to_string(triangle) + " out of range (" +
+                            std::to_string(m_asset->triangle_count()) + " triangles)");
+    switch (m_collider->triangle_class(triangle)) {
+      case Orientation::kPositive:
+        return "positive";
+      case Orientation::kNegative:
+        return "negative";
+      case Orientation::kUncertain:
+        break;
+    }
+    return "uncertain";
+  }
+
+ private:
+  static std::string step_failure_detail(ColliderStatus status) {
+    switch (status) {
+      case ColliderStatus::kNonFinite:
+        return "a position of a surface or detector node is NaN or infinite (step rejected)";
+      case ColliderStatus::kSizeMismatch:
+        return "position count differs from node_count * 3";
+      default:
+        return "";
+    }
+  }
+
+  void check_query(const char* what, ColliderStatus status) const {
+    if (status == ColliderStatus::kOk) return;
+    std::string detail;
+    if (m_last_step != ColliderStatus::kOk) {
+      detail = m_last_step == ColliderStatus::kNotReady
+                   ? "no step yet: call step(x0, x1) first"
+                   : std::string("the last step failed (") + to_string(m_last_step) +
+                         "): call step(x0, x1) with valid positions first";
+    }
+    raise_status(errors().collider, what, to_string(status), detail);
+  }
+
+  py::object m_asset_object;  // the Python Asset: the binding's reference keeps it alive
+  AssetPtr m_asset;
+  std::unique_ptr<Collider> m_collider;             // declared after m_asset: destroyed before it
+  py::object m_x0 = py::none(), m_x1 = py::none();  // arrays the collider reads this step
+  ColliderStatus m_last_step = ColliderStatus::kNotReady;
+  std::size_t m_contacts_capacity = 256;
+  std::mutex m_mutex;
+};
+
+ColliderOptions make_options(const std::string& mode, double min_separation, double time_tolerance,
+                             std::uint32_t max_intervals, std::uint32_t bvh_leaf_size,
+                             bool use_openmp, bool check_first_step, bool time_tests) {
+  ColliderOptions o;
+  if (!parse_collider_mode(mode.c_str(), o.mode))
+    throw py::value_error("unknown mode '" + mode + "' (rvbc, bvh, brute, cone)");
+  o.ccd.min_separation = min_separation;
+  o.ccd.time_tolerance = time_tolerance;
+  o.ccd.max_intervals = max_intervals;
+  o.bvh_leaf_size = bvh_leaf_size;
+  o.use_openmp = use_openmp;
+  o.check_first_step = check_first_step;
+  o.time_tests = time_tests;
+  return o;
+}
+
+// ---------------------------------------------------------------------------------------
+// Frame files
+
+py::array read_frames_array(const py::object& path_like) {
+  const std::string path = py::module_::import("os").attr("fspath")(path_like).cast<std::string>();
+  auto frames = std::make_unique<FrameSequence>();
+  std::string detail;
+  FramesStatus status;
+  {
+    py::gil_scoped_release release;
+    status = read_frames_file(path, *frames, &detail);
+  }
+  if (status != FramesStatus::kOk) raise_status(errors().frames, path, to_string(status), detail);
+  const auto f = static_cast<py::ssize_t>(frames->frame_count);
+  const auto n = static_cast<py::ssize_t>(frames->node_count);
+  const double* data = frames->positions.data();
+  py::capsule owner(frames.release(), [](void* p) { delete static_cast<FrameSequence*>(p); });
+  const py::ssize_t d = sizeof(double);
+  return py::array(py::dtype::of<double>(), {f, n, py::ssize_t{3}}, {n * 3 * d, 3 * d, d}, data,
+                   owner);
+}
+
+}  // namespace
+}  // namespace tetseg::python
+
+PYBIND11_MODULE(_runtime, m) {
+  using namespace tetseg;
+  using namespace tetseg::python;
+  m.doc() =
+      "tetseg runtime: load assets and query continuous self-collisions of a deforming "
+      "tetrahedral mesh per step (docs/python.md, docs/runtime.md). Links the runtime only.";
+  m.attr("__version__") = TETSEG_VERSION_STRING;
+
+  errors().asset = add_status_exception(
+      m, "tetseg", "AssetError", PyExc_ValueError,
+      "An asset could not be loaded. Attributes: status (e.g. 'payload checksum', 'i/o error') "
+      "and detail (one line).");
+  errors().collider = add_status_exception(
+      m, "tetseg", "ColliderError", PyExc_RuntimeError,
+      "A collider call failed. Attributes: status (e.g. 'non-finite position', 'not ready') and "
+      "detail. Queries never answer without a valid step.");
+  errors().frames = add_status_exception(
+      m, "tetseg", "FramesError", PyExc_ValueError,
+      "A frame-sequence file could not be read. Attributes: status and detail.");
+
+  m.attr("CONTACT_DTYPE") = contact_dtype();
+  m.attr("VERTEX_FACE") = static_cast<int>(ContactKind::kVertexFace);
+  m.attr("EDGE_EDGE") = static_cast<int>(ContactKind::kEdgeEdge);
+  m.attr("MODES") = py::make_tuple("rvbc", "bvh", "brute", "cone");
+
+  py::class_<PyAsset>(m, "Asset",
+                      "A validated, immutable asset (load with tetseg.load_asset). Arrays are "
+                      "read-only views of the asset's memory and keep it alive.")
+      .def_static(
+          "from_file",
+          [](const py::object& path) {
+            const py::object p = py::module_::import("os").attr("fspath")(path);
+            if (!py::isinstance<py::str>(p))
+              throw py::type_error("asset path must be str or os.PathLike[str]");
+            return PyAsset{load_from_path(p.cast<std::string>())};
+          },
+          py::arg("path"), "Loads and validates an asset file. Raises AssetError.")
+      .def_static(
+          "from_bytes", [](const py::buffer& data) { return PyAsset{load_from_bytes(data)}; },
+          py::arg("data"), "Loads and validates an asset from bytes. Raises AssetError.")
+      .def_property_readonly(
+          "node_count", [](const PyAsset& a) { return a.asset->node_count(); },
+          "Tet-mesh nodes expected per step (rows of the position arrays).")
+      .def_property_readonly(
+          "triangle_count", [](const PyAsset& a) { return a.asset->triangle_count(); },
+          "Surface triangles.")
+      .def_property_readonly(
+          "cluster_count", [](const PyAsset& a) { return a.asset->cluster_count(); }, "Clusters.")
+      .def_property_readonly(
+          "triangles",
+          [](const PyAsset& a) {
+            return vector_view(a.asset->data().triangles, py::dtype::of<std::uint32_t>(), 3,
+                               a.asset);
+          },
+          "(T, 3) uint32: surface triangles as tet-mesh node ids, wound outward.")
+      .def_property_readonly(
+          "triangle_cluster",
+          [](const PyAsset& a) {
+            return vector_view(a.asset->data().triangle_cluster, py::dtype::of<std::uint32_t>(), 0,
+                               a.asset);
+          },
+          "(T,) uint32: the cluster of each surface triangle.")
+      .def_property_readonly(
+          "clusters",
+          [](const PyAsset& a) {
+            return vector_view(a.asset->data().clusters, cluster_dtype(), 0, a.asset);
+          },
+          "(C,) structured: detector_node, rest_positive_fraction, triangle_offset, "
+          "triangle_count, bvh_offset, bvh_count.")
+      .def_property_readonly(
+          "detectors",
+          [](const PyAsset& a) -> py::object {
+            const py::object clusters =
+                vector_view(a.asset->data().clusters, cluster_dtype(), 0, a.asset);
+            return clusters[py::str("detector_node")];
+          },
+          "(C,) uint32: the detector node (interior tet-mesh node) of each cluster.")
+      .def_property_readonly(
+          "cluster_triangles",
+          [](const PyAsset& a) {
+            return vector_view(a.asset->data().cluster_triangles, py::dtype::of<std::uint32_t>(), 0,
+                               a.asset);
+          },
+          "(T,) uint32: surface triangle ids grouped by cluster (see clusters.triangle_offset).")
+      .def_property_readonly(
+          "bvh_nodes",
+          [](const PyAsset& a) {
+            return vector_view(a.asset->data().bvh_nodes, bvh_node_dtype(), 0, a.asset);
+          },
+          "(B,) structured: first, second, count (docs/format.md).")
+      .def_property_readonly(
+          "boundaries",
+          [](const PyAsset& a) {
+            return vector_view(a.asset->data().boundaries, boundary_dtype(), 0, a.asset);
+          },
+          "(L,) structured: node_offset, node_count of each segment-boundary loop.")
+      .def_property_readonly(
+          "boundary_nodes",
+          [](const PyAsset& a) {
+            return vector_view(a.asset->data().boundary_nodes, py::dtype::of<std::uint32_t>(), 0,
+                               a.asset);
+          },
+          "(K,) uint32: the loops' node ids, grouped, in loop order.")
+      .def_property_readonly(
+          "rest_positions",
+          [](const PyAsset& a) -> py::object {
+            if (a.asset->data().rest_positions.empty()) return py::none();
+            return vector_view(a.asset->data().rest_positions, py::dtype::of<double>(), 3, a.asset);
+          },
+          "(N, 3) float64 rest positions, or None when the asset was built without them.")
+      .def_property_readonly(
+          "provenance",
+          [](const PyAsset& a) { return provenance_dict(a.asset->data().provenance); },
+          "dict: tool_version, source and the build options.")
+      .def("__repr__", [](const PyAsset& a) {
+        return "<tetseg.Asset: " + std::to_string(a.asset->node_count()) + " nodes, " +
+               std::to_string(a.asset->triangle_count()) + " surface triangles, " +
+               std::to_string(a.asset->cluster_count()) + " clusters>";
+      });
+
+  m.def("load_asset", &load_any, py::arg("source"),
+        "Returns an Asset. "
+        "Loads and validates an asset from a path (str or os.PathLike) or from bytes. Raises "
+        "AssetError (with .status and .detail) when it is unreadable, corrupt or invalid.");
+
+  m.def("read_frames", &read_frames_array, py::arg("path"),
+        "Returns a (frames, nodes, 3) float64 array. "
+        "Reads a frame-sequence file (docs/format.md). Each frames[i] is C-contiguous and can "
+        "be passed to Collider.step without a copy. Raises FramesError.");
+
+  const ColliderOptions defaults;
+  py::class_<PyCollider>(m, "Collider",
+                         "Continuous self-collision queries for one asset, step by step.\n\n"
+                         "Per step: step(x0, x1), then any of any_collision(), earliest_toi(), "
+                         "contacts(). One thread at a time per Collider; several colliders may "
+                         "share an asset. The GIL is released during steps and queries.")
+      .def(py::init([](py::object asset, const std::string& mode, double min_separation,
+                       double time_tolerance, std::uint32_t max_intervals,
+                       std::uint32_t bvh_leaf_size, bool use_openmp, bool check_first_step,
+                       bool time_tests) {
+             if (!py::isinstance<PyAsset>(asset))
+               throw py::type_error("Collider expects a tetseg.Asset (see tetseg.load_asset)");
+             return std::make_unique<PyCollider>(
+                 std::move(asset),
+                 make_options(mode, min_separation, time_tolerance, max_intervals, bvh_leaf_size,
+                              use_openmp, check_first_step, time_tests));
+           }),
+           py::arg("asset"), py::kw_only(), py::arg("mode") = std::string(to_string(defaults.mode)),
+           py::arg("min_separation") = defaults.ccd.min_separation,
+           py::arg("time_tolerance") = defaults.ccd.time_tolerance,
+           py::arg("max_intervals") = defaults.ccd.max_intervals,
+           py::arg("bvh_leaf_size") = defaults.bvh_leaf_size,
+           py::arg("use_openmp") = defaults.use_openmp,
+           py::arg("check_first_step") = defaults.check_first_step,
+           py::arg("time_tests") = defaults.time_tests,
+           "Builds a collider (allocates all scratch memory). Options as "
+           "tetseg::ColliderOptions (docs/runtime.md): mode is one of MODES; min_separation, "
+           "time_tolerance and max_intervals go to the elementary tests. The collider holds a "
+           "reference to the asset, so it keeps working when the caller drops the Asset.")
+      .def("step", &PyCollider::step, py::arg("x0"), py::arg("x1"),
+           "Starts a step from positions x0 (t = 0) to x1 (t = 1): "
+           "(node_count, 3) C-contiguous float64 arrays, used in place (not copied) and "
+           "referenced by the collider until the next step; do not modify them in between. "
+           "TypeError for a non-array or another dtype, ValueError for a wrong shape or a "
+           "non-contiguous array, ColliderError ('non-finite position') for NaN/inf.")
+      .def("any_collision", &PyCollider::any_collision,
+           "Whether any feature pair is in contact during the step. "
+           "Raises ColliderError without a valid step.")
+      .def("earliest_toi", &PyCollider::earliest_toi,
+           "The earliest contact of the step as a numpy.void record of CONTACT_DTYPE (fields "
+           "kind, nodes, triangle, toi, at_start), or None when there is none. "
+           "Raises ColliderError without a valid step.")
+      .def("contacts", &PyCollider::contacts,
+           "An ndarray of CONTACT_DTYPE: all contacts of the step, sorted by toi, "
+           "kind, nodes. kind is VERTEX_FACE (nodes = p, a, b, c) or EDGE_EDGE (edge a-b "
+           "against c-d); toi is a lower bound of the first contact time in [0, 1]. Raises "
+           "ColliderError without a valid step.")
+      .def("check_rest_intersection", &PyCollider::check_rest_intersection, py::arg("x"),
+           "Returns dict(intersecting, triangle_a, triangle_b). "
+           "Static check of positions x ((node_count, 3) float64): do two non-adjacent parts of "
+           "the surface intersect or touch? Conservative.")
+      .def_property_readonly("stats", &PyCollider::stats,
+                             "dict: counts and times (ms) of the current step.")
+      .def_property_readonly("rest_intersection", &PyCollider::rest_intersection,
+                             "dict: result of check_first_step (intersecting False when not run).")
+      .def_property_readonly("options", &PyCollider::options, "dict: the collider's options.")
+      .def_property_readonly("node_count", &PyCollider::node_count, "Rows expected in x0 and x1.")
+      .def_property_readonly("asset", &PyCollider::asset, "The Asset this collider was built on.")
+      .def("triangle_class", &PyCollider::triangle_class, py::arg("triangle"),
+           "Orientation class of a surface triangle in the current step (rvbc mode): "
+           "'positive', 'negative' or 'uncertain'. For diagnostics.");
+}

@@ -1,0 +1,194 @@
+"""tetseg.preprocess against the `tetseg` CLI: same options and defaults give the same bytes."""
+
+import json
+
+import numpy as np
+import pytest
+
+from conftest import run_tool
+
+pytestmark = pytest.mark.preprocess
+
+
+@pytest.fixture(scope="module")
+def pp():
+    import tetseg.preprocess
+    return tetseg.preprocess
+
+
+@pytest.fixture(scope="module")
+def sphere_mesh(bin_dir, tmp_path_factory):
+    path = tmp_path_factory.mktemp("sphere") / "sphere.mesh"
+    run_tool(bin_dir, "tetseg", "generate", "sphere", "-o", path, "--size", 0.5)
+    return path
+
+
+def cli_build(bin_dir, mesh, folder, *flags):
+    asset, report = folder / "cli.tetseg", folder / "cli.json"
+    run_tool(bin_dir, "tetseg", "build", mesh, "-o", asset, "--report", report, "-q", *flags)
+    return asset.read_bytes(), json.loads(report.read_text())
+
+
+OPTION_SETS = [
+    ({}, []),
+    (dict(clusters="charge", alpha=0.2, beta_divisor=200, equalization="rank", growth_bound=0.3,
+          grow_through_marked=False, min_cluster_triangles=10, detector="nearest-centroid",
+          solver="direct", rest_positions=False),
+     ["--clusters", "charge", "--alpha", 0.2, "--beta-divisor", 200, "--equalization", "rank",
+      "--growth-bound", 0.3, "--grow-through-marked", "false", "--min-cluster-triangles", 10,
+      "--detector", "nearest-centroid", "--solver", "direct", "--no-rest-positions"]),
+    (dict(clusters="refined", refine_visibility=0.9, refine_max_clusters=4, refine_gain=0.5,
+          refine_merge=False, solver="gmres", tolerance=1e-7, equalization="log-histogram"),
+     ["--clusters", "refined", "--refine-visibility", 0.9, "--refine-max-clusters", 4,
+      "--refine-gain", 0.5, "--refine-merge", "false", "--solver", "gmres", "--tolerance", 1e-7,
+      "--equalization", "log-histogram"]),
+    (dict(clusters="single"), ["--clusters", "single"]),
+]
+
+
+@pytest.mark.parametrize("options,flags", OPTION_SETS)
+def test_build_equals_cli(pp, bin_dir, sphere_mesh, tmp_path, options, flags):
+    expected_bytes, expected_report = cli_build(bin_dir, sphere_mesh, tmp_path, *flags)
+    data, report = pp.build(sphere_mesh, **options)
+    assert data == expected_bytes
+    for key in ("counts", "segmentation", "refinement", "clusters", "options", "asset_bytes"):
+        assert report[key] == pytest.approx(expected_report[key]), key
+    assert ("charge" in report) == ("charge" in expected_report)
+    assert set(report["seconds"]) == set(expected_report["seconds"])
+    import tetseg
+    asset = tetseg.load_asset(data)
+    assert asset.triangle_count == report["counts"]["surface_triangles"]
+    assert (asset.rest_positions is None) == (options.get("rest_positions") is False)
+    assert len(asset.boundaries) == report["counts"]["boundaries"]
+    assert len(asset.clusters) == len(report["clusters"])
+
+
+def test_build_from_generated_arrays_equals_cli(pp, bin_dir, sphere_mesh, tmp_path):
+    expected, _ = cli_build(bin_dir, sphere_mesh, tmp_path)
+    nodes, tets = pp.generate("sphere", size=0.5)
+    assert nodes.shape[1] == 3 and tets.shape[1] == 4 and tets.dtype == np.uint32
+    data, _ = pp.build((nodes, tets), source="sphere.mesh")
+    assert data == expected
+    data64, _ = pp.build((nodes.tolist(), tets.astype(np.int64)), source="sphere.mesh")
+    assert data64 == expected
+
+
+def test_build_from_closed_surface_equals_cli(pp, bin_dir, sphere_mesh, tmp_path):
+    import tetseg
+    asset = tetseg.load_asset(pp.build(sphere_mesh, clusters="single")[0])
+    used, triangles = np.unique(asset.triangles, return_inverse=True)
+    triangles = triangles.reshape(-1, 3)
+    points = asset.rest_positions[used]
+    off = tmp_path / "sphere.off"
+    with open(off, "w") as out:
+        out.write(f"OFF\n{len(points)} {len(triangles)} 0\n")
+        out.writelines(f"{x!r} {y!r} {z!r}\n" for x, y, z in points.tolist())
+        out.writelines(f"3 {a} {b} {c}\n" for a, b, c in triangles.tolist())
+    expected, expected_report = cli_build(bin_dir, off, tmp_path, "--cell-size", 0.2,
+                                          "--no-optimize")
+    data, report = pp.build(off, cell_size=0.2, optimize=False)
+    assert data == expected
+    assert [s[0] for s in report["stages"]][:2] == ["read", "tetrahedralize"]
+    assert report["counts"] == expected_report["counts"]
+
+
+def test_charge_equals_cli(pp, bin_dir, sphere_mesh, tmp_path):
+    csv = tmp_path / "charge.csv"
+    run_tool(bin_dir, "tetseg", "charge", sphere_mesh, "-o", csv, "--solver", "direct",
+             "--equalize", "rank")
+    expected = np.loadtxt(csv, delimiter=",", skiprows=1)
+    result = pp.charge(sphere_mesh, solver="direct", equalize="rank")
+    assert result["solver"] == "direct" and result["equalization"] == "rank"
+    assert result["triangles"].shape == (len(expected), 3)
+    assert np.allclose(result["density"], expected[:, 5], rtol=1e-8, atol=0)
+    assert np.allclose(result["equalized"], expected[:, 6], rtol=1e-8, atol=0)
+    # A sphere's relative density is 1 everywhere, up to the discretisation.
+    assert abs(result["density"].mean() - 1.0) < 0.05
+    nodes, tets = pp.generate("sphere", size=0.5)
+    again = pp.charge((nodes, tets), solver="direct", equalize="rank")
+    assert np.array_equal(again["density"], result["density"])
+
+
+def test_on_stage_reports_every_stage(pp, sphere_mesh):
+    seen = []
+    _, report = pp.build(sphere_mesh, on_stage=lambda *stage: seen.append(stage))
+    assert [s[0] for s in seen] == [s[0] for s in report["stages"]]
+    assert {"read", "surface", "detectors", "bvh", "write"} <= {s[0] for s in seen}
+
+    def fail(*_):
+        raise ZeroDivisionError("from the callback")
+
+    with pytest.raises(ZeroDivisionError, match="from the callback"):
+        pp.build(sphere_mesh, on_stage=fail)
+    assert pp.build(sphere_mesh)[0]  # still usable
+
+
+def test_bad_options_raise_value_errors(pp, sphere_mesh):
+    cases = [
+        (dict(alpha=7), r"alpha must be in \[0, 1\], got 7$"),
+        (dict(alpha=float("nan")), "alpha must be in"),
+        (dict(beta_divisor=0), "beta_divisor must be positive"),
+        (dict(refine_max_clusters=0), "refine_max_clusters must be in"),
+        (dict(tolerance=0.7), "tolerance must be in"),
+        (dict(cell_size=-1), "cell_size must be in"),
+        (dict(clusters="many"), r"clusters: unknown value 'many' \(single, charge, refined\)"),
+        (dict(detector="x"), "detector: unknown value 'x' .nearest-centroid, visibility."),
+        (dict(equalization="log"), "equalization: unknown value 'log'"),
+        (dict(solver="lu"), "solver: unknown value 'lu'"),
+    ]
+    for options, message in cases:
+        with pytest.raises(ValueError, match=message):
+            pp.build(sphere_mesh, **options)
+    with pytest.raises(TypeError):
+        pp.build(sphere_mesh, no_such_option=1)
+    for options, message in [(dict(theta=1.5), "theta must be in"),
+                             (dict(bins=0), "bins must be in"),
+                             (dict(equalize="log-histogram"), "equalize: unknown value")]:
+        with pytest.raises(ValueError, match=message):
+            pp.charge(sphere_mesh, **options)
+
+
+def test_bad_meshes_raise_clear_errors(pp, sphere_mesh, tmp_path):
+    nodes, tets = pp.generate("sphere", size=0.5)
+    with pytest.raises(pp.InputError, match="missing.mesh: ") as error:
+        pp.build(tmp_path / "missing.mesh")
+    assert error.value.file.endswith("missing.mesh") and isinstance(error.value, ValueError)
+    assert pp.InputError.__module__ == "tetseg.preprocess"
+    broken = tmp_path / "broken.mesh"
+    broken.write_text("MeshVersionFormatted 2\nDimension 3\nVertices\n2\n0 0\n")
+    with pytest.raises(pp.InputError, match="broken.mesh: line"):
+        pp.build(broken)
+    bad = tets.copy()
+    bad[0, 0] = len(nodes)
+    with pytest.raises(pp.InputError, match="arrays: "):
+        pp.build((nodes, bad))
+    nan = nodes.copy()
+    nan[3, 1] = np.nan
+    with pytest.raises(pp.InputError, match="mine.mesh: "):
+        pp.build((nan, tets), source="mine.mesh")
+    inverted = tets.copy()
+    inverted[:, [0, 1]] = inverted[:, [1, 0]]
+    inverted[5:] = tets[5:]
+    with pytest.raises(pp.InputError, match="inverted"):
+        pp.build((nodes, inverted))
+    open_surface = (nodes, np.array([[0, 1, 2], [0, 2, 3]]))
+    with pytest.raises(pp.InputError, match="not closed"):
+        pp.build(open_surface)
+    with pytest.raises(ValueError, match="outside"):
+        pp.build((nodes, tets.astype(np.int64) - 1))
+    with pytest.raises(TypeError, match="integer array"):
+        pp.build((nodes, tets.astype(np.float64)))
+    with pytest.raises(ValueError, match=r"\(M, 4\) .tets. or \(M, 3\)"):
+        pp.build((nodes, tets[:, :2]))
+    with pytest.raises(ValueError, match=r"nodes must be an \(N, 3\) array"):
+        pp.build((nodes[:, :2], tets))
+    with pytest.raises(TypeError, match="file path or a pair of arrays"):
+        pp.build(42)
+    with pytest.raises(ValueError, match="unknown"):
+        pp.generate("cube")
+
+
+def test_preprocess_module_carries_the_gpl_code(pp):
+    # Positive control for test_runtime_package_does_not_load_preprocess.
+    assert b"CGAL" in open(pp.__file__, "rb").read()
+    assert "GPL" in pp.__doc__

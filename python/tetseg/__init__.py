@@ -1,0 +1,35 @@
+"""tetseg: continuous self-collision detection for deformable tetrahedral objects.
+
+The runtime part (this package) loads assets and answers per-step collision queries on NumPy
+arrays; it links the tetseg runtime only. Building assets is in the separate, GPL-licensed
+``tetseg.preprocess`` module (CGAL), which this package never imports. See docs/python.md.
+"""
+
+from ._runtime import (  # noqa: F401
+    CONTACT_DTYPE,
+    EDGE_EDGE,
+    MODES,
+    VERTEX_FACE,
+    Asset,
+    AssetError,
+    Collider,
+    ColliderError,
+    FramesError,
+    __version__,
+    load_asset,
+    read_frames,
+)
+
+__all__ = [
+    "Asset",
+    "AssetError",
+    "CONTACT_DTYPE",
+    "Collider",
+    "ColliderError",
+    "EDGE_EDGE",
+    "FramesError",
+    "MODES",
+    "VERTEX_FACE",
+    "load_asset",
+    "read_frames",
+]
