@@ -11,12 +11,13 @@ jobs=${TETSEG_JOBS:-$(nproc)}
 bash scripts/install-deps.sh
 
 echo "== full build and tests"
-cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release
+cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DTETSEG_REQUIRE_TEST_DATA=ON
 cmake --build build -j "$jobs"
 ctest --test-dir build --output-on-failure -j "$jobs"
 
 echo "== runtime-only build (no CGAL, Eigen, assimp)"
 cmake -S . -B build-runtime-only -G Ninja -DCMAKE_BUILD_TYPE=Release -DTETSEG_BUILD_PREPROCESS=OFF \
+  -DTETSEG_REQUIRE_TEST_DATA=ON \
   -DCMAKE_DISABLE_FIND_PACKAGE_CGAL=ON -DCMAKE_DISABLE_FIND_PACKAGE_Eigen3=ON \
   -DCMAKE_DISABLE_FIND_PACKAGE_assimp=ON
 cmake --build build-runtime-only -j "$jobs"

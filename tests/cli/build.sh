@@ -55,7 +55,7 @@ if [[ -f "${TETSEG_CGAL_MESH_DIR:-/nonexistent}/dino.off" ]]; then
   expect_exit 0 "tetseg: note: [0-9]* of [0-9]* clusters are seen less than 80% positive" -- \
     "$bin/tetseg" build "$TETSEG_CGAL_MESH_DIR/dino.off" -o dino.tetseg
 else
-  echo "WARN: CGAL demo meshes not found; skipping the visibility note" >&2
+  skip_without_data "CGAL demo mesh dino.off (visibility note)"
 fi
 
 # Same input and options give byte-identical assets.

@@ -11,6 +11,7 @@
 #include <catch2/catch.hpp>
 
 #include "../../tools/ccd/ccd_io.hpp"
+#include "support/test_data.hpp"
 
 namespace {
 
@@ -125,10 +126,7 @@ TEST_CASE("Edges are numbered as in the scalable-CCD data.", "[ccd][io]") {
   SECTION("The numbering reproduces the coordinates of the data's own query CSVs.") {
     const fs::path dir =
         fs::path(TETSEG_SHARED_DIR) / "data/ccd-queries/sample-scalable-ccd-data/cloth-funnel";
-    if (!fs::is_directory(dir / "queries")) {
-      WARN("cloth-funnel queries not found under " << dir.string() << ": skipped");
-      return;
-    }
+    if (!tetseg::test::have_test_data((dir / "queries").string(), "cloth-funnel queries")) return;
     const io::Mesh m0 = io::read_ply((dir / "frames/227.ply").string());
     const io::Mesh m1 = io::read_ply((dir / "frames/228.ply").string());
     const auto edges = io::unique_edges(m0.faces);
