@@ -16,6 +16,7 @@
 #include "commands.hpp"
 #include "tetseg/preprocess/charge.hpp"
 #include "tetseg/preprocess/io.hpp"
+#include "tetseg/preprocess/names.hpp"
 #include "tetseg/preprocess/surface.hpp"
 #include "tool_support.hpp"
 
@@ -26,8 +27,8 @@ struct ChargeArgs {
   std::string input;
   std::string output;
   std::string report;
-  std::string solver = "auto";
-  std::string equalization = "histogram";
+  preprocess::ChargeSolver solver = preprocess::ChargeSolver::kAuto;
+  preprocess::Equalization equalization = preprocess::Equalization::kHistogram;
   double tolerance = 0.0;  // 0: automatic (charge.hpp)
   int max_iterations = 500;
   double theta = 0.0;  // 0: automatic (charge.hpp)
@@ -190,13 +191,8 @@ void run_charge(const ChargeArgs& args) {
     throw CLI::ValidationError("--output", "output must end in .csv, .vtu or .ply: " + args.output);
   }
   preprocess::ChargeOptions options;
-  if (!preprocess::parse_charge_solver(args.solver, options.solver)) {
-    throw CLI::ValidationError("--solver", "unknown solver: " + args.solver);
-  }
-  preprocess::Equalization method;
-  if (!preprocess::parse_equalization(args.equalization, method)) {
-    throw CLI::ValidationError("--equalize", "unknown equalisation: " + args.equalization);
-  }
+  options.solver = args.solver;
+  const preprocess::Equalization method = args.equalization;
   options.tolerance = args.tolerance;
   options.max_iterations = args.max_iterations;
   options.fast_theta = args.theta;
@@ -254,7 +250,7 @@ void run_charge(const ChargeArgs& args) {
       << ",\n  \"converged\": " << (r.converged ? "true" : "false")
       << ",\n  \"tolerance\": " << r.tolerance << ",\n  \"capacitance\": " << r.capacitance
       << ",\n  \"total_area\": " << r.total_area << ",\n  \"equalization\": \""
-      << preprocess::to_string(method) << "\",\n  \"assembly_seconds\": " << r.assembly_seconds
+      << preprocess::name_of(method) << "\",\n  \"assembly_seconds\": " << r.assembly_seconds
       << ",\n  \"solve_seconds\": " << r.solve_seconds << "\n}\n";
     write_file_atomic(args.report, j.str());
   }
@@ -273,8 +269,9 @@ void add_charge_command(CLI::App& root) {
                   "Per-triangle output: .csv (triangle,cx,cy,cz,area,density,equalized), "
                   ".vtu (cell data) or .ply (gray faces)")
       ->required();
-  cmd->add_option("--solver", args->solver, "auto | direct | gmres | fast")
-      ->check(CLI::IsMember({"auto", "direct", "gmres", "fast"}));
+  cmd->add_option("--solver", args->solver, "Charge solver")
+      ->transform(CLI::CheckedTransformer(preprocess::name_map<preprocess::ChargeSolver>()))
+      ->option_text(preprocess::name_list<preprocess::ChargeSolver>() + " (auto)");
   cmd->add_option("--tolerance", args->tolerance,
                   "Relative residual of the iterative solvers (0: 1e-6 below 10k triangles, "
                   "1e-8 above)")
@@ -287,8 +284,10 @@ void add_charge_command(CLI::App& root) {
   cmd->add_option("--order", args->order,
                   "Fast solver expansion order (-1 = 7 below 10k triangles, else 8)")
       ->check(CLI::Range(-1, 16));
-  cmd->add_option("--equalize", args->equalization, "histogram (paper) | rank | log")
-      ->check(CLI::IsMember({"histogram", "rank", "log"}));
+  cmd->add_option("--equalization,--equalize", args->equalization,
+                  "histogram (the paper), rank or log-histogram (alias log)")
+      ->transform(CLI::CheckedTransformer(preprocess::name_map<preprocess::Equalization>()))
+      ->option_text(preprocess::name_list<preprocess::Equalization>() + " (histogram)");
   cmd->add_option("--bins", args->bins, "Histogram bins")->check(CLI::Range(1, 1 << 20));
   cmd->add_option("--report", args->report, "Write a JSON report (solver, iterations, times)");
   cmd->callback([args] { run_charge(*args); });

@@ -12,6 +12,7 @@
 #include "commands.hpp"
 #include "tetseg/preprocess/io.hpp"
 #include "tetseg/preprocess/meshing.hpp"
+#include "tetseg/preprocess/names.hpp"
 #include "tetseg/preprocess/surface.hpp"
 #include "tool_support.hpp"
 
@@ -162,9 +163,9 @@ void add_generate_command(CLI::App& root) {
   auto args = std::make_shared<GenerateArgs>();
   CLI::App* cmd = root.add_subcommand(
       "generate", "Mesh a procedural shape (sphere, ellipsoid, dumbbell, pawn) into tets");
-  cmd->add_option("shape", args->shape, "sphere | ellipsoid | dumbbell | pawn")
+  cmd->add_option("shape", args->shape, preprocess::name_list<preprocess::Shape>(" | "))
       ->required()
-      ->check(CLI::IsMember({"sphere", "ellipsoid", "dumbbell", "pawn"}));
+      ->check(CLI::IsMember(preprocess::name_map<preprocess::Shape>()));
   cmd->add_option("-o,--output", args->output, "Output tet mesh (.mesh, .node/.ele, .msh)")
       ->required();
   cmd->add_option("--size", args->shape_options.size,
