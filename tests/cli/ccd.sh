@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # tetseg-ccd end to end: exit codes and messages, the reference queries (zero false negatives),
 # and whole frames of the scalable-CCD data (every true pair reported).
+# needs: bench
 set -euo pipefail
 tool="${TETSEG_BIN_DIR:?}/tetseg-ccd"
 data="${TETSEG_SHARED_DIR:-}/data/ccd-queries"

@@ -8,11 +8,11 @@
 #include <fstream>
 #include <stdexcept>
 
-#include "preprocess/charge_shapes.hpp"
 #include "support/test_data.hpp"
 #include "tetseg/preprocess/io.hpp"
 #include "tetseg/preprocess/meshing.hpp"
 #include "tetseg/preprocess/surface.hpp"
+#include "tetseg/testing/charge_shapes.hpp"
 
 using namespace tetseg::preprocess;
 

@@ -2,11 +2,11 @@
 #include <catch2/catch.hpp>
 #include <set>
 
-#include "preprocess/charge_shapes.hpp"
 #include "tetseg/format/asset_io.hpp"
 #include "tetseg/preprocess/meshing.hpp"
 #include "tetseg/preprocess/pipeline.hpp"
 #include "tetseg/preprocess/surface.hpp"
+#include "tetseg/testing/charge_shapes.hpp"
 
 using namespace tetseg::preprocess;
 

@@ -1,5 +1,5 @@
-// Readers of the CCD reference data (tools/ccd/ccd_io.hpp): PLY variants, JSON arrays, the
-// edge numbering of the scalable-CCD data (checked against the data's own query CSVs).
+// Readers of the CCD reference data (testing/include/tetseg/testing/ccd_io.hpp): PLY variants, JSON
+// arrays, the edge numbering of the scalable-CCD data (checked against the data's own query CSVs).
 
 #include <algorithm>
 #include <cstring>
@@ -10,13 +10,13 @@
 
 #include <catch2/catch.hpp>
 
-#include "../../tools/ccd/ccd_io.hpp"
 #include "support/test_data.hpp"
+#include "tetseg/testing/ccd_io.hpp"
 
 namespace {
 
 namespace fs = std::filesystem;
-namespace io = tetseg::tools::ccd_io;
+namespace io = tetseg::test::ccd_io;
 
 fs::path scratch(const std::string& name) {
   const fs::path dir = fs::path(TETSEG_BINARY_DIR) / "test-scratch" / "ccd_io";

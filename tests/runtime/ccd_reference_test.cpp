@@ -9,14 +9,14 @@
 
 #include <catch2/catch.hpp>
 
-#include "../../tools/ccd/ccd_io.hpp"
 #include "support/test_data.hpp"
 #include "tetseg/runtime/ccd.hpp"
+#include "tetseg/testing/ccd_io.hpp"
 
 namespace {
 
 namespace fs = std::filesystem;
-namespace io = tetseg::tools::ccd_io;
+namespace io = tetseg::test::ccd_io;
 
 const fs::path kQueries = fs::path(TETSEG_SHARED_DIR) / "data/ccd-queries/sample-queries";
 const fs::path kFrames = fs::path(TETSEG_SHARED_DIR) / "data/ccd-queries/sample-scalable-ccd-data";

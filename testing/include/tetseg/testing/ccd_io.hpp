@@ -17,7 +17,7 @@
 #include <string>
 #include <vector>
 
-namespace tetseg::tools::ccd_io {
+namespace tetseg::test::ccd_io {
 
 using Vec3 = std::array<double, 3>;
 
@@ -401,4 +401,4 @@ inline std::vector<std::array<std::uint32_t, 2>> unique_edges(
   return edges;
 }
 
-}  // namespace tetseg::tools::ccd_io
+}  // namespace tetseg::test::ccd_io

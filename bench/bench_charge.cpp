@@ -14,10 +14,10 @@
 #include <string>
 #include <vector>
 
-#include "../../preprocess/src/charge_solvers.hpp"
-#include "charge_shapes.hpp"
+#include "../preprocess/src/charge_solvers.hpp"
 #include "tetseg/preprocess/charge.hpp"
 #include "tetseg/preprocess/names.hpp"
+#include "tetseg/testing/charge_shapes.hpp"
 
 using namespace tetseg;
 using preprocess::ChargeOptions;
