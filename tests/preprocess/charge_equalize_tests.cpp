@@ -102,7 +102,7 @@ TEST_CASE("The rank and log variants resolve heavy tails", "[charge][equalize]")
   }
   SECTION("Names parse and print back; the old spelling log is an alias.") {
     for (const char* name : {"histogram", "rank", "log-histogram"}) {
-      Equalization e;
+      Equalization e{};
       REQUIRE(parse_name(name, e));
       CHECK(std::string(name_of(e)) == name);
     }
