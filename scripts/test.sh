@@ -3,7 +3,8 @@
 #  1. the full build (preprocess, tools, tests) and ctest;
 #  2. a runtime-only build with CGAL, Eigen and assimp made unfindable, and its tests;
 #  3. install of the runtime package and a consumer project built with find_package(tetseg);
-#  4. the loader fuzz target, briefly, when clang with libFuzzer is available.
+#  4. the loader fuzz target, briefly, when clang with libFuzzer is available;
+#  5. every C++ source follows .clang-format (scripts/check-format.sh).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 root=$PWD
@@ -40,4 +41,6 @@ if command -v clang++ >/dev/null && [ -e /usr/lib/llvm-14/lib/clang/14.0.6/lib/l
   cp tests/golden/*.tetseg build-fuzz/corpus/
   build-fuzz/tests/fuzz/fuzz_load_asset -max_total_time=60 build-fuzz/corpus
 fi
+echo "== format"
+bash scripts/check-format.sh
 echo "== all tests passed"
