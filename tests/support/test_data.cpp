@@ -5,7 +5,7 @@
 
 namespace tetseg::test {
 namespace {
-bool g_skipped = false;
+bool g_missing = false;
 }  // namespace
 
 bool have_test_data(const std::string& path, const std::string& what) {
@@ -15,16 +15,13 @@ bool have_test_data(const std::string& path, const std::string& what) {
   FAIL(what << " not found at " << path << " (required: TETSEG_REQUIRE_TEST_DATA=ON)");
 #else
   WARN(what << " not found at " << path << ": test case skipped");
-  g_skipped = true;
+  g_missing = true;
 #endif
   return false;
 }
 
-bool current_test_case_skipped() {
-  return g_skipped;
-}
-void reset_current_test_case_skipped() {
-  g_skipped = false;
+bool test_data_missing() {
+  return g_missing;
 }
 
 }  // namespace tetseg::test
