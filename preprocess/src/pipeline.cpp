@@ -73,9 +73,9 @@ bool parse_integer(const std::string& text, Int& value) {
   errno = 0;
   const long long parsed = std::strtoll(text.c_str(), &end, 10);
   if (errno != 0 || end != text.c_str() + text.size()) return false;
+  static_assert(sizeof(Int) < sizeof(long long), "the limits must fit a long long");
   if (parsed < static_cast<long long>(std::numeric_limits<Int>::min()) ||
-      static_cast<unsigned long long>(parsed) >
-          static_cast<unsigned long long>(std::numeric_limits<Int>::max())) {
+      parsed > static_cast<long long>(std::numeric_limits<Int>::max())) {
     return false;
   }
   value = static_cast<Int>(parsed);
@@ -90,16 +90,22 @@ ProvenanceField number(const char* key, bool (*recorded)(const BuildOptions&),
           [=](BuildOptions& o) {
             const T value = access(o);
             if (has_auto && value == automatic) return std::string("auto");
-            if constexpr (std::is_floating_point_v<T>) return format_number(value);
-            return std::to_string(value);
+            if constexpr (std::is_floating_point_v<T>) {
+              return format_number(value);
+            } else {
+              return std::to_string(value);
+            }
           },
           [=](const std::string& text, BuildOptions& o) {
             if (has_auto && text == "auto") {
               access(o) = automatic;
               return true;
             }
-            if constexpr (std::is_floating_point_v<T>) return parse_double(text, access(o));
-            return parse_integer(text, access(o));
+            if constexpr (std::is_floating_point_v<T>) {
+              return parse_double(text, access(o));
+            } else {
+              return parse_integer(text, access(o));
+            }
           }};
 }
 

@@ -190,6 +190,9 @@ TEST_CASE("Provenance options that cannot be read back are refused", "[pipeline]
   CHECK(error == "bad value for clusters: 'many'");
   CHECK_FALSE(options_from_provenance({{"segmentation.alpha", "0.1x"}}, options, &error));
   CHECK_FALSE(options_from_provenance({{"refine.max_clusters", "-1"}}, options, &error));
+  CHECK_FALSE(options_from_provenance({{"refine.max_clusters", "4294967296"}}, options, &error));
+  REQUIRE(options_from_provenance({{"charge.fast_order", "-2"}}, options, &error));
+  CHECK(options.charge.fast_order == -2);  // read as written; compute_charge judges it
   CHECK_FALSE(options_from_provenance({{"colour", "blue"}}, options, &error));
   CHECK(error == "unknown option colour: 'blue'");
   REQUIRE(options_from_provenance({{"segmentation.alpha", "0.05"}}, options, &error));
