@@ -8,9 +8,10 @@ packages=(
   libcgal-dev libcgal-demo libgmp-dev libmpfr-dev libboost-dev   # preprocess (CGAL, GPL)
   libeigen3-dev libassimp-dev libomp-dev                           # preprocess
   libcereal-dev                                                    # asset payload (header-only)
-  libcli11-dev                                                     # command-line tools
+  libcli11-dev libpng-dev                                          # command-line tools
   catch2                                                           # tests
   clang libclang-rt-14-dev                                         # libFuzzer target
+  clang-format                                                     # scripts/check-format.sh
   python3                                                          # test helpers
   pybind11-dev python3-dev python3-numpy                           # Python package (python/)
   python3-pytest python3-venv python3-pip python3-setuptools python3-wheel  # its tests, pip install

@@ -5,12 +5,15 @@
 #  3. install of the runtime package and a consumer project built with find_package(tetseg);
 #  4. the Python package: pip install into a fresh virtual environment, pytest against it;
 #  5. the loader fuzz target, briefly, when clang with libFuzzer is available.
+# First of all, every C++ source must follow .clang-format (scripts/check-format.sh).
 # The Python tests also run inside ctest (builds 1 and 2) against the build tree.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 root=$PWD
 jobs=${TETSEG_JOBS:-$(nproc)}
 bash scripts/install-deps.sh
+echo "== format (.clang-format)"
+bash scripts/check-format.sh
 # The Debian interpreter: python3-numpy, python3-pytest and pybind11 are installed for it (a
 # python3 earlier on PATH, e.g. pyenv's, may lack them). TETSEG_BUILD_PYTHON=ON makes a
 # missing dependency a configure error instead of a silently skipped package.
@@ -18,12 +21,14 @@ python=/usr/bin/python3
 py_flags=(-DTETSEG_BUILD_PYTHON=ON "-DPython_EXECUTABLE=$python")
 
 echo "== full build and tests"
-cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release "${py_flags[@]}"
+cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DTETSEG_REQUIRE_TEST_DATA=ON \
+  "${py_flags[@]}"
 cmake --build build -j "$jobs"
 ctest --test-dir build --output-on-failure -j "$jobs"
 
 echo "== runtime-only build (no CGAL, Eigen, assimp)"
 cmake -S . -B build-runtime-only -G Ninja -DCMAKE_BUILD_TYPE=Release -DTETSEG_BUILD_PREPROCESS=OFF \
+  -DTETSEG_REQUIRE_TEST_DATA=ON \
   -DCMAKE_DISABLE_FIND_PACKAGE_CGAL=ON -DCMAKE_DISABLE_FIND_PACKAGE_Eigen3=ON \
   -DCMAKE_DISABLE_FIND_PACKAGE_assimp=ON "${py_flags[@]}"
 cmake --build build-runtime-only -j "$jobs"

@@ -203,12 +203,12 @@ Status read_asset_file(const std::string& path, Asset& out, std::string* detail)
     out = Asset{};
     std::ifstream in(path, std::ios::binary);
     if (!in) {
-      set_detail(detail, "cannot open " + path);
+      set_detail(detail, "cannot open file");
       return Status::kIoError;
     }
     bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
     if (in.bad()) {
-      set_detail(detail, "read error in " + path);
+      set_detail(detail, "read error");
       return Status::kIoError;
     }
   } catch (...) {

@@ -13,6 +13,7 @@
 #include "charge_solvers.hpp"
 #include "charge_tree.hpp"
 #include "tetseg/preprocess/charge.hpp"
+#include "tetseg/preprocess/names.hpp"
 
 namespace tetseg::preprocess {
 namespace {
@@ -59,34 +60,6 @@ std::size_t available_memory() {
 
 }  // namespace
 
-bool parse_charge_solver(const std::string& name, ChargeSolver& out) {
-  if (name == "auto")
-    out = ChargeSolver::kAuto;
-  else if (name == "direct")
-    out = ChargeSolver::kDirect;
-  else if (name == "gmres")
-    out = ChargeSolver::kGmres;
-  else if (name == "fast")
-    out = ChargeSolver::kFast;
-  else
-    return false;
-  return true;
-}
-
-const char* to_string(ChargeSolver solver) {
-  switch (solver) {
-    case ChargeSolver::kAuto:
-      return "auto";
-    case ChargeSolver::kDirect:
-      return "direct";
-    case ChargeSolver::kGmres:
-      return "gmres";
-    case ChargeSolver::kFast:
-      return "fast";
-  }
-  return "auto";
-}
-
 ChargeResult compute_charge(const std::vector<Vec3>& points, const std::vector<Tri>& triangles,
                             const ChargeOptions& options, const std::string& file) {
   const auto t0 = Clock::now();
@@ -120,14 +93,14 @@ ChargeResult compute_charge(const std::vector<Vec3>& points, const std::vector<T
   if ((solver == ChargeSolver::kDirect || solver == ChargeSolver::kGmres) &&
       dense_bytes > static_cast<double>(limit)) {
     std::ostringstream msg;
-    msg << "the dense " << to_string(solver) << " solver needs " << dense_bytes / 1e9 << " GB for "
+    msg << "the dense " << name_of(solver) << " solver needs " << dense_bytes / 1e9 << " GB for "
         << n << " triangles but the limit is " << static_cast<double>(limit) / 1e9
         << " GB; use --solver fast or auto";
     throw std::runtime_error(msg.str());
   }
 
   ChargeResult result;
-  result.solver = to_string(solver);
+  result.solver = name_of(solver);
   result.tolerance = tolerance;
   progress("assembly", 0.0);
   const ClusterTree tree = build_cluster_tree(panels, options.leaf_size);
@@ -149,7 +122,8 @@ ChargeResult compute_charge(const std::vector<Vec3>& points, const std::vector<T
   if (options.preconditioner == ChargePreconditioner::kTwoLevel &&
       solver != ChargeSolver::kDirect) {
     // K: at most 256, clusters of at least ~64 triangles, and N x K floats <= 100 MB.
-    const std::size_t k = std::min({kCoarseMax, n / 64, kCoarseEntries / std::max<std::size_t>(n, 1)});
+    const std::size_t k =
+        std::min({kCoarseMax, n / 64, kCoarseEntries / std::max<std::size_t>(n, 1)});
     two_level = std::make_unique<TwoLevelSchwarz>(panels, tree, near, kSchwarzSet, k);
   }
   const ApplyFn precondition = [&](const double* in, double* out) {

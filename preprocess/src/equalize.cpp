@@ -33,30 +33,6 @@ std::vector<double> histogram_equalize(const std::vector<double>& v, int bins) {
 
 }  // namespace
 
-bool parse_equalization(const std::string& name, Equalization& out) {
-  if (name == "histogram")
-    out = Equalization::kHistogram;
-  else if (name == "rank")
-    out = Equalization::kRank;
-  else if (name == "log")
-    out = Equalization::kLogHistogram;
-  else
-    return false;
-  return true;
-}
-
-const char* to_string(Equalization method) {
-  switch (method) {
-    case Equalization::kHistogram:
-      return "histogram";
-    case Equalization::kRank:
-      return "rank";
-    case Equalization::kLogHistogram:
-      return "log";
-  }
-  return "histogram";
-}
-
 std::vector<double> equalize(const std::vector<double>& density, Equalization method, int bins) {
   if (bins < 1) throw std::invalid_argument("equalize: bins must be at least 1");
   for (const double v : density) {

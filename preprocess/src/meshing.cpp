@@ -46,15 +46,6 @@ detail::Mesh3Criteria resolve(const MeshingOptions& o, double default_facet) {
 
 }  // namespace
 
-Shape shape_from_name(const std::string& name) {
-  if (name == "sphere") return Shape::kSphere;
-  if (name == "ellipsoid") return Shape::kEllipsoid;
-  if (name == "dumbbell") return Shape::kDumbbell;
-  if (name == "pawn") return Shape::kPawn;
-  throw std::invalid_argument("unknown shape '" + name +
-                              "' (expected sphere, ellipsoid, dumbbell or pawn)");
-}
-
 double default_facet_size(Shape shape, const ShapeOptions& o) {
   double h = 0.0;
   switch (shape) {

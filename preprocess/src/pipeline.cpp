@@ -1,13 +1,17 @@
 #include "tetseg/preprocess/pipeline.hpp"
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <limits>
 #include <numeric>
 #include <sstream>
+#include <type_traits>
 
 #include "tetseg/format/asset_io.hpp"
+#include "tetseg/preprocess/names.hpp"
 #include "tetseg/preprocess/surface.hpp"
 
 namespace tetseg::preprocess {
@@ -27,38 +31,6 @@ std::string format_number(double value) {
   return buffer;
 }
 
-const char* solver_name(ChargeSolver solver) {
-  switch (solver) {
-    case ChargeSolver::kAuto: return "auto";
-    case ChargeSolver::kDirect: return "direct";
-    case ChargeSolver::kGmres: return "gmres";
-    case ChargeSolver::kFast: return "fast";
-  }
-  return "auto";
-}
-
-const char* equalization_name(Equalization method) {
-  switch (method) {
-    case Equalization::kHistogram: return "histogram";
-    case Equalization::kRank: return "rank";
-    case Equalization::kLogHistogram: return "log-histogram";
-  }
-  return "histogram";
-}
-
-const char* detector_name(DetectorStrategy strategy) {
-  return strategy == DetectorStrategy::kNearestCentroid ? "nearest-centroid" : "visibility";
-}
-
-const char* cluster_method_name(ClusterMethod method) {
-  switch (method) {
-    case ClusterMethod::kSingle: return "single";
-    case ClusterMethod::kCharge: return "charge";
-    case ClusterMethod::kRefined: return "refined";
-  }
-  return "charge";
-}
-
 std::string base_name(const std::string& path) {
   const auto slash = path.find_last_of('/');
   return slash == std::string::npos ? path : path.substr(slash + 1);
@@ -66,34 +38,188 @@ std::string base_name(const std::string& path) {
 
 }  // namespace
 
-std::vector<std::pair<std::string, std::string>> provenance_options(const BuildOptions& options) {
-  const SegmentationOptions& seg = options.segmentation;
-  std::vector<std::pair<std::string, std::string>> out = {
-      {"clusters", cluster_method_name(options.clusters)},
-      {"charge.solver", solver_name(options.charge.solver)},
-      {"charge.tolerance",
-       options.charge.tolerance == 0.0 ? "auto" : format_number(options.charge.tolerance)},
-      {"segmentation.alpha", format_number(seg.alpha)},
-      {"segmentation.beta_divisor", format_number(seg.beta_divisor)},
-      {"segmentation.equalization", equalization_name(seg.equalization)},
-      {"segmentation.growth_bound", format_number(seg.growth_bound)},
-      {"segmentation.grow_through_marked", seg.grow_through_marked ? "yes" : "no"},
-      {"segmentation.min_cluster_triangles", std::to_string(seg.min_cluster_triangles)},
-      {"segmentation.detector", detector_name(seg.detector)},
-      {"rest_positions", options.keep_rest_positions ? "yes" : "no"},
+namespace {
+
+// One provenance key: when it is recorded, how its value is written and read back. The single
+// description of the provenance, used both ways.
+struct ProvenanceField {
+  const char* key;
+  bool (*recorded)(const BuildOptions&);
+  std::function<std::string(BuildOptions&)> write;
+  std::function<bool(const std::string&, BuildOptions&)> read;
+};
+
+bool always(const BuildOptions&) {
+  return true;
+}
+bool refined(const BuildOptions& o) {
+  return o.clusters == ClusterMethod::kRefined;
+}
+bool meshed(const BuildOptions& o) {
+  return o.meshing.has_value();
+}
+
+bool parse_double(const std::string& text, double& value) {
+  if (text.empty()) return false;
+  char* end = nullptr;
+  value = std::strtod(text.c_str(), &end);
+  return end == text.c_str() + text.size() && std::isfinite(value);
+}
+
+template <typename Int>
+bool parse_integer(const std::string& text, Int& value) {
+  if (text.empty()) return false;
+  char* end = nullptr;
+  errno = 0;
+  const long long parsed = std::strtoll(text.c_str(), &end, 10);
+  if (errno != 0 || end != text.c_str() + text.size()) return false;
+  static_assert(sizeof(Int) < sizeof(long long), "the limits must fit a long long");
+  if (parsed < static_cast<long long>(std::numeric_limits<Int>::min()) ||
+      parsed > static_cast<long long>(std::numeric_limits<Int>::max())) {
+    return false;
+  }
+  value = static_cast<Int>(parsed);
+  return true;
+}
+
+// A number; `automatic` (0 or -1) is written "auto" when `has_auto`.
+template <typename T>
+ProvenanceField number(const char* key, bool (*recorded)(const BuildOptions&),
+                       T& (*access)(BuildOptions&), bool has_auto = false, T automatic = T{}) {
+  return {key, recorded,
+          [=](BuildOptions& o) {
+            const T value = access(o);
+            if (has_auto && value == automatic) return std::string("auto");
+            if constexpr (std::is_floating_point_v<T>) {
+              return format_number(value);
+            } else {
+              return std::to_string(value);
+            }
+          },
+          [=](const std::string& text, BuildOptions& o) {
+            if (has_auto && text == "auto") {
+              access(o) = automatic;
+              return true;
+            }
+            if constexpr (std::is_floating_point_v<T>) {
+              return parse_double(text, access(o));
+            } else {
+              return parse_integer(text, access(o));
+            }
+          }};
+}
+
+ProvenanceField flag(const char* key, bool (*recorded)(const BuildOptions&),
+                     bool& (*access)(BuildOptions&)) {
+  return {key, recorded, [=](BuildOptions& o) { return std::string(access(o) ? "yes" : "no"); },
+          [=](const std::string& text, BuildOptions& o) {
+            if (text != "yes" && text != "no") return false;
+            access(o) = text == "yes";
+            return true;
+          }};
+}
+
+template <typename Enum>
+ProvenanceField named(const char* key, Enum& (*access)(BuildOptions&)) {
+  return {key, always, [=](BuildOptions& o) { return std::string(name_of(access(o))); },
+          [=](const std::string& text, BuildOptions& o) { return parse_name(text, access(o)); }};
+}
+
+MeshingOptions& meshing_of(BuildOptions& o) {
+  if (!o.meshing) o.meshing.emplace();
+  return *o.meshing;
+}
+
+const std::vector<ProvenanceField>& provenance_fields() {
+  using O = BuildOptions;
+  static const std::vector<ProvenanceField> fields = {
+      named<ClusterMethod>("clusters", [](O& o) -> ClusterMethod& { return o.clusters; }),
+      named<ChargeSolver>("charge.solver", [](O& o) -> ChargeSolver& { return o.charge.solver; }),
+      number<double>(
+          "charge.tolerance", always, [](O& o) -> double& { return o.charge.tolerance; }, true,
+          0.0),
+      number<int>("charge.max_iterations", always,
+                  [](O& o) -> int& { return o.charge.max_iterations; }),
+      number<int>("charge.restart", always, [](O& o) -> int& { return o.charge.restart; }),
+      named<ChargePreconditioner>(
+          "charge.preconditioner",
+          [](O& o) -> ChargePreconditioner& { return o.charge.preconditioner; }),
+      number<double>(
+          "charge.fast_theta", always, [](O& o) -> double& { return o.charge.fast_theta; }, true,
+          0.0),
+      number<int>(
+          "charge.fast_order", always, [](O& o) -> int& { return o.charge.fast_order; }, true, -1),
+      number<int>("charge.leaf_size", always, [](O& o) -> int& { return o.charge.leaf_size; }),
+      number<double>("segmentation.alpha", always,
+                     [](O& o) -> double& { return o.segmentation.alpha; }),
+      number<double>("segmentation.beta_divisor", always,
+                     [](O& o) -> double& { return o.segmentation.beta_divisor; }),
+      named<Equalization>("segmentation.equalization",
+                          [](O& o) -> Equalization& { return o.segmentation.equalization; }),
+      number<double>("segmentation.growth_bound", always,
+                     [](O& o) -> double& { return o.segmentation.growth_bound; }),
+      flag("segmentation.grow_through_marked", always,
+           [](O& o) -> bool& { return o.segmentation.grow_through_marked; }),
+      number<std::uint32_t>(
+          "segmentation.min_cluster_triangles", always,
+          [](O& o) -> std::uint32_t& { return o.segmentation.min_cluster_triangles; }),
+      named<DetectorStrategy>("segmentation.detector",
+                              [](O& o) -> DetectorStrategy& { return o.segmentation.detector; }),
+      flag("rest_positions", always, [](O& o) -> bool& { return o.keep_rest_positions; }),
+      number<double>("refine.min_visibility", refined,
+                     [](O& o) -> double& { return o.refinement.min_visibility; }),
+      number<double>("refine.gain_per_cut_edge", refined,
+                     [](O& o) -> double& { return o.refinement.gain_per_cut_edge; }),
+      number<double>("refine.invisibility_cost", refined,
+                     [](O& o) -> double& { return o.refinement.invisibility_cost; }),
+      number<std::uint32_t>("refine.max_clusters", refined,
+                            [](O& o) -> std::uint32_t& { return o.refinement.max_clusters; }),
+      number<std::uint32_t>(
+          "refine.min_cluster_triangles", refined,
+          [](O& o) -> std::uint32_t& { return o.refinement.min_cluster_triangles; }),
+      flag("refine.merge", refined, [](O& o) -> bool& { return o.refinement.merge; }),
+      number<double>("meshing.cell_size", meshed,
+                     [](O& o) -> double& { return meshing_of(o).cell_size; }),
+      number<double>("meshing.facet_size", meshed,
+                     [](O& o) -> double& { return meshing_of(o).facet_size; }),
+      number<double>("meshing.facet_distance", meshed,
+                     [](O& o) -> double& { return meshing_of(o).facet_distance; }),
+      number<double>("meshing.facet_angle", meshed,
+                     [](O& o) -> double& { return meshing_of(o).facet_angle; }),
+      number<double>("meshing.cell_radius_edge_ratio", meshed,
+                     [](O& o) -> double& { return meshing_of(o).cell_radius_edge_ratio; }),
+      flag("meshing.optimize", meshed, [](O& o) -> bool& { return meshing_of(o).optimize; }),
   };
-  if (options.clusters == ClusterMethod::kRefined) {
-    const RefinementOptions& ref = options.refinement;
-    out.insert(out.end(), {{"refine.min_visibility", format_number(ref.min_visibility)},
-                           {"refine.gain_per_cut_edge", format_number(ref.gain_per_cut_edge)},
-                           {"refine.invisibility_cost", format_number(ref.invisibility_cost)},
-                           {"refine.max_clusters", std::to_string(ref.max_clusters)},
-                           {"refine.min_cluster_triangles",
-                            std::to_string(ref.min_cluster_triangles)},
-                           {"refine.merge", ref.merge ? "yes" : "no"}});
+  return fields;
+}
+
+}  // namespace
+
+std::vector<std::pair<std::string, std::string>> provenance_options(const BuildOptions& options) {
+  BuildOptions copy = options;
+  std::vector<std::pair<std::string, std::string>> out;
+  for (const ProvenanceField& field : provenance_fields()) {
+    if (field.recorded(options)) out.emplace_back(field.key, field.write(copy));
   }
   std::sort(out.begin(), out.end());
   return out;
+}
+
+bool options_from_provenance(const std::vector<std::pair<std::string, std::string>>& recorded,
+                             BuildOptions& options, std::string* error) {
+  options = BuildOptions{};
+  for (const auto& [key, value] : recorded) {
+    const auto& fields = provenance_fields();
+    const auto field = std::find_if(fields.begin(), fields.end(),
+                                    [&](const ProvenanceField& f) { return key == f.key; });
+    if (field == fields.end() || !field->read(value, options)) {
+      if (error)
+        *error = (field == fields.end() ? "unknown option " : "bad value for ") + key + ": '" +
+                 value + "'";
+      return false;
+    }
+  }
+  return true;
 }
 
 format::Asset build_asset(const TetMesh& mesh, const std::string& source,
@@ -113,8 +239,9 @@ format::Asset build_asset(const TetMesh& mesh, const std::string& source,
   report.surface_triangles = static_cast<std::uint32_t>(surface.triangles.size());
   report.interior_nodes = static_cast<std::uint32_t>(surface.interior_nodes.size());
   if (surface.interior_nodes.empty()) {
-    throw InputError(source, "tet mesh has no interior node to serve as a detector point "
-                             "(refine the mesh or tetrahedralise with a smaller cell size)");
+    throw InputError(source,
+                     "tet mesh has no interior node to serve as a detector point "
+                     "(refine the mesh or tetrahedralise with a smaller cell size)");
   }
 
   Segmentation segmentation;
@@ -133,7 +260,7 @@ format::Asset build_asset(const TetMesh& mesh, const std::string& source,
       return r;
     });
     const std::vector<double> equalized = timer.run("equalize", [&](std::string& summary) {
-      summary = equalization_name(options.segmentation.equalization);
+      summary = name_of(options.segmentation.equalization);
       return equalize(charge.density, options.segmentation.equalization);
     });
     charge.density.clear();
@@ -165,7 +292,8 @@ format::Asset build_asset(const TetMesh& mesh, const std::string& source,
         choose_detectors(mesh.nodes, surface, segmentation.triangle_cluster,
                          segmentation.cluster_count, options.segmentation.detector);
     double worst = 1.0;
-    for (const Detector& detector : d) worst = std::min<double>(worst, detector.rest_positive_fraction);
+    for (const Detector& detector : d)
+      worst = std::min<double>(worst, detector.rest_positive_fraction);
     std::ostringstream text;
     text << d.size() << " detector nodes, lowest rest visibility " << worst;
     summary = text.str();
@@ -208,7 +336,9 @@ format::Asset build_asset(const TetMesh& mesh, const std::string& source,
   if (options.keep_rest_positions) asset.rest_positions = mesh.nodes;
   asset.provenance.tool_version = std::string("tetseg ") + TETSEG_VERSION_STRING;
   asset.provenance.source = base_name(source);
-  asset.provenance.options = provenance_options(options);
+  BuildOptions used = options;  // with the charge solver actually used in place of "auto"
+  if (!report.charge.solver.empty()) parse_name(report.charge.solver, used.charge.solver);
+  asset.provenance.options = provenance_options(used);
   for (const Detector& detector : detectors) {
     report.rest_positive_fraction.push_back(detector.rest_positive_fraction);
   }

@@ -1,9 +1,5 @@
 #include "tetseg/runtime/asset.hpp"
 
-#include <fstream>
-#include <iterator>
-#include <vector>
-
 namespace tetseg {
 
 Status load_asset(const std::uint8_t* data, std::size_t size, Asset& out,
@@ -13,26 +9,7 @@ Status load_asset(const std::uint8_t* data, std::size_t size, Asset& out,
 }
 
 Status load_asset_file(const std::string& path, Asset& out, std::string* detail) noexcept {
-  try {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) {
-      if (detail) *detail = "cannot open file";
-      out.m_data = format::Asset{};
-      return Status::kIoError;
-    }
-    std::vector<std::uint8_t> bytes((std::istreambuf_iterator<char>(in)),
-                                    std::istreambuf_iterator<char>());
-    if (in.bad()) {
-      if (detail) *detail = "read error";
-      out.m_data = format::Asset{};
-      return Status::kIoError;
-    }
-    return load_asset(bytes.data(), bytes.size(), out, detail);
-  } catch (...) {
-    if (detail) *detail = "out of memory while reading";
-    out.m_data = format::Asset{};
-    return Status::kIoError;
-  }
+  return format::read_asset_file(path, out.m_data, detail);  // clears out.m_data on failure
 }
 
 }  // namespace tetseg

@@ -5,6 +5,7 @@
 # agree) on every step with an intersection-free start; bvh and cone must find all of them
 # (the cone mode culls only patches proven embedded for the whole step).
 # needs: preprocess
+# needs: bench
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/common.bash"
 

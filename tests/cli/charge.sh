@@ -70,6 +70,14 @@ if "$bin/tetseg" generate sphere -o ball.mesh --size 0.5 2>gen.txt; then
   "$bin/tetseg" charge ball.mesh -o ball.ply --equalize log 2>err.txt || { cat err.txt >&2; fail "ply"; }
   head -1 ball.ply | grep -q '^ply$' || fail "not a ply"
   grep -q 'property uchar red' ball.ply || fail "ply without colours"
+  # One spelling everywhere: --equalization log-histogram as in `tetseg build`, and the report
+  # names it so whichever alias (--equalize log) was given.
+  for spelling in "--equalization log-histogram" "--equalize log"; do
+    # shellcheck disable=SC2086
+    "$bin/tetseg" charge ball.mesh -o eq.csv $spelling --report eq.json 2>err.txt ||
+      { cat err.txt >&2; fail "charge $spelling"; }
+    grep -q '"equalization": "log-histogram"' eq.json || fail "charge $spelling: report $(cat eq.json)"
+  done
 else
   echo "WARN: tetseg generate failed; tet-mesh input not tested" >&2
   cat gen.txt >&2

@@ -5,11 +5,7 @@
 set -euo pipefail
 
 tetseg="${TETSEG_BIN_DIR:?}/tetseg"
-work="$(mktemp -d)"
-trap 'rm -rf "$work"' EXIT
-cd "$work"
-
-fail() { echo "FAIL: $*" >&2; exit 1; }
+source "$(dirname "${BASH_SOURCE[0]}")/common.bash"  # $work (the current folder), fail, skip_without_data
 
 # expect_exit <code> <command...>: runs the command, captures stderr in $work/err.
 expect_exit() {
@@ -66,7 +62,7 @@ grep -q '^tetseg: validating octa.off \.\.\. ' err || { cat err >&2; fail "no va
 if [[ -f "${TETSEG_CGAL_MESH_DIR:-/nonexistent}/elephant.off" ]]; then
   expect_exit 0 "$tetseg" tetrahedralize "$TETSEG_CGAL_MESH_DIR/elephant.off" --facet-size 0.05 -o elephant.msh
 else
-  echo "WARN: CGAL demo meshes not found; skipping elephant" >&2
+  skip_without_data "CGAL demo mesh elephant.off"
 fi
 
 leftovers="$(find . -name '*.tmp*' | head -n 1)"

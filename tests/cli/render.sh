@@ -13,7 +13,7 @@ expect_exit 3 "tetseg-render: error: missing.tetseg: " -- "$bin/tetseg-render" m
 [ ! -e x.png ] || fail "a failed render left a file"
 expect_exit 4 "tetseg-render: error: nodir/x.png" -- "$bin/tetseg-render" "$golden" -o nodir/x.png
 
-# decode FILE: pixels of a PNG decoded independently (python zlib; filters None and Sub),
+# decode FILE: pixels of a PNG decoded independently (python zlib; the five PNG row filters),
 # after checking signature, chunk CRCs, IHDR and the zlib stream (with its Adler-32).
 cat > png.py <<'PY'
 import struct, zlib
@@ -36,9 +36,18 @@ def decode(path):
     rows = []
     for y in range(h):
         f, line = raw[y * (3 * w + 1)], bytearray(raw[y * (3 * w + 1) + 1:(y + 1) * (3 * w + 1)])
-        assert f in (0, 1), "filter %d" % f
-        if f == 1:
-            for x in range(3, len(line)): line[x] = (line[x] + line[x - 3]) & 255
+        assert f in (0, 1, 2, 3, 4), "filter %d" % f
+        prev = rows[-1] if rows else bytes(len(line))
+        for x in range(len(line)):
+            a = line[x - 3] if x >= 3 else 0
+            b, c = prev[x], (prev[x - 3] if x >= 3 else 0)
+            if f == 4:
+                p = a + b - c
+                pa, pb, pc = abs(p - a), abs(p - b), abs(p - c)
+                predictor = a if pa <= pb and pa <= pc else (b if pb <= pc else c)
+            else:
+                predictor = (0, a, b, (a + b) // 2)[f]
+            line[x] = (line[x] + predictor) & 255
         rows.append(bytes(line))
     return w, h, rows
 PY

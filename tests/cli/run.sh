@@ -2,6 +2,7 @@
 # End to end: tetseg-scene -> tetseg-run in every mode and query (JSON shape, agreement of the
 # modes on "any" and on the earliest time of impact), tetseg-frames from .obj/.ply files,
 # exit codes on bad input.
+# needs: bench
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/common.bash"
 

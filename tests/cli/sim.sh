@@ -5,6 +5,7 @@
 # does intersect (so the check can fail), that contacts were resolved, that two runs are
 # byte-identical, and the exit codes on bad input.
 # needs: preprocess
+# needs: bench
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/common.bash"
 

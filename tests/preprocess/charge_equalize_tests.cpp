@@ -6,6 +6,7 @@
 #include <random>
 
 #include "tetseg/preprocess/charge.hpp"
+#include "tetseg/preprocess/names.hpp"
 
 using namespace tetseg::preprocess;
 
@@ -99,13 +100,16 @@ TEST_CASE("The rank and log variants resolve heavy tails", "[charge][equalize]")
     CHECK(eq[1] == 0.5);
     CHECK(eq[3] == 1.0);
   }
-  SECTION("Names parse and print back.") {
-    for (const char* name : {"histogram", "rank", "log"}) {
-      Equalization e;
-      REQUIRE(parse_equalization(name, e));
-      CHECK(std::string(to_string(e)) == name);
+  SECTION("Names parse and print back; the old spelling log is an alias.") {
+    for (const char* name : {"histogram", "rank", "log-histogram"}) {
+      Equalization e{};
+      REQUIRE(parse_name(name, e));
+      CHECK(std::string(name_of(e)) == name);
     }
-    Equalization e;
-    CHECK_FALSE(parse_equalization("linear", e));
+    Equalization e = Equalization::kHistogram;
+    REQUIRE(parse_name("log", e));
+    CHECK(e == Equalization::kLogHistogram);
+    CHECK_FALSE(parse_name("linear", e));
+    CHECK(name_list<Equalization>() == "histogram|rank|log-histogram");
   }
 }

@@ -9,8 +9,8 @@
 #include "../../preprocess/src/charge_potential.hpp"
 #include "../../preprocess/src/charge_solvers.hpp"
 #include "../../preprocess/src/charge_tree.hpp"
-#include "charge_shapes.hpp"
 #include "tetseg/preprocess/charge.hpp"
+#include "tetseg/testing/charge_shapes.hpp"
 
 using namespace tetseg::preprocess::charge_detail;
 

@@ -5,8 +5,9 @@
 #include <cmath>
 #include <numeric>
 
-#include "charge_shapes.hpp"
 #include "tetseg/preprocess/charge.hpp"
+#include "tetseg/preprocess/names.hpp"
+#include "tetseg/testing/charge_shapes.hpp"
 
 using namespace tetseg::preprocess;
 using tetseg::test::TriangleMesh;
@@ -198,8 +199,7 @@ TEST_CASE("The near-field and two-level preconditioners need far fewer iteration
       const ChargeResult near = compute_charge(m->vertices, m->triangles, o);
       o.preconditioner = ChargePreconditioner::kTwoLevel;
       const ChargeResult two = compute_charge(m->vertices, m->triangles, o);
-      CAPTURE(m->triangles.size(), near.solver, jacobi.iterations, near.iterations,
-              two.iterations);
+      CAPTURE(m->triangles.size(), near.solver, jacobi.iterations, near.iterations, two.iterations);
       CHECK(jacobi.converged);
       CHECK(near.converged);
       CHECK(two.converged);
@@ -339,7 +339,7 @@ TEST_CASE("The lowest equalised densities lie in the concave necks", "[charge]")
         for (const auto& band : tetseg::test::pawn_neck_bands()) {
           in_band = in_band || (z >= band.first && z <= band.second);
         }
-        CAPTURE(to_string(method), q, z);
+        CAPTURE(name_of(method), q, z);
         CHECK(in_band);
       }
     }

@@ -10,10 +10,10 @@
 #include <cstdio>
 #include <filesystem>
 
-#include "preprocess/charge_shapes.hpp"
 #include "tetseg/preprocess/io.hpp"
 #include "tetseg/preprocess/meshing.hpp"
 #include "tetseg/preprocess/surface.hpp"
+#include "tetseg/testing/charge_shapes.hpp"
 
 using namespace tetseg::preprocess;
 
@@ -30,7 +30,6 @@ double best_of(int runs, F&& f) {
   }
   return best;
 }
-
 
 }  // namespace
 

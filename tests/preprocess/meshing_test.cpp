@@ -8,10 +8,11 @@
 #include <fstream>
 #include <stdexcept>
 
-#include "preprocess/charge_shapes.hpp"
+#include "support/test_data.hpp"
 #include "tetseg/preprocess/io.hpp"
 #include "tetseg/preprocess/meshing.hpp"
 #include "tetseg/preprocess/surface.hpp"
+#include "tetseg/testing/charge_shapes.hpp"
 
 using namespace tetseg::preprocess;
 
@@ -41,7 +42,6 @@ Checked check_valid(const TetMesh& m) {
     }
   return c;
 }
-
 
 }  // namespace
 
@@ -162,10 +162,7 @@ TEST_CASE("A closed surface is filled with valid tets of the same volume", "[mes
 
 TEST_CASE("Real meshes from libcgal-demo import and tetrahedralise", "[meshing][cgal-data]") {
   const std::string dir = TETSEG_CGAL_MESH_DIR;
-  if (!std::filesystem::exists(dir + "/elephant.off")) {
-    WARN("CGAL demo meshes not found in " << dir << "; skipping");
-    return;
-  }
+  if (!tetseg::test::have_test_data(dir + "/elephant.off", "CGAL demo meshes")) return;
   MeshingOptions coarse;
   coarse.optimize = false;  // keeps the test fast; the optimised path is tested above
   SECTION("Elephant, dino and hand give valid meshes close to the input volume.") {

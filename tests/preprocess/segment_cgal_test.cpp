@@ -9,6 +9,7 @@
 #include <string>
 
 #include "segment_invariants.hpp"
+#include "support/test_data.hpp"
 #include "tetseg/format/asset_io.hpp"
 #include "tetseg/preprocess/charge.hpp"
 #include "tetseg/preprocess/io.hpp"
@@ -22,11 +23,7 @@ namespace {
 
 std::string cgal_mesh(const std::string& name) {
   const std::string path = std::string(TETSEG_CGAL_MESH_DIR) + "/" + name + ".off";
-  if (!std::ifstream(path)) {
-    WARN("libcgal-demo mesh " << path << " is absent; skipped");
-    return {};
-  }
-  return path;
+  return tetseg::test::have_test_data(path, "libcgal-demo mesh") ? path : std::string();
 }
 
 }  // namespace
@@ -113,6 +110,7 @@ TEST_CASE("Real meshes build into valid assets with interior detector nodes",
     return sum;
   };
   CAPTURE(non_positive(charge_asset), non_positive(asset));
-  CHECK(non_positive(charge_asset) > 0.04 * static_cast<double>(asset.triangles.size()));  // premise
+  CHECK(non_positive(charge_asset) >
+        0.04 * static_cast<double>(asset.triangles.size()));  // premise
   CHECK(non_positive(asset) < 0.5 * non_positive(charge_asset));
 }

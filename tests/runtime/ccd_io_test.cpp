@@ -1,5 +1,5 @@
-// Readers of the CCD reference data (tools/ccd/ccd_io.hpp): PLY variants, JSON arrays, the
-// edge numbering of the scalable-CCD data (checked against the data's own query CSVs).
+// Readers of the CCD reference data (testing/include/tetseg/testing/ccd_io.hpp): PLY variants, JSON
+// arrays, the edge numbering of the scalable-CCD data (checked against the data's own query CSVs).
 
 #include <algorithm>
 #include <cstring>
@@ -10,12 +10,13 @@
 
 #include <catch2/catch.hpp>
 
-#include "../../tools/ccd/ccd_io.hpp"
+#include "support/test_data.hpp"
+#include "tetseg/testing/ccd_io.hpp"
 
 namespace {
 
 namespace fs = std::filesystem;
-namespace io = tetseg::tools::ccd_io;
+namespace io = tetseg::test::ccd_io;
 
 fs::path scratch(const std::string& name) {
   const fs::path dir = fs::path(TETSEG_BINARY_DIR) / "test-scratch" / "ccd_io";
@@ -125,10 +126,7 @@ TEST_CASE("Edges are numbered as in the scalable-CCD data.", "[ccd][io]") {
   SECTION("The numbering reproduces the coordinates of the data's own query CSVs.") {
     const fs::path dir =
         fs::path(TETSEG_SHARED_DIR) / "data/ccd-queries/sample-scalable-ccd-data/cloth-funnel";
-    if (!fs::is_directory(dir / "queries")) {
-      WARN("cloth-funnel queries not found under " << dir.string() << ": skipped");
-      return;
-    }
+    if (!tetseg::test::have_test_data((dir / "queries").string(), "cloth-funnel queries")) return;
     const io::Mesh m0 = io::read_ply((dir / "frames/227.ply").string());
     const io::Mesh m1 = io::read_ply((dir / "frames/228.ply").string());
     const auto edges = io::unique_edges(m0.faces);

@@ -1,5 +1,5 @@
 // Elementary CCD tests against the exact ground truth of the public reference data
-// (../shared/data/ccd-queries, read in place; skipped with a warning when absent).
+// (../shared/data/ccd-queries, read in place; skipped when absent, support/test_data.hpp).
 
 #include <algorithm>
 #include <array>
@@ -9,13 +9,14 @@
 
 #include <catch2/catch.hpp>
 
-#include "../../tools/ccd/ccd_io.hpp"
+#include "support/test_data.hpp"
 #include "tetseg/runtime/ccd.hpp"
+#include "tetseg/testing/ccd_io.hpp"
 
 namespace {
 
 namespace fs = std::filesystem;
-namespace io = tetseg::tools::ccd_io;
+namespace io = tetseg::test::ccd_io;
 
 const fs::path kQueries = fs::path(TETSEG_SHARED_DIR) / "data/ccd-queries/sample-queries";
 const fs::path kFrames = fs::path(TETSEG_SHARED_DIR) / "data/ccd-queries/sample-scalable-ccd-data";
@@ -93,12 +94,8 @@ TEST_CASE("Rational CSV values convert exactly to the nearest double.", "[ccd][i
 
 TEST_CASE("The elementary tests have no false negative on the reference queries.",
           "[ccd][reference]") {
-  if (!fs::is_directory(kQueries)) {
-    WARN("reference queries not found at " << kQueries.string() << ": skipped");
-    return;
-  }
-  SECTION(
-      "Vertex-face: every true contact is reported; false positives within Tight-Inclusion's 85.") {
+  if (!tetseg::test::have_test_data(kQueries.string(), "CCD reference queries")) return;
+  SECTION("Vertex-face: every true contact is reported; 0 false positives (Tight-Inclusion: 85).") {
     const Counts c = run_kind("vertex-face", true);
     WARN("vertex-face: " << c.queries << " queries, " << c.positives << " positives, "
                          << c.false_positives << " false positives");
@@ -106,10 +103,9 @@ TEST_CASE("The elementary tests have no false negative on the reference queries.
     CHECK(c.positives == 248);
     CHECK(c.false_negatives == 0);
     CHECK(c.filter_false_negatives == 0);
-    CHECK(c.false_positives <= 85);
+    CHECK(c.false_positives == 0);  // measured; docs/ccd.md and docs/benchmarks.md quote it
   }
-  SECTION(
-      "Edge-edge: every true contact is reported; false positives within Tight-Inclusion's 137.") {
+  SECTION("Edge-edge: every true contact is reported; 3 false positives (Tight-Inclusion: 137).") {
     const Counts c = run_kind("edge-edge", false);
     WARN("edge-edge: " << c.queries << " queries, " << c.positives << " positives, "
                        << c.false_positives << " false positives");
@@ -117,7 +113,7 @@ TEST_CASE("The elementary tests have no false negative on the reference queries.
     CHECK(c.positives == 187);
     CHECK(c.false_negatives == 0);
     CHECK(c.filter_false_negatives == 0);
-    CHECK(c.false_positives <= 137);
+    CHECK(c.false_positives == 3);  // measured; docs/ccd.md and docs/benchmarks.md quote it
   }
 }
 
@@ -132,10 +128,7 @@ struct FrameCase {
 
 void check_frame(const FrameCase& fc) {
   const fs::path dir = kFrames / fc.scene;
-  if (!fs::is_directory(dir)) {
-    WARN("scalable-CCD scene " << dir.string() << " not found: skipped");
-    return;
-  }
+  if (!tetseg::test::have_test_data(dir.string(), "scalable-CCD scene")) return;
   const io::Mesh m0 = io::read_ply((dir / "frames" / fc.frame0).string());
   const io::Mesh m1 = io::read_ply((dir / "frames" / fc.frame1).string());
   REQUIRE(m0.vertices.size() == m1.vertices.size());

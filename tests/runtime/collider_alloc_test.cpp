@@ -4,9 +4,9 @@
 #include <catch2/catch.hpp>
 #include <random>
 
-#include "common/synthetic_scenes.hpp"
 #include "support/allocation_probe.hpp"
 #include "tetseg/runtime/collider.hpp"
+#include "tetseg/testing/synthetic_scenes.hpp"
 
 using namespace tetseg;
 using namespace tetseg::test;

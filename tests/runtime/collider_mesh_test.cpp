@@ -1,5 +1,5 @@
 // The collider against brute force on random smooth deformations of real meshes (CGAL demo
-// meshes unpacked into the build tree; skipped with a warning when absent).
+// meshes unpacked into the build tree; skipped when absent, support/test_data.hpp).
 
 #include <catch2/catch.hpp>
 #include <cmath>
@@ -7,6 +7,7 @@
 
 #include "runtime/support/compare.hpp"
 #include "runtime/support/off.hpp"
+#include "support/test_data.hpp"
 
 using namespace tetseg;
 using namespace tetseg::test;
@@ -17,10 +18,9 @@ TEST_CASE("Radial-view culling matches brute force on deformed real meshes",
   const unsigned seed = GENERATE(11u, 12u);
   CAPTURE(name, seed);
   Surface s;
-  if (!read_off(std::string(TETSEG_CGAL_MESH_DIR) + "/" + name + ".off", s)) {
-    WARN("CGAL demo mesh " << name << ".off not found in " << TETSEG_CGAL_MESH_DIR << ": skipped");
-    return;
-  }
+  const std::string path = std::string(TETSEG_CGAL_MESH_DIR) + "/" + name + ".off";
+  if (!have_test_data(path, "CGAL demo mesh")) return;
+  REQUIRE(read_off(path, s));
   REQUIRE(closed_and_consistent(s));
   orient_outward(s);
   const Scene scene = slab_scene(s, 5);

@@ -4,9 +4,9 @@
 #include <cmath>
 #include <random>
 
-#include "common/synthetic_scenes.hpp"
 #include "runtime/support/compare.hpp"
 #include "tetseg/runtime/collider.hpp"
+#include "tetseg/testing/synthetic_scenes.hpp"
 
 using namespace tetseg;
 using namespace tetseg::test;

@@ -8,9 +8,9 @@
 
 #include <catch2/catch.hpp>
 
-#include "common/synthetic_scenes.hpp"
 #include "support/compare.hpp"
 #include "tetseg/runtime/collider.hpp"
+#include "tetseg/testing/synthetic_scenes.hpp"
 
 namespace tetseg::test {
 namespace {

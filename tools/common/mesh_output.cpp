@@ -6,6 +6,7 @@
 #include <sstream>
 #include <vector>
 
+#include "mesh_io.hpp"
 #include "tool_support.hpp"
 
 namespace tetseg::tools {
@@ -24,12 +25,6 @@ constexpr double kScalarMap[9][3] = {
     {68, 1, 84},    {71, 44, 122}, {59, 81, 139},  {44, 113, 142}, {33, 144, 141},
     {39, 173, 129}, {92, 200, 99}, {170, 220, 50}, {253, 231, 37},
 };
-
-std::string number(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.9g", v);
-  return buf;
-}
 
 /// Nodes the pictures use, in ascending id, and the map node id -> point index.
 struct UsedNodes {
@@ -88,99 +83,73 @@ void require_rest_positions(const format::Asset& asset, const std::string& sourc
 std::string asset_to_vtu(const format::Asset& asset, const std::string& source) {
   require_rest_positions(asset, source);
   const UsedNodes used = used_nodes(asset, true);
-  const std::size_t tri_count = asset.triangles.size();
-  const std::size_t loop_count = asset.boundaries.size();
-  const std::size_t det_count = asset.clusters.size();
-  const std::size_t cells = tri_count + loop_count + det_count;
-  std::ostringstream out;
-  out << "<?xml version=\"1.0\"?>\n"
-      << "<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
-      << "<UnstructuredGrid>\n"
-      << "<Piece NumberOfPoints=\"" << used.ids.size() << "\" NumberOfCells=\"" << cells
-      << "\">\n<Points>\n<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n";
+  io::UnstructuredGrid grid;
+  io::DataArray node_id{"node_id", "UInt32", {}};
   for (std::uint32_t v : used.ids) {
-    const auto& p = asset.rest_positions[v];
-    out << number(p[0]) << ' ' << number(p[1]) << ' ' << number(p[2]) << '\n';
+    grid.points.push_back(asset.rest_positions[v]);
+    node_id.values.push_back(v);
   }
-  out << "</DataArray>\n</Points>\n<PointData>\n"
-      << "<DataArray type=\"UInt32\" Name=\"node_id\" format=\"ascii\">\n";
-  for (std::uint32_t v : used.ids) out << v << '\n';
-  out << "</DataArray>\n</PointData>\n<Cells>\n"
-      << "<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n";
-  for (const auto& t : asset.triangles)
-    out << used.index[t[0]] << ' ' << used.index[t[1]] << ' ' << used.index[t[2]] << '\n';
-  for (const auto& loop : asset.boundaries) {
-    for (std::uint32_t i = 0; i < loop.node_count; ++i)
-      out << used.index[asset.boundary_nodes[loop.node_offset + i]] << ' ';
-    out << used.index[asset.boundary_nodes[loop.node_offset]] << '\n';  // closed
-  }
-  for (const auto& c : asset.clusters) out << used.index[c.detector_node] << '\n';
-  out << "</DataArray>\n<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n";
-  std::uint64_t offset = 0;
-  for (std::size_t t = 0; t < tri_count; ++t) out << (offset += 3) << '\n';
-  for (const auto& loop : asset.boundaries) out << (offset += loop.node_count + 1) << '\n';
-  for (std::size_t c = 0; c < det_count; ++c) out << (offset += 1) << '\n';
-  out << "</DataArray>\n<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">\n";
-  for (std::size_t t = 0; t < tri_count; ++t) out << "5\n";
-  for (std::size_t l = 0; l < loop_count; ++l) out << "4\n";
-  for (std::size_t c = 0; c < det_count; ++c) out << "1\n";
-  out << "</DataArray>\n</Cells>\n<CellData Scalars=\"cluster\">\n"
-      << "<DataArray type=\"Int32\" Name=\"cluster\" format=\"ascii\">\n";
-  for (std::size_t t = 0; t < tri_count; ++t) out << asset.triangle_cluster[t] << '\n';
-  for (std::size_t l = 0; l < loop_count; ++l) out << "-1\n";
-  for (std::size_t c = 0; c < det_count; ++c) out << c << '\n';
-  out << "</DataArray>\n<DataArray type=\"UInt8\" Name=\"kind\" format=\"ascii\">\n";
-  for (std::size_t t = 0; t < tri_count; ++t) out << "0\n";
-  for (std::size_t l = 0; l < loop_count; ++l) out << "1\n";
-  for (std::size_t c = 0; c < det_count; ++c) out << "2\n";
-  out << "</DataArray>\n<DataArray type=\"Int32\" Name=\"boundary\" format=\"ascii\">\n";
-  for (std::size_t t = 0; t < tri_count; ++t) out << "-1\n";
-  for (std::size_t l = 0; l < loop_count; ++l) out << l << '\n';
-  for (std::size_t c = 0; c < det_count; ++c) out << "-1\n";
-  out << "</DataArray>\n"
-      << "<DataArray type=\"Float32\" Name=\"rest_positive_fraction\" format=\"ascii\">\n";
-  for (std::size_t t = 0; t < tri_count; ++t) {
+  grid.point_data.push_back(std::move(node_id));
+  io::DataArray cluster{"cluster", "Int32", {}}, kind{"kind", "UInt8", {}},
+      boundary{"boundary", "Int32", {}}, visibility{"rest_positive_fraction", "Float32", {}};
+  auto add_cell = [&](std::uint8_t type, std::vector<std::uint32_t> points, double cluster_id,
+                      double kind_id, double boundary_id, double fraction) {
+    grid.cell_types.push_back(type);
+    grid.cells.push_back(std::move(points));
+    cluster.values.push_back(cluster_id);
+    kind.values.push_back(kind_id);
+    boundary.values.push_back(boundary_id);
+    visibility.values.push_back(fraction);
+  };
+  const std::size_t det_count = asset.clusters.size();
+  for (std::size_t t = 0; t < asset.triangles.size(); ++t) {
+    const auto& tri = asset.triangles[t];
     const std::uint32_t c = asset.triangle_cluster[t];
-    out << (c < det_count ? number(asset.clusters[c].rest_positive_fraction) : "0") << '\n';
+    add_cell(5, {used.index[tri[0]], used.index[tri[1]], used.index[tri[2]]}, c, 0, -1,
+             c < det_count ? asset.clusters[c].rest_positive_fraction : 0.0f);
   }
-  for (std::size_t l = 0; l < loop_count; ++l) out << "0\n";
-  for (const auto& c : asset.clusters) out << number(c.rest_positive_fraction) << '\n';
-  out << "</DataArray>\n</CellData>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n";
-  return out.str();
+  for (std::size_t l = 0; l < asset.boundaries.size(); ++l) {
+    const auto& loop = asset.boundaries[l];
+    std::vector<std::uint32_t> points;
+    for (std::uint32_t i = 0; i < loop.node_count; ++i)
+      points.push_back(used.index[asset.boundary_nodes[loop.node_offset + i]]);
+    points.push_back(used.index[asset.boundary_nodes[loop.node_offset]]);  // closed
+    add_cell(4, std::move(points), -1, 1, static_cast<double>(l), 0.0);
+  }
+  for (std::size_t c = 0; c < det_count; ++c) {
+    add_cell(1, {used.index[asset.clusters[c].detector_node]}, static_cast<double>(c), 2, -1,
+             asset.clusters[c].rest_positive_fraction);
+  }
+  grid.cell_data = {std::move(cluster), std::move(kind), std::move(boundary),
+                    std::move(visibility)};
+  return io::vtu_text(grid);
 }
 
 std::string asset_to_ply(const format::Asset& asset, const std::string& source) {
   require_rest_positions(asset, source);
   const UsedNodes used = used_nodes(asset, false);
-  std::size_t edges = 0;
-  for (const auto& loop : asset.boundaries) edges += loop.node_count;
-  std::ostringstream out;
-  out << "ply\nformat ascii 1.0\ncomment tetseg asset surface: face colour = cluster, "
-         "edges = segment boundaries\n"
-      << "element vertex " << used.ids.size() << "\nproperty double x\nproperty double y\n"
-      << "property double z\nelement face " << asset.triangles.size()
-      << "\nproperty list uchar int vertex_indices\nproperty uchar red\nproperty uchar green\n"
-      << "property uchar blue\nproperty int cluster\nelement edge " << edges
-      << "\nproperty int vertex1\nproperty int vertex2\nproperty uchar red\n"
-      << "property uchar green\nproperty uchar blue\nend_header\n";
-  for (std::uint32_t v : used.ids) {
-    const auto& p = asset.rest_positions[v];
-    out << number(p[0]) << ' ' << number(p[1]) << ' ' << number(p[2]) << '\n';
-  }
+  io::PlyOutMesh ply;
+  ply.comment = "tetseg asset surface: face colour = cluster, edges = segment boundaries";
+  for (std::uint32_t v : used.ids) ply.vertices.push_back(asset.rest_positions[v]);
+  ply.face_properties = {
+      {"red", "uchar", {}}, {"green", "uchar", {}}, {"blue", "uchar", {}}, {"cluster", "int", {}}};
   for (std::size_t t = 0; t < asset.triangles.size(); ++t) {
     const auto& tri = asset.triangles[t];
+    ply.triangles.push_back({used.index[tri[0]], used.index[tri[1]], used.index[tri[2]]});
     const Rgb c = palette_color(asset.triangle_cluster[t]);
-    out << "3 " << used.index[tri[0]] << ' ' << used.index[tri[1]] << ' ' << used.index[tri[2]]
-        << ' ' << int(c[0]) << ' ' << int(c[1]) << ' ' << int(c[2]) << ' '
-        << asset.triangle_cluster[t] << '\n';
+    for (int k = 0; k < 3; ++k) ply.face_properties[k].values.push_back(c[k]);
+    ply.face_properties[3].values.push_back(asset.triangle_cluster[t]);
   }
-  for (const auto& loop : asset.boundaries)
+  ply.edge_properties = {{"red", "uchar", {}}, {"green", "uchar", {}}, {"blue", "uchar", {}}};
+  for (const auto& loop : asset.boundaries) {
     for (std::uint32_t i = 0; i < loop.node_count; ++i) {
       const std::uint32_t a = asset.boundary_nodes[loop.node_offset + i];
       const std::uint32_t b = asset.boundary_nodes[loop.node_offset + (i + 1) % loop.node_count];
-      out << used.index[a] << ' ' << used.index[b] << " 0 0 0\n";
+      ply.edges.push_back({used.index[a], used.index[b]});
+      for (auto& channel : ply.edge_properties) channel.values.push_back(0);  // black
     }
-  return out.str();
+  }
+  return io::ply_text(ply);
 }
 
 }  // namespace tetseg::tools

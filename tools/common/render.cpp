@@ -8,6 +8,11 @@
 #include <limits>
 #include <sstream>
 
+#include <png.h>
+
+#include <new>
+#include <stdexcept>
+
 #include "tool_support.hpp"
 
 namespace tetseg::tools {
@@ -42,159 +47,50 @@ struct Camera {
   }
 };
 
-void put_be32(std::vector<std::uint8_t>& out, std::uint32_t v) {
-  out.push_back(static_cast<std::uint8_t>(v >> 24));
-  out.push_back(static_cast<std::uint8_t>(v >> 16));
-  out.push_back(static_cast<std::uint8_t>(v >> 8));
-  out.push_back(static_cast<std::uint8_t>(v));
-}
-
-void put_chunk(std::vector<std::uint8_t>& out, const char* type,
-               const std::vector<std::uint8_t>& data) {
-  put_be32(out, static_cast<std::uint32_t>(data.size()));
-  const std::size_t start = out.size();
-  out.insert(out.end(), type, type + 4);
-  out.insert(out.end(), data.begin(), data.end());
-  put_be32(out, crc32(out.data() + start, out.size() - start));
-}
-
 }  // namespace
-
-std::uint32_t crc32(const std::uint8_t* data, std::size_t size, std::uint32_t crc) noexcept {
-  static const auto table = [] {
-    std::array<std::uint32_t, 256> t{};
-    for (std::uint32_t i = 0; i < 256; ++i) {
-      std::uint32_t c = i;
-      for (int k = 0; k < 8; ++k) c = (c & 1) ? 0xEDB88320u ^ (c >> 1) : c >> 1;
-      t[i] = c;
-    }
-    return t;
-  }();
-  crc = ~crc;
-  for (std::size_t i = 0; i < size; ++i) crc = table[(crc ^ data[i]) & 0xFF] ^ (crc >> 8);
-  return ~crc;
-}
-
-std::uint32_t adler32(const std::uint8_t* data, std::size_t size) noexcept {
-  std::uint32_t a = 1, b = 0;
-  for (std::size_t i = 0; i < size; ++i) {
-    a = (a + data[i]) % 65521u;
-    b = (b + a) % 65521u;
-  }
-  return (b << 16) | a;
-}
 
 namespace {
 
-/// Deflate bit writer: bits go LSB first; Huffman codes are written most significant bit first.
-class BitWriter {
- public:
-  explicit BitWriter(std::vector<std::uint8_t>& out) : m_out(out) {}
-  void bits(std::uint32_t value, int count) {
-    for (int i = 0; i < count; ++i) {
-      if (m_used == 0) m_out.push_back(0);
-      m_out.back() |= static_cast<std::uint8_t>(((value >> i) & 1u) << m_used);
-      m_used = (m_used + 1) & 7;
-    }
-  }
-  void code(std::uint32_t value, int count) {
-    for (int i = count - 1; i >= 0; --i) bits((value >> i) & 1u, 1);
-  }
-
- private:
-  std::vector<std::uint8_t>& m_out;
-  int m_used = 0;
-};
-
-/// A literal/length symbol with the fixed Huffman code of RFC 1951, 3.2.6.
-void fixed_symbol(BitWriter& w, std::uint32_t symbol) {
-  if (symbol < 144)
-    w.code(0x30 + symbol, 8);
-  else if (symbol < 256)
-    w.code(0x190 + symbol - 144, 9);
-  else if (symbol < 280)
-    w.code(symbol - 256, 7);
-  else
-    w.code(0xC0 + symbol - 280, 8);
-}
-
-/// One fixed-Huffman block: literals, and runs of the previous byte as (length, distance 1).
-void deflate_fixed(const std::vector<std::uint8_t>& data, std::vector<std::uint8_t>& out) {
-  static constexpr std::uint16_t kBase[29] = {3,  4,  5,  6,   7,   8,   9,   10,  11, 13,
-                                              15, 17, 19, 23,  27,  31,  35,  43,  51, 59,
-                                              67, 83, 99, 115, 131, 163, 195, 227, 258};
-  static constexpr std::uint8_t kExtra[29] = {0, 0, 0, 0, 0, 0, 0, 0, 1, 1, 1, 1, 2, 2, 2,
-                                              2, 3, 3, 3, 3, 4, 4, 4, 4, 5, 5, 5, 5, 0};
-  BitWriter w(out);
-  w.bits(1, 1);  // final block
-  w.bits(1, 2);  // fixed Huffman codes
-  std::size_t i = 0;
-  while (i < data.size()) {
-    std::size_t run = 0;
-    if (i > 0)
-      while (run < 258 && i + run < data.size() && data[i + run] == data[i - 1]) ++run;
-    if (run >= 3) {
-      int k = 28;
-      while (kBase[k] > run) --k;
-      fixed_symbol(w, 257 + static_cast<std::uint32_t>(k));
-      w.bits(static_cast<std::uint32_t>(run - kBase[k]), kExtra[k]);
-      w.code(0, 5);  // distance code 0: distance 1
-      i += run;
-    } else {
-      fixed_symbol(w, data[i]);
-      ++i;
-    }
-  }
-  fixed_symbol(w, 256);  // end of block
+void append_to_vector(png_structp png, png_bytep data, png_size_t size) {
+  auto* out = static_cast<std::vector<std::uint8_t>*>(png_get_io_ptr(png));
+  out->insert(out->end(), data, data + size);
 }
 
 }  // namespace
 
 std::vector<std::uint8_t> encode_png(const std::vector<std::uint8_t>& rgb, int width, int height,
                                      bool compress) {
-  const std::size_t row = static_cast<std::size_t>(width) * 3;
-  std::vector<std::uint8_t> raw;
-  raw.reserve((row + 1) * static_cast<std::size_t>(height));
+  std::vector<std::uint8_t> out;
+  std::vector<png_bytep> rows(static_cast<std::size_t>(height));
   for (int y = 0; y < height; ++y) {
-    const std::uint8_t* line = rgb.data() + row * static_cast<std::size_t>(y);
-    if (compress) {
-      raw.push_back(1);  // filter: Sub (flat areas become runs of zeros)
-      for (std::size_t x = 0; x < row; ++x)
-        raw.push_back(static_cast<std::uint8_t>(line[x] - (x >= 3 ? line[x - 3] : 0)));
-    } else {
-      raw.push_back(0);  // filter: none
-      raw.insert(raw.end(), line, line + row);
-    }
+    // libpng reads the rows only; its API takes them as non-const.
+    rows[static_cast<std::size_t>(y)] = const_cast<png_bytep>(
+        rgb.data() + static_cast<std::size_t>(width) * 3 * static_cast<std::size_t>(y));
   }
-  std::vector<std::uint8_t> z{0x78, 0x01};
+  png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
+  png_infop info = png ? png_create_info_struct(png) : nullptr;
+  if (!info) {
+    png_destroy_write_struct(&png, nullptr);
+    throw std::bad_alloc();
+  }
+  if (setjmp(png_jmpbuf(png))) {  // libpng reports errors by longjmp here
+    png_destroy_write_struct(&png, &info);
+    throw std::runtime_error("PNG encoding failed");
+  }
+  png_set_write_fn(png, &out, append_to_vector, nullptr);
+  png_set_IHDR(png, info, static_cast<png_uint_32>(width), static_cast<png_uint_32>(height), 8,
+               PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT,
+               PNG_FILTER_TYPE_DEFAULT);
   if (compress) {
-    deflate_fixed(raw, z);
+    png_set_compression_level(png, 9);
   } else {
-    std::size_t pos = 0;
-    do {
-      const std::size_t len = std::min<std::size_t>(65535, raw.size() - pos);
-      const bool last = pos + len == raw.size();
-      z.push_back(last ? 1 : 0);
-      z.push_back(static_cast<std::uint8_t>(len & 0xFF));
-      z.push_back(static_cast<std::uint8_t>(len >> 8));
-      z.push_back(static_cast<std::uint8_t>(~len & 0xFF));
-      z.push_back(static_cast<std::uint8_t>((~len >> 8) & 0xFF));
-      z.insert(z.end(), raw.begin() + static_cast<std::ptrdiff_t>(pos),
-               raw.begin() + static_cast<std::ptrdiff_t>(pos + len));
-      pos += len;
-    } while (pos < raw.size());
+    png_set_compression_level(png, 0);  // zlib stored blocks
+    png_set_filter(png, PNG_FILTER_TYPE_BASE, PNG_FILTER_NONE);
   }
-  put_be32(z, adler32(raw.data(), raw.size()));
-
-  std::vector<std::uint8_t> png{0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
-  std::vector<std::uint8_t> ihdr;
-  put_be32(ihdr, static_cast<std::uint32_t>(width));
-  put_be32(ihdr, static_cast<std::uint32_t>(height));
-  ihdr.insert(ihdr.end(), {8, 2, 0, 0, 0});  // 8-bit, RGB, deflate, adaptive filters, no interlace
-  put_chunk(png, "IHDR", ihdr);
-  put_chunk(png, "IDAT", z);
-  put_chunk(png, "IEND", {});
-  return png;
+  png_set_rows(png, info, rows.data());
+  png_write_png(png, info, PNG_TRANSFORM_IDENTITY, nullptr);
+  png_destroy_write_struct(&png, &info);
+  return out;
 }
 
 std::vector<std::uint8_t> render_rgb(const RenderMesh& mesh, const RenderOptions& options) {

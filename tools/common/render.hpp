@@ -1,10 +1,9 @@
 #pragma once
 /// \file
 /// A small software rasteriser for pictures of meshes (clusters, charge): orthographic view,
-/// z-buffer, flat Lambert shading, optional poly-lines drawn on top, 2x2 supersampling; and a
-/// PNG writer with no dependency (own deflate: fixed Huffman + runs, or stored blocks; CRC-32,
-/// Adler-32). Deterministic: the same mesh and options give the same bytes. Single-threaded;
-/// no global state.
+/// z-buffer, flat Lambert shading, optional poly-lines drawn on top, 2x2 supersampling; and
+/// PNG encoding through libpng. Deterministic: the same mesh and options give the same bytes.
+/// Single-threaded; no global state.
 
 #include <array>
 #include <cstdint>
@@ -44,14 +43,10 @@ struct RenderOptions {
 /// skipped. Throws ToolError(kExitUsage) for sizes outside 16..8192 or a zero view vector.
 std::vector<std::uint8_t> render_rgb(const RenderMesh& mesh, const RenderOptions& options);
 
-/// PNG (8-bit RGB, no interlace) of `rgb` (width * height * 3 bytes, rows top to bottom).
-/// `compress`: Sub-filtered rows in one fixed-Huffman deflate block whose only matches are runs
-/// of the previous byte (flat areas shrink ~50x); otherwise unfiltered rows in stored blocks.
+/// PNG (8-bit RGB, no interlace) of `rgb` (width * height * 3 bytes, rows top to bottom),
+/// encoded by libpng: `compress` gives zlib level 9 with libpng's adaptive filters; otherwise
+/// unfiltered rows in zlib stored blocks. Deterministic for a given libpng and zlib.
 std::vector<std::uint8_t> encode_png(const std::vector<std::uint8_t>& rgb, int width, int height,
                                      bool compress = true);
-
-/// CRC-32 (ISO-HDLC, as PNG uses) and Adler-32 (as zlib uses), exposed for tests.
-std::uint32_t crc32(const std::uint8_t* data, std::size_t size, std::uint32_t crc = 0) noexcept;
-std::uint32_t adler32(const std::uint8_t* data, std::size_t size) noexcept;
 
 }  // namespace tetseg::tools

@@ -1,10 +1,10 @@
 #include "tool_support.hpp"
 
+#include <cctype>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
 #include <iostream>
-#include <cctype>
 
 #include <unistd.h>
 
@@ -18,23 +18,48 @@ void print_error(const std::string& tool, const std::string& file, const std::st
   std::cerr << message << '\n';
 }
 
+void write_files_atomic(const std::vector<std::string>& paths,
+                        const std::function<void(const std::vector<std::string>&)>& write) {
+  std::vector<std::string> temps;
+  for (const std::string& path : paths) {
+    const std::string ext = extension_of(path);
+    temps.push_back(path.substr(0, path.size() - ext.size()) + ".tmp" + std::to_string(::getpid()) +
+                    ext);
+  }
+  auto remove_temps = [&] {
+    for (const std::string& temp : temps) std::remove(temp.c_str());
+  };
+  try {
+    write(temps);
+  } catch (...) {
+    remove_temps();
+    throw;
+  }
+  for (std::size_t i = 0; i < paths.size(); ++i) {
+    if (std::rename(temps[i].c_str(), paths[i].c_str()) != 0) {
+      const int saved = errno;
+      remove_temps();
+      throw ToolError(kExitOutputFailed, paths[i],
+                      std::string("cannot rename into place: ") + std::strerror(saved));
+    }
+  }
+}
+
 void write_file_atomic(const std::string& path, const void* bytes, std::size_t size) {
-  const std::string temp = path + ".tmp" + std::to_string(::getpid());
-  std::FILE* file = std::fopen(temp.c_str(), "wb");
-  if (!file) throw ToolError(kExitOutputFailed, path, std::string("cannot write: ") + std::strerror(errno));
-  const bool written = size == 0 || std::fwrite(bytes, 1, size, file) == size;
-  const bool flushed = std::fflush(file) == 0;
-  const bool closed = std::fclose(file) == 0;
-  if (!written || !flushed || !closed) {
-    const int saved = errno;
-    std::remove(temp.c_str());
-    throw ToolError(kExitOutputFailed, path, std::string("write failed: ") + std::strerror(saved));
-  }
-  if (std::rename(temp.c_str(), path.c_str()) != 0) {
-    const int saved = errno;
-    std::remove(temp.c_str());
-    throw ToolError(kExitOutputFailed, path, std::string("cannot rename into place: ") + std::strerror(saved));
-  }
+  write_files_atomic({path}, [&](const std::vector<std::string>& temps) {
+    std::FILE* file = std::fopen(temps[0].c_str(), "wb");
+    if (!file) {
+      throw ToolError(kExitOutputFailed, path,
+                      std::string("cannot write: ") + std::strerror(errno));
+    }
+    const bool written = size == 0 || std::fwrite(bytes, 1, size, file) == size;
+    const bool flushed = std::fflush(file) == 0;
+    const bool closed = std::fclose(file) == 0;
+    if (!written || !flushed || !closed) {
+      throw ToolError(kExitOutputFailed, path,
+                      std::string("write failed: ") + std::strerror(errno));
+    }
+  });
 }
 
 std::string base_name(const std::string& path) {
@@ -56,11 +81,21 @@ std::string json_escape(const std::string& text) {
   out.reserve(text.size());
   for (unsigned char c : text) {
     switch (c) {
-      case '"': out += "\\\""; break;
-      case '\\': out += "\\\\"; break;
-      case '\n': out += "\\n"; break;
-      case '\t': out += "\\t"; break;
-      case '\r': out += "\\r"; break;
+      case '"':
+        out += "\\\"";
+        break;
+      case '\\':
+        out += "\\\\";
+        break;
+      case '\n':
+        out += "\\n";
+        break;
+      case '\t':
+        out += "\\t";
+        break;
+      case '\r':
+        out += "\\r";
+        break;
       default:
         if (c < 0x20) {
           char buf[8];

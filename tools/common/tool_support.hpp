@@ -3,6 +3,7 @@
 /// What every tetseg command-line tool shares: exit codes, error reporting, atomic output.
 
 #include <cstdint>
+#include <functional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -39,9 +40,15 @@ class ToolError : public std::runtime_error {
 /// Prints `<tool>: error: <file>: <message>` (or without the file when empty) to stderr.
 void print_error(const std::string& tool, const std::string& file, const std::string& message);
 
-/// Writes `bytes` to `path` through a temporary file in the same directory and a rename, so
-/// readers never see a partial file. Throws ToolError(kExitOutputFailed) on failure and leaves
-/// no temporary file behind.
+/// Writes files all or nothing, so readers never see a partial file: `write(temporaries)`
+/// writes each file to the temporary path given for it (beside its final path, same
+/// extension: `x.tmp<pid>.ext`), then every file is renamed into place. When `write` throws
+/// or a rename fails, no temporary file is left behind; a failed rename throws
+/// ToolError(kExitOutputFailed) naming the file. The tools' one atomic writer.
+void write_files_atomic(const std::vector<std::string>& paths,
+                        const std::function<void(const std::vector<std::string>&)>& write);
+
+/// write_files_atomic of one file holding `bytes`. Throws ToolError(kExitOutputFailed).
 void write_file_atomic(const std::string& path, const void* bytes, std::size_t size);
 inline void write_file_atomic(const std::string& path, const std::string& text) {
   write_file_atomic(path, text.data(), text.size());

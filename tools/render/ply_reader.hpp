@@ -13,9 +13,9 @@ namespace tetseg::tools {
 /// red/green/blue as uchar, or as float/double in [0,1]; faces without colour are grey; other
 /// elements and properties are skipped. Safe on hostile input: counts are checked against the
 /// file size before anything is allocated. Throws ToolError(kExitBadInput, path, ...) naming
-/// the problem. When `scalar_property` names a face property (e.g. "charge"), faces are
-/// coloured by it instead: scalar_color of the value rescaled from [min, max] to [0, 1]; a
-/// missing property is bad input.
+/// the problem (reading through tetseg_mesh_io). When `scalar_property` names a face property (e.g.
+/// "charge"), faces are coloured by it instead: scalar_color of the value rescaled from [min, max]
+/// to [0, 1]; a missing property is bad input.
 RenderMesh read_colored_ply(const std::string& path, const std::string& scalar_property = {});
 
 }  // namespace tetseg::tools

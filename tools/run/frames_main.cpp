@@ -7,7 +7,7 @@
 
 #include <CLI/CLI.hpp>
 
-#include "mesh_positions.hpp"
+#include "mesh_io.hpp"
 #include "tetseg/runtime/frames.hpp"
 #include "tool_support.hpp"
 
@@ -25,7 +25,9 @@ int main(int argc, char** argv) {
     app.parse(argc, argv);
     tetseg::FrameSequence frames;
     for (const std::string& path : inputs) {
-      const std::vector<double> xyz = read_mesh_positions(path);
+      std::vector<double> xyz;
+      const tetseg::io::IoStatus read = tetseg::io::read_vertex_positions(path, xyz);
+      if (!read.ok()) throw ToolError(kExitBadInput, path, read.error);
       const std::uint32_t nodes = static_cast<std::uint32_t>(xyz.size() / 3);
       if (frames.frame_count == 0) frames.node_count = nodes;
       if (nodes != frames.node_count)

@@ -11,6 +11,7 @@
 #include "tetseg/format/asset_io.hpp"
 #include "tetseg/preprocess/io.hpp"
 #include "tetseg/preprocess/meshing.hpp"
+#include "tetseg/preprocess/names.hpp"
 #include "tetseg/preprocess/pipeline.hpp"
 #include "tetseg/preprocess/surface.hpp"
 #include "tool_support.hpp"
@@ -65,8 +66,8 @@ std::string report_json(const BuildArgs& args, const BuildReport& report,
     const ChargeResult& c = report.charge;
     out << "  \"charge\": {\"solver\": \"" << c.solver << "\", \"tolerance\": " << c.tolerance
         << ", \"converged\": " << (c.converged ? "true" : "false")
-        << ", \"iterations\": " << c.iterations
-        << ", \"residual\": " << c.residual << ", \"capacitance\": " << c.capacitance
+        << ", \"iterations\": " << c.iterations << ", \"residual\": " << c.residual
+        << ", \"capacitance\": " << c.capacitance
         << ", \"assembly_seconds\": " << c.assembly_seconds
         << ", \"solve_seconds\": " << c.solve_seconds << "},\n";
   }
@@ -97,11 +98,14 @@ void run_build(const BuildArgs& args) {
   };
   StageTimer timer(report, on_stage);
 
+  BuildOptions options = args.options;
+  options.keep_rest_positions = !args.no_rest_positions;
   TetMesh mesh;
   if (is_tet_mesh_path(args.input)) {
     mesh = timer.run("read", [&](std::string& summary) {
       TetMesh m = read_tet_mesh(args.input);
-      summary = std::to_string(m.nodes.size()) + " nodes, " + std::to_string(m.tets.size()) + " tets";
+      summary =
+          std::to_string(m.nodes.size()) + " nodes, " + std::to_string(m.tets.size()) + " tets";
       return m;
     });
   } else {
@@ -114,13 +118,13 @@ void run_build(const BuildArgs& args) {
     });
     mesh = timer.run("tetrahedralize", [&](std::string& summary) {
       TetMesh m = tetrahedralize(surface, args.meshing, args.input);
-      summary = std::to_string(m.nodes.size()) + " nodes, " + std::to_string(m.tets.size()) + " tets";
+      options.meshing = args.meshing;  // recorded in the provenance
+      summary =
+          std::to_string(m.nodes.size()) + " nodes, " + std::to_string(m.tets.size()) + " tets";
       return m;
     });
   }
 
-  BuildOptions options = args.options;
-  options.keep_rest_positions = !args.no_rest_positions;
   const format::Asset asset = build_asset(mesh, args.input, options, report, on_stage);
   const std::vector<std::uint8_t> bytes = timer.run("write", [&](std::string& summary) {
     std::vector<std::uint8_t> b = format::write_asset(asset);
@@ -158,30 +162,30 @@ void run_build(const BuildArgs& args) {
 void add_build_command(CLI::App& root) {
   auto args = std::make_shared<BuildArgs>();
   CLI::App* cmd = root.add_subcommand(
-      "build", "Run the whole pipeline on a tet mesh (or a closed surface, tetrahedralised first) "
-               "and write the runtime asset");
-  cmd->add_option("input", args->input,
-                  "Tet mesh (.mesh, .node/.ele, .msh) or closed surface (.obj, .ply, .stl, .off, ...)")
+      "build",
+      "Run the whole pipeline on a tet mesh (or a closed surface, tetrahedralised first) "
+      "and write the runtime asset");
+  cmd->add_option(
+         "input", args->input,
+         "Tet mesh (.mesh, .node/.ele, .msh) or closed surface (.obj, .ply, .stl, .off, ...)")
       ->required();
   cmd->add_option("-o,--output", args->output, "Asset file to write (.tetseg)")->required();
   cmd->add_option("--report", args->report_path, "Write a JSON report: per-stage seconds, counts");
 
-  const std::map<std::string, ClusterMethod> cluster_methods{{"single", ClusterMethod::kSingle},
-                                                             {"charge", ClusterMethod::kCharge},
-                                                             {"refined", ClusterMethod::kRefined}};
   cmd->add_option("--clusters", args->options.clusters,
                   "single: one cluster; charge: the paper's charge-based segmentation; "
                   "refined: charge, then split clusters no node sees whole and merge neighbours "
                   "one node sees whole (docs/segmentation.md)")
-      ->transform(CLI::CheckedTransformer(cluster_methods, CLI::ignore_case))
-      ->option_text("single|charge|refined (refined)");
+      ->transform(CLI::CheckedTransformer(name_map<ClusterMethod>(), CLI::ignore_case))
+      ->option_text(name_list<ClusterMethod>() + " (refined)");
   RefinementOptions& ref = args->options.refinement;
   cmd->add_option("--refine-visibility", ref.min_visibility,
                   "refined: split clusters seen positive below this share at rest; merge "
                   "neighbours seen at least this well")
       ->check(CLI::Range(0.0, 1.0))
       ->capture_default_str();
-  cmd->add_option("--refine-max-clusters", ref.max_clusters, "refined: no split beyond this many clusters")
+  cmd->add_option("--refine-max-clusters", ref.max_clusters,
+                  "refined: no split beyond this many clusters")
       ->check(CLI::Range(1u, 100000u))
       ->capture_default_str();
   cmd->add_option("--refine-gain", ref.gain_per_cut_edge,
@@ -199,14 +203,10 @@ void add_build_command(CLI::App& root) {
                   "Segments larger than N/beta-divisor triangles are grown")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
-  const std::map<std::string, Equalization> equalizations{
-      {"histogram", Equalization::kHistogram},
-      {"rank", Equalization::kRank},
-      {"log-histogram", Equalization::kLogHistogram}};
-  cmd->add_option("--equalization", seg.equalization,
-                  "histogram (the paper, 256 bins), rank (exact) or log-histogram")
-      ->transform(CLI::CheckedTransformer(equalizations, CLI::ignore_case))
-      ->option_text("histogram|rank|log-histogram (histogram)");
+  cmd->add_option("--equalization,--equalize", seg.equalization,
+                  "histogram (the paper, 256 bins), rank (exact) or log-histogram (alias log)")
+      ->transform(CLI::CheckedTransformer(name_map<Equalization>(), CLI::ignore_case))
+      ->option_text(name_list<Equalization>() + " (histogram)");
   cmd->add_option("--growth-bound", seg.growth_bound,
                   "A segment never grows beyond this fraction of the surface")
       ->check(CLI::Range(0.0, 1.0))
@@ -217,21 +217,15 @@ void add_build_command(CLI::App& root) {
   cmd->add_option("--min-cluster-triangles", seg.min_cluster_triangles,
                   "Clusters smaller than this are merged into a neighbour (0: derived)")
       ->capture_default_str();
-  const std::map<std::string, DetectorStrategy> detectors{
-      {"nearest-centroid", DetectorStrategy::kNearestCentroid},
-      {"visibility", DetectorStrategy::kVisibility}};
   cmd->add_option("--detector", seg.detector,
                   "nearest-centroid (the paper) or visibility (most triangles positive at rest)")
-      ->transform(CLI::CheckedTransformer(detectors, CLI::ignore_case))
-      ->option_text("nearest-centroid|visibility (visibility)");
+      ->transform(CLI::CheckedTransformer(name_map<DetectorStrategy>(), CLI::ignore_case))
+      ->option_text(name_list<DetectorStrategy>() + " (visibility)");
 
-  const std::map<std::string, ChargeSolver> solvers{{"auto", ChargeSolver::kAuto},
-                                                    {"direct", ChargeSolver::kDirect},
-                                                    {"gmres", ChargeSolver::kGmres},
-                                                    {"fast", ChargeSolver::kFast}};
-  cmd->add_option("--solver", args->options.charge.solver, "Charge solver: auto, direct, gmres, fast")
-      ->transform(CLI::CheckedTransformer(solvers, CLI::ignore_case))
-      ->option_text("auto|direct|gmres|fast (auto)");
+  cmd->add_option("--solver", args->options.charge.solver,
+                  "Charge solver: auto, direct, gmres, fast")
+      ->transform(CLI::CheckedTransformer(name_map<ChargeSolver>(), CLI::ignore_case))
+      ->option_text(name_list<ChargeSolver>() + " (auto)");
   cmd->add_option("--tolerance", args->options.charge.tolerance,
                   "Relative residual of the iterative charge solvers (0: 1e-6 below 10k "
                   "triangles, 1e-8 above)")
@@ -250,8 +244,9 @@ void add_build_command(CLI::App& root) {
                   "Surface input only: max surface approximation error (0: derived)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
-  cmd->add_flag("--no-optimize", [args](std::int64_t) { args->meshing.optimize = false; },
-                "Surface input only: skip sliver perturbation and exudation (faster meshing)");
+  cmd->add_flag(
+      "--no-optimize", [args](std::int64_t) { args->meshing.optimize = false; },
+      "Surface input only: skip sliver perturbation and exudation (faster meshing)");
   cmd->add_flag("--no-rest-positions", args->no_rest_positions,
                 "Do not store rest positions in the asset (smaller; tools cannot draw it)");
   cmd->add_flag("-q,--quiet", args->quiet, "No stage lines");

@@ -14,8 +14,10 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "mesh_io.hpp"
 #include "tetseg/preprocess/charge.hpp"
 #include "tetseg/preprocess/io.hpp"
+#include "tetseg/preprocess/names.hpp"
 #include "tetseg/preprocess/surface.hpp"
 #include "tool_support.hpp"
 
@@ -26,8 +28,8 @@ struct ChargeArgs {
   std::string input;
   std::string output;
   std::string report;
-  std::string solver = "auto";
-  std::string equalization = "histogram";
+  preprocess::ChargeSolver solver = preprocess::ChargeSolver::kAuto;
+  preprocess::Equalization equalization = preprocess::Equalization::kHistogram;
   double tolerance = 0.0;  // 0: automatic (charge.hpp)
   int max_iterations = 500;
   double theta = 0.0;  // 0: automatic (charge.hpp)
@@ -132,56 +134,36 @@ std::string format_csv(const Outputs& o) {
   return s;
 }
 
+/// VTK XML unstructured grid of the used vertices and triangles, with `density` and
+/// `equalized` as cell data.
 std::string format_vtu(const Outputs& o) {
   std::vector<preprocess::Vec3> pts;
   std::vector<preprocess::Tri> tris;
   compact(o, pts, tris);
-  std::ostringstream s;
-  s.precision(9);
-  s << "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" "
-       "byte_order=\"LittleEndian\">\n<UnstructuredGrid>\n<Piece NumberOfPoints=\""
-    << pts.size() << "\" NumberOfCells=\"" << tris.size() << "\">\n";
-  s << "<Points>\n<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n";
-  for (const auto& p : pts) s << p[0] << ' ' << p[1] << ' ' << p[2] << '\n';
-  s << "</DataArray>\n</Points>\n<Cells>\n"
-       "<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n";
-  for (const auto& t : tris) s << t[0] << ' ' << t[1] << ' ' << t[2] << '\n';
-  s << "</DataArray>\n<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n";
-  for (std::size_t j = 0; j < tris.size(); ++j) s << 3 * (j + 1) << '\n';
-  s << "</DataArray>\n<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">\n";
-  for (std::size_t j = 0; j < tris.size(); ++j) s << "5\n";
-  s << "</DataArray>\n</Cells>\n<CellData Scalars=\"density\">\n";
-  const std::pair<const char*, const std::vector<double>*> arrays[] = {{"density", &o.density},
-                                                                       {"equalized", &o.equalized}};
-  for (const auto& [name, values] : arrays) {
-    s << "<DataArray type=\"Float64\" Name=\"" << name << "\" format=\"ascii\">\n";
-    for (const double v : *values) s << v << '\n';
-    s << "</DataArray>\n";
+  io::UnstructuredGrid grid;
+  grid.points = pts;
+  for (const auto& t : tris) {
+    grid.cell_types.push_back(5);
+    grid.cells.push_back({t[0], t[1], t[2]});
   }
-  s << "</CellData>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n";
-  return s.str();
+  grid.cell_data = {{"density", "Float64", o.density}, {"equalized", "Float64", o.equalized}};
+  return io::vtu_text(grid);
 }
 
 /// ASCII PLY, faces in gray levels of the equalised density (the paper's Fig. 4 encoding:
 /// darker = less charge), plus the two values as face properties.
 std::string format_ply(const Outputs& o) {
-  std::vector<preprocess::Vec3> pts;
-  std::vector<preprocess::Tri> tris;
-  compact(o, pts, tris);
-  std::ostringstream s;
-  s.precision(9);
-  s << "ply\nformat ascii 1.0\ncomment tetseg charge: gray = equalized density\n"
-    << "element vertex " << pts.size() << "\nproperty double x\nproperty double y\n"
-    << "property double z\nelement face " << tris.size()
-    << "\nproperty list uchar int vertex_indices\nproperty uchar red\nproperty uchar green\n"
-       "property uchar blue\nproperty double density\nproperty double equalized\nend_header\n";
-  for (const auto& p : pts) s << p[0] << ' ' << p[1] << ' ' << p[2] << '\n';
-  for (std::size_t j = 0; j < tris.size(); ++j) {
-    const int g = static_cast<int>(std::lround(std::clamp(o.equalized[j], 0.0, 1.0) * 255.0));
-    s << "3 " << tris[j][0] << ' ' << tris[j][1] << ' ' << tris[j][2] << ' ' << g << ' ' << g << ' '
-      << g << ' ' << o.density[j] << ' ' << o.equalized[j] << '\n';
-  }
-  return s.str();
+  io::PlyOutMesh ply;
+  ply.comment = "tetseg charge: gray = equalized density";
+  compact(o, ply.vertices, ply.triangles);
+  std::vector<double> gray;
+  for (const double e : o.equalized) gray.push_back(std::lround(std::clamp(e, 0.0, 1.0) * 255.0));
+  ply.face_properties = {{"red", "uchar", gray},
+                         {"green", "uchar", gray},
+                         {"blue", "uchar", gray},
+                         {"density", "double", o.density},
+                         {"equalized", "double", o.equalized}};
+  return io::ply_text(ply);
 }
 
 void run_charge(const ChargeArgs& args) {
@@ -190,13 +172,8 @@ void run_charge(const ChargeArgs& args) {
     throw CLI::ValidationError("--output", "output must end in .csv, .vtu or .ply: " + args.output);
   }
   preprocess::ChargeOptions options;
-  if (!preprocess::parse_charge_solver(args.solver, options.solver)) {
-    throw CLI::ValidationError("--solver", "unknown solver: " + args.solver);
-  }
-  preprocess::Equalization method;
-  if (!preprocess::parse_equalization(args.equalization, method)) {
-    throw CLI::ValidationError("--equalize", "unknown equalisation: " + args.equalization);
-  }
+  options.solver = args.solver;
+  const preprocess::Equalization method = args.equalization;
   options.tolerance = args.tolerance;
   options.max_iterations = args.max_iterations;
   options.fast_theta = args.theta;
@@ -254,7 +231,7 @@ void run_charge(const ChargeArgs& args) {
       << ",\n  \"converged\": " << (r.converged ? "true" : "false")
       << ",\n  \"tolerance\": " << r.tolerance << ",\n  \"capacitance\": " << r.capacitance
       << ",\n  \"total_area\": " << r.total_area << ",\n  \"equalization\": \""
-      << preprocess::to_string(method) << "\",\n  \"assembly_seconds\": " << r.assembly_seconds
+      << preprocess::name_of(method) << "\",\n  \"assembly_seconds\": " << r.assembly_seconds
       << ",\n  \"solve_seconds\": " << r.solve_seconds << "\n}\n";
     write_file_atomic(args.report, j.str());
   }
@@ -273,8 +250,9 @@ void add_charge_command(CLI::App& root) {
                   "Per-triangle output: .csv (triangle,cx,cy,cz,area,density,equalized), "
                   ".vtu (cell data) or .ply (gray faces)")
       ->required();
-  cmd->add_option("--solver", args->solver, "auto | direct | gmres | fast")
-      ->check(CLI::IsMember({"auto", "direct", "gmres", "fast"}));
+  cmd->add_option("--solver", args->solver, "Charge solver")
+      ->transform(CLI::CheckedTransformer(preprocess::name_map<preprocess::ChargeSolver>()))
+      ->option_text(preprocess::name_list<preprocess::ChargeSolver>() + " (auto)");
   cmd->add_option("--tolerance", args->tolerance,
                   "Relative residual of the iterative solvers (0: 1e-6 below 10k triangles, "
                   "1e-8 above)")
@@ -287,8 +265,10 @@ void add_charge_command(CLI::App& root) {
   cmd->add_option("--order", args->order,
                   "Fast solver expansion order (-1 = 7 below 10k triangles, else 8)")
       ->check(CLI::Range(-1, 16));
-  cmd->add_option("--equalize", args->equalization, "histogram (paper) | rank | log")
-      ->check(CLI::IsMember({"histogram", "rank", "log"}));
+  cmd->add_option("--equalization,--equalize", args->equalization,
+                  "histogram (the paper), rank or log-histogram (alias log)")
+      ->transform(CLI::CheckedTransformer(preprocess::name_map<preprocess::Equalization>()))
+      ->option_text(preprocess::name_list<preprocess::Equalization>() + " (histogram)");
   cmd->add_option("--bins", args->bins, "Histogram bins")->check(CLI::Range(1, 1 << 20));
   cmd->add_option("--report", args->report, "Write a JSON report (solver, iterations, times)");
   cmd->callback([args] { run_charge(*args); });

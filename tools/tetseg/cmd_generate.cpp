@@ -1,8 +1,6 @@
 // `tetseg generate`: procedural tet meshes (sphere, ellipsoid, dumbbell, pawn) with CGAL Mesh_3.
 // Also defines the meshing-option and output helpers shared with cmd_tetrahedralize.cpp.
 
-#include <unistd.h>
-
 #include <chrono>
 #include <cstdio>
 #include <memory>
@@ -12,6 +10,7 @@
 #include "commands.hpp"
 #include "tetseg/preprocess/io.hpp"
 #include "tetseg/preprocess/meshing.hpp"
+#include "tetseg/preprocess/names.hpp"
 #include "tetseg/preprocess/surface.hpp"
 #include "tool_support.hpp"
 
@@ -78,34 +77,19 @@ void write_one(const std::string& path, const preprocess::TetMesh& mesh, bool gm
   }
 }
 
-/// Writes through temporary files in the output's directory and renames them into place;
-/// on failure no temporary file is left behind.
+/// Writes all files of the output (both of a TetGen pair) or none (write_files_atomic).
 void write_atomic(const std::string& output, const preprocess::TetMesh& mesh, bool gmsh22) {
   const std::string ext = extension_of(output);
   const std::string stem = output.substr(0, output.size() - ext.size());
-  const std::string temp_stem = stem + ".tmp" + std::to_string(::getpid());
-  std::vector<std::string> finals;
-  if (ext == ".node" || ext == ".ele") {
-    finals = {stem + ".node", stem + ".ele"};
-  } else {
-    finals = {output};
-  }
-  std::vector<std::string> temps;
-  for (const std::string& f : finals) temps.push_back(temp_stem + f.substr(stem.size()));
-  auto remove_temps = [&] {
-    for (const std::string& t : temps) std::remove(t.c_str());
-  };
-  try {
-    write_one(temps.front(), mesh, gmsh22);
-  } catch (const preprocess::OutputError& e) {
-    remove_temps();
-    throw preprocess::OutputError(output, e.what());
-  }
-  for (std::size_t i = 0; i < finals.size(); ++i)
-    if (std::rename(temps[i].c_str(), finals[i].c_str()) != 0) {
-      remove_temps();
-      throw preprocess::OutputError(finals[i], "cannot rename the temporary file into place");
+  std::vector<std::string> finals = {output};
+  if (ext == ".node" || ext == ".ele") finals = {stem + ".node", stem + ".ele"};
+  write_files_atomic(finals, [&](const std::vector<std::string>& temps) {
+    try {
+      write_one(temps.front(), mesh, gmsh22);  // a TetGen writer finds the .ele beside the .node
+    } catch (const preprocess::OutputError& e) {
+      throw preprocess::OutputError(output, e.what());
     }
+  });
 }
 
 }  // namespace
@@ -162,9 +146,9 @@ void add_generate_command(CLI::App& root) {
   auto args = std::make_shared<GenerateArgs>();
   CLI::App* cmd = root.add_subcommand(
       "generate", "Mesh a procedural shape (sphere, ellipsoid, dumbbell, pawn) into tets");
-  cmd->add_option("shape", args->shape, "sphere | ellipsoid | dumbbell | pawn")
+  cmd->add_option("shape", args->shape, preprocess::name_list<preprocess::Shape>(" | "))
       ->required()
-      ->check(CLI::IsMember({"sphere", "ellipsoid", "dumbbell", "pawn"}));
+      ->check(CLI::IsMember(preprocess::name_map<preprocess::Shape>()));
   cmd->add_option("-o,--output", args->output, "Output tet mesh (.mesh, .node/.ele, .msh)")
       ->required();
   cmd->add_option("--size", args->shape_options.size,

@@ -6,7 +6,7 @@
 #include <string>
 #include <utility>
 
-#include "common/synthetic_scenes.hpp"
+#include "tetseg/testing/synthetic_scenes.hpp"
 
 namespace tetseg::test {
 

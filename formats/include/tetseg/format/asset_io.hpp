@@ -54,7 +54,8 @@ bool peek_version(const std::uint8_t* data, std::size_t size, std::uint16_t& maj
                   std::uint16_t& minor) noexcept;
 
 /// Reads a whole file and calls `read_asset`. Returns kIoError (and an empty `out`) when the
-/// file cannot be opened or read. Thread-safe; never throws.
+/// file cannot be opened or read (`detail`: "cannot open file" or "read error"; callers name
+/// the file). The runtime's load_asset_file is this function. Thread-safe; never throws.
 Status read_asset_file(const std::string& path, Asset& out, std::string* detail = nullptr) noexcept;
 
 /// Semantic validation alone (what `read_asset` checks after decoding; the full rule list

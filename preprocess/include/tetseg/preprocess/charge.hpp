@@ -21,10 +21,7 @@ enum class ChargeSolver {
   kFast,    ///< preconditioned GMRES, matrix-free FMM products, O(N log N) time and memory
 };
 
-/// Parses "auto", "direct", "gmres", "fast"; returns false for anything else.
-bool parse_charge_solver(const std::string& name, ChargeSolver& out);
-/// "auto", "direct", "gmres" or "fast".
-const char* to_string(ChargeSolver solver);
+// Names: enum_names<ChargeSolver>() (tetseg/preprocess/names.hpp).
 
 /// Preconditioner of the iterative solvers.
 enum class ChargePreconditioner {
@@ -99,9 +96,7 @@ enum class Equalization {
   kLogHistogram,  ///< the paper's rule on bins over [log min, log max] (needs density > 0)
 };
 
-/// Parses "histogram", "rank", "log"; returns false for anything else.
-bool parse_equalization(const std::string& name, Equalization& out);
-const char* to_string(Equalization method);
+// Names: enum_names<Equalization>() (tetseg/preprocess/names.hpp).
 
 /// Maps densities to (0, 1] so that the order is kept (non-decreasing map). Histogram: bin
 /// b = floor((v - min) / (max - min) * bins) clamped to bins - 1, CDF[b] = number of values in

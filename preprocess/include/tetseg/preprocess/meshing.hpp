@@ -33,7 +33,8 @@ struct ShapeOptions {
   double size = 1.0;
 };
 
-/// "sphere", "ellipsoid", "dumbbell", "pawn". Throws std::invalid_argument on an unknown name.
+/// A name of enum_names<Shape>() (tetseg/preprocess/names.hpp). Throws std::invalid_argument on
+/// an unknown name.
 Shape shape_from_name(const std::string& name);
 
 /// Meshes a procedural shape: sphere of `radius` at the origin; ellipsoid with semi-axes

@@ -6,19 +6,21 @@
 #include <chrono>
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "tetseg/format/asset.hpp"
 #include "tetseg/preprocess/charge.hpp"
 #include "tetseg/preprocess/mesh.hpp"
+#include "tetseg/preprocess/meshing.hpp"
 #include "tetseg/preprocess/segmentation.hpp"
 
 namespace tetseg::preprocess {
 
 /// How the surface is cut into clusters.
 enum class ClusterMethod {
-  kSingle,  ///< one cluster (no charge, no segmentation)
+  kSingle,   ///< one cluster (no charge, no segmentation)
   kCharge,   ///< the paper: charge density, segment boundaries, clusters
   kRefined,  ///< kCharge, then refine_clusters (split by rest visibility, merge)
 };
@@ -29,8 +31,11 @@ struct BuildOptions {
   ClusterMethod clusters = ClusterMethod::kRefined;
   ChargeOptions charge;
   SegmentationOptions segmentation;
-  RefinementOptions refinement;  ///< used by kRefined
+  RefinementOptions refinement;     ///< used by kRefined
   bool keep_rest_positions = true;  ///< store rest positions in the asset (docs/format.md)
+  /// Set when the tet mesh was made from the source surface by tetrahedralize with these
+  /// options; only recorded (provenance keys meshing.*), so that the asset can be rebuilt.
+  std::optional<MeshingOptions> meshing;
 };
 
 /// One finished stage: its name, wall time and a short human summary.
@@ -50,17 +55,18 @@ struct BuildReport {
   std::uint32_t clusters = 0;
   std::uint32_t boundaries = 0;
   SegmentationCounts segmentation;
-  RefinementCounts refinement;  ///< zero unless kRefined
-  ChargeResult charge;  ///< density left empty; solver figures only
+  RefinementCounts refinement;                ///< zero unless kRefined
+  ChargeResult charge;                        ///< density left empty; solver figures only
   std::vector<float> rest_positive_fraction;  ///< per cluster
 };
 
 /// Runs stages, timing each, appending it to `report.stages` and passing it to `on_stage`.
 /// `work(summary)` does the stage, may fill the human summary, and returns its result.
+/// Keeps a copy of `on_stage` (a temporary lambda may be passed) and a reference to `report`.
 class StageTimer {
  public:
-  StageTimer(BuildReport& report, const std::function<void(const StageReport&)>& on_stage)
-      : m_report(report), m_on_stage(on_stage) {}
+  StageTimer(BuildReport& report, std::function<void(const StageReport&)> on_stage)
+      : m_report(report), m_on_stage(std::move(on_stage)) {}
 
   template <typename Work>
   auto run(const char* name, Work&& work) {
@@ -76,11 +82,22 @@ class StageTimer {
 
  private:
   BuildReport& m_report;
-  const std::function<void(const StageReport&)>& m_on_stage;
+  std::function<void(const StageReport&)> m_on_stage;
 };
 
-/// Options as the key/value pairs recorded in the asset's provenance (sorted by key).
+/// Options as the key/value pairs recorded in the asset's provenance, sorted by key: every
+/// option that changes the asset (charge solver and its parameters, segmentation, refinement
+/// when used, rest positions, meshing when set); enum values by their canonical names
+/// (names.hpp), numbers as the shortest text that reads back exactly. build_asset records
+/// the charge solver it actually used in place of "auto".
 std::vector<std::pair<std::string, std::string>> provenance_options(const BuildOptions& options);
+
+/// The inverse of provenance_options: sets `options` from recorded pairs (options not named
+/// keep their defaults). Returns false, with the offending key and value in `error`, for an
+/// unknown key or a value that does not parse. Building the recorded source with the result
+/// (tetrahedralised with `options.meshing` when set) gives the same asset byte for byte.
+bool options_from_provenance(const std::vector<std::pair<std::string, std::string>>& recorded,
+                             BuildOptions& options, std::string* error = nullptr);
 
 /// Runs every stage on a tet mesh read from `source` (used in messages and provenance: only
 /// its file name is stored). Validates the mesh first (InputError on defects). Calls

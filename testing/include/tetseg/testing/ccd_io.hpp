@@ -17,7 +17,9 @@
 #include <string>
 #include <vector>
 
-namespace tetseg::tools::ccd_io {
+#include "mesh_io.hpp"
+
+namespace tetseg::test::ccd_io {
 
 using Vec3 = std::array<double, 3>;
 
@@ -150,147 +152,20 @@ struct Mesh {
   std::vector<std::array<std::uint32_t, 3>> faces;
 };
 
-/// Reads a PLY file (ascii, binary_little_endian or binary_big_endian). Vertex x, y, z of any
-/// scalar type, any extra properties (skipped); faces as a list property of triangles.
+/// Reads a PLY triangle soup through the tools' mesh I/O layer (tetseg_mesh_io: ascii,
+/// binary little or big endian, any scalar types, extra properties skipped). Throws
+/// std::runtime_error on malformed input and on faces that are not triangles.
 inline Mesh read_ply(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw std::runtime_error("cannot open");
-  std::string line;
-  if (!std::getline(in, line) || line.rfind("ply", 0) != 0)
-    throw std::runtime_error("not a PLY file");
-  enum class Format { kAscii, kLittle, kBig } format = Format::kAscii;
-  struct Property {
-    std::string name, type, count_type;
-    bool list = false;
-  };
-  struct Element {
-    std::string name;
-    std::uint64_t count = 0;
-    std::vector<Property> properties;
-  };
-  std::vector<Element> elements;
-  bool header_done = false;
-  while (std::getline(in, line)) {
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    std::stringstream ss(line);
-    std::string word;
-    ss >> word;
-    if (word == "format") {
-      std::string f;
-      ss >> f;
-      if (f == "ascii")
-        format = Format::kAscii;
-      else if (f == "binary_little_endian")
-        format = Format::kLittle;
-      else if (f == "binary_big_endian")
-        format = Format::kBig;
-      else
-        throw std::runtime_error("unknown PLY format '" + f + "'");
-    } else if (word == "element") {
-      Element e;
-      ss >> e.name >> e.count;
-      if (!ss || e.count > (1u << 28)) throw std::runtime_error("bad element line '" + line + "'");
-      elements.push_back(e);
-    } else if (word == "property") {
-      if (elements.empty()) throw std::runtime_error("property before element");
-      Property p;
-      ss >> p.type;
-      if (p.type == "list") {
-        p.list = true;
-        ss >> p.count_type >> p.type;
-      }
-      ss >> p.name;
-      if (!ss) throw std::runtime_error("bad property line '" + line + "'");
-      elements.back().properties.push_back(p);
-    } else if (word == "end_header") {
-      header_done = true;
-      break;
-    }
-  }
-  if (!header_done) throw std::runtime_error("PLY header without end_header");
-  auto type_size = [](const std::string& t) -> std::size_t {
-    if (t == "char" || t == "uchar" || t == "int8" || t == "uint8") return 1;
-    if (t == "short" || t == "ushort" || t == "int16" || t == "uint16") return 2;
-    if (t == "int" || t == "uint" || t == "int32" || t == "uint32" || t == "float" ||
-        t == "float32")
-      return 4;
-    if (t == "double" || t == "float64") return 8;
-    throw std::runtime_error("unknown PLY type '" + t + "'");
-  };
-  const bool swap = format == Format::kBig;
-  auto read_scalar = [&](const std::string& t) -> double {
-    if (format == Format::kAscii) {
-      double v;
-      if (!(in >> v)) throw std::runtime_error("truncated ASCII PLY data");
-      return v;
-    }
-    unsigned char bytes[8];
-    const std::size_t n = type_size(t);
-    if (!in.read(reinterpret_cast<char*>(bytes), static_cast<std::streamsize>(n)))
-      throw std::runtime_error("truncated binary PLY data");
-    if (swap) std::reverse(bytes, bytes + n);
-    if (t == "char" || t == "int8") return static_cast<std::int8_t>(bytes[0]);
-    if (t == "uchar" || t == "uint8") return bytes[0];
-    if (n == 2) {
-      std::uint16_t v;
-      std::memcpy(&v, bytes, 2);
-      return (t == "short" || t == "int16") ? static_cast<double>(static_cast<std::int16_t>(v)) : v;
-    }
-    if (t == "float" || t == "float32") {
-      float v;
-      std::memcpy(&v, bytes, 4);
-      return v;
-    }
-    if (n == 4) {
-      std::uint32_t v;
-      std::memcpy(&v, bytes, 4);
-      return (t == "int" || t == "int32") ? static_cast<double>(static_cast<std::int32_t>(v)) : v;
-    }
-    double v;
-    std::memcpy(&v, bytes, 8);
-    return v;
-  };
+  io::PlyMesh ply;
+  const io::IoStatus read = io::read_ply(path, ply);
+  if (!read.ok()) throw std::runtime_error(read.error);
   Mesh mesh;
-  for (const auto& e : elements) {
-    const bool is_vertex = e.name == "vertex";
-    const bool is_face = e.name == "face";
-    for (std::uint64_t i = 0; i < e.count; ++i) {
-      Vec3 v{0, 0, 0};
-      int found = 0;
-      for (const auto& p : e.properties) {
-        if (p.list) {
-          const double count = read_scalar(p.count_type);
-          if (!(count >= 0 && count <= 1024)) throw std::runtime_error("bad list length");
-          std::vector<double> items(static_cast<std::size_t>(count));
-          for (auto& item : items) item = read_scalar(p.type);
-          if (is_face && (p.name == "vertex_indices" || p.name == "vertex_index")) {
-            if (items.size() != 3) throw std::runtime_error("face is not a triangle");
-            std::array<std::uint32_t, 3> f{};
-            for (int k = 0; k < 3; ++k) {
-              const double idx = items[static_cast<std::size_t>(k)];
-              if (!(idx >= 0 && idx < 4294967295.0)) throw std::runtime_error("bad face index");
-              f[static_cast<std::size_t>(k)] = static_cast<std::uint32_t>(idx);
-            }
-            mesh.faces.push_back(f);
-          }
-        } else {
-          const double value = read_scalar(p.type);
-          if (is_vertex) {
-            if (p.name == "x") v[0] = value, found |= 1;
-            if (p.name == "y") v[1] = value, found |= 2;
-            if (p.name == "z") v[2] = value, found |= 4;
-          }
-        }
-      }
-      if (is_vertex) {
-        if (found != 7) throw std::runtime_error("vertex without x, y, z");
-        mesh.vertices.push_back(v);
-      }
-    }
+  mesh.vertices.assign(ply.vertices.begin(), ply.vertices.end());
+  for (const auto& face : ply.faces) {
+    if (face.size() != 3) throw std::runtime_error("face is not a triangle");
+    mesh.faces.push_back({face[0], face[1], face[2]});
   }
-  for (const auto& f : mesh.faces)
-    for (auto idx : f)
-      if (idx >= mesh.vertices.size()) throw std::runtime_error("face index out of range");
+  if (!ply.faces.empty() && ply.vertices.empty()) throw std::runtime_error("no vertices");
   return mesh;
 }
 
@@ -401,4 +276,4 @@ inline std::vector<std::array<std::uint32_t, 2>> unique_edges(
   return edges;
 }
 
-}  // namespace tetseg::tools::ccd_io
+}  // namespace tetseg::test::ccd_io

@@ -1,6 +1,6 @@
 // Generated closed surfaces for the charge tests and benchmark (see charge_shapes.hpp).
 
-#include "charge_shapes.hpp"
+#include "tetseg/testing/charge_shapes.hpp"
 
 #include <algorithm>
 #include <cmath>

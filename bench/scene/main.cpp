@@ -1,7 +1,8 @@
 // tetseg-scene: writes a generated scene (asset + frame sequence) for benchmarks, demos and
 // CLI tests of tetseg-run: closed surfaces of revolution over tet-node ids, clusters cut
 // along the axis with detector nodes on it, per-cluster median-split BVHs (the same builder as
-// tools/common/synthetic_scenes.hpp), and a deforming motion that ends in self-contact.
+// testing/include/tetseg/testing/synthetic_scenes.hpp), and a deforming motion that ends in
+// self-contact.
 
 #include <cmath>
 #include <cstdio>
@@ -10,9 +11,9 @@
 
 #include <CLI/CLI.hpp>
 
-#include "common/synthetic_scenes.hpp"
 #include "tetseg/format/asset_io.hpp"
 #include "tetseg/runtime/frames.hpp"
+#include "tetseg/testing/synthetic_scenes.hpp"
 #include "tool_support.hpp"
 
 namespace {

@@ -15,17 +15,17 @@
 
 #include <CLI/CLI.hpp>
 
-#include "ccd_io.hpp"
 #include "fast_cubic.hpp"
 #include "soup_ccd.hpp"
 #include "tetseg/runtime/ccd.hpp"
+#include "tetseg/testing/ccd_io.hpp"
 #include "tool_support.hpp"
 
 namespace {
 
 namespace fs = std::filesystem;
 using namespace tetseg::tools;
-namespace io = tetseg::tools::ccd_io;
+namespace io = tetseg::test::ccd_io;
 
 constexpr const char* kTool = "tetseg-ccd";
 

@@ -14,9 +14,10 @@
 #include <string>
 #include <vector>
 
-#include "../../preprocess/src/charge_solvers.hpp"
-#include "charge_shapes.hpp"
+#include "../preprocess/src/charge_solvers.hpp"
 #include "tetseg/preprocess/charge.hpp"
+#include "tetseg/preprocess/names.hpp"
+#include "tetseg/testing/charge_shapes.hpp"
 
 using namespace tetseg;
 using preprocess::ChargeOptions;
@@ -306,18 +307,8 @@ int main(int argc, char** argv) {
       const std::string s = head.substr(0, slash);
       const std::string pre = slash == std::string::npos ? "" : head.substr(slash + 1);
       ChargeOptions o;
-      bool known = preprocess::parse_charge_solver(s, o.solver);
-      if (pre == "jacobi") {
-        o.preconditioner = preprocess::ChargePreconditioner::kJacobi;
-      } else if (pre == "block") {
-        o.preconditioner = preprocess::ChargePreconditioner::kBlock;
-      } else if (pre == "near") {
-        o.preconditioner = preprocess::ChargePreconditioner::kNearField;
-      } else if (pre == "two") {
-        o.preconditioner = preprocess::ChargePreconditioner::kTwoLevel;
-      } else if (!pre.empty()) {
-        known = false;
-      }
+      bool known = preprocess::parse_name(s, o.solver);
+      if (!pre.empty()) known = known && preprocess::parse_name(pre, o.preconditioner);
       if (!known) {
         std::fprintf(stderr, "bench: unknown solver %s\n", spec.c_str());
         return 2;
@@ -369,8 +360,7 @@ int main(int argc, char** argv) {
           "|\n",
           m.name.c_str(), n, spec.c_str(), r.assembly, r.solve, r.assembly + r.solve, r.cpu,
           r.iterations, r.residual, exact_res.c_str(), static_cast<double>(r.peak_kb) / 1024.0,
-          analytic.c_str(),
-          vs_ref.c_str(), vs_ref_abs.c_str(), ref_name.c_str());
+          analytic.c_str(), vs_ref.c_str(), vs_ref_abs.c_str(), ref_name.c_str());
       std::fflush(stdout);
     }
   }

@@ -1,0 +1,72 @@
+#include "tetseg/preprocess/names.hpp"
+
+#include <stdexcept>
+
+namespace tetseg::preprocess {
+
+template <>
+const std::vector<EnumName<ChargeSolver>>& enum_names<ChargeSolver>() {
+  static const std::vector<EnumName<ChargeSolver>> table = {{"auto", ChargeSolver::kAuto},
+                                                            {"direct", ChargeSolver::kDirect},
+                                                            {"gmres", ChargeSolver::kGmres},
+                                                            {"fast", ChargeSolver::kFast}};
+  return table;
+}
+
+template <>
+const std::vector<EnumName<ChargePreconditioner>>& enum_names<ChargePreconditioner>() {
+  static const std::vector<EnumName<ChargePreconditioner>> table = {
+      {"jacobi", ChargePreconditioner::kJacobi},
+      {"block", ChargePreconditioner::kBlock},
+      {"near-field", ChargePreconditioner::kNearField},
+      {"two-level", ChargePreconditioner::kTwoLevel},
+      {"near", ChargePreconditioner::kNearField},  // tetseg-bench-charge's short names
+      {"two", ChargePreconditioner::kTwoLevel}};
+  return table;
+}
+
+template <>
+const std::vector<EnumName<Equalization>>& enum_names<Equalization>() {
+  static const std::vector<EnumName<Equalization>> table = {
+      {"histogram", Equalization::kHistogram},
+      {"rank", Equalization::kRank},
+      {"log-histogram", Equalization::kLogHistogram},
+      {"log", Equalization::kLogHistogram}};  // `tetseg charge --equalize log` before 0.2
+  return table;
+}
+
+template <>
+const std::vector<EnumName<DetectorStrategy>>& enum_names<DetectorStrategy>() {
+  static const std::vector<EnumName<DetectorStrategy>> table = {
+      {"nearest-centroid", DetectorStrategy::kNearestCentroid},
+      {"visibility", DetectorStrategy::kVisibility}};
+  return table;
+}
+
+template <>
+const std::vector<EnumName<ClusterMethod>>& enum_names<ClusterMethod>() {
+  static const std::vector<EnumName<ClusterMethod>> table = {{"single", ClusterMethod::kSingle},
+                                                             {"charge", ClusterMethod::kCharge},
+                                                             {"refined", ClusterMethod::kRefined}};
+  return table;
+}
+
+template <>
+const std::vector<EnumName<Shape>>& enum_names<Shape>() {
+  static const std::vector<EnumName<Shape>> table = {{"sphere", Shape::kSphere},
+                                                     {"ellipsoid", Shape::kEllipsoid},
+                                                     {"dumbbell", Shape::kDumbbell},
+                                                     {"pawn", Shape::kPawn}};
+  return table;
+}
+
+Shape shape_from_name(const std::string& name) {
+  Shape shape;
+  if (!parse_name(name, shape)) {
+    throw std::invalid_argument("unknown shape '" + name + "' (expected " + name_list<Shape>(", ") +
+                                ")");
+  }
+  return shape;
+}
+
+}  // namespace tetseg::preprocess
