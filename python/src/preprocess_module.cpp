@@ -23,6 +23,7 @@
 #include "tetseg/preprocess/charge.hpp"
 #include "tetseg/preprocess/io.hpp"
 #include "tetseg/preprocess/meshing.hpp"
+#include "tetseg/preprocess/names.hpp"
 #include "tetseg/preprocess/pipeline.hpp"
 #include "tetseg/preprocess/surface.hpp"
 
@@ -31,40 +32,14 @@ namespace {
 
 using namespace tetseg::preprocess;
 
-// ---------------------------------------------------------------------------------------
-// Option names. The names of `tetseg build` for the enums that have no name table in the
-// library yet (ClusterMethod, DetectorStrategy, and Equalization's "log-histogram" spelling);
-// replace with the library's tables when they exist.
+// Option names: the library's name tables (tetseg/preprocess/names.hpp), as in the CLI.
 
 template <typename Enum>
-using NameTable = std::vector<std::pair<const char*, Enum>>;
-
-const NameTable<ClusterMethod> kClusterMethods{{"single", ClusterMethod::kSingle},
-                                               {"charge", ClusterMethod::kCharge},
-                                               {"refined", ClusterMethod::kRefined}};
-const NameTable<DetectorStrategy> kDetectors{
-    {"nearest-centroid", DetectorStrategy::kNearestCentroid},
-    {"visibility", DetectorStrategy::kVisibility}};
-const NameTable<Equalization> kBuildEqualizations{{"histogram", Equalization::kHistogram},
-                                                  {"rank", Equalization::kRank},
-                                                  {"log-histogram", Equalization::kLogHistogram}};
-
-template <typename Enum>
-Enum enum_from_name(const NameTable<Enum>& table, const char* option, const std::string& name) {
-  std::string names;
-  for (const auto& [n, value] : table) {
-    if (name == n) return value;
-    names += (names.empty() ? "" : ", ") + std::string(n);
-  }
-  throw py::value_error(std::string(option) + ": unknown value '" + name + "' (" + names + ")");
-}
-
-template <typename Enum>
-std::string name_of(const NameTable<Enum>& table, Enum value) {
-  for (const auto& [n, v] : table) {
-    if (v == value) return n;
-  }
-  return "";
+Enum enum_from_name(const char* option, const std::string& name) {
+  Enum value{};
+  if (parse_name(name, value)) return value;
+  throw py::value_error(std::string(option) + ": unknown value '" + name + "' (" +
+                        name_list<Enum>(", ") + ")");
 }
 
 std::string number(double value) {
@@ -279,7 +254,7 @@ py::tuple build(const py::object& mesh, const py::object& source, const std::str
                 double facet_distance, bool optimize, bool rest_positions,
                 const py::object& on_stage) {
   BuildOptions options;
-  options.clusters = enum_from_name(kClusterMethods, "clusters", clusters);
+  options.clusters = enum_from_name<ClusterMethod>("clusters", clusters);
   check_range("refine_visibility", refine_visibility, 0.0, 1.0);
   check_range("refine_max_clusters", refine_max_clusters, 1, 100000);
   check_range("refine_gain", refine_gain, 0.0, kUnbounded);
@@ -293,13 +268,12 @@ py::tuple build(const py::object& mesh, const py::object& source, const std::str
   options.segmentation.alpha = alpha;
   options.segmentation.beta_divisor = beta_divisor;
   options.segmentation.equalization =
-      enum_from_name(kBuildEqualizations, "equalization", equalization);
+      enum_from_name<Equalization>("equalization", equalization);
   options.segmentation.growth_bound = growth_bound;
   options.segmentation.grow_through_marked = grow_through_marked;
   options.segmentation.min_cluster_triangles = min_cluster_triangles;
-  options.segmentation.detector = enum_from_name(kDetectors, "detector", detector);
-  if (!parse_charge_solver(solver, options.charge.solver))
-    throw py::value_error("solver: unknown value '" + solver + "' (auto, direct, gmres, fast)");
+  options.segmentation.detector = enum_from_name<DetectorStrategy>("detector", detector);
+  options.charge.solver = enum_from_name<ChargeSolver>("solver", solver);
   check_range("tolerance", tolerance, 0.0, 0.5);
   options.charge.tolerance = tolerance;
   options.keep_rest_positions = rest_positions;
@@ -349,6 +323,7 @@ py::tuple build(const py::object& mesh, const py::object& source, const std::str
       });
       in.tet_mesh = timer.run("tetrahedralize", [&](std::string& summary) {
         TetMesh m = tetrahedralize(in.surface, meshing, in.source);
+        options.meshing = meshing;  // recorded in the provenance, as by `tetseg build`
         summary =
             std::to_string(m.nodes.size()) + " nodes, " + std::to_string(m.tets.size()) + " tets";
         return m;
@@ -373,11 +348,8 @@ py::dict charge(const py::object& mesh, const py::object& source, const std::str
                 double tolerance, int max_iterations, double theta, int order,
                 const std::string& equalize_name, int bins) {
   ChargeOptions options;
-  if (!parse_charge_solver(solver, options.solver))
-    throw py::value_error("solver: unknown value '" + solver + "' (auto, direct, gmres, fast)");
-  Equalization method;
-  if (!parse_equalization(equalize_name, method))
-    throw py::value_error("equalize: unknown value '" + equalize_name + "' (histogram, rank, log)");
+  options.solver = enum_from_name<ChargeSolver>("solver", solver);
+  const Equalization method = enum_from_name<Equalization>("equalize", equalize_name);
   check_range("tolerance", tolerance, 0.0, 0.5);
   check_range("max_iterations", max_iterations, 1, 100000);
   check_range("theta", theta, 0.0, 0.95);
@@ -423,7 +395,7 @@ py::dict charge(const py::object& mesh, const py::object& source, const std::str
   d["tolerance"] = result.tolerance;
   d["capacitance"] = result.capacitance;
   d["total_area"] = result.total_area;
-  d["equalization"] = to_string(method);
+  d["equalization"] = name_of(method);
   d["assembly_seconds"] = result.assembly_seconds;
   d["solve_seconds"] = result.solve_seconds;
   return d;
@@ -495,18 +467,18 @@ PYBIND11_MODULE(preprocess, m) {
   const BuildOptions b;
   const MeshingOptions meshing;
   m.def("build", &build, py::arg("mesh"), py::kw_only(), py::arg("source") = py::none(),
-        py::arg("clusters") = name_of(kClusterMethods, b.clusters),
+        py::arg("clusters") = std::string(name_of(b.clusters)),
         py::arg("refine_visibility") = b.refinement.min_visibility,
         py::arg("refine_max_clusters") = b.refinement.max_clusters,
         py::arg("refine_gain") = b.refinement.gain_per_cut_edge,
         py::arg("refine_merge") = b.refinement.merge, py::arg("alpha") = b.segmentation.alpha,
         py::arg("beta_divisor") = b.segmentation.beta_divisor,
-        py::arg("equalization") = name_of(kBuildEqualizations, b.segmentation.equalization),
+        py::arg("equalization") = std::string(name_of(b.segmentation.equalization)),
         py::arg("growth_bound") = b.segmentation.growth_bound,
         py::arg("grow_through_marked") = b.segmentation.grow_through_marked,
         py::arg("min_cluster_triangles") = b.segmentation.min_cluster_triangles,
-        py::arg("detector") = name_of(kDetectors, b.segmentation.detector),
-        py::arg("solver") = std::string(to_string(b.charge.solver)),
+        py::arg("detector") = std::string(name_of(b.segmentation.detector)),
+        py::arg("solver") = std::string(name_of(b.charge.solver)),
         py::arg("tolerance") = b.charge.tolerance, py::arg("cell_size") = meshing.cell_size,
         py::arg("facet_size") = meshing.facet_size,
         py::arg("facet_distance") = meshing.facet_distance, py::arg("optimize") = meshing.optimize,
@@ -525,10 +497,10 @@ PYBIND11_MODULE(preprocess, m) {
 
   const ChargeOptions c;
   m.def("charge", &charge, py::arg("mesh"), py::kw_only(), py::arg("source") = py::none(),
-        py::arg("solver") = std::string(to_string(c.solver)), py::arg("tolerance") = c.tolerance,
+        py::arg("solver") = std::string(name_of(c.solver)), py::arg("tolerance") = c.tolerance,
         py::arg("max_iterations") = c.max_iterations, py::arg("theta") = c.fast_theta,
         py::arg("order") = c.fast_order,
-        py::arg("equalize") = std::string(to_string(Equalization::kHistogram)),
+        py::arg("equalize") = std::string(name_of(Equalization::kHistogram)),
         py::arg("bins") = 256,
         "Returns a dict. "
         "Relative charge density of a tet mesh's boundary or of a closed surface, as "

@@ -133,7 +133,7 @@ def test_bad_options_raise_value_errors(pp, sphere_mesh):
         (dict(cell_size=-1), "cell_size must be in"),
         (dict(clusters="many"), r"clusters: unknown value 'many' \(single, charge, refined\)"),
         (dict(detector="x"), "detector: unknown value 'x' .nearest-centroid, visibility."),
-        (dict(equalization="log"), "equalization: unknown value 'log'"),
+        (dict(equalization="logarithmic"), "equalization: unknown value 'logarithmic'"),
         (dict(solver="lu"), "solver: unknown value 'lu'"),
     ]
     for options, message in cases:
@@ -143,7 +143,7 @@ def test_bad_options_raise_value_errors(pp, sphere_mesh):
         pp.build(sphere_mesh, no_such_option=1)
     for options, message in [(dict(theta=1.5), "theta must be in"),
                              (dict(bins=0), "bins must be in"),
-                             (dict(equalize="log-histogram"), "equalize: unknown value")]:
+                             (dict(equalize="logarithmic"), "equalize: unknown value")]:
         with pytest.raises(ValueError, match=message):
             pp.charge(sphere_mesh, **options)
 
