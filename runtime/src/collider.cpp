@@ -180,7 +180,7 @@ void Collider::Impl::construct(const Asset& a, const ColliderOptions& o) {
     gnodes.resize(cap);
     gleaf.resize(tri_count);
     gcentroid.resize(std::size_t(tri_count) * 3);
-    gbuild_stack.resize(128);
+    gbuild_stack.resize(kMedianBvhStack);
     gbox.resize(cap);
     gntris.assign(cap, 0);
     gmov.assign(cap, 0);

@@ -5,13 +5,13 @@
 #include <cmath>
 
 #include "collider_impl.hpp"
+#include "tetseg/runtime/median_bvh.hpp"
 
 namespace tetseg {
 
 void Collider::Impl::build_global_bvh(const double* positions) noexcept {
   // Topology from `positions` (rest positions when the asset has them, else the first step's
-  // start): recursive median split of triangle centroids along the widest centroid axis,
-  // children allocated after their parent (as in the asset's per-cluster BVHs).
+  // start), by the median-split builder the asset's per-cluster BVHs come from.
   const format::Asset& fa = *asset;
   gnode_count = 0;
   if (tri_count == 0) {
@@ -26,42 +26,8 @@ void Collider::Impl::build_global_bvh(const double* positions) noexcept {
       gcentroid[std::size_t(t) * 3 + k] = s / 3.0;
     }
   }
-  const std::uint32_t leaf_size = opt.bvh_leaf_size;
-  std::size_t top = 0;
-  gnodes[0] = {0, 0, 0};
-  gnode_count = 1;
-  gbuild_stack[top++] = {0, 0, tri_count};
-  while (top > 0) {
-    const auto item = gbuild_stack[--top];
-    const std::uint32_t node = item[0], begin = item[1], end = item[2];
-    if (end - begin <= leaf_size || top + 2 > gbuild_stack.size()) {
-      gnodes[node] = {begin, 0, end - begin};
-      continue;
-    }
-    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-    for (std::uint32_t i = begin; i < end; ++i) {
-      for (int k = 0; k < 3; ++k) {
-        const double c = gcentroid[std::size_t(gleaf[i]) * 3 + k];
-        lo[k] = std::min(lo[k], c);
-        hi[k] = std::max(hi[k], c);
-      }
-    }
-    int axis = 0;
-    for (int k = 1; k < 3; ++k)
-      if (hi[k] - lo[k] > hi[axis] - lo[axis]) axis = k;
-    const std::uint32_t mid = begin + (end - begin) / 2;
-    const double* cen = gcentroid.data();
-    std::nth_element(gleaf.begin() + begin, gleaf.begin() + mid, gleaf.begin() + end,
-                     [cen, axis](std::uint32_t a, std::uint32_t b) {
-                       const double ca = cen[std::size_t(a) * 3 + axis];
-                       const double cb = cen[std::size_t(b) * 3 + axis];
-                       return ca < cb || (ca == cb && a < b);
-                     });
-    const std::uint32_t left = gnode_count++, right = gnode_count++;
-    gnodes[node] = {left, right, 0};
-    gbuild_stack[top++] = {right, mid, end};
-    gbuild_stack[top++] = {left, begin, mid};
-  }
+  gnode_count = build_median_bvh(gcentroid.data(), gleaf.data(), tri_count, opt.bvh_leaf_size,
+                                 gnodes.data(), gbuild_stack.data(), gbuild_stack.size());
   for (std::uint32_t i = gnode_count; i-- > 0;) {
     const format::BvhNode& n = gnodes[i];
     gntris[i] = n.count > 0 ? n.count : gntris[n.first] + gntris[n.second];

@@ -9,6 +9,7 @@
 #include "normal_cone.hpp"
 #include "tetseg/runtime/classify.hpp"
 #include "tetseg/runtime/collider.hpp"
+#include "tetseg/runtime/median_bvh.hpp"
 
 namespace tetseg {
 
@@ -145,7 +146,7 @@ struct Collider::Impl {
   std::uint32_t gnode_count = 0;
   std::vector<std::uint32_t> gleaf;  // triangle ids in leaf order
   std::vector<double> gcentroid;     // scratch for the build
-  std::vector<std::array<std::uint32_t, 3>> gbuild_stack;
+  std::vector<MedianBvhTask> gbuild_stack;
   std::vector<Box> gbox;
   std::vector<std::uint32_t> gntris, gmov;
 
