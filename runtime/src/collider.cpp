@@ -63,8 +63,12 @@ const char* to_string(ColliderStatus status) noexcept {
       return "size mismatch";
     case ColliderStatus::kNonFinite:
       return "non-finite position";
-    case ColliderStatus::kInternal:
-      return "internal limit exceeded";
+    case ColliderStatus::kNoStep:
+      return "no valid step";
+    case ColliderStatus::kOverflow:
+      return "traversal stack overflow";
+    case ColliderStatus::kInvalidArgument:
+      return "invalid argument";
   }
   return "unknown";
 }
@@ -150,7 +154,9 @@ void Collider::Impl::construct(const Asset& a, const ColliderOptions& o) {
     }
   }
   // The kBvh tree is a median split: depth <= log2(triangles) + 1 < 64.
-  const std::size_t stack_size = 4 * (std::size_t(std::max<std::uint32_t>(max_depth, 64)) + 4);
+  const std::size_t stack_size =
+      opt.traversal_stack > 0 ? opt.traversal_stack
+                              : 4 * (std::size_t(std::max<std::uint32_t>(max_depth, 64)) + 4);
   std::size_t threads = 1;
 #if defined(TETSEG_HAVE_OPENMP)
   if (opt.use_openmp) threads = static_cast<std::size_t>(std::max(1, omp_get_max_threads()));
@@ -388,51 +394,60 @@ ColliderStatus Collider::step(const double* x0, const double* x1,
   return ColliderStatus::kOk;
 }
 
-bool Collider::any_collision() noexcept {
-  if (!m_impl || !m_impl->have_step) return false;
-  Impl& s = *m_impl;
-  if (s.any_known) return s.any_value;
-  s.qkind = QueryKind::kAny;
-  if (!s.run_query(nullptr, 0)) return true;  // internal overflow: conservatively "maybe"
-  s.any_known = true;
-  s.any_value = s.query_hit;
-  return s.any_value;
+ColliderStatus Collider::Impl::query_status() const noexcept {
+  if (ctor_status != ColliderStatus::kOk) return ColliderStatus::kNotReady;
+  return have_step ? ColliderStatus::kOk : ColliderStatus::kNoStep;
 }
 
-EarliestContact Collider::earliest_toi() noexcept {
-  EarliestContact r;
-  if (!m_impl || !m_impl->have_step) return r;
+ColliderStatus Collider::any_collision(bool& hit) noexcept {
+  hit = false;
+  if (!m_impl) return ColliderStatus::kNotReady;
   Impl& s = *m_impl;
+  const ColliderStatus st = s.query_status();
+  if (st != ColliderStatus::kOk) return st;
+  if (!s.any_known) {
+    s.qkind = QueryKind::kAny;
+    if (!s.run_query(nullptr, 0)) return ColliderStatus::kOverflow;
+    s.any_known = true;
+    s.any_value = s.query_hit;
+  }
+  hit = s.any_value;
+  return ColliderStatus::kOk;
+}
+
+ColliderStatus Collider::earliest_toi(EarliestContact& out) noexcept {
+  out = EarliestContact{};
+  if (!m_impl) return ColliderStatus::kNotReady;
+  Impl& s = *m_impl;
+  const ColliderStatus st = s.query_status();
+  if (st != ColliderStatus::kOk) return st;
   if (!s.full_done) {
     s.qkind = QueryKind::kFull;
-    if (!s.run_query(nullptr, 0)) return r;
+    if (!s.run_query(nullptr, 0)) return ColliderStatus::kOverflow;
   }
-  r.found = s.has_best;
-  r.contact = s.best;
-  return r;
+  out.found = s.has_best;
+  out.contact = s.best;
+  return ColliderStatus::kOk;
 }
 
-ContactsResult Collider::contacts(Contact* buffer, std::size_t capacity) noexcept {
-  ContactsResult r;
-  if (!m_impl || !m_impl->have_step) {
-    r.status = ColliderStatus::kNotReady;
-    return r;
-  }
+ColliderStatus Collider::contacts(Contact* buffer, std::size_t capacity,
+                                  ContactsResult& out) noexcept {
+  out = ContactsResult{};
+  if (!m_impl) return ColliderStatus::kNotReady;
   Impl& s = *m_impl;
+  const ColliderStatus st = s.query_status();
+  if (st != ColliderStatus::kOk) return st;
   if (!buffer) capacity = 0;
   if (s.full_done && capacity == 0) {
-    r.found = s.full_found;
-    return r;
+    out.found = s.full_found;
+    return ColliderStatus::kOk;
   }
   s.qkind = QueryKind::kFull;
-  if (!s.run_query(capacity > 0 ? buffer : nullptr, capacity)) {
-    r.status = ColliderStatus::kInternal;
-    return r;
-  }
-  r.found = s.full_found;
-  r.written = s.out_written;
-  if (r.written > 0) std::sort(buffer, buffer + r.written, contact_less);
-  return r;
+  if (!s.run_query(capacity > 0 ? buffer : nullptr, capacity)) return ColliderStatus::kOverflow;
+  out.found = s.full_found;
+  out.written = s.out_written;
+  if (out.written > 0) std::sort(buffer, buffer + out.written, contact_less);
+  return ColliderStatus::kOk;
 }
 
 const ColliderStats& Collider::stats() const noexcept {

@@ -145,7 +145,7 @@ RestCheck Collider::check_rest_intersection(const double* x, std::size_t value_c
   s.have_step = false;
   s.stats = ColliderStats{};
   if (!ok) {
-    r.status = ColliderStatus::kInternal;
+    r.status = ColliderStatus::kOverflow;
     return r;
   }
   r.intersecting = s.rest_hit;

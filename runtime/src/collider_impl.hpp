@@ -190,6 +190,8 @@ struct Collider::Impl {
   void construct(const Asset& a, const ColliderOptions& o);
   ColliderStatus begin_step(const double* p0, const double* p1, std::size_t count) noexcept;
   void refit_and_classify() noexcept;
+  /// kOk when a query can run, else kNotReady or kNoStep.
+  ColliderStatus query_status() const noexcept;
   const double* pos0(std::uint32_t node) const noexcept { return x0 + std::size_t(node) * 3; }
   const double* pos1(std::uint32_t node) const noexcept { return x1 + std::size_t(node) * 3; }
 
