@@ -12,7 +12,6 @@ namespace tetseg {
 void Collider::Impl::build_global_bvh(const double* positions) noexcept {
   // Topology from `positions` (rest positions when the asset has them, else the first step's
   // start), by the median-split builder the asset's per-cluster BVHs come from.
-  const format::Asset& fa = *asset;
   gnode_count = 0;
   if (tri_count == 0) {
     gbvh_built = true;
@@ -22,7 +21,7 @@ void Collider::Impl::build_global_bvh(const double* positions) noexcept {
     gleaf[t] = t;
     for (int k = 0; k < 3; ++k) {
       double s = 0;
-      for (std::uint32_t v : fa.triangles[t]) s += positions[std::size_t(v) * 3 + k];
+      for (std::uint32_t v : tris[t]) s += positions[std::size_t(v) * 3 + k];
       gcentroid[std::size_t(t) * 3 + k] = s / 3.0;
     }
   }
@@ -102,8 +101,8 @@ bool segment_meets_triangle(const double* p, const double* q, const double* a, c
 
 void Collider::Impl::rest_triangle_pair(Worker& w, std::uint32_t t1,
                                         std::uint32_t t2) const noexcept {
-  const auto& A = asset->triangles[t1];
-  const auto& B = asset->triangles[t2];
+  const auto& A = tris[t1];
+  const auto& B = tris[t2];
   int shared = 0;
   for (std::uint32_t u : A)
     for (std::uint32_t v : B) shared += u == v;

@@ -4,8 +4,10 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
+#include "body_shape_data.hpp"
 #include "normal_cone.hpp"
 #include "tetseg/runtime/classify.hpp"
 #include "tetseg/runtime/collider.hpp"
@@ -126,19 +128,16 @@ struct Worker {
 
 struct Collider::Impl {
   // --- construction-time data
-  const format::Asset* asset = nullptr;
+  std::shared_ptr<const BodyShape> shape;  // immutable topology, shared
+  const BodyShape::Data* topo = nullptr;
+  const format::Asset* asset = nullptr;    // topo->asset: null for a surface-only body
+  const format::Triangle* tris = nullptr;  // topo->triangles
   ColliderOptions opt;
   ColliderStatus ctor_status = ColliderStatus::kNotReady;
   std::uint32_t node_count = 0;
   std::uint32_t tri_count = 0;
-  std::vector<std::uint32_t> surf_nodes;                // surface vertex -> node id (sorted)
-  std::vector<std::uint32_t> surf_index;                // node id -> surface vertex or kNone
-  std::vector<std::uint32_t> vt_offset, vt_list;        // surface vertex -> triangles (CSR)
-  std::vector<std::array<std::uint32_t, 2>> edges;      // node ids, [0] < [1], sorted
-  std::vector<std::array<std::uint32_t, 3>> tri_edges;  // edge ids of each triangle
-  std::vector<std::uint32_t> et_offset, et_list;        // edge -> triangles (CSR)
-  std::vector<std::uint32_t> cluster_node_ntris;        // per asset BVH node (static)
-  std::uint32_t max_depth = 0;
+  std::uint32_t body_id = 0;  // stamped on contacts (scene body id; 0 for a Collider)
+  bool always_refit = false;  // scene body: boxes are refit even when nothing moved
 
   // global BVH of the kBvh mode (topology built once, from rest or first positions)
   bool gbvh_built = false;
@@ -187,7 +186,23 @@ struct Collider::Impl {
   std::uint32_t rest_a = 0, rest_b = 0;
 
   // --- collider.cpp
-  void construct(const Asset& a, const ColliderOptions& o);
+  /// Allocates all scratch for `sh` (non-null). Throws on allocation failure.
+  void construct(std::shared_ptr<const BodyShape> sh, const ColliderOptions& o);
+  std::uint32_t cluster_count() const noexcept {
+    return asset ? static_cast<std::uint32_t>(asset->clusters.size()) : 0;
+  }
+  /// The whole-surface BVH serves this body's queries (bvh and cone modes; every mode but brute
+  /// force of a surface-only body, which has no clusters).
+  bool uses_global_bvh() const noexcept {
+    return opt.mode == ColliderMode::kBvh || opt.mode == ColliderMode::kCone ||
+           (!asset && opt.mode != ColliderMode::kBrute);
+  }
+  /// The whole-surface BVH is refit and traversed by the current query kind.
+  bool global_bvh_active() const noexcept { return rest_mode ? !asset : uses_global_bvh(); }
+  /// The asset's cluster BVHs are refit and traversed (rvbc, and the rest check of a tet body).
+  bool uses_clusters() const noexcept {
+    return asset && (opt.mode == ColliderMode::kRvbc || rest_mode);
+  }
   ColliderStatus begin_step(const double* p0, const double* p1, std::size_t count) noexcept;
   void refit_and_classify() noexcept;
   /// kOk when a query can run, else kNotReady or kNoStep.

@@ -41,7 +41,7 @@ TreeView Collider::Impl::cluster_view(std::uint32_t c) const noexcept {
   v.nodes = asset->bvh_nodes.data() + cl.bvh_offset;
   v.leaf_tris = asset->cluster_triangles.data() + cl.triangle_offset;
   v.box = nbox.data() + cl.bvh_offset;
-  v.ntris = cluster_node_ntris.data() + cl.bvh_offset;
+  v.ntris = topo->cluster_node_ntris.data() + cl.bvh_offset;
   v.nmov = nmov.data() + cl.bvh_offset;
   if (orientation_mode()) {
     v.nneg = nneg.data() + cl.bvh_offset;
@@ -97,8 +97,8 @@ void Collider::Impl::record(Worker& w, const Contact& c) const noexcept {
 
 void Collider::Impl::process_vertex_face(Worker& w, std::uint32_t p,
                                          std::uint32_t face) const noexcept {
-  const auto& f = asset->triangles[face];
-  const std::uint32_t ip = surf_index[p];
+  const auto& f = tris[face];
+  const std::uint32_t ip = topo->surf_index[p];
   if (!vmoved[ip] && !tmov[face]) return;  // still feature pair: only t = 0 contact possible
   const double ms = opt.ccd.min_separation;
   if (!boxes_overlap(vbox[ip], tbox[face], ms)) return;
@@ -137,7 +137,8 @@ bool Collider::Impl::edge_boxes_overlap(std::uint32_t e1, std::uint32_t e2) cons
 void Collider::Impl::process_edge_edge(Worker& w, std::uint32_t e1,
                                        std::uint32_t e2) const noexcept {
   if (e1 > e2) std::swap(e1, e2);
-  const std::uint32_t a = edges[e1][0], b = edges[e1][1], c = edges[e2][0], d = edges[e2][1];
+  const std::uint32_t a = topo->edges[e1][0], b = topo->edges[e1][1], c = topo->edges[e2][0],
+                      d = topo->edges[e2][1];
   const double ms = opt.ccd.min_separation;
   if (!edge_boxes_overlap(e1, e2)) return;  // also: all four nodes still
   ++w.stats.feature_pairs;
@@ -172,8 +173,8 @@ void Collider::Impl::process_edge_edge(Worker& w, std::uint32_t e1,
 template <typename Claimed>
 void Collider::Impl::test_features(Worker& w, std::uint32_t t1, std::uint32_t t2,
                                    Claimed&& claimed) const noexcept {
-  const auto& A = asset->triangles[t1];
-  const auto& B = asset->triangles[t2];
+  const auto& A = tris[t1];
+  const auto& B = tris[t2];
   // Vertex-face, both directions.
   for (int dir = 0; dir < 2 && !w.stop; ++dir) {
     const auto& P = dir == 0 ? A : B;
@@ -181,32 +182,32 @@ void Collider::Impl::test_features(Worker& w, std::uint32_t t1, std::uint32_t t2
     const std::uint32_t face = dir == 0 ? t2 : t1;
     for (std::uint32_t p : P) {
       if (p == F[0] || p == F[1] || p == F[2]) continue;
-      const std::uint32_t ip = surf_index[p];
+      const std::uint32_t ip = topo->surf_index[p];
       // Cheap rejections before the ownership scan (repeated inside, harmless).
       if (!vmoved[ip] && !tmov[face]) continue;
       if (!boxes_overlap(vbox[ip], tbox[face], opt.ccd.min_separation)) continue;
       bool owner = true;
-      for (std::uint32_t k = vt_offset[ip]; k < vt_offset[ip + 1] && owner; ++k)
-        if (claimed(vt_list[k], face)) owner = false;
+      for (std::uint32_t k = topo->vt_offset[ip]; k < topo->vt_offset[ip + 1] && owner; ++k)
+        if (claimed(topo->vt_list[k], face)) owner = false;
       if (owner) process_vertex_face(w, p, face);
       if (w.stop) return;
     }
   }
   // Edge-edge.
   for (std::uint32_t i = 0; i < 3; ++i) {
-    const std::uint32_t e1 = tri_edges[t1][i];
+    const std::uint32_t e1 = topo->tri_edges[t1][i];
     // tbox[t2] contains the boxes of t2's edges: one check rejects all three.
     if (!boxes_overlap(ebox[e1], tbox[t2], opt.ccd.min_separation)) continue;
     for (std::uint32_t j = 0; j < 3; ++j) {
-      const std::uint32_t e2 = tri_edges[t2][j];
-      const auto& E1 = edges[e1];
-      const auto& E2 = edges[e2];
+      const std::uint32_t e2 = topo->tri_edges[t2][j];
+      const auto& E1 = topo->edges[e1];
+      const auto& E2 = topo->edges[e2];
       if (E1[0] == E2[0] || E1[0] == E2[1] || E1[1] == E2[0] || E1[1] == E2[1]) continue;
       if (!edge_boxes_overlap(e1, e2)) continue;
       bool owner = true;
-      for (std::uint32_t k1 = et_offset[e1]; k1 < et_offset[e1 + 1] && owner; ++k1) {
-        for (std::uint32_t k2 = et_offset[e2]; k2 < et_offset[e2 + 1] && owner; ++k2) {
-          const std::uint32_t u = et_list[k1], v = et_list[k2];
+      for (std::uint32_t k1 = topo->et_offset[e1]; k1 < topo->et_offset[e1 + 1] && owner; ++k1) {
+        for (std::uint32_t k2 = topo->et_offset[e2]; k2 < topo->et_offset[e2 + 1] && owner; ++k2) {
+          const std::uint32_t u = topo->et_list[k1], v = topo->et_list[k2];
           if (u != v && claimed(u, v)) owner = false;
         }
       }
@@ -240,9 +241,9 @@ void Collider::Impl::close_contacts(Worker& w, double toi) noexcept {
   auto add_ring = [&](const Contact& c) {
     if (c.toi != toi) return;
     for (std::uint32_t node : c.nodes) {
-      const std::uint32_t iv = surf_index[node];
-      for (std::uint32_t k = vt_offset[iv]; k < vt_offset[iv + 1]; ++k) {
-        const std::uint32_t t = vt_list[k];
+      const std::uint32_t iv = topo->surf_index[node];
+      for (std::uint32_t k = topo->vt_offset[iv]; k < topo->vt_offset[iv + 1]; ++k) {
+        const std::uint32_t t = topo->vt_list[k];
         if (!closure_mark[t]) {
           closure_mark[t] = 1;
           closure_ring.push_back(t);
@@ -367,9 +368,9 @@ bool Collider::Impl::traverse_self(Worker& w, const TreeView& t) const noexcept 
 
 void Collider::Impl::brute_vertex_faces(Worker& w, std::uint32_t i) const noexcept {
   // Vertex i against every triangle not containing it (swept-box overlap checked inside).
-  const std::uint32_t p = surf_nodes[i];
+  const std::uint32_t p = topo->surf_nodes[i];
   for (std::uint32_t f = 0; f < tri_count && !w.stop; ++f) {
-    const auto& F = asset->triangles[f];
+    const auto& F = tris[f];
     if (p == F[0] || p == F[1] || p == F[2]) continue;
     process_vertex_face(w, p, f);
   }
@@ -377,17 +378,17 @@ void Collider::Impl::brute_vertex_faces(Worker& w, std::uint32_t i) const noexce
 
 void Collider::Impl::brute_edge_edges(Worker& w, std::uint32_t i) const noexcept {
   // Edge i against every later edge with four distinct nodes.
-  const std::uint32_t ne = static_cast<std::uint32_t>(edges.size());
-  const auto& E1 = edges[i];
+  const std::uint32_t ne = static_cast<std::uint32_t>(topo->edges.size());
+  const auto& E1 = topo->edges[i];
   for (std::uint32_t j = i + 1; j < ne && !w.stop; ++j) {
-    const auto& E2 = edges[j];
+    const auto& E2 = topo->edges[j];
     if (E1[0] == E2[0] || E1[0] == E2[1] || E1[1] == E2[0] || E1[1] == E2[1]) continue;
     process_edge_edge(w, i, j);
   }
 }
 
 bool Collider::Impl::cluster_tasks(Worker& w, std::uint32_t c1, bool count_skips) const noexcept {
-  const std::uint32_t nc = static_cast<std::uint32_t>(asset->clusters.size());
+  const std::uint32_t nc = cluster_count();
   const TreeView v1 = cluster_view(c1);
   const bool still = !rest_mode && v1.nmov[0] == 0;
   const bool one_sign =
@@ -435,11 +436,10 @@ bool Collider::Impl::run_query(Contact* out, std::size_t out_cap) noexcept {
   const bool parallel = workers.size() > 1 && out == nullptr && !rest_mode;
   (void)parallel;
   if (!stats.nothing_moved || rest_mode) {
-    const format::Asset& fa = *asset;
-    const std::uint32_t nc = static_cast<std::uint32_t>(fa.clusters.size());
-    const std::int64_t nv = static_cast<std::int64_t>(surf_nodes.size());
-    const std::int64_t ne = static_cast<std::int64_t>(edges.size());
-    if ((opt.mode == ColliderMode::kBvh || opt.mode == ColliderMode::kCone) && !rest_mode) {
+    const std::uint32_t nc = cluster_count();
+    const std::int64_t nv = static_cast<std::int64_t>(topo->surf_nodes.size());
+    const std::int64_t ne = static_cast<std::int64_t>(topo->edges.size());
+    if (global_bvh_active()) {
       if (tri_count > 0 && !traverse_self(w0, global_view())) w0.overflow = true;
     } else if (opt.mode == ColliderMode::kBrute && !rest_mode) {
 #if defined(TETSEG_HAVE_OPENMP)

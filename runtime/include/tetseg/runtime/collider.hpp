@@ -18,6 +18,7 @@
 #include <memory>
 
 #include "tetseg/runtime/asset.hpp"
+#include "tetseg/runtime/body_shape.hpp"
 #include "tetseg/runtime/ccd.hpp"
 #include "tetseg/runtime/classify.hpp"
 
@@ -139,6 +140,9 @@ class Collider {
   /// Builds the collider and allocates all scratch memory. `asset` must outlive the collider
   /// and stay unchanged. On allocation failure `status()` is kNotReady and every call fails.
   Collider(const Asset& asset, const ColliderOptions& options = {}) noexcept;
+  /// Same over a shared, prebuilt topology (`BodyShape::from_asset` or, for a surface-only
+  /// mesh, `from_triangles`: no clusters, so `kRvbc` runs as `kBvh`). Null shape: kNotReady.
+  Collider(std::shared_ptr<const BodyShape> shape, const ColliderOptions& options = {}) noexcept;
   ~Collider();
   Collider(Collider&&) noexcept;
   Collider& operator=(Collider&&) noexcept;
