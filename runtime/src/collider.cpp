@@ -76,6 +76,7 @@ const char* to_string(ColliderStatus status) noexcept {
 bool contact_less(const Contact& a, const Contact& b) noexcept {
   if (a.toi != b.toi) return a.toi < b.toi;
   if (a.kind != b.kind) return a.kind < b.kind;
+  if (a.bodies != b.bodies) return a.bodies < b.bodies;
   if (a.nodes != b.nodes) return a.nodes < b.nodes;
   return a.triangle < b.triangle;
 }

@@ -117,6 +117,9 @@ struct Worker {
   std::size_t out_cap = 0, out_written = 0;
   bool rest_hit = false;
   std::uint32_t rest_a = 0, rest_b = 0;
+  QueryKind qkind = QueryKind::kFull;
+  /// Counts a contact: stops the traversal for kAny, else keeps the earliest and fills `out`.
+  void record(const Contact& c) noexcept;
   void reset() noexcept {
     stats = ColliderStats{};
     stop = overflow = has_best = rest_hit = false;
@@ -217,21 +220,8 @@ struct Collider::Impl {
   bool run_query(Contact* out, std::size_t out_cap) noexcept;
   bool non_culled(std::uint32_t t1, std::uint32_t t2) const noexcept;
   void process_triangle_pair(Worker& w, std::uint32_t t1, std::uint32_t t2) const noexcept;
-  template <typename Claimed>
-  void test_features(Worker& w, std::uint32_t t1, std::uint32_t t2,
-                     Claimed&& claimed) const noexcept;
-  void process_vertex_face(Worker& w, std::uint32_t p, std::uint32_t face) const noexcept;
-  void process_edge_edge(Worker& w, std::uint32_t e1, std::uint32_t e2) const noexcept;
-  /// Swept boxes of two edges overlap and not all four nodes are still.
-  bool edge_boxes_overlap(std::uint32_t e1, std::uint32_t e2) const noexcept;
-  void record(Worker& w, const Contact& c) const noexcept;
   bool traverse_self(Worker& w, const TreeView& tree) const noexcept;
   bool traverse_pair(Worker& w, const TreeView& ta, const TreeView& tb) const noexcept;
-  template <typename Live>
-  bool descend_pair(Worker& w, const TreeView& ta, const TreeView& tb, const StackItem& it,
-                    Live&& live, std::size_t& top) const noexcept;
-  void leaf_pair(Worker& w, const TreeView& ta, std::uint32_t a, const TreeView& tb,
-                 std::uint32_t b) const noexcept;
   void brute_vertex_faces(Worker& w, std::uint32_t i) const noexcept;
   void brute_edge_edges(Worker& w, std::uint32_t i) const noexcept;
   /// Intra-cluster work of cluster c1 and its pairs with every cluster c2 > c1.

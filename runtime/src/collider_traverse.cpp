@@ -81,32 +81,38 @@ bool Collider::Impl::orientation_culled(std::uint32_t t1, std::uint32_t t2) cons
   return boxes_overlap(tbox[t1], tbox[t2], opt.ccd.min_separation);
 }
 
-void Collider::Impl::record(Worker& w, const Contact& c) const noexcept {
-  ++w.stats.contacts;
+void Worker::record(const Contact& c) noexcept {
+  ++stats.contacts;
   if (qkind == QueryKind::kAny) {
-    w.stop = true;
+    stop = true;
     return;
   }
-  ++w.found;
-  if (!w.has_best || contact_less(c, w.best)) {
-    w.best = c;
-    w.has_best = true;
+  ++found;
+  if (!has_best || contact_less(c, best)) {
+    best = c;
+    has_best = true;
   }
-  if (w.out && w.out_written < w.out_cap) w.out[w.out_written++] = c;
+  if (out && out_written < out_cap) out[out_written++] = c;
 }
 
-void Collider::Impl::process_vertex_face(Worker& w, std::uint32_t p,
-                                         std::uint32_t face) const noexcept {
-  const auto& f = tris[face];
-  const std::uint32_t ip = topo->surf_index[p];
-  if (!vmoved[ip] && !tmov[face]) return;  // still feature pair: only t = 0 contact possible
+// ------------------------------------------------- the one feature-pair path
+// Feature pairs of a triangle of body A and a triangle of body B (A == B for self-collision):
+// swept-box checks, the coplanarity filter, the elementary test, the contact. Options (ccd,
+// timing) are A's; a scene gives all its bodies the same.
+
+void process_vertex_face(Worker& w, const Collider::Impl& P, std::uint32_t p,
+                         const Collider::Impl& F, std::uint32_t face) noexcept {
+  const auto& f = F.tris[face];
+  const std::uint32_t ip = P.topo->surf_index[p];
+  if (!P.vmoved[ip] && !F.tmov[face]) return;  // still feature pair: only t = 0 contact possible
+  const ColliderOptions& opt = P.opt;
   const double ms = opt.ccd.min_separation;
-  if (!boxes_overlap(vbox[ip], tbox[face], ms)) return;
+  if (!boxes_overlap(P.vbox[ip], F.tbox[face], ms)) return;
   ++w.stats.feature_pairs;
   if (ms <= 0) {
     // Coplanarity cubic det[b-a, c-a, p-a] with a proven strict sign: never coplanar.
-    const Orientation o = classify_orientation(pos0(f[0]), pos0(f[1]), pos0(f[2]), pos0(p),
-                                               pos1(f[0]), pos1(f[1]), pos1(f[2]), pos1(p));
+    const Orientation o = classify_orientation(F.pos0(f[0]), F.pos0(f[1]), F.pos0(f[2]), P.pos0(p),
+                                               F.pos1(f[0]), F.pos1(f[1]), F.pos1(f[2]), P.pos1(p));
     if (o != Orientation::kUncertain) {
       ++w.stats.feature_pairs_filtered;
       return;
@@ -116,36 +122,40 @@ void Collider::Impl::process_vertex_face(Worker& w, std::uint32_t p,
   Clock::time_point t0;
   if (opt.time_tests) t0 = Clock::now();
   const CcdResult r =
-      vertex_face_ccd(v3(pos0(p)), v3(pos0(f[0])), v3(pos0(f[1])), v3(pos0(f[2])), v3(pos1(p)),
-                      v3(pos1(f[0])), v3(pos1(f[1])), v3(pos1(f[2])), opt.ccd);
+      vertex_face_ccd(v3(P.pos0(p)), v3(F.pos0(f[0])), v3(F.pos0(f[1])), v3(F.pos0(f[2])),
+                      v3(P.pos1(p)), v3(F.pos1(f[0])), v3(F.pos1(f[1])), v3(F.pos1(f[2])), opt.ccd);
   if (opt.time_tests) w.tests_seconds += std::chrono::duration<double>(Clock::now() - t0).count();
   if (!r.hit()) return;
   Contact c;
   c.kind = ContactKind::kVertexFace;
+  c.bodies = {P.body_id, F.body_id};
   c.nodes = {p, f[0], f[1], f[2]};
   c.triangle = face;
   c.at_start = r.outcome == CcdOutcome::kContactAtStart;
   c.toi = c.at_start ? 0.0 : r.toi;
-  record(w, c);
+  w.record(c);
 }
 
-bool Collider::Impl::edge_boxes_overlap(std::uint32_t e1, std::uint32_t e2) const noexcept {
-  if (!emov[e1] && !emov[e2]) return false;
-  return boxes_overlap(ebox[e1], ebox[e2], opt.ccd.min_separation);
+// Swept boxes of two edges overlap and not all four nodes are still.
+inline bool edge_boxes_overlap(const Collider::Impl& A, std::uint32_t e1, const Collider::Impl& B,
+                               std::uint32_t e2) noexcept {
+  if (!A.emov[e1] && !B.emov[e2]) return false;
+  return boxes_overlap(A.ebox[e1], B.ebox[e2], A.opt.ccd.min_separation);
 }
 
-void Collider::Impl::process_edge_edge(Worker& w, std::uint32_t e1,
-                                       std::uint32_t e2) const noexcept {
-  if (e1 > e2) std::swap(e1, e2);
-  const std::uint32_t a = topo->edges[e1][0], b = topo->edges[e1][1], c = topo->edges[e2][0],
-                      d = topo->edges[e2][1];
+void process_edge_edge(Worker& w, const Collider::Impl& A, std::uint32_t e1,
+                       const Collider::Impl& B, std::uint32_t e2) noexcept {
+  if (&A == &B && e1 > e2) std::swap(e1, e2);
+  const std::uint32_t a = A.topo->edges[e1][0], b = A.topo->edges[e1][1];
+  const std::uint32_t c = B.topo->edges[e2][0], d = B.topo->edges[e2][1];
+  const ColliderOptions& opt = A.opt;
   const double ms = opt.ccd.min_separation;
-  if (!edge_boxes_overlap(e1, e2)) return;  // also: all four nodes still
+  if (!edge_boxes_overlap(A, e1, B, e2)) return;  // also: all four nodes still
   ++w.stats.feature_pairs;
   if (ms <= 0) {
     // det[b-a, d-c, c-a] = det[b-a, d-a, c-a]: orientation of (a; b, d, c).
-    const Orientation o = classify_orientation(pos0(a), pos0(b), pos0(d), pos0(c), pos1(a), pos1(b),
-                                               pos1(d), pos1(c));
+    const Orientation o = classify_orientation(A.pos0(a), A.pos0(b), B.pos0(d), B.pos0(c),
+                                               A.pos1(a), A.pos1(b), B.pos1(d), B.pos1(c));
     if (o != Orientation::kUncertain) {
       ++w.stats.feature_pairs_filtered;
       return;
@@ -154,64 +164,80 @@ void Collider::Impl::process_edge_edge(Worker& w, std::uint32_t e1,
   ++w.stats.feature_tests;
   Clock::time_point t0;
   if (opt.time_tests) t0 = Clock::now();
-  const CcdResult r = edge_edge_ccd(v3(pos0(a)), v3(pos0(b)), v3(pos0(c)), v3(pos0(d)), v3(pos1(a)),
-                                    v3(pos1(b)), v3(pos1(c)), v3(pos1(d)), opt.ccd);
+  const CcdResult r =
+      edge_edge_ccd(v3(A.pos0(a)), v3(A.pos0(b)), v3(B.pos0(c)), v3(B.pos0(d)), v3(A.pos1(a)),
+                    v3(A.pos1(b)), v3(B.pos1(c)), v3(B.pos1(d)), opt.ccd);
   if (opt.time_tests) w.tests_seconds += std::chrono::duration<double>(Clock::now() - t0).count();
   if (!r.hit()) return;
   Contact k;
   k.kind = ContactKind::kEdgeEdge;
-  k.nodes = {a, b, c, d};  // edges sorted (a<b, c<d) and e1 < e2 in sorted edge order
+  k.bodies = {A.body_id, B.body_id};
+  // Edges sorted (a<b, c<d); within one body e1 < e2 in sorted edge order.
+  k.nodes = {a, b, c, d};
   k.triangle = 0;
   k.at_start = r.outcome == CcdOutcome::kContactAtStart;
   k.toi = k.at_start ? 0.0 : r.toi;
-  record(w, k);
+  w.record(k);
 }
 
-// Tests the feature pairs of triangles t1 != t2 (vertex-face both ways, edge-edge; features
-// with four distinct nodes) that no other triangle pair claims: `claimed(u, v)` is true when
-// the pair (u, v) tests a shared feature pair instead of this one (exact deduplication).
+// Tests the feature pairs of triangle t1 of A and t2 of B (t1 != t2 within one body):
+// vertex-face both ways and edge-edge, features with four distinct nodes, that no other
+// triangle pair claims: `claimed(u, v)` (u of A, v of B) is true when the pair (u, v) tests a
+// shared feature pair instead of this one (exact deduplication).
 template <typename Claimed>
-void Collider::Impl::test_features(Worker& w, std::uint32_t t1, std::uint32_t t2,
-                                   Claimed&& claimed) const noexcept {
-  const auto& A = tris[t1];
-  const auto& B = tris[t2];
+void test_features(Worker& w, const Collider::Impl& A, std::uint32_t t1, const Collider::Impl& B,
+                   std::uint32_t t2, Claimed&& claimed) noexcept {
+  const bool same = &A == &B;
+  const auto& TA = A.tris[t1];
+  const auto& TB = B.tris[t2];
+  const double ms = A.opt.ccd.min_separation;
   // Vertex-face, both directions.
   for (int dir = 0; dir < 2 && !w.stop; ++dir) {
-    const auto& P = dir == 0 ? A : B;
-    const auto& F = dir == 0 ? B : A;
+    const Collider::Impl& PB = dir == 0 ? A : B;  // the vertices' body
+    const Collider::Impl& FB = dir == 0 ? B : A;  // the face's body
+    const auto& P = dir == 0 ? TA : TB;
+    const auto& F = dir == 0 ? TB : TA;
     const std::uint32_t face = dir == 0 ? t2 : t1;
     for (std::uint32_t p : P) {
-      if (p == F[0] || p == F[1] || p == F[2]) continue;
-      const std::uint32_t ip = topo->surf_index[p];
+      if (same && (p == F[0] || p == F[1] || p == F[2])) continue;
+      const std::uint32_t ip = PB.topo->surf_index[p];
       // Cheap rejections before the ownership scan (repeated inside, harmless).
-      if (!vmoved[ip] && !tmov[face]) continue;
-      if (!boxes_overlap(vbox[ip], tbox[face], opt.ccd.min_separation)) continue;
+      if (!PB.vmoved[ip] && !FB.tmov[face]) continue;
+      if (!boxes_overlap(PB.vbox[ip], FB.tbox[face], ms)) continue;
       bool owner = true;
-      for (std::uint32_t k = topo->vt_offset[ip]; k < topo->vt_offset[ip + 1] && owner; ++k)
-        if (claimed(topo->vt_list[k], face)) owner = false;
-      if (owner) process_vertex_face(w, p, face);
+      const auto& vt_offset = PB.topo->vt_offset;
+      const auto& vt_list = PB.topo->vt_list;
+      for (std::uint32_t k = vt_offset[ip]; k < vt_offset[ip + 1] && owner; ++k)
+        if (dir == 0 ? claimed(vt_list[k], face) : claimed(face, vt_list[k])) owner = false;
+      if (owner) process_vertex_face(w, PB, p, FB, face);
       if (w.stop) return;
     }
   }
   // Edge-edge.
+  const auto& EA = A.topo->edges;
+  const auto& EB = B.topo->edges;
   for (std::uint32_t i = 0; i < 3; ++i) {
-    const std::uint32_t e1 = topo->tri_edges[t1][i];
+    const std::uint32_t e1 = A.topo->tri_edges[t1][i];
     // tbox[t2] contains the boxes of t2's edges: one check rejects all three.
-    if (!boxes_overlap(ebox[e1], tbox[t2], opt.ccd.min_separation)) continue;
+    if (!boxes_overlap(A.ebox[e1], B.tbox[t2], ms)) continue;
     for (std::uint32_t j = 0; j < 3; ++j) {
-      const std::uint32_t e2 = topo->tri_edges[t2][j];
-      const auto& E1 = topo->edges[e1];
-      const auto& E2 = topo->edges[e2];
-      if (E1[0] == E2[0] || E1[0] == E2[1] || E1[1] == E2[0] || E1[1] == E2[1]) continue;
-      if (!edge_boxes_overlap(e1, e2)) continue;
+      const std::uint32_t e2 = B.topo->tri_edges[t2][j];
+      const auto& E1 = EA[e1];
+      const auto& E2 = EB[e2];
+      if (same && (E1[0] == E2[0] || E1[0] == E2[1] || E1[1] == E2[0] || E1[1] == E2[1])) continue;
+      if (!edge_boxes_overlap(A, e1, B, e2)) continue;
       bool owner = true;
-      for (std::uint32_t k1 = topo->et_offset[e1]; k1 < topo->et_offset[e1 + 1] && owner; ++k1) {
-        for (std::uint32_t k2 = topo->et_offset[e2]; k2 < topo->et_offset[e2 + 1] && owner; ++k2) {
-          const std::uint32_t u = topo->et_list[k1], v = topo->et_list[k2];
-          if (u != v && claimed(u, v)) owner = false;
+      const auto& ea_offset = A.topo->et_offset;
+      const auto& ea_list = A.topo->et_list;
+      const auto& eb_offset = B.topo->et_offset;
+      const auto& eb_list = B.topo->et_list;
+      for (std::uint32_t k1 = ea_offset[e1]; k1 < ea_offset[e1 + 1] && owner; ++k1) {
+        for (std::uint32_t k2 = eb_offset[e2]; k2 < eb_offset[e2 + 1] && owner; ++k2) {
+          const std::uint32_t u = ea_list[k1], v = eb_list[k2];
+          if ((!same || u != v) && claimed(u, v)) owner = false;
         }
       }
-      if (owner) process_edge_edge(w, e1, e2);
+      if (owner) process_edge_edge(w, A, e1, B, e2);
       if (w.stop) return;
     }
   }
@@ -226,7 +252,7 @@ void Collider::Impl::process_triangle_pair(Worker& w, std::uint32_t t1,
   }
   ++w.stats.triangle_pairs;
   const std::uint64_t key = pair_key(t1, t2);
-  test_features(w, t1, t2, [&](std::uint32_t u, std::uint32_t v) {
+  test_features(w, *this, t1, *this, t2, [&](std::uint32_t u, std::uint32_t v) {
     return pair_key(u, v) < key && non_culled(u, v);
   });
 }
@@ -262,7 +288,7 @@ void Collider::Impl::close_contacts(Worker& w, double toi) noexcept {
       ++w.stats.closure_pairs;
       const std::uint64_t key = pair_key(t1, t2);
       // Claimed: tested by the traversal (non-culled), or earlier in this closure.
-      test_features(w, t1, t2, [&](std::uint32_t u, std::uint32_t v) {
+      test_features(w, *this, t1, *this, t2, [&](std::uint32_t u, std::uint32_t v) {
         return non_culled(u, v) || (pair_key(u, v) < key && closure_mark[u] && closure_mark[v] &&
                                     orientation_culled(u, v));
       });
@@ -271,25 +297,26 @@ void Collider::Impl::close_contacts(Worker& w, double toi) noexcept {
   for (std::uint32_t t : closure_ring) closure_mark[t] = 0;
 }
 
-void Collider::Impl::leaf_pair(Worker& w, const TreeView& ta, std::uint32_t a, const TreeView& tb,
-                               std::uint32_t b) const noexcept {
+// Calls `triangle_pair(t1, t2)` for every triangle pair of leaf a of ta and leaf b of tb.
+template <typename TrianglePair>
+inline void leaf_pair(Worker& w, const TreeView& ta, std::uint32_t a, const TreeView& tb,
+                      std::uint32_t b, TrianglePair&& triangle_pair) noexcept {
   const format::BvhNode& na = ta.nodes[a];
   const format::BvhNode& nb = tb.nodes[b];
   for (std::uint32_t i = 0; i < na.count && !w.stop; ++i) {
     for (std::uint32_t j = 0; j < nb.count && !w.stop; ++j) {
-      process_triangle_pair(w, ta.leaf_tris[na.first + i], tb.leaf_tris[nb.first + j]);
+      triangle_pair(ta.leaf_tris[na.first + i], tb.leaf_tris[nb.first + j]);
     }
   }
 }
 
 // One step of a pair descent: a pair of leaves is processed, otherwise the live child pairs
 // are pushed. False when the stack has no room.
-template <typename Live>
-bool Collider::Impl::descend_pair(Worker& w, const TreeView& ta, const TreeView& tb,
-                                  const StackItem& it, Live&& live,
-                                  std::size_t& top) const noexcept {
+template <typename Live, typename TrianglePair>
+inline bool descend_pair(Worker& w, const TreeView& ta, const TreeView& tb, const StackItem& it,
+                         Live&& live, TrianglePair&& triangle_pair, std::size_t& top) noexcept {
   if (ta.nodes[it.a].count > 0 && tb.nodes[it.b].count > 0) {
-    leaf_pair(w, ta, it.a, tb, it.b);
+    leaf_pair(w, ta, it.a, tb, it.b, triangle_pair);
     return true;
   }
   if (top + 2 > w.stack.size()) return false;
@@ -297,14 +324,14 @@ bool Collider::Impl::descend_pair(Worker& w, const TreeView& ta, const TreeView&
   return true;
 }
 
-bool Collider::Impl::traverse_pair(Worker& w, const TreeView& ta,
-                                   const TreeView& tb) const noexcept {
-  // Same-tree pairs come from traverse_self; here the roots of two trees. A pair is tested
-  // (not both still, boxes overlap) before it is pushed, so popped pairs are live.
-  const double ms = opt.ccd.min_separation;
+// Traverses two different trees (of one body or of two bodies) culled by overlap only. A pair
+// is tested (not both still unless `rest`, boxes overlap) before it is pushed, so popped pairs
+// are live. False on stack overflow.
+template <typename TrianglePair>
+bool traverse_tree_pair(Worker& w, const TreeView& ta, const TreeView& tb, double ms, bool rest,
+                        TrianglePair&& triangle_pair) noexcept {
   auto live = [&](std::uint32_t a, std::uint32_t b) {
-    return (rest_mode || ta.nmov[a] != 0 || tb.nmov[b] != 0) &&
-           boxes_overlap(ta.box[a], tb.box[b], ms);
+    return (rest || ta.nmov[a] != 0 || tb.nmov[b] != 0) && boxes_overlap(ta.box[a], tb.box[b], ms);
   };
   if (!live(0, 0)) return true;
   std::size_t top = 0;
@@ -312,9 +339,16 @@ bool Collider::Impl::traverse_pair(Worker& w, const TreeView& ta,
   while (top > 0 && !w.stop) {
     const StackItem it = w.stack[--top];
     ++w.stats.node_pairs_visited;
-    if (!descend_pair(w, ta, tb, it, live, top)) return false;
+    if (!descend_pair(w, ta, tb, it, live, triangle_pair, top)) return false;
   }
   return true;
+}
+
+bool Collider::Impl::traverse_pair(Worker& w, const TreeView& ta,
+                                   const TreeView& tb) const noexcept {
+  return traverse_tree_pair(
+      w, ta, tb, opt.ccd.min_separation, rest_mode,
+      [&](std::uint32_t t1, std::uint32_t t2) { process_triangle_pair(w, t1, t2); });
 }
 
 bool Collider::Impl::traverse_self(Worker& w, const TreeView& t) const noexcept {
@@ -336,6 +370,7 @@ bool Collider::Impl::traverse_self(Worker& w, const TreeView& t) const noexcept 
     }
     return true;
   };
+  auto self_pair = [&](std::uint32_t t1, std::uint32_t t2) { process_triangle_pair(w, t1, t2); };
   std::size_t top = 0;
   w.stack[top++] = {0, kNone};
   while (top > 0 && !w.stop) {
@@ -361,7 +396,7 @@ bool Collider::Impl::traverse_self(Worker& w, const TreeView& t) const noexcept 
       w.stack[top++] = {nd.first, kNone};
       continue;
     }
-    if (!descend_pair(w, t, t, it, live_pair, top)) return false;
+    if (!descend_pair(w, t, t, it, live_pair, self_pair, top)) return false;
   }
   return true;
 }
@@ -372,7 +407,7 @@ void Collider::Impl::brute_vertex_faces(Worker& w, std::uint32_t i) const noexce
   for (std::uint32_t f = 0; f < tri_count && !w.stop; ++f) {
     const auto& F = tris[f];
     if (p == F[0] || p == F[1] || p == F[2]) continue;
-    process_vertex_face(w, p, f);
+    process_vertex_face(w, *this, p, *this, f);
   }
 }
 
@@ -383,7 +418,7 @@ void Collider::Impl::brute_edge_edges(Worker& w, std::uint32_t i) const noexcept
   for (std::uint32_t j = i + 1; j < ne && !w.stop; ++j) {
     const auto& E2 = topo->edges[j];
     if (E1[0] == E2[0] || E1[0] == E2[1] || E1[1] == E2[0] || E1[1] == E2[1]) continue;
-    process_edge_edge(w, i, j);
+    process_edge_edge(w, *this, i, *this, j);
   }
 }
 
@@ -425,7 +460,10 @@ void add_counts(ColliderStats& to, const ColliderStats& from) noexcept {
 
 bool Collider::Impl::run_query(Contact* out, std::size_t out_cap) noexcept {
   const auto t_start = Clock::now();
-  for (Worker& w : workers) w.reset();
+  for (Worker& w : workers) {
+    w.reset();
+    w.qkind = qkind;
+  }
   Worker& w0 = workers[0];
   w0.out = out;
   w0.out_cap = out ? out_cap : 0;

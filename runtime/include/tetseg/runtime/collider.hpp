@@ -81,17 +81,20 @@ enum class ContactKind : std::uint8_t {
   kEdgeEdge = 1,    ///< nodes = {a, b, c, d}: edge (a, b) against edge (c, d)
 };
 
-/// One feature pair found in contact. Tet-mesh node ids. Edge-edge pairs are normalised:
-/// a < b, c < d, (a, b) < (c, d) lexicographically.
+/// One feature pair found in contact. Node ids are local to their body: `nodes[0]` (the vertex,
+/// or edge (a, b)) belongs to body `bodies[0]`, the rest (the face, or edge (c, d)) to
+/// `bodies[1]` (a `Collider` is body 0; a `Scene` numbers its bodies). Edges are normalised:
+/// a < b, c < d, and within one body (a, b) < (c, d) lexicographically.
 struct Contact {
   ContactKind kind = ContactKind::kVertexFace;
+  std::array<std::uint32_t, 2> bodies{};
   std::array<std::uint32_t, 4> nodes{};
-  std::uint32_t triangle = 0;  ///< vertex-face: the surface triangle id of the face
+  std::uint32_t triangle = 0;  ///< vertex-face: the face's triangle id (in its body)
   double toi = 1.0;            ///< lower bound on the first contact time in [0,1]
   bool at_start = false;       ///< touching at t = 0 (toi == 0)
 };
 
-/// Strict total order used for deterministic results: by toi, then kind, then nodes.
+/// Strict total order used for deterministic results: by toi, then kind, bodies, nodes.
 bool contact_less(const Contact& a, const Contact& b) noexcept;
 
 struct EarliestContact {
