@@ -227,6 +227,10 @@ struct Collider::Impl {
   /// Intra-cluster work of cluster c1 and its pairs with every cluster c2 > c1.
   bool cluster_tasks(Worker& w, std::uint32_t c1, bool count_skips) const noexcept;
   TreeView cluster_view(std::uint32_t c) const noexcept;
+  /// Broad-phase trees of this body against other bodies: its cluster BVHs (rvbc) or its
+  /// whole-surface BVH (after a refit).
+  std::uint32_t tree_count() const noexcept;
+  TreeView tree(std::uint32_t i) const noexcept;
   TreeView global_view() const noexcept;
 
   // --- normal_cone.cpp (kCone)
@@ -246,5 +250,10 @@ struct Collider::Impl {
   void refit_global_bvh() noexcept;
   void rest_triangle_pair(Worker& w, std::uint32_t t1, std::uint32_t t2) const noexcept;
 };
+
+/// Contacts between two different bodies A and B (scene): every pair of their trees, culled by
+/// overlap only, triangle pairs deduplicated over all overlapping pairs of the two bodies.
+/// Both bodies refit for the same step. False on stack overflow.
+bool traverse_bodies(Worker& w, const Collider::Impl& A, const Collider::Impl& B) noexcept;
 
 }  // namespace tetseg

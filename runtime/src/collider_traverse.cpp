@@ -61,6 +61,15 @@ TreeView Collider::Impl::global_view() const noexcept {
   return v;
 }
 
+std::uint32_t Collider::Impl::tree_count() const noexcept {
+  if (uses_clusters()) return cluster_count();
+  return global_bvh_active() && gnode_count > 0 ? 1 : 0;
+}
+
+TreeView Collider::Impl::tree(std::uint32_t i) const noexcept {
+  return uses_clusters() ? cluster_view(i) : global_view();
+}
+
 bool Collider::Impl::non_culled(std::uint32_t t1, std::uint32_t t2) const noexcept {
   if (t1 == t2) return false;
   if (!rest_mode && !tmov[t1] && !tmov[t2]) return false;
@@ -349,6 +358,30 @@ bool Collider::Impl::traverse_pair(Worker& w, const TreeView& ta,
   return traverse_tree_pair(
       w, ta, tb, opt.ccd.min_separation, rest_mode,
       [&](std::uint32_t t1, std::uint32_t t2) { process_triangle_pair(w, t1, t2); });
+}
+
+bool traverse_bodies(Worker& w, const Collider::Impl& A, const Collider::Impl& B) noexcept {
+  const double ms = A.opt.ccd.min_separation;
+  // A triangle pair of two bodies is non-culled when not both triangles are still and their
+  // swept boxes overlap; a feature pair is tested from the smallest (t of A, t of B) such pair.
+  auto live = [&](std::uint32_t u, std::uint32_t v) {
+    return (A.tmov[u] || B.tmov[v]) && boxes_overlap(A.tbox[u], B.tbox[v], ms);
+  };
+  auto triangle_pair = [&](std::uint32_t t1, std::uint32_t t2) {
+    if (!live(t1, t2)) return;
+    ++w.stats.triangle_pairs;
+    test_features(w, A, t1, B, t2, [&](std::uint32_t u, std::uint32_t v) {
+      return (u < t1 || (u == t1 && v < t2)) && live(u, v);
+    });
+  };
+  const std::uint32_t na = A.tree_count(), nb = B.tree_count();
+  for (std::uint32_t i = 0; i < na && !w.stop; ++i) {
+    const TreeView ta = A.tree(i);
+    for (std::uint32_t j = 0; j < nb && !w.stop; ++j) {
+      if (!traverse_tree_pair(w, ta, B.tree(j), ms, false, triangle_pair)) return false;
+    }
+  }
+  return true;
 }
 
 bool Collider::Impl::traverse_self(Worker& w, const TreeView& t) const noexcept {

@@ -1,0 +1,359 @@
+// Scene: several bodies in one runtime (scene.hpp). Each body is a collider core
+// (Collider::Impl over a shared BodyShape); the scene validates and refits every body per
+// step, runs each body's self-collision query and traverses every enabled pair of bodies
+// whose swept boxes overlap (body boxes, then BVH against BVH; traverse_bodies).
+
+#include "tetseg/runtime/scene.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <new>
+
+#include "collider_impl.hpp"
+
+namespace tetseg {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double ms_since(Clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+void add_counts(ColliderStats& to, const ColliderStats& from) noexcept {
+  to.node_pairs_visited += from.node_pairs_visited;
+  to.triangle_pairs += from.triangle_pairs;
+  to.feature_pairs += from.feature_pairs;
+  to.feature_pairs_filtered += from.feature_pairs_filtered;
+  to.feature_tests += from.feature_tests;
+  to.contacts += from.contacts;
+}
+
+}  // namespace
+
+struct SceneBody {
+  std::unique_ptr<Collider::Impl> core;
+  BodyOptions options;
+  const double* own_x0 = nullptr;  // kOwnPositions layout
+  const double* own_x1 = nullptr;
+  bool moved = false;  // some node moved this step
+  Box box{};           // swept box of the body this step
+};
+
+struct Scene::Impl {
+  SceneOptions opt;
+  std::vector<SceneBody> bodies;
+  std::vector<std::uint8_t> pair_enabled;  // upper triangle, index pair_index(a, b)
+  std::vector<ColliderStats> pair_stats;
+  Worker worker;  // inter-body traversal
+  SceneStats stats;
+  bool have_step = false;
+
+  // query state within a step
+  bool any_known = false, any_value = false;
+  bool full_done = false, has_best = false;
+  Contact best;
+  std::size_t full_found = 0;
+
+  std::size_t pair_index(std::uint32_t a, std::uint32_t b) const noexcept {
+    if (a > b) std::swap(a, b);
+    return std::size_t(b) * (b - 1) / 2 + a;  // pairs (a < b) ordered by b, then a
+  }
+  ColliderStatus run(QueryKind kind, Contact* out, std::size_t cap, bool& hit,
+                     std::size_t& written) noexcept;
+};
+
+Scene::Scene(const SceneOptions& options) noexcept {
+  try {
+    m_impl = std::make_unique<Impl>();
+    m_impl->opt = options;
+    m_impl->worker.stack.resize(options.traversal_stack > 0 ? options.traversal_stack : 4 * 68);
+  } catch (...) {
+    m_impl.reset();
+  }
+}
+
+Scene::~Scene() = default;
+Scene::Scene(Scene&&) noexcept = default;
+Scene& Scene::operator=(Scene&&) noexcept = default;
+
+ColliderStatus Scene::add_body(std::shared_ptr<const BodyShape> shape, const BodyOptions& options,
+                               std::uint32_t* id) noexcept {
+  if (!m_impl) return ColliderStatus::kNotReady;
+  Impl& s = *m_impl;
+  if (!shape || options.mode == ColliderMode::kBrute) return ColliderStatus::kInvalidArgument;
+  s.have_step = false;
+  try {
+    ColliderOptions co;
+    co.mode = options.mode;
+    co.ccd = s.opt.ccd;
+    co.bvh_leaf_size = s.opt.bvh_leaf_size;
+    co.use_openmp = s.opt.use_openmp;
+    co.time_tests = s.opt.time_tests;
+    co.traversal_stack = s.opt.traversal_stack;
+    SceneBody body;
+    body.core = std::make_unique<Collider::Impl>();
+    body.core->construct(std::move(shape), co);
+    body.core->body_id = static_cast<std::uint32_t>(s.bodies.size());
+    body.core->always_refit = true;
+    body.options = options;
+    // Inter-body descent depth is at most the sum of two trees' depths.
+    const std::size_t depth = std::max<std::size_t>(body.core->topo->max_depth, 64) + 4;
+    if (s.opt.traversal_stack == 0 && s.worker.stack.size() < 8 * depth)
+      s.worker.stack.resize(8 * depth);
+    const std::size_t n = s.bodies.size() + 1;
+    s.pair_enabled.resize(n * (n - 1) / 2, 1);
+    s.pair_stats.resize(n * (n - 1) / 2);
+    s.bodies.push_back(std::move(body));
+  } catch (...) {
+    return ColliderStatus::kNotReady;
+  }
+  if (id) *id = static_cast<std::uint32_t>(s.bodies.size() - 1);
+  return ColliderStatus::kOk;
+}
+
+std::uint32_t Scene::body_count() const noexcept {
+  return m_impl ? static_cast<std::uint32_t>(m_impl->bodies.size()) : 0;
+}
+
+ColliderStatus Scene::set_self_collision(std::uint32_t body, bool enabled) noexcept {
+  if (!m_impl) return ColliderStatus::kNotReady;
+  if (body >= m_impl->bodies.size()) return ColliderStatus::kInvalidArgument;
+  m_impl->bodies[body].options.self_collision = enabled;
+  m_impl->any_known = m_impl->full_done = false;
+  return ColliderStatus::kOk;
+}
+
+ColliderStatus Scene::set_pair_enabled(std::uint32_t a, std::uint32_t b, bool enabled) noexcept {
+  if (!m_impl) return ColliderStatus::kNotReady;
+  Impl& s = *m_impl;
+  if (a == b || a >= s.bodies.size() || b >= s.bodies.size())
+    return ColliderStatus::kInvalidArgument;
+  s.pair_enabled[s.pair_index(a, b)] = enabled ? 1 : 0;
+  s.any_known = s.full_done = false;
+  return ColliderStatus::kOk;
+}
+
+ColliderStatus Scene::set_positions(std::uint32_t body, const double* x0, const double* x1,
+                                    std::size_t value_count) noexcept {
+  if (!m_impl) return ColliderStatus::kNotReady;
+  Impl& s = *m_impl;
+  if (body >= s.bodies.size() || s.bodies[body].options.global_offset != kOwnPositions)
+    return ColliderStatus::kInvalidArgument;
+  SceneBody& b = s.bodies[body];
+  if (value_count != std::size_t(b.core->node_count) * 3) return ColliderStatus::kSizeMismatch;
+  b.own_x0 = x0;
+  b.own_x1 = x1;
+  return ColliderStatus::kOk;
+}
+
+ColliderStatus Scene::step(const double* x0, const double* x1, std::size_t value_count) noexcept {
+  if (!m_impl) return ColliderStatus::kNotReady;
+  Impl& s = *m_impl;
+  s.have_step = false;
+  s.stats = SceneStats{};
+  s.any_known = s.any_value = s.full_done = s.has_best = false;
+  s.full_found = 0;
+  for (ColliderStats& p : s.pair_stats) p = ColliderStats{};
+  // Validate every body before refitting any.
+  for (SceneBody& b : s.bodies) {
+    Collider::Impl& core = *b.core;
+    const std::size_t values = std::size_t(core.node_count) * 3;
+    const double* p0 = b.own_x0;
+    const double* p1 = b.own_x1;
+    if (b.options.global_offset != kOwnPositions) {
+      const std::size_t first = b.options.global_offset;
+      if (first > value_count / 3 || value_count / 3 - first < core.node_count)
+        return ColliderStatus::kSizeMismatch;
+      p0 = x0 ? x0 + first * 3 : nullptr;
+      p1 = x1 ? x1 + first * 3 : nullptr;
+    }
+    if (b.options.still) p1 = p0;
+    const ColliderStatus st = core.begin_step(p0, p1, values);
+    if (st != ColliderStatus::kOk) {
+      for (SceneBody& other : s.bodies) other.core->have_step = false;
+      return st;
+    }
+  }
+  for (SceneBody& b : s.bodies) {
+    Collider::Impl& core = *b.core;
+    core.refit_and_classify();
+    b.moved = core.stats.nodes_moved > 0;
+    s.stats.bodies_moved += b.moved ? 1 : 0;
+    s.stats.refit_ms += core.stats.refit_ms;
+    s.stats.classify_ms += core.stats.classify_ms;
+    // Body box: union of its trees' root boxes.
+    const std::uint32_t trees = core.tree_count();
+    for (std::uint32_t i = 0; i < trees; ++i) {
+      const Box& root = core.tree(i).box[0];
+      if (i == 0) {
+        b.box = root;
+      } else {
+        box_union(b.box, root);
+      }
+    }
+  }
+  s.have_step = true;
+  return ColliderStatus::kOk;
+}
+
+// Runs one query over the scene: self queries of the bodies, then the enabled pairs of bodies
+// in order (a, b) with a < b. `out`/`cap`: optional buffer, filled in that order.
+ColliderStatus Scene::Impl::run(QueryKind kind, Contact* out, std::size_t cap, bool& hit,
+                                std::size_t& written) noexcept {
+  hit = false;
+  written = 0;
+  std::size_t found = 0;
+  bool has = false;
+  Contact first;
+  auto merge = [&](bool h, const Contact& c) {
+    if (h && (!has || contact_less(c, first))) {
+      first = c;
+      has = true;
+    }
+  };
+  const auto t_self = Clock::now();
+  for (SceneBody& b : bodies) {
+    if (!b.options.self_collision || !b.moved) continue;
+    Collider::Impl& core = *b.core;
+    core.qkind = kind;
+    const std::uint64_t contacts_before = core.stats.contacts;
+    if (!core.run_query(out ? out + written : nullptr, out ? cap - written : 0))
+      return ColliderStatus::kOverflow;
+    stats.contacts += core.stats.contacts - contacts_before;
+    if (kind == QueryKind::kAny) {
+      if (core.query_hit) {
+        hit = true;
+        stats.self_ms += ms_since(t_self);
+        return ColliderStatus::kOk;
+      }
+      continue;
+    }
+    found += core.full_found;
+    written += core.out_written;
+    merge(core.has_best, core.best);
+  }
+  stats.self_ms += ms_since(t_self);
+  const auto t_pairs = Clock::now();
+  const double ms = opt.ccd.min_separation;
+  std::uint64_t tested = 0, skipped = 0;
+  const std::uint32_t n = static_cast<std::uint32_t>(bodies.size());
+  for (std::uint32_t bi = 1; bi < n; ++bi) {
+    for (std::uint32_t ai = 0; ai < bi; ++ai) {
+      const SceneBody& A = bodies[ai];
+      const SceneBody& B = bodies[bi];
+      const std::size_t pi = pair_index(ai, bi);
+      if (!pair_enabled[pi] || (!A.moved && !B.moved) || !boxes_overlap(A.box, B.box, ms)) {
+        ++skipped;
+        continue;
+      }
+      ++tested;
+      worker.reset();
+      worker.qkind = kind;
+      worker.out = out ? out + written : nullptr;
+      worker.out_cap = out ? cap - written : 0;
+      const bool ok = traverse_bodies(worker, *A.core, *B.core);
+      add_counts(pair_stats[pi], worker.stats);
+      stats.contacts += worker.stats.contacts;
+      if (!ok) return ColliderStatus::kOverflow;
+      if (kind == QueryKind::kAny) {
+        if (worker.stop) {
+          hit = true;
+          stats.pairs_ms += ms_since(t_pairs);
+          return ColliderStatus::kOk;
+        }
+        continue;
+      }
+      found += worker.found;
+      written += worker.out_written;
+      merge(worker.has_best, worker.best);
+    }
+  }
+  stats.pairs_ms += ms_since(t_pairs);
+  if (kind == QueryKind::kFull) {
+    stats.body_pairs_tested = tested;
+    stats.body_pairs_skipped = skipped;
+    full_done = true;
+    full_found = found;
+    has_best = has;
+    best = first;
+    any_known = true;
+    any_value = found > 0;
+    hit = found > 0;
+  }
+  return ColliderStatus::kOk;
+}
+
+ColliderStatus Scene::any_collision(bool& hit) noexcept {
+  hit = false;
+  if (!m_impl) return ColliderStatus::kNotReady;
+  Impl& s = *m_impl;
+  if (!s.have_step) return ColliderStatus::kNoStep;
+  if (!s.any_known) {
+    bool h = false;
+    std::size_t written = 0;
+    const ColliderStatus st = s.run(QueryKind::kAny, nullptr, 0, h, written);
+    if (st != ColliderStatus::kOk) return st;
+    s.any_known = true;
+    s.any_value = h;
+  }
+  hit = s.any_value;
+  return ColliderStatus::kOk;
+}
+
+ColliderStatus Scene::earliest_toi(EarliestContact& out) noexcept {
+  out = EarliestContact{};
+  if (!m_impl) return ColliderStatus::kNotReady;
+  Impl& s = *m_impl;
+  if (!s.have_step) return ColliderStatus::kNoStep;
+  if (!s.full_done) {
+    bool h = false;
+    std::size_t written = 0;
+    const ColliderStatus st = s.run(QueryKind::kFull, nullptr, 0, h, written);
+    if (st != ColliderStatus::kOk) return st;
+  }
+  out.found = s.has_best;
+  out.contact = s.best;
+  return ColliderStatus::kOk;
+}
+
+ColliderStatus Scene::contacts(Contact* buffer, std::size_t capacity,
+                               ContactsResult& out) noexcept {
+  out = ContactsResult{};
+  if (!m_impl) return ColliderStatus::kNotReady;
+  Impl& s = *m_impl;
+  if (!s.have_step) return ColliderStatus::kNoStep;
+  if (!buffer) capacity = 0;
+  if (s.full_done && capacity == 0) {
+    out.found = s.full_found;
+    return ColliderStatus::kOk;
+  }
+  bool h = false;
+  std::size_t written = 0;
+  const ColliderStatus st =
+      s.run(QueryKind::kFull, capacity > 0 ? buffer : nullptr, capacity, h, written);
+  if (st != ColliderStatus::kOk) return st;
+  out.found = s.full_found;
+  out.written = written;
+  if (written > 0) std::sort(buffer, buffer + written, contact_less);
+  return ColliderStatus::kOk;
+}
+
+const SceneStats& Scene::stats() const noexcept {
+  static const SceneStats kEmpty{};
+  return m_impl ? m_impl->stats : kEmpty;
+}
+
+const ColliderStats& Scene::body_stats(std::uint32_t body) const noexcept {
+  static const ColliderStats kEmpty{};
+  if (!m_impl || body >= m_impl->bodies.size()) return kEmpty;
+  return m_impl->bodies[body].core->stats;
+}
+
+const ColliderStats& Scene::pair_stats(std::uint32_t a, std::uint32_t b) const noexcept {
+  static const ColliderStats kEmpty{};
+  if (!m_impl || a == b || a >= m_impl->bodies.size() || b >= m_impl->bodies.size()) return kEmpty;
+  return m_impl->pair_stats[m_impl->pair_index(a, b)];
+}
+
+}  // namespace tetseg
