@@ -15,16 +15,6 @@
 #endif
 
 namespace tetseg {
-namespace {
-
-using Clock = std::chrono::steady_clock;
-
-double ms_since(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
-
-}  // namespace
-
 const char* to_string(ColliderMode mode) noexcept {
   switch (mode) {
     case ColliderMode::kRvbc:
@@ -142,8 +132,7 @@ ColliderStatus Collider::Impl::begin_step(const double* p0, const double* p1,
                                           std::size_t count) noexcept {
   have_step = false;
   stats = ColliderStats{};
-  any_known = any_value = full_done = has_best = false;
-  full_found = 0;
+  cache = QueryCache{};
   if (ctor_status != ColliderStatus::kOk) return ColliderStatus::kNotReady;
   if (count != std::size_t(node_count) * 3) return ColliderStatus::kSizeMismatch;
   if (node_count > 0 && (!p0 || !p1)) return ColliderStatus::kNullInput;
@@ -347,55 +336,47 @@ ColliderStatus Collider::Impl::query_status() const noexcept {
   return have_step ? ColliderStatus::kOk : ColliderStatus::kNoStep;
 }
 
+namespace {
+
+// The Collider's traversal function for answer_any / answer_earliest / answer_contacts.
+auto collider_run(Collider::Impl& s) noexcept {
+  return [&s](QueryKind kind, Contact* out, std::size_t cap, std::size_t& written) noexcept {
+    s.qkind = kind;
+    if (!s.run_query(out, cap)) return ColliderStatus::kOverflow;
+    if (kind == QueryKind::kAny) {
+      s.cache.any_known = true;
+      s.cache.any_value = s.query_hit;
+    }
+    written = s.out_written;
+    return ColliderStatus::kOk;
+  };
+}
+
+}  // namespace
+
 ColliderStatus Collider::any_collision(bool& hit) noexcept {
   hit = false;
   if (!m_impl) return ColliderStatus::kNotReady;
-  Impl& s = *m_impl;
-  const ColliderStatus st = s.query_status();
+  const ColliderStatus st = m_impl->query_status();
   if (st != ColliderStatus::kOk) return st;
-  if (!s.any_known) {
-    s.qkind = QueryKind::kAny;
-    if (!s.run_query(nullptr, 0)) return ColliderStatus::kOverflow;
-    s.any_known = true;
-    s.any_value = s.query_hit;
-  }
-  hit = s.any_value;
-  return ColliderStatus::kOk;
+  return answer_any(m_impl->cache, collider_run(*m_impl), hit);
 }
 
 ColliderStatus Collider::earliest_toi(EarliestContact& out) noexcept {
   out = EarliestContact{};
   if (!m_impl) return ColliderStatus::kNotReady;
-  Impl& s = *m_impl;
-  const ColliderStatus st = s.query_status();
+  const ColliderStatus st = m_impl->query_status();
   if (st != ColliderStatus::kOk) return st;
-  if (!s.full_done) {
-    s.qkind = QueryKind::kFull;
-    if (!s.run_query(nullptr, 0)) return ColliderStatus::kOverflow;
-  }
-  out.found = s.has_best;
-  out.contact = s.best;
-  return ColliderStatus::kOk;
+  return answer_earliest(m_impl->cache, collider_run(*m_impl), out);
 }
 
 ColliderStatus Collider::contacts(Contact* buffer, std::size_t capacity,
                                   ContactsResult& out) noexcept {
   out = ContactsResult{};
   if (!m_impl) return ColliderStatus::kNotReady;
-  Impl& s = *m_impl;
-  const ColliderStatus st = s.query_status();
+  const ColliderStatus st = m_impl->query_status();
   if (st != ColliderStatus::kOk) return st;
-  if (!buffer) capacity = 0;
-  if (s.full_done && capacity == 0) {
-    out.found = s.full_found;
-    return ColliderStatus::kOk;
-  }
-  s.qkind = QueryKind::kFull;
-  if (!s.run_query(capacity > 0 ? buffer : nullptr, capacity)) return ColliderStatus::kOverflow;
-  out.found = s.full_found;
-  out.written = s.out_written;
-  if (out.written > 0) std::sort(buffer, buffer + out.written, contact_less);
-  return ColliderStatus::kOk;
+  return answer_contacts(m_impl->cache, collider_run(*m_impl), buffer, capacity, out);
 }
 
 const ColliderStats& Collider::stats() const noexcept {

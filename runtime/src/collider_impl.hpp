@@ -1,7 +1,9 @@
 #pragma once
 // Private state of tetseg::Collider, shared by collider*.cpp. Not installed.
 
+#include <algorithm>
 #include <array>
+#include <chrono>
 #include <cstddef>
 #include <cstdint>
 #include <memory>
@@ -129,6 +131,95 @@ struct Worker {
   }
 };
 
+/// Per-step answers shared by the queries of a Collider or a Scene (reset by `step`).
+struct QueryCache {
+  bool any_known = false, any_value = false;
+  bool full_done = false;  // a full traversal ran: the fields below are valid
+  bool has_best = false;
+  Contact best;
+  std::size_t full_found = 0;
+  /// Records the outcome of a complete traversal.
+  void set_full(std::size_t found, bool has, const Contact& earliest) noexcept {
+    full_done = any_known = true;
+    any_value = found > 0;
+    full_found = found;
+    has_best = has;
+    best = earliest;
+  }
+};
+
+/// Keeps in (has, first) the smaller in `contact_less` of itself and (h, c).
+inline void keep_earliest(bool& has, Contact& first, bool h, const Contact& c) noexcept {
+  if (h && (!has || contact_less(c, first))) {
+    first = c;
+    has = true;
+  }
+}
+
+using Clock = std::chrono::steady_clock;
+inline double ms_since(Clock::time_point start) noexcept {
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+/// Accumulates the traversal counters of `from` into `to`.
+inline void add_counts(ColliderStats& to, const ColliderStats& from) noexcept {
+  to.clusters_skipped += from.clusters_skipped;
+  to.closure_pairs += from.closure_pairs;
+  to.node_pairs_visited += from.node_pairs_visited;
+  to.node_pairs_orientation_culled += from.node_pairs_orientation_culled;
+  to.triangle_pairs += from.triangle_pairs;
+  to.feature_pairs += from.feature_pairs;
+  to.feature_pairs_filtered += from.feature_pairs_filtered;
+  to.feature_tests += from.feature_tests;
+  to.contacts += from.contacts;
+}
+
+// The three queries of a Collider or a Scene over one traversal function
+// `run(kind, out, capacity, written) -> ColliderStatus`, which on kOk records a kAny answer in
+// cache.any_known/any_value and a kFull answer in every cache field (and `written`, the
+// contacts written to `out`). Failures leave the out parameter empty.
+template <typename Run>
+ColliderStatus answer_any(QueryCache& cache, Run&& run, bool& hit) noexcept {
+  hit = false;
+  if (!cache.any_known) {
+    std::size_t written = 0;
+    const ColliderStatus st = run(QueryKind::kAny, nullptr, 0, written);
+    if (st != ColliderStatus::kOk) return st;
+  }
+  hit = cache.any_value;
+  return ColliderStatus::kOk;
+}
+
+template <typename Run>
+ColliderStatus answer_earliest(QueryCache& cache, Run&& run, EarliestContact& out) noexcept {
+  out = EarliestContact{};
+  if (!cache.full_done) {
+    std::size_t written = 0;
+    const ColliderStatus st = run(QueryKind::kFull, nullptr, 0, written);
+    if (st != ColliderStatus::kOk) return st;
+  }
+  out.found = cache.has_best;
+  out.contact = cache.best;
+  return ColliderStatus::kOk;
+}
+
+template <typename Run>
+ColliderStatus answer_contacts(QueryCache& cache, Run&& run, Contact* buffer, std::size_t capacity,
+                               ContactsResult& out) noexcept {
+  out = ContactsResult{};
+  if (!buffer) capacity = 0;
+  if (!cache.full_done || capacity > 0) {
+    std::size_t written = 0;
+    const ColliderStatus st =
+        run(QueryKind::kFull, capacity > 0 ? buffer : nullptr, capacity, written);
+    if (st != ColliderStatus::kOk) return st;
+    out.written = written;
+    if (written > 0) std::sort(buffer, buffer + written, contact_less);
+  }
+  out.found = cache.full_found;
+  return ColliderStatus::kOk;
+}
+
 struct Collider::Impl {
   // --- construction-time data
   std::shared_ptr<const BodyShape> shape;  // immutable topology, shared
@@ -174,12 +265,7 @@ struct Collider::Impl {
   ColliderStats stats;
   RestCheck rest;
 
-  // query state within a step
-  bool any_known = false, any_value = false;
-  bool full_done = false;
-  bool has_best = false;
-  Contact best;
-  std::size_t full_found = 0;
+  QueryCache cache;  // answers of the current step
 
   // running query (shared, read-only during traversal) and its merged outcome
   QueryKind qkind = QueryKind::kFull;

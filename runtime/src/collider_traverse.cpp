@@ -21,8 +21,6 @@
 namespace tetseg {
 namespace {
 
-using Clock = std::chrono::steady_clock;
-
 constexpr std::uint8_t kUnc = static_cast<std::uint8_t>(Orientation::kUncertain);
 
 inline std::uint64_t pair_key(std::uint32_t a, std::uint32_t b) noexcept {
@@ -475,22 +473,6 @@ bool Collider::Impl::cluster_tasks(Worker& w, std::uint32_t c1, bool count_skips
   return true;
 }
 
-namespace {
-
-void add_counts(ColliderStats& to, const ColliderStats& from) noexcept {
-  to.clusters_skipped += from.clusters_skipped;
-  to.closure_pairs += from.closure_pairs;
-  to.node_pairs_visited += from.node_pairs_visited;
-  to.node_pairs_orientation_culled += from.node_pairs_orientation_culled;
-  to.triangle_pairs += from.triangle_pairs;
-  to.feature_pairs += from.feature_pairs;
-  to.feature_pairs_filtered += from.feature_pairs_filtered;
-  to.feature_tests += from.feature_tests;
-  to.contacts += from.contacts;
-}
-
-}  // namespace
-
 bool Collider::Impl::run_query(Contact* out, std::size_t out_cap) noexcept {
   const auto t_start = Clock::now();
   for (Worker& w : workers) {
@@ -579,12 +561,9 @@ bool Collider::Impl::run_query(Contact* out, std::size_t out_cap) noexcept {
     hit = hit || w.stop;
     found += w.found;
     tests_seconds += w.tests_seconds;
-    if (w.has_best && (!has || contact_less(w.best, first))) {
-      first = w.best;
-      has = true;
-    }
+    keep_earliest(has, first, w.has_best, w.best);
   }
-  const double total_ms = std::chrono::duration<double, std::milli>(Clock::now() - t_start).count();
+  const double total_ms = ms_since(t_start);
   const double tests_ms = tests_seconds * 1e3;
   stats.tests_ms += tests_ms;
   stats.traversal_ms += std::max(0.0, total_ms - tests_ms);
@@ -593,12 +572,7 @@ bool Collider::Impl::run_query(Contact* out, std::size_t out_cap) noexcept {
   out_written = w0.out_written;
   if (qkind == QueryKind::kFull && !rest_mode) {
     stats.full_traversal = true;
-    full_done = true;
-    full_found = found;
-    has_best = has;
-    best = first;
-    any_known = true;
-    any_value = found > 0;
+    cache.set_full(found, has, first);
   }
   return true;
 }

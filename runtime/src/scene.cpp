@@ -12,25 +12,6 @@
 #include "collider_impl.hpp"
 
 namespace tetseg {
-namespace {
-
-using Clock = std::chrono::steady_clock;
-
-double ms_since(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
-
-void add_counts(ColliderStats& to, const ColliderStats& from) noexcept {
-  to.node_pairs_visited += from.node_pairs_visited;
-  to.triangle_pairs += from.triangle_pairs;
-  to.feature_pairs += from.feature_pairs;
-  to.feature_pairs_filtered += from.feature_pairs_filtered;
-  to.feature_tests += from.feature_tests;
-  to.contacts += from.contacts;
-}
-
-}  // namespace
-
 struct SceneBody {
   std::unique_ptr<Collider::Impl> core;
   BodyOptions options;
@@ -49,18 +30,14 @@ struct Scene::Impl {
   SceneStats stats;
   bool have_step = false;
 
-  // query state within a step
-  bool any_known = false, any_value = false;
-  bool full_done = false, has_best = false;
-  Contact best;
-  std::size_t full_found = 0;
+  QueryCache cache;  // answers of the current step
 
   std::size_t pair_index(std::uint32_t a, std::uint32_t b) const noexcept {
     if (a > b) std::swap(a, b);
     return std::size_t(b) * (b - 1) / 2 + a;  // pairs (a < b) ordered by b, then a
   }
-  ColliderStatus run(QueryKind kind, Contact* out, std::size_t cap, bool& hit,
-                     std::size_t& written) noexcept;
+  /// Traversal function of the scene's queries (answer_any and the others).
+  ColliderStatus run(QueryKind kind, Contact* out, std::size_t cap, std::size_t& written) noexcept;
 };
 
 Scene::Scene(const SceneOptions& options) noexcept {
@@ -120,7 +97,7 @@ ColliderStatus Scene::set_self_collision(std::uint32_t body, bool enabled) noexc
   if (!m_impl) return ColliderStatus::kNotReady;
   if (body >= m_impl->bodies.size()) return ColliderStatus::kInvalidArgument;
   m_impl->bodies[body].options.self_collision = enabled;
-  m_impl->any_known = m_impl->full_done = false;
+  m_impl->cache = QueryCache{};
   return ColliderStatus::kOk;
 }
 
@@ -130,7 +107,7 @@ ColliderStatus Scene::set_pair_enabled(std::uint32_t a, std::uint32_t b, bool en
   if (a == b || a >= s.bodies.size() || b >= s.bodies.size())
     return ColliderStatus::kInvalidArgument;
   s.pair_enabled[s.pair_index(a, b)] = enabled ? 1 : 0;
-  s.any_known = s.full_done = false;
+  s.cache = QueryCache{};
   return ColliderStatus::kOk;
 }
 
@@ -152,8 +129,7 @@ ColliderStatus Scene::step(const double* x0, const double* x1, std::size_t value
   Impl& s = *m_impl;
   s.have_step = false;
   s.stats = SceneStats{};
-  s.any_known = s.any_value = s.full_done = s.has_best = false;
-  s.full_found = 0;
+  s.cache = QueryCache{};
   for (ColliderStats& p : s.pair_stats) p = ColliderStats{};
   // Validate every body before refitting any.
   for (SceneBody& b : s.bodies) {
@@ -199,19 +175,12 @@ ColliderStatus Scene::step(const double* x0, const double* x1, std::size_t value
 
 // Runs one query over the scene: self queries of the bodies, then the enabled pairs of bodies
 // in order (a, b) with a < b. `out`/`cap`: optional buffer, filled in that order.
-ColliderStatus Scene::Impl::run(QueryKind kind, Contact* out, std::size_t cap, bool& hit,
+ColliderStatus Scene::Impl::run(QueryKind kind, Contact* out, std::size_t cap,
                                 std::size_t& written) noexcept {
-  hit = false;
   written = 0;
   std::size_t found = 0;
   bool has = false;
   Contact first;
-  auto merge = [&](bool h, const Contact& c) {
-    if (h && (!has || contact_less(c, first))) {
-      first = c;
-      has = true;
-    }
-  };
   const auto t_self = Clock::now();
   for (SceneBody& b : bodies) {
     if (!b.options.self_collision || !b.moved) continue;
@@ -223,15 +192,15 @@ ColliderStatus Scene::Impl::run(QueryKind kind, Contact* out, std::size_t cap, b
     stats.contacts += core.stats.contacts - contacts_before;
     if (kind == QueryKind::kAny) {
       if (core.query_hit) {
-        hit = true;
+        cache.any_known = cache.any_value = true;
         stats.self_ms += ms_since(t_self);
         return ColliderStatus::kOk;
       }
       continue;
     }
-    found += core.full_found;
+    found += core.cache.full_found;
     written += core.out_written;
-    merge(core.has_best, core.best);
+    keep_earliest(has, first, core.cache.has_best, core.cache.best);
   }
   stats.self_ms += ms_since(t_self);
   const auto t_pairs = Clock::now();
@@ -258,7 +227,7 @@ ColliderStatus Scene::Impl::run(QueryKind kind, Contact* out, std::size_t cap, b
       if (!ok) return ColliderStatus::kOverflow;
       if (kind == QueryKind::kAny) {
         if (worker.stop) {
-          hit = true;
+          cache.any_known = cache.any_value = true;
           stats.pairs_ms += ms_since(t_pairs);
           return ColliderStatus::kOk;
         }
@@ -266,77 +235,55 @@ ColliderStatus Scene::Impl::run(QueryKind kind, Contact* out, std::size_t cap, b
       }
       found += worker.found;
       written += worker.out_written;
-      merge(worker.has_best, worker.best);
+      keep_earliest(has, first, worker.has_best, worker.best);
     }
   }
   stats.pairs_ms += ms_since(t_pairs);
+  cache.any_known = true;
+  cache.any_value = found > 0;
   if (kind == QueryKind::kFull) {
     stats.body_pairs_tested = tested;
     stats.body_pairs_skipped = skipped;
-    full_done = true;
-    full_found = found;
-    has_best = has;
-    best = first;
-    any_known = true;
-    any_value = found > 0;
-    hit = found > 0;
+    cache.set_full(found, has, first);
   }
   return ColliderStatus::kOk;
 }
 
+namespace {
+
+// The scene's traversal function for answer_any / answer_earliest / answer_contacts.
+auto scene_run(Scene::Impl& s) noexcept {
+  return [&s](QueryKind kind, Contact* out, std::size_t cap, std::size_t& written) noexcept {
+    return s.run(kind, out, cap, written);
+  };
+}
+
+ColliderStatus scene_ready(const std::unique_ptr<Scene::Impl>& s) noexcept {
+  if (!s) return ColliderStatus::kNotReady;
+  return s->have_step ? ColliderStatus::kOk : ColliderStatus::kNoStep;
+}
+
+}  // namespace
+
 ColliderStatus Scene::any_collision(bool& hit) noexcept {
   hit = false;
-  if (!m_impl) return ColliderStatus::kNotReady;
-  Impl& s = *m_impl;
-  if (!s.have_step) return ColliderStatus::kNoStep;
-  if (!s.any_known) {
-    bool h = false;
-    std::size_t written = 0;
-    const ColliderStatus st = s.run(QueryKind::kAny, nullptr, 0, h, written);
-    if (st != ColliderStatus::kOk) return st;
-    s.any_known = true;
-    s.any_value = h;
-  }
-  hit = s.any_value;
-  return ColliderStatus::kOk;
+  const ColliderStatus st = scene_ready(m_impl);
+  return st != ColliderStatus::kOk ? st : answer_any(m_impl->cache, scene_run(*m_impl), hit);
 }
 
 ColliderStatus Scene::earliest_toi(EarliestContact& out) noexcept {
   out = EarliestContact{};
-  if (!m_impl) return ColliderStatus::kNotReady;
-  Impl& s = *m_impl;
-  if (!s.have_step) return ColliderStatus::kNoStep;
-  if (!s.full_done) {
-    bool h = false;
-    std::size_t written = 0;
-    const ColliderStatus st = s.run(QueryKind::kFull, nullptr, 0, h, written);
-    if (st != ColliderStatus::kOk) return st;
-  }
-  out.found = s.has_best;
-  out.contact = s.best;
-  return ColliderStatus::kOk;
+  const ColliderStatus st = scene_ready(m_impl);
+  return st != ColliderStatus::kOk ? st : answer_earliest(m_impl->cache, scene_run(*m_impl), out);
 }
 
 ColliderStatus Scene::contacts(Contact* buffer, std::size_t capacity,
                                ContactsResult& out) noexcept {
   out = ContactsResult{};
-  if (!m_impl) return ColliderStatus::kNotReady;
-  Impl& s = *m_impl;
-  if (!s.have_step) return ColliderStatus::kNoStep;
-  if (!buffer) capacity = 0;
-  if (s.full_done && capacity == 0) {
-    out.found = s.full_found;
-    return ColliderStatus::kOk;
-  }
-  bool h = false;
-  std::size_t written = 0;
-  const ColliderStatus st =
-      s.run(QueryKind::kFull, capacity > 0 ? buffer : nullptr, capacity, h, written);
-  if (st != ColliderStatus::kOk) return st;
-  out.found = s.full_found;
-  out.written = written;
-  if (written > 0) std::sort(buffer, buffer + written, contact_less);
-  return ColliderStatus::kOk;
+  const ColliderStatus st = scene_ready(m_impl);
+  return st != ColliderStatus::kOk
+             ? st
+             : answer_contacts(m_impl->cache, scene_run(*m_impl), buffer, capacity, out);
 }
 
 const SceneStats& Scene::stats() const noexcept {
