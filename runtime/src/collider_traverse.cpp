@@ -187,6 +187,38 @@ void process_edge_edge(Worker& w, const Collider::Impl& A, std::uint32_t e1,
   w.record(k);
 }
 
+// Triangle-pair plane filter (exact contact only): true when the vertices of one triangle that
+// the other does not share stay strictly on one side of the other's plane for the whole step
+// (the error-bounded orientation cubic of the vertex-face filter, one proven sign for all of
+// them). The triangles can then meet at most in their shared vertices, so no feature pair of
+// theirs with four distinct nodes can touch (a degenerate plane makes the cubic vanish:
+// uncertain, never filtered). docs/runtime.md, "Triangle-pair plane filter".
+bool plane_separated(const Collider::Impl& A, std::uint32_t t1, const Collider::Impl& B,
+                     std::uint32_t t2) noexcept {
+  const bool same = &A == &B;
+  for (int dir = 0; dir < 2; ++dir) {
+    const Collider::Impl& XB = dir == 0 ? A : B;  // body of the vertices
+    const Collider::Impl& YB = dir == 0 ? B : A;  // body of the plane
+    const auto& X = XB.tris[dir == 0 ? t1 : t2];
+    const auto& Y = YB.tris[dir == 0 ? t2 : t1];
+    Orientation side = Orientation::kUncertain;
+    bool separated = true;
+    for (std::uint32_t v : X) {
+      if (same && (v == Y[0] || v == Y[1] || v == Y[2])) continue;
+      const Orientation o =
+          classify_orientation(YB.pos0(Y[0]), YB.pos0(Y[1]), YB.pos0(Y[2]), XB.pos0(v),
+                               YB.pos1(Y[0]), YB.pos1(Y[1]), YB.pos1(Y[2]), XB.pos1(v));
+      if (o == Orientation::kUncertain || (side != Orientation::kUncertain && o != side)) {
+        separated = false;
+        break;
+      }
+      side = o;
+    }
+    if (separated) return true;
+  }
+  return false;
+}
+
 // Tests the feature pairs of triangle t1 of A and t2 of B (t1 != t2 within one body):
 // vertex-face both ways and edge-edge, features with four distinct nodes, that no other
 // triangle pair claims: `claimed(u, v)` (u of A, v of B) is true when the pair (u, v) tests a
@@ -194,10 +226,19 @@ void process_edge_edge(Worker& w, const Collider::Impl& A, std::uint32_t e1,
 template <typename Claimed>
 void test_features(Worker& w, const Collider::Impl& A, std::uint32_t t1, const Collider::Impl& B,
                    std::uint32_t t2, Claimed&& claimed) noexcept {
+  const double ms = A.opt.ccd.min_separation;
+  // The plane filter runs once, lazily: when the first feature pair passes its box checks.
+  int plane = ms <= 0 ? -1 : 0;  // -1 unknown, 0 not separated, 1 separated
+  auto separated = [&]() {
+    if (plane < 0) {
+      plane = plane_separated(A, t1, B, t2) ? 1 : 0;
+      w.stats.triangle_pairs_plane_filtered += plane;
+    }
+    return plane == 1;
+  };
   const bool same = &A == &B;
   const auto& TA = A.tris[t1];
   const auto& TB = B.tris[t2];
-  const double ms = A.opt.ccd.min_separation;
   // Vertex-face, both directions.
   for (int dir = 0; dir < 2 && !w.stop; ++dir) {
     const Collider::Impl& PB = dir == 0 ? A : B;  // the vertices' body
@@ -211,6 +252,7 @@ void test_features(Worker& w, const Collider::Impl& A, std::uint32_t t1, const C
       // Cheap rejections before the ownership scan (repeated inside, harmless).
       if (!PB.vmoved[ip] && !FB.tmov[face]) continue;
       if (!boxes_overlap(PB.vbox[ip], FB.tbox[face], ms)) continue;
+      if (separated()) return;
       bool owner = true;
       const auto& vt_offset = PB.topo->vt_offset;
       const auto& vt_list = PB.topo->vt_list;
@@ -233,6 +275,7 @@ void test_features(Worker& w, const Collider::Impl& A, std::uint32_t t1, const C
       const auto& E2 = EB[e2];
       if (same && (E1[0] == E2[0] || E1[0] == E2[1] || E1[1] == E2[0] || E1[1] == E2[1])) continue;
       if (!edge_boxes_overlap(A, e1, B, e2)) continue;
+      if (separated()) return;
       bool owner = true;
       const auto& ea_offset = A.topo->et_offset;
       const auto& ea_list = A.topo->et_list;
