@@ -112,16 +112,9 @@ void Collider::Impl::construct(std::shared_ptr<const BodyShape> sh, const Collid
   // kBvh topology storage (built from rest positions now when available, else on the first
   // step or rest check, without allocating).
   if (uses_global_bvh() || !asset) {
-    const std::size_t cap = tri_count == 0 ? 1 : 2 * std::size_t(tri_count) - 1;
-    gnodes.resize(cap);
-    gleaf.resize(tri_count);
-    gcentroid.resize(std::size_t(tri_count) * 3);
-    gbuild_stack.resize(kMedianBvhStack);
-    gbox.resize(cap);
-    gntris.assign(cap, 0);
-    gmov.assign(cap, 0);
+    gbvh.reserve(tri_count);
     if (asset && asset->rest_positions.size() == node_count && node_count > 0) {
-      build_global_bvh(asset->rest_positions[0].data());
+      gbvh.build(tris, tri_count, asset->rest_positions[0].data(), opt.bvh_leaf_size);
       if (opt.mode == ColliderMode::kCone) build_global_cones();
     }
   }
@@ -221,8 +214,8 @@ void Collider::Impl::refit_and_classify() noexcept {
                 nmov.data() + cl.bvh_offset);
     }
   } else if (global_bvh_active()) {
-    if (!gbvh_built) build_global_bvh(x0);
-    refit_global_bvh();
+    if (!gbvh.built) gbvh.build(tris, tri_count, x0, opt.bvh_leaf_size);
+    gbvh.refit(tbox.data(), tmov.data());
   }
   std::uint64_t moving = 0;
   for (std::uint32_t t = 0; t < tri_count; ++t) moving += tmov[t];

@@ -1,5 +1,5 @@
-// The kBvh mode's single BVH (median split, built once without allocation into storage
-// reserved at construction) and the static rest-intersection check.
+// The whole-surface BVH (median split, built once without allocation into storage reserved
+// at construction) and the static rest-intersection check.
 
 #include <algorithm>
 #include <cmath>
@@ -9,34 +9,35 @@
 
 namespace tetseg {
 
-void Collider::Impl::build_global_bvh(const double* positions) noexcept {
-  // Topology from `positions` (rest positions when the asset has them, else the first step's
-  // start), by the median-split builder the asset's per-cluster BVHs come from.
-  gnode_count = 0;
-  if (tri_count == 0) {
-    gbvh_built = true;
-    return;
-  }
+void WholeSurfaceBvh::reserve(std::uint32_t tri_count) {
+  const std::size_t cap = tri_count == 0 ? 1 : 2 * std::size_t(tri_count) - 1;
+  nodes.resize(cap);
+  leaf.resize(tri_count);
+  centroid.resize(std::size_t(tri_count) * 3);
+  build_stack.resize(kMedianBvhStack);
+  box.resize(cap);
+  ntris.assign(cap, 0);
+  mov.assign(cap, 0);
+}
+
+void WholeSurfaceBvh::build(const format::Triangle* tris, std::uint32_t tri_count,
+                            const double* positions, std::uint32_t leaf_size) noexcept {
+  // By the median-split builder the asset's per-cluster BVHs come from.
   for (std::uint32_t t = 0; t < tri_count; ++t) {
-    gleaf[t] = t;
+    leaf[t] = t;
     for (int k = 0; k < 3; ++k) {
       double s = 0;
       for (std::uint32_t v : tris[t]) s += positions[std::size_t(v) * 3 + k];
-      gcentroid[std::size_t(t) * 3 + k] = s / 3.0;
+      centroid[std::size_t(t) * 3 + k] = s / 3.0;
     }
   }
-  gnode_count = build_median_bvh(gcentroid.data(), gleaf.data(), tri_count, opt.bvh_leaf_size,
-                                 gnodes.data(), gbuild_stack.data(), gbuild_stack.size());
-  for (std::uint32_t i = gnode_count; i-- > 0;) {
-    const format::BvhNode& n = gnodes[i];
-    gntris[i] = n.count > 0 ? n.count : gntris[n.first] + gntris[n.second];
+  count = build_median_bvh(centroid.data(), leaf.data(), tri_count, leaf_size, nodes.data(),
+                           build_stack.data(), build_stack.size());
+  for (std::uint32_t i = count; i-- > 0;) {
+    const format::BvhNode& n = nodes[i];
+    ntris[i] = n.count > 0 ? n.count : ntris[n.first] + ntris[n.second];
   }
-  gbvh_built = true;
-}
-
-void Collider::Impl::refit_global_bvh() noexcept {
-  refit_bvh(gnodes.data(), gnode_count, gleaf.data(), tbox.data(), tmov.data(), gbox.data(),
-            gmov.data());
+  built = true;
 }
 
 namespace {

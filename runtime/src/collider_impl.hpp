@@ -104,6 +104,29 @@ inline void push_child_pairs(const StackItem& item, const TreeView& ta, const Tr
 
 enum class QueryKind : std::uint8_t { kAny, kFull };
 
+/// One median-split BVH over a whole surface: topology built once (from rest positions, or
+/// from the first step's start) into storage reserved by `reserve`, then refit per step.
+struct WholeSurfaceBvh {
+  bool built = false;
+  std::vector<format::BvhNode> nodes;
+  std::uint32_t count = 0;          // nodes in use
+  std::vector<std::uint32_t> leaf;  // triangle ids in leaf order
+  std::vector<double> centroid;     // scratch for the build
+  std::vector<MedianBvhTask> build_stack;
+  std::vector<Box> box;                   // per node, this step
+  std::vector<std::uint32_t> ntris, mov;  // per node: triangles, moving triangles
+
+  /// Allocates everything for `tri_count` triangles (may throw).
+  void reserve(std::uint32_t tri_count);
+  /// Builds the topology from `positions` (3 doubles per node) without allocating.
+  void build(const format::Triangle* tris, std::uint32_t tri_count, const double* positions,
+             std::uint32_t leaf_size) noexcept;
+  /// Node boxes and moving counts from the triangles' swept boxes and moving flags.
+  void refit(const Box* tbox, const std::uint8_t* tmov) noexcept {
+    refit_bvh(nodes.data(), count, leaf.data(), tbox, tmov, box.data(), mov.data());
+  }
+};
+
 /// Running state of one traversal thread (index 0 is the serial one). Allocated at
 /// construction: one per OpenMP thread when `use_openmp`, else one.
 struct Worker {
@@ -234,15 +257,8 @@ struct Collider::Impl {
   std::uint32_t body_id = 0;  // stamped on contacts (scene body id; 0 for a Collider)
   bool always_refit = false;  // scene body: boxes are refit even when nothing moved
 
-  // global BVH of the kBvh mode (topology built once, from rest or first positions)
-  bool gbvh_built = false;
-  std::vector<format::BvhNode> gnodes;
-  std::uint32_t gnode_count = 0;
-  std::vector<std::uint32_t> gleaf;  // triangle ids in leaf order
-  std::vector<double> gcentroid;     // scratch for the build
-  std::vector<MedianBvhTask> gbuild_stack;
-  std::vector<Box> gbox;
-  std::vector<std::uint32_t> gntris, gmov;
+  // whole-surface BVH of the bvh and cone modes and of surface-only bodies
+  WholeSurfaceBvh gbvh;
 
   // --- per-step data
   const double* x0 = nullptr;
@@ -333,8 +349,6 @@ struct Collider::Impl {
   void close_contacts(Worker& w, double toi) noexcept;
 
   // --- collider_bvh.cpp
-  void build_global_bvh(const double* positions) noexcept;
-  void refit_global_bvh() noexcept;
   void rest_triangle_pair(Worker& w, std::uint32_t t1, std::uint32_t t2) const noexcept;
 };
 

@@ -50,18 +50,18 @@ TreeView Collider::Impl::cluster_view(std::uint32_t c) const noexcept {
 
 TreeView Collider::Impl::global_view() const noexcept {
   TreeView v;
-  v.nodes = gnodes.data();
-  v.leaf_tris = gleaf.data();
-  v.box = gbox.data();
-  v.ntris = gntris.data();
-  v.nmov = gmov.data();
+  v.nodes = gbvh.nodes.data();
+  v.leaf_tris = gbvh.leaf.data();
+  v.box = gbvh.box.data();
+  v.ntris = gbvh.ntris.data();
+  v.nmov = gbvh.mov.data();
   if (opt.mode == ColliderMode::kCone && !rest_mode) v.cone = &cone;
   return v;
 }
 
 std::uint32_t Collider::Impl::tree_count() const noexcept {
   if (uses_clusters()) return cluster_count();
-  return global_bvh_active() && gnode_count > 0 ? 1 : 0;
+  return global_bvh_active() && gbvh.count > 0 ? 1 : 0;
 }
 
 TreeView Collider::Impl::tree(std::uint32_t i) const noexcept {

@@ -172,9 +172,10 @@ void Collider::Impl::build_cone_topology(ConeData& cd, const ConeTree& tree,
 }
 
 void Collider::Impl::build_global_cones() {
-  cone.init(gnode_count);
+  cone.init(gbvh.count);
   std::vector<std::uint32_t> pos(tri_count, kNone);
-  build_cone_topology(cone, ConeTree{gnodes.data(), gleaf.data(), gnode_count, tri_count, 0}, pos);
+  build_cone_topology(cone, ConeTree{gbvh.nodes.data(), gbvh.leaf.data(), gbvh.count, tri_count, 0},
+                      pos);
   cone.topology_built = true;
 }
 
@@ -186,7 +187,7 @@ void Collider::Impl::update_cones() noexcept {
       return;  // angles stay wide: nothing is culled
     }
   }
-  update_cone_tree(cone, ConeTree{gnodes.data(), gleaf.data(), gnode_count, tri_count, 0});
+  update_cone_tree(cone, ConeTree{gbvh.nodes.data(), gbvh.leaf.data(), gbvh.count, tri_count, 0});
 }
 
 void Collider::Impl::update_cone_tree(ConeData& cd, const ConeTree& tree) noexcept {
