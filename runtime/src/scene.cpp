@@ -11,6 +11,10 @@
 
 #include "collider_impl.hpp"
 
+#if defined(TETSEG_HAVE_OPENMP)
+#include <omp.h>
+#endif
+
 namespace tetseg {
 struct SceneBody {
   std::unique_ptr<Collider::Impl> core;
@@ -26,7 +30,16 @@ struct Scene::Impl {
   std::vector<SceneBody> bodies;
   std::vector<std::uint8_t> pair_enabled;  // upper triangle, index pair_index(a, b)
   std::vector<ColliderStats> pair_stats;
-  Worker worker;  // inter-body traversal
+  std::vector<Worker> workers;  // inter-body traversal: one per OpenMP thread, else one
+  /// Outcome of one body pair's traversal in a query, merged in pair order.
+  struct PairOutcome {
+    std::uint32_t a = 0, b = 0;
+    bool ran = false, overflow = false, hit = false, has_best = false;
+    std::size_t found = 0, written = 0;
+    std::uint64_t contacts = 0;
+    Contact best;
+  };
+  std::vector<PairOutcome> live;  // capacity: every pair (reserved in add_body)
   SceneStats stats;
   bool have_step = false;
 
@@ -44,7 +57,13 @@ Scene::Scene(const SceneOptions& options) noexcept {
   try {
     m_impl = std::make_unique<Impl>();
     m_impl->opt = options;
-    m_impl->worker.stack.resize(options.traversal_stack > 0 ? options.traversal_stack : 4 * 68);
+    std::size_t threads = 1;
+#if defined(TETSEG_HAVE_OPENMP)
+    if (options.use_openmp) threads = static_cast<std::size_t>(std::max(1, omp_get_max_threads()));
+#endif
+    m_impl->workers.resize(threads);
+    for (Worker& w : m_impl->workers)
+      w.stack.resize(options.traversal_stack > 0 ? options.traversal_stack : 4 * 68);
   } catch (...) {
     m_impl.reset();
   }
@@ -76,11 +95,12 @@ ColliderStatus Scene::add_body(std::shared_ptr<const BodyShape> shape, const Bod
     body.options = options;
     // Inter-body descent depth is at most the sum of two trees' depths.
     const std::size_t depth = std::max<std::size_t>(body.core->topo->max_depth, 64) + 4;
-    if (s.opt.traversal_stack == 0 && s.worker.stack.size() < 8 * depth)
-      s.worker.stack.resize(8 * depth);
+    for (Worker& w : s.workers)
+      if (s.opt.traversal_stack == 0 && w.stack.size() < 8 * depth) w.stack.resize(8 * depth);
     const std::size_t n = s.bodies.size() + 1;
     s.pair_enabled.resize(n * (n - 1) / 2, 1);
     s.pair_stats.resize(n * (n - 1) / 2);
+    s.live.reserve(n * (n - 1) / 2);
     s.bodies.push_back(std::move(body));
   } catch (...) {
     return ColliderStatus::kNotReady;
@@ -174,12 +194,15 @@ ColliderStatus Scene::step(const double* x0, const double* x1, std::size_t value
 }
 
 // Runs one query over the scene: self queries of the bodies, then the enabled pairs of bodies
-// in order (a, b) with a < b. `out`/`cap`: optional buffer, filled in that order.
+// in order (a, b) with a < b (ordered by b, then a). `out`/`cap`: optional buffer, filled in
+// that order. Pairs run on OpenMP threads when enabled and there is no buffer; outcomes are
+// merged in pair order, so every answer and count equals the serial one. A kAny query answers
+// "hit" when any part finds a contact, and kOverflow only when none does and a part overflowed.
 ColliderStatus Scene::Impl::run(QueryKind kind, Contact* out, std::size_t cap,
                                 std::size_t& written) noexcept {
   written = 0;
   std::size_t found = 0;
-  bool has = false;
+  bool has = false, overflow = false;
   Contact first;
   const auto t_self = Clock::now();
   for (SceneBody& b : bodies) {
@@ -187,9 +210,13 @@ ColliderStatus Scene::Impl::run(QueryKind kind, Contact* out, std::size_t cap,
     Collider::Impl& core = *b.core;
     core.qkind = kind;
     const std::uint64_t contacts_before = core.stats.contacts;
-    if (!core.run_query(out ? out + written : nullptr, out ? cap - written : 0))
-      return ColliderStatus::kOverflow;
+    const bool ok = core.run_query(out ? out + written : nullptr, out ? cap - written : 0);
     stats.contacts += core.stats.contacts - contacts_before;
+    if (!ok) {
+      if (kind == QueryKind::kFull) return ColliderStatus::kOverflow;
+      overflow = true;
+      continue;
+    }
     if (kind == QueryKind::kAny) {
       if (core.query_hit) {
         cache.any_known = cache.any_value = true;
@@ -203,46 +230,93 @@ ColliderStatus Scene::Impl::run(QueryKind kind, Contact* out, std::size_t cap,
     keep_earliest(has, first, core.cache.has_best, core.cache.best);
   }
   stats.self_ms += ms_since(t_self);
+
+  // Body pairs: culled by the switches, the still rule and the body boxes.
   const auto t_pairs = Clock::now();
   const double ms = opt.ccd.min_separation;
-  std::uint64_t tested = 0, skipped = 0;
+  std::uint64_t skipped = 0;
+  live.clear();  // within the capacity reserved by add_body
   const std::uint32_t n = static_cast<std::uint32_t>(bodies.size());
   for (std::uint32_t bi = 1; bi < n; ++bi) {
     for (std::uint32_t ai = 0; ai < bi; ++ai) {
       const SceneBody& A = bodies[ai];
       const SceneBody& B = bodies[bi];
-      const std::size_t pi = pair_index(ai, bi);
-      if (!pair_enabled[pi] || (!A.moved && !B.moved) || !boxes_overlap(A.box, B.box, ms)) {
+      if (!pair_enabled[pair_index(ai, bi)] || (!A.moved && !B.moved) ||
+          !boxes_overlap(A.box, B.box, ms)) {
         ++skipped;
         continue;
       }
-      ++tested;
-      worker.reset();
-      worker.qkind = kind;
-      worker.out = out ? out + written : nullptr;
-      worker.out_cap = out ? cap - written : 0;
-      const bool ok = traverse_bodies(worker, *A.core, *B.core);
-      add_counts(pair_stats[pi], worker.stats);
-      stats.contacts += worker.stats.contacts;
-      if (!ok) return ColliderStatus::kOverflow;
-      if (kind == QueryKind::kAny) {
-        if (worker.stop) {
-          cache.any_known = cache.any_value = true;
-          stats.pairs_ms += ms_since(t_pairs);
-          return ColliderStatus::kOk;
-        }
-        continue;
-      }
-      found += worker.found;
-      written += worker.out_written;
-      keep_earliest(has, first, worker.has_best, worker.best);
+      PairOutcome p;
+      p.a = ai;
+      p.b = bi;
+      live.push_back(p);
     }
   }
+  bool stop = false;  // kAny: a pair found a contact (read racily: only saves work)
+  auto run_pair = [&](Worker& w, PairOutcome& p, Contact* pair_out, std::size_t pair_cap) {
+    w.reset();
+    w.qkind = kind;
+    w.out = pair_out;
+    w.out_cap = pair_out ? pair_cap : 0;
+    p.overflow = !traverse_bodies(w, *bodies[p.a].core, *bodies[p.b].core);
+    p.ran = true;
+    p.hit = w.stop;
+    p.found = w.found;
+    p.written = w.out_written;
+    p.has_best = w.has_best;
+    p.best = w.best;
+    p.contacts = w.stats.contacts;
+    add_counts(pair_stats[pair_index(p.a, p.b)], w.stats);
+  };
+  const std::int64_t count = static_cast<std::int64_t>(live.size());
+#if defined(TETSEG_HAVE_OPENMP)
+  if (workers.size() > 1 && out == nullptr && count > 1) {
+#pragma omp parallel num_threads(static_cast <int>(workers.size()))
+    {
+      Worker& w = workers[static_cast<std::size_t>(omp_get_thread_num())];
+#pragma omp for schedule(dynamic, 1)
+      for (std::int64_t k = 0; k < count; ++k) {
+        bool stopped;
+#pragma omp atomic read
+        stopped = stop;
+        if (stopped) continue;
+        run_pair(w, live[static_cast<std::size_t>(k)], nullptr, 0);
+        if (kind == QueryKind::kAny && live[static_cast<std::size_t>(k)].hit) {
+#pragma omp atomic write
+          stop = true;
+        }
+      }
+    }
+  } else
+#endif
+  {
+    for (PairOutcome& p : live) {
+      run_pair(workers[0], p, out ? out + written : nullptr, out ? cap - written : 0);
+      written += p.written;
+      if (p.overflow && kind == QueryKind::kFull) break;
+      if (p.hit && kind == QueryKind::kAny) break;
+    }
+  }
+  // Merge in pair order.
+  bool hit = false;
+  for (const PairOutcome& p : live) {
+    if (!p.ran) continue;
+    stats.contacts += p.contacts;
+    overflow = overflow || p.overflow;
+    hit = hit || p.hit;
+    found += p.found;
+    keep_earliest(has, first, p.has_best, p.best);
+  }
   stats.pairs_ms += ms_since(t_pairs);
+  if (kind == QueryKind::kAny && hit) {
+    cache.any_known = cache.any_value = true;
+    return ColliderStatus::kOk;
+  }
+  if (overflow) return ColliderStatus::kOverflow;
   cache.any_known = true;
   cache.any_value = found > 0;
   if (kind == QueryKind::kFull) {
-    stats.body_pairs_tested = tested;
+    stats.body_pairs_tested = live.size();
     stats.body_pairs_skipped = skipped;
     cache.set_full(found, has, first);
   }

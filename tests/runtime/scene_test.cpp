@@ -626,3 +626,60 @@ TEST_CASE("Scene: neighbouring triangles folding through each other", "[scene][p
   }
   CHECK(filtered > 0);  // the filter ran on the steps where the pairs stay apart
 }
+
+TEST_CASE("Scene: OpenMP results equal serial results", "[scene][openmp]") {
+  // Six balls in a squeezing ring: many body pairs traversed at once.
+  std::vector<TestBody> bodies;
+  for (int b = 0; b < 6; ++b) {
+    const double a = b * M_PI / 3;
+    const P3 from{2.4 * std::cos(a), 2.4 * std::sin(a), 0.1 * b};
+    const P3 to{1.7 * std::cos(a), 1.7 * std::sin(a), 0.1 * b};
+    bodies.push_back(b % 2 ? surface_body(small_sphere(), 6, translate(from, to))
+                           : tet_body(small_sphere(), 6, translate(from, to)));
+  }
+  std::vector<std::vector<double>> global_frames;
+  tetseg::Scene serial = make_runtime_scene(bodies, true, &global_frames);
+  tetseg::SceneOptions po;
+  po.use_openmp = true;
+  tetseg::Scene parallel(po);
+  std::size_t offset = 0;
+  for (const TestBody& b : bodies) {
+    BodyOptions o;
+    o.global_offset = offset;
+    offset += b.node_count;
+    REQUIRE(parallel.add_body(b.shape, o) == ColliderStatus::kOk);
+  }
+  std::size_t total = 0;
+  for (std::size_t f = 0; f + 1 < global_frames.size(); ++f) {
+    const auto& g0 = global_frames[f];
+    const auto& g1 = global_frames[f + 1];
+    for (tetseg::Scene* s : {&serial, &parallel})
+      REQUIRE(s->step(g0.data(), g1.data(), g0.size()) == ColliderStatus::kOk);
+    bool hs = false, hp = false;
+    REQUIRE(serial.any_collision(hs) == ColliderStatus::kOk);
+    REQUIRE(parallel.any_collision(hp) == ColliderStatus::kOk);
+    CHECK(hs == hp);
+    for (tetseg::Scene* s : {&serial, &parallel})
+      REQUIRE(s->step(g0.data(), g1.data(), g0.size()) == ColliderStatus::kOk);
+    EarliestContact es, ep;
+    REQUIRE(serial.earliest_toi(es) == ColliderStatus::kOk);
+    REQUIRE(parallel.earliest_toi(ep) == ColliderStatus::kOk);
+    REQUIRE(es.found == ep.found);
+    if (es.found) {
+      CHECK(key_of(es.contact) == key_of(ep.contact));
+      CHECK(es.contact.toi == ep.contact.toi);
+    }
+    ContactsResult rs, rp;
+    REQUIRE(serial.contacts(nullptr, 0, rs) == ColliderStatus::kOk);
+    REQUIRE(parallel.contacts(nullptr, 0, rp) == ColliderStatus::kOk);
+    CHECK(rs.found == rp.found);
+    CHECK(serial.stats().body_pairs_tested == parallel.stats().body_pairs_tested);
+    for (std::uint32_t a = 0; a < bodies.size(); ++a)
+      for (std::uint32_t b = a + 1; b < bodies.size(); ++b) {
+        CHECK(serial.pair_stats(a, b).feature_tests == parallel.pair_stats(a, b).feature_tests);
+        CHECK(serial.pair_stats(a, b).contacts == parallel.pair_stats(a, b).contacts);
+      }
+    total += rs.found;
+  }
+  CHECK(total > 0);
+}
