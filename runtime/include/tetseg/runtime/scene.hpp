@@ -24,8 +24,10 @@ struct SceneOptions {
   CcdOptions ccd;
   /// Leaf size of whole-surface BVHs (surface-only bodies, `kBvh` bodies).
   std::uint32_t bvh_leaf_size = 4;
-  /// OpenMP inside each body's self-collision queries (as `ColliderOptions::use_openmp`);
-  /// pairs of bodies are traversed serially. Results are identical either way.
+  /// OpenMP threads (when built with it): inside each body's self-collision queries (as
+  /// `ColliderOptions::use_openmp`), and over the pairs of bodies of queries without a contact
+  /// buffer (one pair per task, a worker with its own stack per thread, outcomes merged in
+  /// pair order). Results and counts are identical to serial ones. Off by default.
   bool use_openmp = false;
   bool time_tests = true;
   /// Traversal stack capacity in node pairs (0: never overflows). Small values are for tests.
