@@ -9,6 +9,7 @@
 #include <cmath>
 #include <map>
 #include <memory>
+#include <random>
 #include <set>
 #include <string>
 #include <tuple>
@@ -682,4 +683,36 @@ TEST_CASE("Scene: OpenMP results equal serial results", "[scene][openmp]") {
     total += rs.found;
   }
   CHECK(total > 0);
+}
+
+TEST_CASE("Scene: random wobbling bodies against the oracle", "[scene][random]") {
+  // Three moving bodies (two tet, one surface-only) with random paths towards each other and
+  // random smooth wobbles, above a still box they may reach: every layout, several seeds.
+  for (unsigned seed : {1u, 2u, 3u}) {
+    CAPTURE(seed);
+    std::mt19937 rng(seed);
+    auto u = [&] { return (rng() / 4294967296.0) * 2 - 1; };
+    std::vector<TestBody> bodies;
+    TestBody box = surface_body(box_surface({-3, -3, -2.2}, {3, 3, -1.2}, 3), 1, fixed({0, 0, 0}));
+    box.still = true;
+    box.self = false;
+    box.frames.resize(7, box.frames[0]);
+    bodies.push_back(box);
+    for (int b = 0; b < 3; ++b) {
+      const double a = 2 * M_PI * b / 3 + 0.3 * u();
+      const P3 from{2.3 * std::cos(a), 2.3 * std::sin(a), 0.3 * u()};
+      const P3 to{0.9 * std::cos(a) + 0.3 * u(), 0.9 * std::sin(a) + 0.3 * u(), -0.4 + 0.3 * u()};
+      const double k[3] = {2 + u(), 2 + u(), 2 + u()}, phase = 3 * u(), amp = 0.08 * (1 + u());
+      Map move = [from, to, k, phase, amp](const P3& p, double t) {
+        const double w = 1 + amp * t * std::sin(k[0] * p[0] + k[1] * p[1] + k[2] * p[2] + phase);
+        return P3{from[0] + t * (to[0] - from[0]) + w * p[0],
+                  from[1] + t * (to[1] - from[1]) + w * p[1],
+                  from[2] + t * (to[2] - from[2]) + w * p[2]};
+      };
+      bodies.push_back(b == 1 ? surface_body(small_sphere(0.8), 7, move)
+                              : tet_body(small_sphere(0.8), 7, move));
+    }
+    const int steps = compare_with_oracle(bodies, seed % 2 == 0);
+    CHECK(steps >= 1);
+  }
 }
