@@ -100,24 +100,31 @@ bool segment_meets_triangle(const double* p, const double* q, const double* a, c
 
 }  // namespace
 
-void Collider::Impl::rest_triangle_pair(Worker& w, std::uint32_t t1,
-                                        std::uint32_t t2) const noexcept {
-  const auto& A = tris[t1];
-  const auto& B = tris[t2];
-  int shared = 0;
-  for (std::uint32_t u : A)
-    for (std::uint32_t v : B) shared += u == v;
-  if (shared >= 2) return;  // edge neighbours: only a flat fold could touch; not checked
+void rest_triangle_pair(Worker& w, const Collider::Impl& A, std::uint32_t t1,
+                        const Collider::Impl& B, std::uint32_t t2) noexcept {
+  const bool same = &A == &B;
+  const auto& TA = A.tris[t1];
+  const auto& TB = B.tris[t2];
+  if (same) {
+    int shared = 0;
+    for (std::uint32_t u : TA)
+      for (std::uint32_t v : TB) shared += u == v;
+    if (shared >= 2) return;  // edge neighbours: only a flat fold could touch; not checked
+  }
   for (int dir = 0; dir < 2 && !w.stop; ++dir) {
-    const auto& E = dir == 0 ? A : B;
-    const auto& F = dir == 0 ? B : A;
+    const Collider::Impl& EB = dir == 0 ? A : B;  // body of the edges
+    const Collider::Impl& FB = dir == 0 ? B : A;  // body of the triangle
+    const auto& E = dir == 0 ? TA : TB;
+    const auto& F = dir == 0 ? TB : TA;
     for (int k = 0; k < 3; ++k) {
       const std::uint32_t p = E[k], q = E[(k + 1) % 3];
-      if (p == F[0] || p == F[1] || p == F[2] || q == F[0] || q == F[1] || q == F[2]) continue;
-      if (segment_meets_triangle(pos0(p), pos0(q), pos0(F[0]), pos0(F[1]), pos0(F[2]))) {
+      if (same && (p == F[0] || p == F[1] || p == F[2] || q == F[0] || q == F[1] || q == F[2]))
+        continue;
+      if (segment_meets_triangle(EB.pos0(p), EB.pos0(q), FB.pos0(F[0]), FB.pos0(F[1]),
+                                 FB.pos0(F[2]))) {
         w.rest_hit = true;
-        w.rest_a = std::min(t1, t2);
-        w.rest_b = std::max(t1, t2);
+        w.rest_a = same ? std::min(t1, t2) : t1;
+        w.rest_b = same ? std::max(t1, t2) : t2;
         w.stop = true;
         return;
       }
@@ -125,33 +132,35 @@ void Collider::Impl::rest_triangle_pair(Worker& w, std::uint32_t t1,
   }
 }
 
-RestCheck Collider::check_rest_intersection(const double* x, std::size_t value_count) noexcept {
+RestCheck Collider::Impl::rest_check(const double* x, std::size_t value_count) noexcept {
   RestCheck r;
-  if (!m_impl) {
-    r.status = ColliderStatus::kNotReady;
-    return r;
-  }
-  Impl& s = *m_impl;
-  r.status = s.begin_step(x, x, value_count);  // invalidates the current step
+  r.status = begin_step(x, x, value_count);  // invalidates the current step
   if (r.status != ColliderStatus::kOk) return r;
-  s.rest_mode = true;
-  s.refit_and_classify();
-  s.qkind = QueryKind::kAny;
-  const bool ok = s.run_query(nullptr, 0);  // rest mode: serial, worker 0
-  s.rest_hit = s.workers[0].rest_hit;
-  s.rest_a = s.workers[0].rest_a;
-  s.rest_b = s.workers[0].rest_b;
-  s.rest_mode = false;
-  s.have_step = false;
-  s.stats = ColliderStats{};
+  rest_mode = true;
+  refit_and_classify();
+  qkind = QueryKind::kAny;
+  const bool ok = run_query(nullptr, 0);  // rest mode: serial, worker 0
+  rest_mode = false;
+  have_step = false;
+  stats = ColliderStats{};
   if (!ok) {
     r.status = ColliderStatus::kOverflow;
     return r;
   }
-  r.intersecting = s.rest_hit;
-  r.triangle_a = s.rest_a;
-  r.triangle_b = s.rest_b;
+  r.intersecting = workers[0].rest_hit;
+  r.triangle_a = workers[0].rest_a;
+  r.triangle_b = workers[0].rest_b;
+  r.bodies = {body_id, body_id};
   return r;
+}
+
+RestCheck Collider::check_rest_intersection(const double* x, std::size_t value_count) noexcept {
+  if (!m_impl) {
+    RestCheck r;
+    r.status = ColliderStatus::kNotReady;
+    return r;
+  }
+  return m_impl->rest_check(x, value_count);
 }
 
 }  // namespace tetseg

@@ -288,8 +288,6 @@ struct Collider::Impl {
   QueryKind qkind = QueryKind::kFull;
   bool query_hit = false;       // kAny: a contact was found
   std::size_t out_written = 0;  // contacts written to the caller's buffer
-  bool rest_hit = false;        // check_rest_intersection outcome
-  std::uint32_t rest_a = 0, rest_b = 0;
 
   // --- collider.cpp
   /// Allocates all scratch for `sh` (non-null). Throws on allocation failure.
@@ -349,12 +347,20 @@ struct Collider::Impl {
   void close_contacts(Worker& w, double toi) noexcept;
 
   // --- collider_bvh.cpp
-  void rest_triangle_pair(Worker& w, std::uint32_t t1, std::uint32_t t2) const noexcept;
+  /// Static intersection check of this body at positions x (check_rest_intersection).
+  RestCheck rest_check(const double* x, std::size_t value_count) noexcept;
 };
+
+/// Static check of triangle t1 of A against t2 of B (A == B within a body): an edge of one
+/// meeting the other, conservatively; records a witness in `w` and stops it.
+void rest_triangle_pair(Worker& w, const Collider::Impl& A, std::uint32_t t1,
+                        const Collider::Impl& B, std::uint32_t t2) noexcept;
 
 /// Contacts between two different bodies A and B (scene): every pair of their trees, culled by
 /// overlap only, triangle pairs deduplicated over all overlapping pairs of the two bodies.
-/// Both bodies refit for the same step. False on stack overflow.
-bool traverse_bodies(Worker& w, const Collider::Impl& A, const Collider::Impl& B) noexcept;
+/// Both bodies refit for the same step. With `rest` (both refit in rest mode): the static
+/// check instead (rest_triangle_pair; the witness in `w`). False on stack overflow.
+bool traverse_bodies(Worker& w, const Collider::Impl& A, const Collider::Impl& B,
+                     bool rest = false) noexcept;
 
 }  // namespace tetseg

@@ -297,7 +297,7 @@ void Collider::Impl::process_triangle_pair(Worker& w, std::uint32_t t1,
                                            std::uint32_t t2) const noexcept {
   if (!non_culled(t1, t2)) return;
   if (rest_mode) {
-    rest_triangle_pair(w, t1, t2);
+    rest_triangle_pair(w, *this, t1, *this, t2);
     return;
   }
   ++w.stats.triangle_pairs;
@@ -401,14 +401,19 @@ bool Collider::Impl::traverse_pair(Worker& w, const TreeView& ta,
       [&](std::uint32_t t1, std::uint32_t t2) { process_triangle_pair(w, t1, t2); });
 }
 
-bool traverse_bodies(Worker& w, const Collider::Impl& A, const Collider::Impl& B) noexcept {
-  const double ms = A.opt.ccd.min_separation;
+bool traverse_bodies(Worker& w, const Collider::Impl& A, const Collider::Impl& B,
+                     bool rest) noexcept {
+  const double ms = rest ? 0.0 : A.opt.ccd.min_separation;
   // A triangle pair of two bodies is non-culled when not both triangles are still and their
   // swept boxes overlap; a feature pair is tested from the smallest (t of A, t of B) such pair.
   auto live = [&](std::uint32_t u, std::uint32_t v) {
     return (A.tmov[u] || B.tmov[v]) && boxes_overlap(A.tbox[u], B.tbox[v], ms);
   };
   auto triangle_pair = [&](std::uint32_t t1, std::uint32_t t2) {
+    if (rest) {
+      if (boxes_overlap(A.tbox[t1], B.tbox[t2], 0.0)) rest_triangle_pair(w, A, t1, B, t2);
+      return;
+    }
     if (!live(t1, t2)) return;
     ++w.stats.triangle_pairs;
     test_features(w, A, t1, B, t2, [&](std::uint32_t u, std::uint32_t v) {
@@ -419,7 +424,7 @@ bool traverse_bodies(Worker& w, const Collider::Impl& A, const Collider::Impl& B
   for (std::uint32_t i = 0; i < na && !w.stop; ++i) {
     const TreeView ta = A.tree(i);
     for (std::uint32_t j = 0; j < nb && !w.stop; ++j) {
-      if (!traverse_tree_pair(w, ta, B.tree(j), ms, false, triangle_pair)) return false;
+      if (!traverse_tree_pair(w, ta, B.tree(j), ms, rest, triangle_pair)) return false;
     }
   }
   return true;

@@ -49,6 +49,36 @@ struct Scene::Impl {
     if (a > b) std::swap(a, b);
     return std::size_t(b) * (b - 1) / 2 + a;  // pairs (a < b) ordered by b, then a
   }
+  /// A body's step arrays from the global arrays (x0, x1, count) or its own; still bodies
+  /// get p1 = p0. kSizeMismatch when a global range exceeds `count`.
+  ColliderStatus body_positions(const SceneBody& b, const double* x0, const double* x1,
+                                std::size_t count, const double*& p0,
+                                const double*& p1) const noexcept {
+    p0 = b.own_x0;
+    p1 = b.own_x1;
+    if (b.options.global_offset != kOwnPositions) {
+      const std::size_t first = b.options.global_offset;
+      if (first > count / 3 || count / 3 - first < b.core->node_count)
+        return ColliderStatus::kSizeMismatch;
+      p0 = x0 ? x0 + first * 3 : nullptr;
+      p1 = x1 ? x1 + first * 3 : nullptr;
+    }
+    if (b.options.still) p1 = p0;
+    return ColliderStatus::kOk;
+  }
+  /// The body's box: the union of its trees' root boxes (after a refit).
+  static void update_box(SceneBody& b) noexcept {
+    const Collider::Impl& core = *b.core;
+    const std::uint32_t trees = core.tree_count();
+    for (std::uint32_t i = 0; i < trees; ++i) {
+      const Box& root = core.tree(i).box[0];
+      if (i == 0) {
+        b.box = root;
+      } else {
+        box_union(b.box, root);
+      }
+    }
+  }
   /// Traversal function of the scene's queries (answer_any and the others).
   ColliderStatus run(QueryKind kind, Contact* out, std::size_t cap, std::size_t& written) noexcept;
 };
@@ -154,18 +184,9 @@ ColliderStatus Scene::step(const double* x0, const double* x1, std::size_t value
   // Validate every body before refitting any.
   for (SceneBody& b : s.bodies) {
     Collider::Impl& core = *b.core;
-    const std::size_t values = std::size_t(core.node_count) * 3;
-    const double* p0 = b.own_x0;
-    const double* p1 = b.own_x1;
-    if (b.options.global_offset != kOwnPositions) {
-      const std::size_t first = b.options.global_offset;
-      if (first > value_count / 3 || value_count / 3 - first < core.node_count)
-        return ColliderStatus::kSizeMismatch;
-      p0 = x0 ? x0 + first * 3 : nullptr;
-      p1 = x1 ? x1 + first * 3 : nullptr;
-    }
-    if (b.options.still) p1 = p0;
-    const ColliderStatus st = core.begin_step(p0, p1, values);
+    const double *p0 = nullptr, *p1 = nullptr;
+    ColliderStatus st = s.body_positions(b, x0, x1, value_count, p0, p1);
+    if (st == ColliderStatus::kOk) st = core.begin_step(p0, p1, std::size_t(core.node_count) * 3);
     if (st != ColliderStatus::kOk) {
       for (SceneBody& other : s.bodies) other.core->have_step = false;
       return st;
@@ -178,16 +199,7 @@ ColliderStatus Scene::step(const double* x0, const double* x1, std::size_t value
     s.stats.bodies_moved += b.moved ? 1 : 0;
     s.stats.refit_ms += core.stats.refit_ms;
     s.stats.classify_ms += core.stats.classify_ms;
-    // Body box: union of its trees' root boxes.
-    const std::uint32_t trees = core.tree_count();
-    for (std::uint32_t i = 0; i < trees; ++i) {
-      const Box& root = core.tree(i).box[0];
-      if (i == 0) {
-        b.box = root;
-      } else {
-        box_union(b.box, root);
-      }
-    }
+    Impl::update_box(b);
   }
   s.have_step = true;
   return ColliderStatus::kOk;
@@ -358,6 +370,71 @@ ColliderStatus Scene::contacts(Contact* buffer, std::size_t capacity,
   return st != ColliderStatus::kOk
              ? st
              : answer_contacts(m_impl->cache, scene_run(*m_impl), buffer, capacity, out);
+}
+
+RestCheck Scene::check_rest_intersection(const double* x, std::size_t value_count) noexcept {
+  RestCheck r;
+  if (!m_impl) {
+    r.status = ColliderStatus::kNotReady;
+    return r;
+  }
+  Impl& s = *m_impl;
+  s.have_step = false;  // the check reuses the step scratch
+  s.cache = QueryCache{};
+  auto finish = [&s](RestCheck result) {
+    for (SceneBody& b : s.bodies) {
+      b.core->rest_mode = false;
+      b.core->have_step = false;
+      b.core->stats = ColliderStats{};
+    }
+    return result;
+  };
+  // Each body with self-collision on, as Collider::check_rest_intersection.
+  for (SceneBody& b : s.bodies) {
+    const double *p0 = nullptr, *p1 = nullptr;
+    r.status = s.body_positions(b, x, x, value_count, p0, p1);
+    if (r.status != ColliderStatus::kOk) return finish(r);
+    if (!b.options.self_collision) continue;
+    r = b.core->rest_check(p0, std::size_t(b.core->node_count) * 3);
+    if (r.status != ColliderStatus::kOk || r.intersecting) return finish(r);
+  }
+  // Every enabled pair of bodies with overlapping boxes: static boxes, every tree pair.
+  for (SceneBody& b : s.bodies) {
+    Collider::Impl& core = *b.core;
+    const double *p0 = nullptr, *p1 = nullptr;
+    r.status = s.body_positions(b, x, x, value_count, p0, p1);
+    if (r.status == ColliderStatus::kOk)
+      r.status = core.begin_step(p0, p0, std::size_t(core.node_count) * 3);
+    if (r.status != ColliderStatus::kOk) return finish(r);
+    core.rest_mode = true;
+    core.refit_and_classify();
+    Impl::update_box(b);
+  }
+  Worker& w = s.workers[0];
+  const std::uint32_t n = static_cast<std::uint32_t>(s.bodies.size());
+  for (std::uint32_t bi = 1; bi < n; ++bi) {
+    for (std::uint32_t ai = 0; ai < bi; ++ai) {
+      const Collider::Impl& A = *s.bodies[ai].core;
+      const Collider::Impl& B = *s.bodies[bi].core;
+      if (!s.pair_enabled[s.pair_index(ai, bi)] ||
+          !boxes_overlap(s.bodies[ai].box, s.bodies[bi].box, 0.0))
+        continue;
+      w.reset();
+      w.qkind = QueryKind::kAny;
+      if (!traverse_bodies(w, A, B, true)) {
+        r.status = ColliderStatus::kOverflow;
+        return finish(r);
+      }
+      if (w.rest_hit) {
+        r.intersecting = true;
+        r.triangle_a = w.rest_a;
+        r.triangle_b = w.rest_b;
+        r.bodies = {ai, bi};
+        return finish(r);
+      }
+    }
+  }
+  return finish(r);
 }
 
 const SceneStats& Scene::stats() const noexcept {

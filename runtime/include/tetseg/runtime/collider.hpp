@@ -138,6 +138,9 @@ struct RestCheck {
   ColliderStatus status = ColliderStatus::kOk;
   bool intersecting = false;                     ///< some pair of triangles may intersect or touch
   std::uint32_t triangle_a = 0, triangle_b = 0;  ///< a witness pair when intersecting
+  /// The witnesses' bodies: triangle_a is in bodies[0], triangle_b in bodies[1] ({0, 0} for a
+  /// Collider).
+  std::array<std::uint32_t, 2> bodies{};
 };
 
 class Collider {

@@ -109,6 +109,16 @@ class Scene {
   [[nodiscard]] ColliderStatus contacts(Contact* buffer, std::size_t capacity,
                                         ContactsResult& out) noexcept;
 
+  /// Static check of a start state (culling inside tet bodies assumes it is free of
+  /// intersections): does a body with self-collision on touch itself, or an enabled pair of
+  /// bodies touch each other, at positions `x` (the global array, `value_count` values, for
+  /// bodies with a `global_offset`; the own arrays' x0 for the others)? Conservative as
+  /// `Collider::check_rest_intersection` (within a body edge-adjacent triangles are not
+  /// checked); the witness names its bodies. Statuses as `step` (and kOverflow); it reuses the
+  /// step scratch: call it before `step`, not between `step` and the queries.
+  RestCheck check_rest_intersection(const double* x = nullptr,
+                                    std::size_t value_count = 0) noexcept;
+
   const SceneStats& stats() const noexcept;
   /// Self-collision statistics of a body in the current step (empty for an unknown body).
   const ColliderStats& body_stats(std::uint32_t body) const noexcept;
