@@ -16,6 +16,11 @@
 #endif
 
 namespace tetseg {
+
+/// Inter-body traversal stack per worker before any body is added (node pairs); add_body grows
+/// it to 8 x (deepest tree + 4), above the sum of two trees' depths that a descent can reach.
+inline constexpr std::size_t kSceneInitialStack = 8 * 68;
+
 struct SceneBody {
   std::unique_ptr<Collider::Impl> core;
   BodyOptions options;
@@ -93,7 +98,7 @@ Scene::Scene(const SceneOptions& options) noexcept {
 #endif
     m_impl->workers.resize(threads);
     for (Worker& w : m_impl->workers)
-      w.stack.resize(options.traversal_stack > 0 ? options.traversal_stack : 4 * 68);
+      w.stack.resize(options.traversal_stack > 0 ? options.traversal_stack : kSceneInitialStack);
   } catch (...) {
     m_impl.reset();
   }
