@@ -53,6 +53,8 @@ const char* to_string(ColliderStatus status) noexcept {
       return "size mismatch";
     case ColliderStatus::kNonFinite:
       return "non-finite position";
+    case ColliderStatus::kInternal:
+      return "internal error";
     case ColliderStatus::kNoStep:
       return "no valid step";
     case ColliderStatus::kOverflow:

@@ -45,6 +45,7 @@ enum class ColliderStatus : std::uint8_t {
   kNullInput,        ///< a position pointer is null
   kSizeMismatch,     ///< value count differs from node_count * 3
   kNonFinite,        ///< a position is NaN or infinite (step rejected, previous state dropped)
+  kInternal,         ///< an internal inconsistency (never expected; not returned by the runtime)
   kNoStep,           ///< query without a valid step (none yet, or the last one was rejected)
   kOverflow,         ///< traversal stack exceeded (`traversal_stack` too small): answer unknown
   kInvalidArgument,  ///< scene: unknown body id, body pair or layout
