@@ -122,17 +122,18 @@ Row run_mode(const Scene& s, tetseg::ColliderMode mode, bool openmp, std::size_t
       const auto t0 = Clock::now();
       if (collider.step(x0, x1) != tetseg::ColliderStatus::kOk)
         throw Failure{kExitBadInput, s.name + ": step " + std::to_string(i) + " rejected"};
-      result = collider.contacts(buffer.data(), buffer.size());
+      const tetseg::ColliderStatus st = collider.contacts(buffer.data(), buffer.size(), result);
       const double ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
       best_cpu = std::min(best_cpu, thread_cpu_ms() - c0);
-      if (result.status != tetseg::ColliderStatus::kOk)
-        throw Failure{kExitFailed, s.name + ": query failed"};
+      if (st != tetseg::ColliderStatus::kOk) throw Failure{kExitFailed, s.name + ": query failed"};
       if (ms < best_total) {
         best_total = ms;
         best_stats = collider.stats();
       }
     }
-    const tetseg::EarliestContact e = collider.earliest_toi();
+    tetseg::EarliestContact e;
+    if (collider.earliest_toi(e) != tetseg::ColliderStatus::kOk)
+      throw Failure{kExitFailed, s.name + ": query failed"};
     row.total += best_total;
     row.cpu += best_cpu;
     row.refit += best_stats.refit_ms;
@@ -335,8 +336,8 @@ int check(const std::string& asset_path, const std::string& frames_path) {
   for (std::size_t f = 0; f + 1 < s.frames.frame_count; ++f) {
     if (collider.step(s.frames.frame(f), s.frames.frame(f + 1)) != tetseg::ColliderStatus::kOk)
       throw Failure{kExitBadInput, frames_path + ": step " + std::to_string(f) + " rejected"};
-    const tetseg::ContactsResult c = collider.contacts(nullptr, 0);
-    if (c.status != tetseg::ColliderStatus::kOk || c.found > 0) {
+    tetseg::ContactsResult c;
+    if (collider.contacts(nullptr, 0, c) != tetseg::ColliderStatus::kOk || c.found > 0) {
       ++bad_steps;
       contacts += c.found;
       std::printf("step %zu: %zu contacts\n", f, c.found);
@@ -361,8 +362,8 @@ int main(int argc, char** argv) {
   int repeat = 3;
   bool openmp = false, json = false, no_truth = false;
   t->add_option("scenes", scenes,
-                 "NAME ASSET FRAMES, repeated per scene (scenes on the same FRAMES file share "
-                 "one brute-force truth)")
+                "NAME ASSET FRAMES, repeated per scene (scenes on the same FRAMES file share "
+                "one brute-force truth)")
       ->required();
   t->add_option("--modes", modes, "Comma-separated modes (brute always runs as the truth)");
   t->add_option("--stride", stride, "Step from frame f to f + stride (default 1)")

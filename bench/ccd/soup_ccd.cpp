@@ -3,6 +3,10 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <stdexcept>
+#include <string>
+
+#include "tetseg/runtime/scene.hpp"
 
 namespace tetseg::tools::soup {
 namespace {
@@ -23,54 +27,64 @@ struct Box {
   }
 };
 
-struct Node {
-  Box box;
-  std::uint32_t begin = 0, end = 0;  // leaf range in the order array
-  std::int32_t left = -1, right = -1;
-};
-
-constexpr std::uint32_t kLeafSize = 4;
-
-struct Bvh {
-  std::vector<Node> nodes;
-  std::vector<std::uint32_t> order;
-  const std::vector<Box>* boxes = nullptr;
-
-  std::int32_t build(std::uint32_t begin, std::uint32_t end) {
-    Node node;
-    node.begin = begin;
-    node.end = end;
-    Box centroids;
-    for (std::uint32_t i = begin; i < end; ++i) {
-      const Box& b = (*boxes)[order[i]];
-      node.box.add(b);
-      Box c;
-      for (int k = 0; k < 3; ++k) c.lo[k] = c.hi[k] = 0.5 * b.lo[k] + 0.5 * b.hi[k];
-      centroids.add(c);
-    }
-    const auto index = static_cast<std::int32_t>(nodes.size());
-    nodes.push_back(node);
-    if (end - begin <= kLeafSize) return index;
-    int axis = 0;
-    for (int k = 1; k < 3; ++k)
-      if (centroids.hi[k] - centroids.lo[k] > centroids.hi[axis] - centroids.lo[axis]) axis = k;
-    const std::uint32_t mid = begin + (end - begin) / 2;
-    std::nth_element(order.begin() + begin, order.begin() + mid, order.begin() + end,
-                     [&](std::uint32_t a, std::uint32_t b) {
-                       const Box& x = (*boxes)[a];
-                       const Box& y = (*boxes)[b];
-                       return x.lo[axis] + x.hi[axis] < y.lo[axis] + y.hi[axis];
-                     });
-    const std::int32_t left = build(begin, mid);
-    const std::int32_t right = build(mid, end);
-    nodes[static_cast<std::size_t>(index)].left = left;
-    nodes[static_cast<std::size_t>(index)].right = right;
-    return index;
-  }
-};
-
 bool shares(const std::array<std::uint32_t, 3>& f, std::uint32_t v) {
   return f[0] == v || f[1] == v || f[2] == v;
+}
+
+// The soup as one surface-only body of a runtime scene (one median-split BVH over the swept
+// triangle boxes, self traversal, exact deduplication, the runtime's feature filters and
+// elementary tests). Memory: the mesh, the scene's scratch and the contacts found.
+std::vector<Contact> scene_contacts(const std::vector<std::array<double, 3>>& x0,
+                                    const std::vector<std::array<double, 3>>& x1,
+                                    const std::vector<std::array<std::uint32_t, 3>>& faces,
+                                    const CcdOptions& options) {
+  const auto nodes = static_cast<std::uint32_t>(x0.size());
+  std::vector<std::uint32_t> ids;
+  ids.reserve(faces.size() * 3);
+  for (const auto& f : faces) ids.insert(ids.end(), f.begin(), f.end());
+  auto shape = BodyShape::from_triangles(ids.data(), faces.size(), nodes);
+  if (!shape) throw std::runtime_error("faces with a repeated or out-of-range vertex");
+  std::vector<double> p0, p1;
+  p0.reserve(x0.size() * 3);
+  p1.reserve(x1.size() * 3);
+  for (const auto& p : x0) p0.insert(p0.end(), p.begin(), p.end());
+  for (const auto& p : x1) p1.insert(p1.end(), p.begin(), p.end());
+  SceneOptions scene_options;
+  scene_options.ccd = options;
+  scene_options.time_tests = false;
+  Scene scene(scene_options);
+  std::uint32_t body = 0;
+  if (scene.add_body(shape, BodyOptions{}, &body) != ColliderStatus::kOk ||
+      scene.set_positions(body, p0.data(), p1.data(), p0.size()) != ColliderStatus::kOk)
+    throw std::runtime_error("cannot set up the scene (out of memory)");
+  ColliderStatus st = scene.step();
+  if (st != ColliderStatus::kOk)
+    throw std::runtime_error(std::string("step rejected: ") + tetseg::to_string(st));
+  // Room for a few contacts per face (dense contact frames such as cloth-ball have about 1.2);
+  // more take a second traversal.
+  std::vector<tetseg::Contact> found(4 * faces.size() + 1024);
+  ContactsResult r;
+  st = scene.contacts(found.data(), found.size(), r);
+  if (st == ColliderStatus::kOk && r.truncated()) {
+    found.resize(r.found);
+    st = scene.contacts(found.data(), found.size(), r);
+  }
+  if (st != ColliderStatus::kOk)
+    throw std::runtime_error(std::string("query failed: ") + tetseg::to_string(st));
+  found.resize(r.written);
+  // Vertex-face by (vertex, face id), then edge-edge by nodes.
+  std::sort(found.begin(), found.end(), [](const tetseg::Contact& a, const tetseg::Contact& b) {
+    if (a.kind != b.kind) return a.kind == ContactKind::kVertexFace;
+    if (a.kind == ContactKind::kVertexFace && a.nodes[0] != b.nodes[0])
+      return a.nodes[0] < b.nodes[0];
+    if (a.kind == ContactKind::kVertexFace) return a.triangle < b.triangle;
+    return a.nodes < b.nodes;
+  });
+  std::vector<Contact> contacts;
+  contacts.reserve(found.size());
+  for (const tetseg::Contact& c : found)
+    contacts.push_back({c.kind == ContactKind::kVertexFace, c.nodes, c.toi});
+  return contacts;
 }
 
 }  // namespace
@@ -79,6 +93,7 @@ std::vector<Contact> find_contacts(const std::vector<std::array<double, 3>>& x0,
                                    const std::vector<std::array<double, 3>>& x1,
                                    const std::vector<std::array<std::uint32_t, 3>>& faces,
                                    const CcdOptions& options, bool brute) {
+  if (!brute) return scene_contacts(x0, x1, faces, options);
   const double delta = options.min_separation > 0 ? options.min_separation : 0.0;
   // Swept vertex boxes, enlarged by the minimum separation (rounded outwards).
   std::vector<Box> vertex_boxes(x0.size());
@@ -95,12 +110,6 @@ std::vector<Contact> find_contacts(const std::vector<std::array<double, 3>>& x0,
   std::vector<Box> face_boxes(faces.size());
   for (std::size_t f = 0; f < faces.size(); ++f)
     for (auto v : faces[f]) face_boxes[f].add(vertex_boxes[v]);
-
-  Bvh bvh;
-  bvh.boxes = &face_boxes;
-  bvh.order.resize(faces.size());
-  std::iota(bvh.order.begin(), bvh.order.end(), 0u);
-  if (!faces.empty()) bvh.build(0, static_cast<std::uint32_t>(faces.size()));
 
   std::vector<std::array<std::uint32_t, 2>> vf_pairs;  // vertex, face
   std::vector<std::array<std::uint32_t, 4>> ee_pairs;  // a < b, c < d, (a,b) < (c,d)
@@ -132,46 +141,9 @@ std::vector<Contact> find_contacts(const std::vector<std::array<double, 3>>& x0,
       }
     }
   };
-  auto leaf_pairs = [&](const Node& p, const Node& q, bool same) {
-    for (std::uint32_t i = p.begin; i < p.end; ++i)
-      for (std::uint32_t j = same ? i + 1 : q.begin; j < q.end; ++j) {
-        const std::uint32_t f = bvh.order[i], g = bvh.order[j];
-        if (face_boxes[f].overlaps(face_boxes[g])) face_pair(f, g);
-      }
-  };
-  if (brute) {
-    for (std::uint32_t f = 0; f < faces.size(); ++f)
-      for (std::uint32_t g = f + 1; g < faces.size(); ++g)
-        if (face_boxes[f].overlaps(face_boxes[g])) face_pair(f, g);
-  }
-  std::vector<std::pair<std::int32_t, std::int32_t>> stack;
-  if (!bvh.nodes.empty() && !brute) stack.push_back({0, 0});
-  while (!stack.empty()) {
-    const auto [pi, qi] = stack.back();
-    stack.pop_back();
-    const Node& p = bvh.nodes[static_cast<std::size_t>(pi)];
-    const Node& q = bvh.nodes[static_cast<std::size_t>(qi)];
-    if (pi == qi) {
-      if (p.left < 0) {
-        leaf_pairs(p, p, true);
-      } else {
-        stack.push_back({p.left, p.left});
-        stack.push_back({p.right, p.right});
-        stack.push_back({p.left, p.right});
-      }
-      continue;
-    }
-    if (!p.box.overlaps(q.box)) continue;
-    if (p.left < 0 && q.left < 0) {
-      leaf_pairs(p, q, false);
-    } else if (q.left < 0 || (p.left >= 0 && p.end - p.begin >= q.end - q.begin)) {
-      stack.push_back({p.left, qi});
-      stack.push_back({p.right, qi});
-    } else {
-      stack.push_back({pi, q.left});
-      stack.push_back({pi, q.right});
-    }
-  }
+  for (std::uint32_t f = 0; f < faces.size(); ++f)
+    for (std::uint32_t g = f + 1; g < faces.size(); ++g)
+      if (face_boxes[f].overlaps(face_boxes[g])) face_pair(f, g);
   std::sort(vf_pairs.begin(), vf_pairs.end());
   vf_pairs.erase(std::unique(vf_pairs.begin(), vf_pairs.end()), vf_pairs.end());
   std::sort(ee_pairs.begin(), ee_pairs.end());

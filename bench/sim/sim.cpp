@@ -217,11 +217,14 @@ void SoftBody::resolve_self_contact() {
       throw std::runtime_error(std::string("collider step failed: ") + tetseg::to_string(st));
     ++rounds;
     ++m_counters.query_rounds;
-    if (!m_collider.any_collision()) break;
-    const tetseg::ContactsResult r = m_collider.contacts(m_contacts.data(), m_contacts.size());
-    if (r.status != tetseg::ColliderStatus::kOk)
-      throw std::runtime_error(std::string("collider query failed: ") +
-                               tetseg::to_string(r.status));
+    bool hit = false;
+    tetseg::ContactsResult r;
+    tetseg::ColliderStatus qs = m_collider.any_collision(hit);
+    if (qs == tetseg::ColliderStatus::kOk && hit)
+      qs = m_collider.contacts(m_contacts.data(), m_contacts.size(), r);
+    if (qs != tetseg::ColliderStatus::kOk)
+      throw std::runtime_error(std::string("collider query failed: ") + tetseg::to_string(qs));
+    if (!hit) break;
     if (first) ++m_counters.substeps_with_contact;
     first = false;
     m_counters.contacts_resolved += r.found;

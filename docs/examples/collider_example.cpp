@@ -26,9 +26,15 @@ int main(int argc, char** argv) {
     // Positions must stay valid until the queries of this step are done.
     if (collider.step(frames.frame(f), frames.frame(f + 1)) != tetseg::ColliderStatus::kOk)
       return 3;
-    if (!collider.any_collision()) continue;  // cheap: stops at the first contact
-    const tetseg::EarliestContact first = collider.earliest_toi();
-    const tetseg::ContactsResult all = collider.contacts(contacts.data(), contacts.size());
+    // Every query returns a status; only kOk comes with an answer.
+    bool hit = false;
+    if (collider.any_collision(hit) != tetseg::ColliderStatus::kOk) return 3;
+    if (!hit) continue;  // cheap: stops at the first contact
+    tetseg::EarliestContact first;
+    tetseg::ContactsResult all;
+    if (collider.earliest_toi(first) != tetseg::ColliderStatus::kOk ||
+        collider.contacts(contacts.data(), contacts.size(), all) != tetseg::ColliderStatus::kOk)
+      return 3;
     std::printf(
         "step %u: first contact at t = %.6f (%s), %zu contacts%s\n", f, first.contact.toi,
         first.contact.kind == tetseg::ContactKind::kVertexFace ? "vertex-face" : "edge-edge",

@@ -4,10 +4,8 @@
 /// call returns a ColliderStatus; the binding raises `tetseg.ColliderError` (naming the
 /// status) on anything but kOk and never returns an answer from a failed call.
 ///
-/// Today's `any_collision()` and `earliest_toi()` return plain answers (false / not found)
-/// when there is no valid step, which would look like "no collision". So the binding keeps
-/// the status of the last `step` and these calls refuse to query without a valid one. When
-/// the collider's queries return statuses themselves, adapt the bodies below only.
+/// The queries themselves refuse to answer without a valid step (kNoStep), so no
+/// answer of a failed call can look like "no collision".
 
 #include <cstddef>
 
@@ -20,25 +18,17 @@ inline ColliderStatus call_step(Collider& collider, const double* x0, const doub
   return collider.step(x0, x1, value_count);
 }
 
-inline ColliderStatus call_any_collision(Collider& collider, ColliderStatus last_step,
-                                         bool& any) noexcept {
-  if (last_step != ColliderStatus::kOk) return ColliderStatus::kNotReady;
-  any = collider.any_collision();
-  return ColliderStatus::kOk;
+inline ColliderStatus call_any_collision(Collider& collider, bool& any) noexcept {
+  return collider.any_collision(any);
 }
 
-inline ColliderStatus call_earliest_toi(Collider& collider, ColliderStatus last_step,
-                                        EarliestContact& earliest) noexcept {
-  if (last_step != ColliderStatus::kOk) return ColliderStatus::kNotReady;
-  earliest = collider.earliest_toi();
-  return ColliderStatus::kOk;
+inline ColliderStatus call_earliest_toi(Collider& collider, EarliestContact& earliest) noexcept {
+  return collider.earliest_toi(earliest);
 }
 
-inline ColliderStatus call_contacts(Collider& collider, ColliderStatus last_step, Contact* buffer,
-                                    std::size_t capacity, ContactsResult& result) noexcept {
-  if (last_step != ColliderStatus::kOk) return ColliderStatus::kNotReady;
-  result = collider.contacts(buffer, capacity);
-  return result.status;
+inline ColliderStatus call_contacts(Collider& collider, Contact* buffer, std::size_t capacity,
+                                    ContactsResult& result) noexcept {
+  return collider.contacts(buffer, capacity, result);
 }
 
 inline ColliderStatus call_check_rest_intersection(Collider& collider, const double* x,

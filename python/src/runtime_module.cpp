@@ -66,9 +66,14 @@ py::dtype contact_dtype() {
   static_assert(std::is_standard_layout_v<Contact>);
   static_assert(sizeof(ContactKind) == 1 && sizeof(bool) == 1);
   return record_dtype(
-      {{"kind", "u1"}, {"nodes", "(4,)u4"}, {"triangle", "u4"}, {"toi", "f8"}, {"at_start", "?"}},
-      {offsetof(Contact, kind), offsetof(Contact, nodes), offsetof(Contact, triangle),
-       offsetof(Contact, toi), offsetof(Contact, at_start)},
+      {{"kind", "u1"},
+       {"bodies", "(2,)u4"},
+       {"nodes", "(4,)u4"},
+       {"triangle", "u4"},
+       {"toi", "f8"},
+       {"at_start", "?"}},
+      {offsetof(Contact, kind), offsetof(Contact, bodies), offsetof(Contact, nodes),
+       offsetof(Contact, triangle), offsetof(Contact, toi), offsetof(Contact, at_start)},
       sizeof(Contact));
 }
 
@@ -314,7 +319,7 @@ class PyCollider {
     ColliderStatus status;
     {
       py::gil_scoped_release release;
-      status = call_any_collision(*m_collider, m_last_step, any);
+      status = call_any_collision(*m_collider, any);
     }
     check_query("any_collision", status);
     return any;
@@ -326,7 +331,7 @@ class PyCollider {
     ColliderStatus status;
     {
       py::gil_scoped_release release;
-      status = call_earliest_toi(*m_collider, m_last_step, earliest);
+      status = call_earliest_toi(*m_collider, earliest);
     }
     check_query("earliest_toi", status);
     if (!earliest.found) return py::none();
@@ -345,7 +350,7 @@ class PyCollider {
       ColliderStatus status;
       {
         py::gil_scoped_release release;
-        status = call_contacts(*m_collider, m_last_step, buffer, capacity, result);
+        status = call_contacts(*m_collider, buffer, capacity, result);
       }
       check_query("contacts", status);
       if (!result.truncated()) {

@@ -55,7 +55,7 @@ def test_nan_is_rejected_and_queries_refuse_to_answer(collider_and_frames):
     for query in (collider.any_collision, collider.earliest_toi, collider.contacts):
         with pytest.raises(tetseg.ColliderError, match="last step failed") as error:
             query()
-        assert error.value.status == "not ready"
+        assert error.value.status == "no valid step"
     x1[asset.triangles[0, 0], 1] = np.inf
     with pytest.raises(tetseg.ColliderError, match="non-finite"):
         collider.step(frames[0], x1)

@@ -15,16 +15,6 @@
 #endif
 
 namespace tetseg {
-namespace {
-
-using Clock = std::chrono::steady_clock;
-
-double ms_since(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
-
-}  // namespace
-
 const char* to_string(ColliderMode mode) noexcept {
   switch (mode) {
     case ColliderMode::kRvbc:
@@ -64,7 +54,13 @@ const char* to_string(ColliderStatus status) noexcept {
     case ColliderStatus::kNonFinite:
       return "non-finite position";
     case ColliderStatus::kInternal:
-      return "internal limit exceeded";
+      return "internal error";
+    case ColliderStatus::kNoStep:
+      return "no valid step";
+    case ColliderStatus::kOverflow:
+      return "traversal stack overflow";
+    case ColliderStatus::kInvalidArgument:
+      return "invalid argument";
   }
   return "unknown";
 }
@@ -72,85 +68,27 @@ const char* to_string(ColliderStatus status) noexcept {
 bool contact_less(const Contact& a, const Contact& b) noexcept {
   if (a.toi != b.toi) return a.toi < b.toi;
   if (a.kind != b.kind) return a.kind < b.kind;
+  if (a.bodies != b.bodies) return a.bodies < b.bodies;
   if (a.nodes != b.nodes) return a.nodes < b.nodes;
   return a.triangle < b.triangle;
 }
 
-void Collider::Impl::construct(const Asset& a, const ColliderOptions& o) {
-  asset = &a.data();
+void Collider::Impl::construct(std::shared_ptr<const BodyShape> sh, const ColliderOptions& o) {
+  shape = std::move(sh);
+  topo = &shape->data();
+  asset = topo->asset;
+  tris = topo->triangles;
   opt = o;
   opt.bvh_leaf_size = std::min<std::uint32_t>(16, std::max<std::uint32_t>(1, opt.bvh_leaf_size));
-  const format::Asset& fa = *asset;
-  node_count = fa.node_count;
-  tri_count = static_cast<std::uint32_t>(fa.triangles.size());
-
-  // Surface vertices and vertex -> triangle adjacency.
-  surf_index.assign(node_count, kNone);
-  for (const auto& t : fa.triangles)
-    for (std::uint32_t v : t) surf_index[v] = 0;
-  for (std::uint32_t n = 0; n < node_count; ++n) {
-    if (surf_index[n] == 0) {
-      surf_index[n] = static_cast<std::uint32_t>(surf_nodes.size());
-      surf_nodes.push_back(n);
-    }
-  }
-  const std::size_t nv = surf_nodes.size();
-  vt_offset.assign(nv + 1, 0);
-  for (const auto& t : fa.triangles)
-    for (std::uint32_t v : t) ++vt_offset[surf_index[v] + 1];
-  for (std::size_t i = 0; i < nv; ++i) vt_offset[i + 1] += vt_offset[i];
-  vt_list.resize(vt_offset[nv]);
-  {
-    std::vector<std::uint32_t> fill(vt_offset.begin(), vt_offset.end() - 1);
-    for (std::uint32_t t = 0; t < tri_count; ++t)
-      for (std::uint32_t v : fa.triangles[t]) vt_list[fill[surf_index[v]]++] = t;
-  }
-
-  // Unique edges and edge -> triangle adjacency.
-  std::vector<std::array<std::uint32_t, 3>> half;  // lo, hi, triangle*3+slot
-  half.reserve(std::size_t(tri_count) * 3);
-  for (std::uint32_t t = 0; t < tri_count; ++t) {
-    for (std::uint32_t s = 0; s < 3; ++s) {
-      std::uint32_t u = fa.triangles[t][s], v = fa.triangles[t][(s + 1) % 3];
-      if (u > v) std::swap(u, v);
-      half.push_back({u, v, t * 3 + s});
-    }
-  }
-  std::sort(half.begin(), half.end());
-  tri_edges.assign(tri_count, {0, 0, 0});
-  et_offset.clear();
-  for (std::size_t i = 0; i < half.size(); ++i) {
-    if (i == 0 || half[i][0] != half[i - 1][0] || half[i][1] != half[i - 1][1]) {
-      edges.push_back({half[i][0], half[i][1]});
-      et_offset.push_back(static_cast<std::uint32_t>(i));
-    }
-    const std::uint32_t e = static_cast<std::uint32_t>(edges.size() - 1);
-    tri_edges[half[i][2] / 3][half[i][2] % 3] = e;
-    et_list.push_back(half[i][2] / 3);
-  }
-  et_offset.push_back(static_cast<std::uint32_t>(half.size()));
-
-  // Per-node static triangle counts and BVH depth (children have larger indices).
-  const std::size_t nn = fa.bvh_nodes.size();
-  cluster_node_ntris.assign(nn, 0);
-  std::vector<std::uint32_t> depth(nn, 0);
-  for (const auto& c : fa.clusters) {
-    const format::BvhNode* nodes = fa.bvh_nodes.data() + c.bvh_offset;
-    std::uint32_t* cnt = cluster_node_ntris.data() + c.bvh_offset;
-    std::uint32_t* dep = depth.data() + c.bvh_offset;
-    for (std::uint32_t i = 0; i < c.bvh_count; ++i) {
-      if (nodes[i].count == 0) {
-        dep[nodes[i].first] = dep[i] + 1;
-        dep[nodes[i].second] = dep[i] + 1;
-      }
-      max_depth = std::max(max_depth, dep[i]);
-    }
-    for (std::uint32_t i = c.bvh_count; i-- > 0;) {
-      cnt[i] = nodes[i].count > 0 ? nodes[i].count : cnt[nodes[i].first] + cnt[nodes[i].second];
-    }
-  }
+  node_count = topo->node_count;
+  tri_count = topo->tri_count;
+  if (!asset && opt.mode == ColliderMode::kRvbc) opt.mode = ColliderMode::kBvh;  // no clusters
+  const std::size_t nv = topo->surf_nodes.size();
+  const std::size_t nn = asset ? asset->bvh_nodes.size() : 0;
   // The kBvh tree is a median split: depth <= log2(triangles) + 1 < 64.
-  const std::size_t stack_size = 4 * (std::size_t(std::max<std::uint32_t>(max_depth, 64)) + 4);
+  const std::size_t stack_size =
+      opt.traversal_stack > 0 ? opt.traversal_stack
+                              : 4 * (std::size_t(std::max<std::uint32_t>(topo->max_depth, 64)) + 4);
   std::size_t threads = 1;
 #if defined(TETSEG_HAVE_OPENMP)
   if (opt.use_openmp) threads = static_cast<std::size_t>(std::max(1, omp_get_max_threads()));
@@ -162,8 +100,8 @@ void Collider::Impl::construct(const Asset& a, const ColliderOptions& o) {
   vmoved.assign(nv, 0);
   vbox.resize(nv);
   tbox.resize(tri_count);
-  ebox.resize(edges.size());
-  emov.assign(edges.size(), 0);
+  ebox.resize(topo->edges.size());
+  emov.assign(topo->edges.size(), 0);
   tcls.assign(tri_count, static_cast<std::uint8_t>(Orientation::kUncertain));
   tmov.assign(tri_count, 0);
   closure_ring.reserve(tri_count);
@@ -175,17 +113,10 @@ void Collider::Impl::construct(const Asset& a, const ColliderOptions& o) {
 
   // kBvh topology storage (built from rest positions now when available, else on the first
   // step or rest check, without allocating).
-  if (opt.mode == ColliderMode::kBvh || opt.mode == ColliderMode::kCone) {
-    const std::size_t cap = tri_count == 0 ? 1 : 2 * std::size_t(tri_count) - 1;
-    gnodes.resize(cap);
-    gleaf.resize(tri_count);
-    gcentroid.resize(std::size_t(tri_count) * 3);
-    gbuild_stack.resize(128);
-    gbox.resize(cap);
-    gntris.assign(cap, 0);
-    gmov.assign(cap, 0);
-    if (fa.rest_positions.size() == node_count && node_count > 0) {
-      build_global_bvh(fa.rest_positions[0].data());
+  if (uses_global_bvh() || !asset) {
+    gbvh.reserve(tri_count);
+    if (asset && asset->rest_positions.size() == node_count && node_count > 0) {
+      gbvh.build(tris, tri_count, asset->rest_positions[0].data(), opt.bvh_leaf_size);
       if (opt.mode == ColliderMode::kCone) build_global_cones();
     }
   }
@@ -196,22 +127,22 @@ ColliderStatus Collider::Impl::begin_step(const double* p0, const double* p1,
                                           std::size_t count) noexcept {
   have_step = false;
   stats = ColliderStats{};
-  any_known = any_value = full_done = has_best = false;
-  full_found = 0;
+  cache = QueryCache{};
   if (ctor_status != ColliderStatus::kOk) return ColliderStatus::kNotReady;
   if (count != std::size_t(node_count) * 3) return ColliderStatus::kSizeMismatch;
   if (node_count > 0 && (!p0 || !p1)) return ColliderStatus::kNullInput;
   // Only surface vertices and detector nodes are read; check exactly those.
-  for (std::uint32_t n : surf_nodes) {
+  for (std::uint32_t n : topo->surf_nodes) {
     for (int k = 0; k < 3; ++k) {
       if (!std::isfinite(p0[std::size_t(n) * 3 + k]) || !std::isfinite(p1[std::size_t(n) * 3 + k]))
         return ColliderStatus::kNonFinite;
     }
   }
-  for (const auto& c : asset->clusters) {
+  for (std::uint32_t c = 0; c < cluster_count(); ++c) {
+    const std::uint32_t det = asset->clusters[c].detector_node;
     for (int k = 0; k < 3; ++k) {
-      if (!std::isfinite(p0[std::size_t(c.detector_node) * 3 + k]) ||
-          !std::isfinite(p1[std::size_t(c.detector_node) * 3 + k]))
+      if (!std::isfinite(p0[std::size_t(det) * 3 + k]) ||
+          !std::isfinite(p1[std::size_t(det) * 3 + k]))
         return ColliderStatus::kNonFinite;
     }
   }
@@ -222,16 +153,15 @@ ColliderStatus Collider::Impl::begin_step(const double* p0, const double* p1,
 }
 
 void Collider::Impl::refit_and_classify() noexcept {
-  const format::Asset& fa = *asset;
   const auto t_refit = Clock::now();
-  const std::int64_t nv = static_cast<std::int64_t>(surf_nodes.size());
+  const std::int64_t nv = static_cast<std::int64_t>(topo->surf_nodes.size());
   std::uint64_t moved = 0;
 #if defined(TETSEG_HAVE_OPENMP)
 #pragma omp parallel for reduction(+ : moved) if (opt.use_openmp && nv > 4096)
 #endif
   for (std::int64_t i = 0; i < nv; ++i) {
-    const double* a = pos0(surf_nodes[i]);
-    const double* b = pos1(surf_nodes[i]);
+    const double* a = pos0(topo->surf_nodes[i]);
+    const double* b = pos1(topo->surf_nodes[i]);
     Box& box = vbox[i];
     const bool m = !rest_mode && (a[0] != b[0] || a[1] != b[1] || a[2] != b[2]);
     vmoved[i] = m ? 1 : 0;
@@ -247,7 +177,7 @@ void Collider::Impl::refit_and_classify() noexcept {
   }
   stats.nodes_moved = moved;
   stats.nothing_moved = moved == 0 && !rest_mode;
-  if (stats.nothing_moved) {
+  if (stats.nothing_moved && !always_refit) {
     stats.refit_ms = ms_since(t_refit);
     return;  // every feature pair is still: no test can run this step
   }
@@ -256,41 +186,44 @@ void Collider::Impl::refit_and_classify() noexcept {
 #pragma omp parallel for if (opt.use_openmp && nt > 4096)
 #endif
   for (std::int64_t t = 0; t < nt; ++t) {
-    const auto& tri = fa.triangles[t];
-    const std::uint32_t i0 = surf_index[tri[0]], i1 = surf_index[tri[1]], i2 = surf_index[tri[2]];
+    const auto& tri = tris[t];
+    const std::uint32_t i0 = topo->surf_index[tri[0]], i1 = topo->surf_index[tri[1]],
+                        i2 = topo->surf_index[tri[2]];
     Box b = vbox[i0];
     box_union(b, vbox[i1]);
     box_union(b, vbox[i2]);
     tbox[t] = b;
     tmov[t] = (vmoved[i0] | vmoved[i1] | vmoved[i2]) ? 1 : 0;
   }
-  const std::int64_t ne = static_cast<std::int64_t>(edges.size());
+  const std::int64_t ne = static_cast<std::int64_t>(topo->edges.size());
 #if defined(TETSEG_HAVE_OPENMP)
 #pragma omp parallel for if (opt.use_openmp && ne > 8192)
 #endif
   for (std::int64_t e = 0; e < ne; ++e) {
-    const std::uint32_t i0 = surf_index[edges[e][0]], i1 = surf_index[edges[e][1]];
+    const std::uint32_t i0 = topo->surf_index[topo->edges[e][0]],
+                        i1 = topo->surf_index[topo->edges[e][1]];
     Box b = vbox[i0];
     box_union(b, vbox[i1]);
     ebox[e] = b;
     emov[e] = vmoved[i0] | vmoved[i1];
   }
-  if (opt.mode == ColliderMode::kRvbc || rest_mode) {
-    for (std::size_t c = 0; c < fa.clusters.size(); ++c) {
-      const format::Cluster& cl = fa.clusters[c];
-      const format::BvhNode* nodes = fa.bvh_nodes.data() + cl.bvh_offset;
-      const std::uint32_t* leaf = fa.cluster_triangles.data() + cl.triangle_offset;
+  if (uses_clusters()) {
+    for (std::uint32_t c = 0; c < cluster_count(); ++c) {
+      const format::Cluster& cl = asset->clusters[c];
+      const format::BvhNode* nodes = asset->bvh_nodes.data() + cl.bvh_offset;
+      const std::uint32_t* leaf = asset->cluster_triangles.data() + cl.triangle_offset;
       refit_bvh(nodes, cl.bvh_count, leaf, tbox.data(), tmov.data(), nbox.data() + cl.bvh_offset,
                 nmov.data() + cl.bvh_offset);
     }
-  } else if (opt.mode == ColliderMode::kBvh || opt.mode == ColliderMode::kCone) {
-    if (!gbvh_built) build_global_bvh(x0);
-    refit_global_bvh();
+  } else if (global_bvh_active()) {
+    if (!gbvh.built) gbvh.build(tris, tri_count, x0, opt.bvh_leaf_size);
+    gbvh.refit(tbox.data(), tmov.data());
   }
   std::uint64_t moving = 0;
   for (std::uint32_t t = 0; t < tri_count; ++t) moving += tmov[t];
   stats.triangles_moving = moving;
   stats.refit_ms = ms_since(t_refit);
+  if (stats.nothing_moved) return;  // scene body: boxes only
   if (opt.mode == ColliderMode::kCone && !rest_mode) {
     const auto t_cone = Clock::now();
     update_cones();  // normal_cone.cpp
@@ -303,8 +236,8 @@ void Collider::Impl::refit_and_classify() noexcept {
 #pragma omp parallel for if (opt.use_openmp && nt > 2048)
 #endif
   for (std::int64_t t = 0; t < nt; ++t) {
-    const auto& tri = fa.triangles[t];
-    const std::uint32_t o = fa.clusters[fa.triangle_cluster[t]].detector_node;
+    const auto& tri = tris[t];
+    const std::uint32_t o = asset->clusters[asset->triangle_cluster[t]].detector_node;
     tcls[t] = static_cast<std::uint8_t>(classify_orientation(pos0(o), pos0(tri[0]), pos0(tri[1]),
                                                              pos0(tri[2]), pos1(o), pos1(tri[0]),
                                                              pos1(tri[1]), pos1(tri[2])));
@@ -315,9 +248,9 @@ void Collider::Impl::refit_and_classify() noexcept {
   stats.triangles_negative = count[1];
   stats.triangles_uncertain = count[2];
   // Per-node counters of negative and uncertain triangles, bottom-up, from this step.
-  for (const format::Cluster& cl : fa.clusters) {
-    const format::BvhNode* nodes = fa.bvh_nodes.data() + cl.bvh_offset;
-    const std::uint32_t* leaf = fa.cluster_triangles.data() + cl.triangle_offset;
+  for (const format::Cluster& cl : asset->clusters) {
+    const format::BvhNode* nodes = asset->bvh_nodes.data() + cl.bvh_offset;
+    const std::uint32_t* leaf = asset->cluster_triangles.data() + cl.triangle_offset;
     std::uint32_t* ng = nneg.data() + cl.bvh_offset;
     std::uint32_t* nu = nunc.data() + cl.bvh_offset;
     for (std::uint32_t i = cl.bvh_count; i-- > 0;) {
@@ -342,10 +275,15 @@ void Collider::Impl::refit_and_classify() noexcept {
 
 // ---------------------------------------------------------------- public API
 
-Collider::Collider(const Asset& asset, const ColliderOptions& options) noexcept {
+Collider::Collider(const Asset& asset, const ColliderOptions& options) noexcept
+    : Collider(BodyShape::from_asset(asset), options) {}
+
+Collider::Collider(std::shared_ptr<const BodyShape> shape,
+                   const ColliderOptions& options) noexcept {
   try {
     m_impl = std::make_unique<Impl>();
-    m_impl->construct(asset, options);
+    m_impl->opt = options;
+    if (shape) m_impl->construct(std::move(shape), options);
   } catch (...) {
     if (m_impl) {
       m_impl->ctor_status = ColliderStatus::kNotReady;
@@ -388,51 +326,52 @@ ColliderStatus Collider::step(const double* x0, const double* x1,
   return ColliderStatus::kOk;
 }
 
-bool Collider::any_collision() noexcept {
-  if (!m_impl || !m_impl->have_step) return false;
-  Impl& s = *m_impl;
-  if (s.any_known) return s.any_value;
-  s.qkind = QueryKind::kAny;
-  if (!s.run_query(nullptr, 0)) return true;  // internal overflow: conservatively "maybe"
-  s.any_known = true;
-  s.any_value = s.query_hit;
-  return s.any_value;
+ColliderStatus Collider::Impl::query_status() const noexcept {
+  if (ctor_status != ColliderStatus::kOk) return ColliderStatus::kNotReady;
+  return have_step ? ColliderStatus::kOk : ColliderStatus::kNoStep;
 }
 
-EarliestContact Collider::earliest_toi() noexcept {
-  EarliestContact r;
-  if (!m_impl || !m_impl->have_step) return r;
-  Impl& s = *m_impl;
-  if (!s.full_done) {
-    s.qkind = QueryKind::kFull;
-    if (!s.run_query(nullptr, 0)) return r;
-  }
-  r.found = s.has_best;
-  r.contact = s.best;
-  return r;
+namespace {
+
+// The Collider's traversal function for answer_any / answer_earliest / answer_contacts.
+auto collider_run(Collider::Impl& s) noexcept {
+  return [&s](QueryKind kind, Contact* out, std::size_t cap, std::size_t& written) noexcept {
+    s.qkind = kind;
+    if (!s.run_query(out, cap)) return ColliderStatus::kOverflow;
+    if (kind == QueryKind::kAny) {
+      s.cache.any_known = true;
+      s.cache.any_value = s.query_hit;
+    }
+    written = s.out_written;
+    return ColliderStatus::kOk;
+  };
 }
 
-ContactsResult Collider::contacts(Contact* buffer, std::size_t capacity) noexcept {
-  ContactsResult r;
-  if (!m_impl || !m_impl->have_step) {
-    r.status = ColliderStatus::kNotReady;
-    return r;
-  }
-  Impl& s = *m_impl;
-  if (!buffer) capacity = 0;
-  if (s.full_done && capacity == 0) {
-    r.found = s.full_found;
-    return r;
-  }
-  s.qkind = QueryKind::kFull;
-  if (!s.run_query(capacity > 0 ? buffer : nullptr, capacity)) {
-    r.status = ColliderStatus::kInternal;
-    return r;
-  }
-  r.found = s.full_found;
-  r.written = s.out_written;
-  if (r.written > 0) std::sort(buffer, buffer + r.written, contact_less);
-  return r;
+}  // namespace
+
+ColliderStatus Collider::any_collision(bool& hit) noexcept {
+  hit = false;
+  if (!m_impl) return ColliderStatus::kNotReady;
+  const ColliderStatus st = m_impl->query_status();
+  if (st != ColliderStatus::kOk) return st;
+  return answer_any(m_impl->cache, collider_run(*m_impl), hit);
+}
+
+ColliderStatus Collider::earliest_toi(EarliestContact& out) noexcept {
+  out = EarliestContact{};
+  if (!m_impl) return ColliderStatus::kNotReady;
+  const ColliderStatus st = m_impl->query_status();
+  if (st != ColliderStatus::kOk) return st;
+  return answer_earliest(m_impl->cache, collider_run(*m_impl), out);
+}
+
+ColliderStatus Collider::contacts(Contact* buffer, std::size_t capacity,
+                                  ContactsResult& out) noexcept {
+  out = ContactsResult{};
+  if (!m_impl) return ColliderStatus::kNotReady;
+  const ColliderStatus st = m_impl->query_status();
+  if (st != ColliderStatus::kOk) return st;
+  return answer_contacts(m_impl->cache, collider_run(*m_impl), buffer, capacity, out);
 }
 
 const ColliderStats& Collider::stats() const noexcept {

@@ -1,77 +1,43 @@
-// The kBvh mode's single BVH (median split, built once without allocation into storage
-// reserved at construction) and the static rest-intersection check.
+// The whole-surface BVH (median split, built once without allocation into storage reserved
+// at construction) and the static rest-intersection check.
 
 #include <algorithm>
 #include <cmath>
 
 #include "collider_impl.hpp"
+#include "tetseg/runtime/median_bvh.hpp"
 
 namespace tetseg {
 
-void Collider::Impl::build_global_bvh(const double* positions) noexcept {
-  // Topology from `positions` (rest positions when the asset has them, else the first step's
-  // start): recursive median split of triangle centroids along the widest centroid axis,
-  // children allocated after their parent (as in the asset's per-cluster BVHs).
-  const format::Asset& fa = *asset;
-  gnode_count = 0;
-  if (tri_count == 0) {
-    gbvh_built = true;
-    return;
-  }
-  for (std::uint32_t t = 0; t < tri_count; ++t) {
-    gleaf[t] = t;
-    for (int k = 0; k < 3; ++k) {
-      double s = 0;
-      for (std::uint32_t v : fa.triangles[t]) s += positions[std::size_t(v) * 3 + k];
-      gcentroid[std::size_t(t) * 3 + k] = s / 3.0;
-    }
-  }
-  const std::uint32_t leaf_size = opt.bvh_leaf_size;
-  std::size_t top = 0;
-  gnodes[0] = {0, 0, 0};
-  gnode_count = 1;
-  gbuild_stack[top++] = {0, 0, tri_count};
-  while (top > 0) {
-    const auto item = gbuild_stack[--top];
-    const std::uint32_t node = item[0], begin = item[1], end = item[2];
-    if (end - begin <= leaf_size || top + 2 > gbuild_stack.size()) {
-      gnodes[node] = {begin, 0, end - begin};
-      continue;
-    }
-    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-    for (std::uint32_t i = begin; i < end; ++i) {
-      for (int k = 0; k < 3; ++k) {
-        const double c = gcentroid[std::size_t(gleaf[i]) * 3 + k];
-        lo[k] = std::min(lo[k], c);
-        hi[k] = std::max(hi[k], c);
-      }
-    }
-    int axis = 0;
-    for (int k = 1; k < 3; ++k)
-      if (hi[k] - lo[k] > hi[axis] - lo[axis]) axis = k;
-    const std::uint32_t mid = begin + (end - begin) / 2;
-    const double* cen = gcentroid.data();
-    std::nth_element(gleaf.begin() + begin, gleaf.begin() + mid, gleaf.begin() + end,
-                     [cen, axis](std::uint32_t a, std::uint32_t b) {
-                       const double ca = cen[std::size_t(a) * 3 + axis];
-                       const double cb = cen[std::size_t(b) * 3 + axis];
-                       return ca < cb || (ca == cb && a < b);
-                     });
-    const std::uint32_t left = gnode_count++, right = gnode_count++;
-    gnodes[node] = {left, right, 0};
-    gbuild_stack[top++] = {right, mid, end};
-    gbuild_stack[top++] = {left, begin, mid};
-  }
-  for (std::uint32_t i = gnode_count; i-- > 0;) {
-    const format::BvhNode& n = gnodes[i];
-    gntris[i] = n.count > 0 ? n.count : gntris[n.first] + gntris[n.second];
-  }
-  gbvh_built = true;
+void WholeSurfaceBvh::reserve(std::uint32_t tri_count) {
+  const std::size_t cap = tri_count == 0 ? 1 : 2 * std::size_t(tri_count) - 1;
+  nodes.resize(cap);
+  leaf.resize(tri_count);
+  centroid.resize(std::size_t(tri_count) * 3);
+  build_stack.resize(kMedianBvhStack);
+  box.resize(cap);
+  ntris.assign(cap, 0);
+  mov.assign(cap, 0);
 }
 
-void Collider::Impl::refit_global_bvh() noexcept {
-  refit_bvh(gnodes.data(), gnode_count, gleaf.data(), tbox.data(), tmov.data(), gbox.data(),
-            gmov.data());
+void WholeSurfaceBvh::build(const format::Triangle* tris, std::uint32_t tri_count,
+                            const double* positions, std::uint32_t leaf_size) noexcept {
+  // By the median-split builder the asset's per-cluster BVHs come from.
+  for (std::uint32_t t = 0; t < tri_count; ++t) {
+    leaf[t] = t;
+    for (int k = 0; k < 3; ++k) {
+      double s = 0;
+      for (std::uint32_t v : tris[t]) s += positions[std::size_t(v) * 3 + k];
+      centroid[std::size_t(t) * 3 + k] = s / 3.0;
+    }
+  }
+  count = build_median_bvh(centroid.data(), leaf.data(), tri_count, leaf_size, nodes.data(),
+                           build_stack.data(), build_stack.size());
+  for (std::uint32_t i = count; i-- > 0;) {
+    const format::BvhNode& n = nodes[i];
+    ntris[i] = n.count > 0 ? n.count : ntris[n.first] + ntris[n.second];
+  }
+  built = true;
 }
 
 namespace {
@@ -134,24 +100,31 @@ bool segment_meets_triangle(const double* p, const double* q, const double* a, c
 
 }  // namespace
 
-void Collider::Impl::rest_triangle_pair(Worker& w, std::uint32_t t1,
-                                        std::uint32_t t2) const noexcept {
-  const auto& A = asset->triangles[t1];
-  const auto& B = asset->triangles[t2];
-  int shared = 0;
-  for (std::uint32_t u : A)
-    for (std::uint32_t v : B) shared += u == v;
-  if (shared >= 2) return;  // edge neighbours: only a flat fold could touch; not checked
+void rest_triangle_pair(Worker& w, const Collider::Impl& A, std::uint32_t t1,
+                        const Collider::Impl& B, std::uint32_t t2) noexcept {
+  const bool same = &A == &B;
+  const auto& TA = A.tris[t1];
+  const auto& TB = B.tris[t2];
+  if (same) {
+    int shared = 0;
+    for (std::uint32_t u : TA)
+      for (std::uint32_t v : TB) shared += u == v;
+    if (shared >= 2) return;  // edge neighbours: only a flat fold could touch; not checked
+  }
   for (int dir = 0; dir < 2 && !w.stop; ++dir) {
-    const auto& E = dir == 0 ? A : B;
-    const auto& F = dir == 0 ? B : A;
+    const Collider::Impl& EB = dir == 0 ? A : B;  // body of the edges
+    const Collider::Impl& FB = dir == 0 ? B : A;  // body of the triangle
+    const auto& E = dir == 0 ? TA : TB;
+    const auto& F = dir == 0 ? TB : TA;
     for (int k = 0; k < 3; ++k) {
       const std::uint32_t p = E[k], q = E[(k + 1) % 3];
-      if (p == F[0] || p == F[1] || p == F[2] || q == F[0] || q == F[1] || q == F[2]) continue;
-      if (segment_meets_triangle(pos0(p), pos0(q), pos0(F[0]), pos0(F[1]), pos0(F[2]))) {
+      if (same && (p == F[0] || p == F[1] || p == F[2] || q == F[0] || q == F[1] || q == F[2]))
+        continue;
+      if (segment_meets_triangle(EB.pos0(p), EB.pos0(q), FB.pos0(F[0]), FB.pos0(F[1]),
+                                 FB.pos0(F[2]))) {
         w.rest_hit = true;
-        w.rest_a = std::min(t1, t2);
-        w.rest_b = std::max(t1, t2);
+        w.rest_a = same ? std::min(t1, t2) : t1;
+        w.rest_b = same ? std::max(t1, t2) : t2;
         w.stop = true;
         return;
       }
@@ -159,33 +132,35 @@ void Collider::Impl::rest_triangle_pair(Worker& w, std::uint32_t t1,
   }
 }
 
-RestCheck Collider::check_rest_intersection(const double* x, std::size_t value_count) noexcept {
+RestCheck Collider::Impl::rest_check(const double* x, std::size_t value_count) noexcept {
   RestCheck r;
+  r.status = begin_step(x, x, value_count);  // invalidates the current step
+  if (r.status != ColliderStatus::kOk) return r;
+  rest_mode = true;
+  refit_and_classify();
+  qkind = QueryKind::kAny;
+  const bool ok = run_query(nullptr, 0);  // rest mode: serial, worker 0
+  rest_mode = false;
+  have_step = false;
+  stats = ColliderStats{};
+  if (!ok) {
+    r.status = ColliderStatus::kOverflow;
+    return r;
+  }
+  r.intersecting = workers[0].rest_hit;
+  r.triangle_a = workers[0].rest_a;
+  r.triangle_b = workers[0].rest_b;
+  r.bodies = {body_id, body_id};
+  return r;
+}
+
+RestCheck Collider::check_rest_intersection(const double* x, std::size_t value_count) noexcept {
   if (!m_impl) {
+    RestCheck r;
     r.status = ColliderStatus::kNotReady;
     return r;
   }
-  Impl& s = *m_impl;
-  r.status = s.begin_step(x, x, value_count);  // invalidates the current step
-  if (r.status != ColliderStatus::kOk) return r;
-  s.rest_mode = true;
-  s.refit_and_classify();
-  s.qkind = QueryKind::kAny;
-  const bool ok = s.run_query(nullptr, 0);  // rest mode: serial, worker 0
-  s.rest_hit = s.workers[0].rest_hit;
-  s.rest_a = s.workers[0].rest_a;
-  s.rest_b = s.workers[0].rest_b;
-  s.rest_mode = false;
-  s.have_step = false;
-  s.stats = ColliderStats{};
-  if (!ok) {
-    r.status = ColliderStatus::kInternal;
-    return r;
-  }
-  r.intersecting = s.rest_hit;
-  r.triangle_a = s.rest_a;
-  r.triangle_b = s.rest_b;
-  return r;
+  return m_impl->rest_check(x, value_count);
 }
 
 }  // namespace tetseg

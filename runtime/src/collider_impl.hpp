@@ -1,14 +1,19 @@
 #pragma once
 // Private state of tetseg::Collider, shared by collider*.cpp. Not installed.
 
+#include <algorithm>
 #include <array>
+#include <chrono>
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
+#include "body_shape_data.hpp"
 #include "normal_cone.hpp"
 #include "tetseg/runtime/classify.hpp"
 #include "tetseg/runtime/collider.hpp"
+#include "tetseg/runtime/median_bvh.hpp"
 
 namespace tetseg {
 
@@ -99,6 +104,29 @@ inline void push_child_pairs(const StackItem& item, const TreeView& ta, const Tr
 
 enum class QueryKind : std::uint8_t { kAny, kFull };
 
+/// One median-split BVH over a whole surface: topology built once (from rest positions, or
+/// from the first step's start) into storage reserved by `reserve`, then refit per step.
+struct WholeSurfaceBvh {
+  bool built = false;
+  std::vector<format::BvhNode> nodes;
+  std::uint32_t count = 0;          // nodes in use
+  std::vector<std::uint32_t> leaf;  // triangle ids in leaf order
+  std::vector<double> centroid;     // scratch for the build
+  std::vector<MedianBvhTask> build_stack;
+  std::vector<Box> box;                   // per node, this step
+  std::vector<std::uint32_t> ntris, mov;  // per node: triangles, moving triangles
+
+  /// Allocates everything for `tri_count` triangles (may throw).
+  void reserve(std::uint32_t tri_count);
+  /// Builds the topology from `positions` (3 doubles per node) without allocating.
+  void build(const format::Triangle* tris, std::uint32_t tri_count, const double* positions,
+             std::uint32_t leaf_size) noexcept;
+  /// Node boxes and moving counts from the triangles' swept boxes and moving flags.
+  void refit(const Box* tbox, const std::uint8_t* tmov) noexcept {
+    refit_bvh(nodes.data(), count, leaf.data(), tbox, tmov, box.data(), mov.data());
+  }
+};
+
 /// Running state of one traversal thread (index 0 is the serial one). Allocated at
 /// construction: one per OpenMP thread when `use_openmp`, else one.
 struct Worker {
@@ -114,6 +142,9 @@ struct Worker {
   std::size_t out_cap = 0, out_written = 0;
   bool rest_hit = false;
   std::uint32_t rest_a = 0, rest_b = 0;
+  QueryKind qkind = QueryKind::kFull;
+  /// Counts a contact: stops the traversal for kAny, else keeps the earliest and fills `out`.
+  void record(const Contact& c) noexcept;
   void reset() noexcept {
     stats = ColliderStats{};
     stop = overflow = has_best = rest_hit = false;
@@ -123,31 +154,111 @@ struct Worker {
   }
 };
 
+/// Per-step answers shared by the queries of a Collider or a Scene (reset by `step`).
+struct QueryCache {
+  bool any_known = false, any_value = false;
+  bool full_done = false;  // a full traversal ran: the fields below are valid
+  bool has_best = false;
+  Contact best;
+  std::size_t full_found = 0;
+  /// Records the outcome of a complete traversal.
+  void set_full(std::size_t found, bool has, const Contact& earliest) noexcept {
+    full_done = any_known = true;
+    any_value = found > 0;
+    full_found = found;
+    has_best = has;
+    best = earliest;
+  }
+};
+
+/// Keeps in (has, first) the smaller in `contact_less` of itself and (h, c).
+inline void keep_earliest(bool& has, Contact& first, bool h, const Contact& c) noexcept {
+  if (h && (!has || contact_less(c, first))) {
+    first = c;
+    has = true;
+  }
+}
+
+using Clock = std::chrono::steady_clock;
+inline double ms_since(Clock::time_point start) noexcept {
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+/// Accumulates the traversal counters of `from` into `to`.
+inline void add_counts(ColliderStats& to, const ColliderStats& from) noexcept {
+  to.clusters_skipped += from.clusters_skipped;
+  to.closure_pairs += from.closure_pairs;
+  to.node_pairs_visited += from.node_pairs_visited;
+  to.node_pairs_orientation_culled += from.node_pairs_orientation_culled;
+  to.triangle_pairs += from.triangle_pairs;
+  to.triangle_pairs_plane_filtered += from.triangle_pairs_plane_filtered;
+  to.feature_pairs += from.feature_pairs;
+  to.feature_pairs_filtered += from.feature_pairs_filtered;
+  to.feature_tests += from.feature_tests;
+  to.contacts += from.contacts;
+}
+
+// The three queries of a Collider or a Scene over one traversal function
+// `run(kind, out, capacity, written) -> ColliderStatus`, which on kOk records a kAny answer in
+// cache.any_known/any_value and a kFull answer in every cache field (and `written`, the
+// contacts written to `out`). Failures leave the out parameter empty.
+template <typename Run>
+ColliderStatus answer_any(QueryCache& cache, Run&& run, bool& hit) noexcept {
+  hit = false;
+  if (!cache.any_known) {
+    std::size_t written = 0;
+    const ColliderStatus st = run(QueryKind::kAny, nullptr, 0, written);
+    if (st != ColliderStatus::kOk) return st;
+  }
+  hit = cache.any_value;
+  return ColliderStatus::kOk;
+}
+
+template <typename Run>
+ColliderStatus answer_earliest(QueryCache& cache, Run&& run, EarliestContact& out) noexcept {
+  out = EarliestContact{};
+  if (!cache.full_done) {
+    std::size_t written = 0;
+    const ColliderStatus st = run(QueryKind::kFull, nullptr, 0, written);
+    if (st != ColliderStatus::kOk) return st;
+  }
+  out.found = cache.has_best;
+  out.contact = cache.best;
+  return ColliderStatus::kOk;
+}
+
+template <typename Run>
+ColliderStatus answer_contacts(QueryCache& cache, Run&& run, Contact* buffer, std::size_t capacity,
+                               ContactsResult& out) noexcept {
+  out = ContactsResult{};
+  if (!buffer) capacity = 0;
+  if (!cache.full_done || capacity > 0) {
+    std::size_t written = 0;
+    const ColliderStatus st =
+        run(QueryKind::kFull, capacity > 0 ? buffer : nullptr, capacity, written);
+    if (st != ColliderStatus::kOk) return st;
+    out.written = written;
+    if (written > 0) std::sort(buffer, buffer + written, contact_less);
+  }
+  out.found = cache.full_found;
+  return ColliderStatus::kOk;
+}
+
 struct Collider::Impl {
   // --- construction-time data
-  const format::Asset* asset = nullptr;
+  std::shared_ptr<const BodyShape> shape;  // immutable topology, shared
+  const BodyShape::Data* topo = nullptr;
+  const format::Asset* asset = nullptr;    // topo->asset: null for a surface-only body
+  const format::Triangle* tris = nullptr;  // topo->triangles
   ColliderOptions opt;
   ColliderStatus ctor_status = ColliderStatus::kNotReady;
   std::uint32_t node_count = 0;
   std::uint32_t tri_count = 0;
-  std::vector<std::uint32_t> surf_nodes;                // surface vertex -> node id (sorted)
-  std::vector<std::uint32_t> surf_index;                // node id -> surface vertex or kNone
-  std::vector<std::uint32_t> vt_offset, vt_list;        // surface vertex -> triangles (CSR)
-  std::vector<std::array<std::uint32_t, 2>> edges;      // node ids, [0] < [1], sorted
-  std::vector<std::array<std::uint32_t, 3>> tri_edges;  // edge ids of each triangle
-  std::vector<std::uint32_t> et_offset, et_list;        // edge -> triangles (CSR)
-  std::vector<std::uint32_t> cluster_node_ntris;        // per asset BVH node (static)
-  std::uint32_t max_depth = 0;
+  std::uint32_t body_id = 0;  // stamped on contacts (scene body id; 0 for a Collider)
+  bool always_refit = false;  // scene body: boxes are refit even when nothing moved
 
-  // global BVH of the kBvh mode (topology built once, from rest or first positions)
-  bool gbvh_built = false;
-  std::vector<format::BvhNode> gnodes;
-  std::uint32_t gnode_count = 0;
-  std::vector<std::uint32_t> gleaf;  // triangle ids in leaf order
-  std::vector<double> gcentroid;     // scratch for the build
-  std::vector<std::array<std::uint32_t, 3>> gbuild_stack;
-  std::vector<Box> gbox;
-  std::vector<std::uint32_t> gntris, gmov;
+  // whole-surface BVH of the bvh and cone modes and of surface-only bodies
+  WholeSurfaceBvh gbvh;
 
   // --- per-step data
   const double* x0 = nullptr;
@@ -171,24 +282,35 @@ struct Collider::Impl {
   ColliderStats stats;
   RestCheck rest;
 
-  // query state within a step
-  bool any_known = false, any_value = false;
-  bool full_done = false;
-  bool has_best = false;
-  Contact best;
-  std::size_t full_found = 0;
+  QueryCache cache;  // answers of the current step
 
   // running query (shared, read-only during traversal) and its merged outcome
   QueryKind qkind = QueryKind::kFull;
   bool query_hit = false;       // kAny: a contact was found
   std::size_t out_written = 0;  // contacts written to the caller's buffer
-  bool rest_hit = false;        // check_rest_intersection outcome
-  std::uint32_t rest_a = 0, rest_b = 0;
 
   // --- collider.cpp
-  void construct(const Asset& a, const ColliderOptions& o);
+  /// Allocates all scratch for `sh` (non-null). Throws on allocation failure.
+  void construct(std::shared_ptr<const BodyShape> sh, const ColliderOptions& o);
+  std::uint32_t cluster_count() const noexcept {
+    return asset ? static_cast<std::uint32_t>(asset->clusters.size()) : 0;
+  }
+  /// The whole-surface BVH serves this body's queries (bvh and cone modes; every mode but brute
+  /// force of a surface-only body, which has no clusters).
+  bool uses_global_bvh() const noexcept {
+    return opt.mode == ColliderMode::kBvh || opt.mode == ColliderMode::kCone ||
+           (!asset && opt.mode != ColliderMode::kBrute);
+  }
+  /// The whole-surface BVH is refit and traversed by the current query kind.
+  bool global_bvh_active() const noexcept { return rest_mode ? !asset : uses_global_bvh(); }
+  /// The asset's cluster BVHs are refit and traversed (rvbc, and the rest check of a tet body).
+  bool uses_clusters() const noexcept {
+    return asset && (opt.mode == ColliderMode::kRvbc || rest_mode);
+  }
   ColliderStatus begin_step(const double* p0, const double* p1, std::size_t count) noexcept;
   void refit_and_classify() noexcept;
+  /// kOk when a query can run, else kNotReady or kNoStep.
+  ColliderStatus query_status() const noexcept;
   const double* pos0(std::uint32_t node) const noexcept { return x0 + std::size_t(node) * 3; }
   const double* pos1(std::uint32_t node) const noexcept { return x1 + std::size_t(node) * 3; }
 
@@ -199,26 +321,17 @@ struct Collider::Impl {
   bool run_query(Contact* out, std::size_t out_cap) noexcept;
   bool non_culled(std::uint32_t t1, std::uint32_t t2) const noexcept;
   void process_triangle_pair(Worker& w, std::uint32_t t1, std::uint32_t t2) const noexcept;
-  template <typename Claimed>
-  void test_features(Worker& w, std::uint32_t t1, std::uint32_t t2,
-                     Claimed&& claimed) const noexcept;
-  void process_vertex_face(Worker& w, std::uint32_t p, std::uint32_t face) const noexcept;
-  void process_edge_edge(Worker& w, std::uint32_t e1, std::uint32_t e2) const noexcept;
-  /// Swept boxes of two edges overlap and not all four nodes are still.
-  bool edge_boxes_overlap(std::uint32_t e1, std::uint32_t e2) const noexcept;
-  void record(Worker& w, const Contact& c) const noexcept;
   bool traverse_self(Worker& w, const TreeView& tree) const noexcept;
   bool traverse_pair(Worker& w, const TreeView& ta, const TreeView& tb) const noexcept;
-  template <typename Live>
-  bool descend_pair(Worker& w, const TreeView& ta, const TreeView& tb, const StackItem& it,
-                    Live&& live, std::size_t& top) const noexcept;
-  void leaf_pair(Worker& w, const TreeView& ta, std::uint32_t a, const TreeView& tb,
-                 std::uint32_t b) const noexcept;
   void brute_vertex_faces(Worker& w, std::uint32_t i) const noexcept;
   void brute_edge_edges(Worker& w, std::uint32_t i) const noexcept;
   /// Intra-cluster work of cluster c1 and its pairs with every cluster c2 > c1.
   bool cluster_tasks(Worker& w, std::uint32_t c1, bool count_skips) const noexcept;
   TreeView cluster_view(std::uint32_t c) const noexcept;
+  /// Broad-phase trees of this body against other bodies: its cluster BVHs (rvbc) or its
+  /// whole-surface BVH (after a refit).
+  std::uint32_t tree_count() const noexcept;
+  TreeView tree(std::uint32_t i) const noexcept;
   TreeView global_view() const noexcept;
 
   // --- normal_cone.cpp (kCone)
@@ -234,9 +347,20 @@ struct Collider::Impl {
   void close_contacts(Worker& w, double toi) noexcept;
 
   // --- collider_bvh.cpp
-  void build_global_bvh(const double* positions) noexcept;
-  void refit_global_bvh() noexcept;
-  void rest_triangle_pair(Worker& w, std::uint32_t t1, std::uint32_t t2) const noexcept;
+  /// Static intersection check of this body at positions x (check_rest_intersection).
+  RestCheck rest_check(const double* x, std::size_t value_count) noexcept;
 };
+
+/// Static check of triangle t1 of A against t2 of B (A == B within a body): an edge of one
+/// meeting the other, conservatively; records a witness in `w` and stops it.
+void rest_triangle_pair(Worker& w, const Collider::Impl& A, std::uint32_t t1,
+                        const Collider::Impl& B, std::uint32_t t2) noexcept;
+
+/// Contacts between two different bodies A and B (scene): every pair of their trees, culled by
+/// overlap only, triangle pairs deduplicated over all overlapping pairs of the two bodies.
+/// Both bodies refit for the same step. With `rest` (both refit in rest mode): the static
+/// check instead (rest_triangle_pair; the witness in `w`). False on stack overflow.
+bool traverse_bodies(Worker& w, const Collider::Impl& A, const Collider::Impl& B,
+                     bool rest = false) noexcept;
 
 }  // namespace tetseg

@@ -21,8 +21,6 @@
 namespace tetseg {
 namespace {
 
-using Clock = std::chrono::steady_clock;
-
 constexpr std::uint8_t kUnc = static_cast<std::uint8_t>(Orientation::kUncertain);
 
 inline std::uint64_t pair_key(std::uint32_t a, std::uint32_t b) noexcept {
@@ -41,7 +39,7 @@ TreeView Collider::Impl::cluster_view(std::uint32_t c) const noexcept {
   v.nodes = asset->bvh_nodes.data() + cl.bvh_offset;
   v.leaf_tris = asset->cluster_triangles.data() + cl.triangle_offset;
   v.box = nbox.data() + cl.bvh_offset;
-  v.ntris = cluster_node_ntris.data() + cl.bvh_offset;
+  v.ntris = topo->cluster_node_ntris.data() + cl.bvh_offset;
   v.nmov = nmov.data() + cl.bvh_offset;
   if (orientation_mode()) {
     v.nneg = nneg.data() + cl.bvh_offset;
@@ -52,13 +50,22 @@ TreeView Collider::Impl::cluster_view(std::uint32_t c) const noexcept {
 
 TreeView Collider::Impl::global_view() const noexcept {
   TreeView v;
-  v.nodes = gnodes.data();
-  v.leaf_tris = gleaf.data();
-  v.box = gbox.data();
-  v.ntris = gntris.data();
-  v.nmov = gmov.data();
+  v.nodes = gbvh.nodes.data();
+  v.leaf_tris = gbvh.leaf.data();
+  v.box = gbvh.box.data();
+  v.ntris = gbvh.ntris.data();
+  v.nmov = gbvh.mov.data();
   if (opt.mode == ColliderMode::kCone && !rest_mode) v.cone = &cone;
   return v;
+}
+
+std::uint32_t Collider::Impl::tree_count() const noexcept {
+  if (uses_clusters()) return cluster_count();
+  return global_bvh_active() && gbvh.count > 0 ? 1 : 0;
+}
+
+TreeView Collider::Impl::tree(std::uint32_t i) const noexcept {
+  return uses_clusters() ? cluster_view(i) : global_view();
 }
 
 bool Collider::Impl::non_culled(std::uint32_t t1, std::uint32_t t2) const noexcept {
@@ -81,32 +88,38 @@ bool Collider::Impl::orientation_culled(std::uint32_t t1, std::uint32_t t2) cons
   return boxes_overlap(tbox[t1], tbox[t2], opt.ccd.min_separation);
 }
 
-void Collider::Impl::record(Worker& w, const Contact& c) const noexcept {
-  ++w.stats.contacts;
+void Worker::record(const Contact& c) noexcept {
+  ++stats.contacts;
   if (qkind == QueryKind::kAny) {
-    w.stop = true;
+    stop = true;
     return;
   }
-  ++w.found;
-  if (!w.has_best || contact_less(c, w.best)) {
-    w.best = c;
-    w.has_best = true;
+  ++found;
+  if (!has_best || contact_less(c, best)) {
+    best = c;
+    has_best = true;
   }
-  if (w.out && w.out_written < w.out_cap) w.out[w.out_written++] = c;
+  if (out && out_written < out_cap) out[out_written++] = c;
 }
 
-void Collider::Impl::process_vertex_face(Worker& w, std::uint32_t p,
-                                         std::uint32_t face) const noexcept {
-  const auto& f = asset->triangles[face];
-  const std::uint32_t ip = surf_index[p];
-  if (!vmoved[ip] && !tmov[face]) return;  // still feature pair: only t = 0 contact possible
+// ------------------------------------------------- the one feature-pair path
+// Feature pairs of a triangle of body A and a triangle of body B (A == B for self-collision):
+// swept-box checks, the coplanarity filter, the elementary test, the contact. Options (ccd,
+// timing) are A's; a scene gives all its bodies the same.
+
+void process_vertex_face(Worker& w, const Collider::Impl& P, std::uint32_t p,
+                         const Collider::Impl& F, std::uint32_t face) noexcept {
+  const auto& f = F.tris[face];
+  const std::uint32_t ip = P.topo->surf_index[p];
+  if (!P.vmoved[ip] && !F.tmov[face]) return;  // still feature pair: only t = 0 contact possible
+  const ColliderOptions& opt = P.opt;
   const double ms = opt.ccd.min_separation;
-  if (!boxes_overlap(vbox[ip], tbox[face], ms)) return;
+  if (!boxes_overlap(P.vbox[ip], F.tbox[face], ms)) return;
   ++w.stats.feature_pairs;
   if (ms <= 0) {
     // Coplanarity cubic det[b-a, c-a, p-a] with a proven strict sign: never coplanar.
-    const Orientation o = classify_orientation(pos0(f[0]), pos0(f[1]), pos0(f[2]), pos0(p),
-                                               pos1(f[0]), pos1(f[1]), pos1(f[2]), pos1(p));
+    const Orientation o = classify_orientation(F.pos0(f[0]), F.pos0(f[1]), F.pos0(f[2]), P.pos0(p),
+                                               F.pos1(f[0]), F.pos1(f[1]), F.pos1(f[2]), P.pos1(p));
     if (o != Orientation::kUncertain) {
       ++w.stats.feature_pairs_filtered;
       return;
@@ -116,35 +129,40 @@ void Collider::Impl::process_vertex_face(Worker& w, std::uint32_t p,
   Clock::time_point t0;
   if (opt.time_tests) t0 = Clock::now();
   const CcdResult r =
-      vertex_face_ccd(v3(pos0(p)), v3(pos0(f[0])), v3(pos0(f[1])), v3(pos0(f[2])), v3(pos1(p)),
-                      v3(pos1(f[0])), v3(pos1(f[1])), v3(pos1(f[2])), opt.ccd);
+      vertex_face_ccd(v3(P.pos0(p)), v3(F.pos0(f[0])), v3(F.pos0(f[1])), v3(F.pos0(f[2])),
+                      v3(P.pos1(p)), v3(F.pos1(f[0])), v3(F.pos1(f[1])), v3(F.pos1(f[2])), opt.ccd);
   if (opt.time_tests) w.tests_seconds += std::chrono::duration<double>(Clock::now() - t0).count();
   if (!r.hit()) return;
   Contact c;
   c.kind = ContactKind::kVertexFace;
+  c.bodies = {P.body_id, F.body_id};
   c.nodes = {p, f[0], f[1], f[2]};
   c.triangle = face;
   c.at_start = r.outcome == CcdOutcome::kContactAtStart;
   c.toi = c.at_start ? 0.0 : r.toi;
-  record(w, c);
+  w.record(c);
 }
 
-bool Collider::Impl::edge_boxes_overlap(std::uint32_t e1, std::uint32_t e2) const noexcept {
-  if (!emov[e1] && !emov[e2]) return false;
-  return boxes_overlap(ebox[e1], ebox[e2], opt.ccd.min_separation);
+// Swept boxes of two edges overlap and not all four nodes are still.
+inline bool edge_boxes_overlap(const Collider::Impl& A, std::uint32_t e1, const Collider::Impl& B,
+                               std::uint32_t e2) noexcept {
+  if (!A.emov[e1] && !B.emov[e2]) return false;
+  return boxes_overlap(A.ebox[e1], B.ebox[e2], A.opt.ccd.min_separation);
 }
 
-void Collider::Impl::process_edge_edge(Worker& w, std::uint32_t e1,
-                                       std::uint32_t e2) const noexcept {
-  if (e1 > e2) std::swap(e1, e2);
-  const std::uint32_t a = edges[e1][0], b = edges[e1][1], c = edges[e2][0], d = edges[e2][1];
+void process_edge_edge(Worker& w, const Collider::Impl& A, std::uint32_t e1,
+                       const Collider::Impl& B, std::uint32_t e2) noexcept {
+  if (&A == &B && e1 > e2) std::swap(e1, e2);
+  const std::uint32_t a = A.topo->edges[e1][0], b = A.topo->edges[e1][1];
+  const std::uint32_t c = B.topo->edges[e2][0], d = B.topo->edges[e2][1];
+  const ColliderOptions& opt = A.opt;
   const double ms = opt.ccd.min_separation;
-  if (!edge_boxes_overlap(e1, e2)) return;  // also: all four nodes still
+  if (!edge_boxes_overlap(A, e1, B, e2)) return;  // also: all four nodes still
   ++w.stats.feature_pairs;
   if (ms <= 0) {
     // det[b-a, d-c, c-a] = det[b-a, d-a, c-a]: orientation of (a; b, d, c).
-    const Orientation o = classify_orientation(pos0(a), pos0(b), pos0(d), pos0(c), pos1(a), pos1(b),
-                                               pos1(d), pos1(c));
+    const Orientation o = classify_orientation(A.pos0(a), A.pos0(b), B.pos0(d), B.pos0(c),
+                                               A.pos1(a), A.pos1(b), B.pos1(d), B.pos1(c));
     if (o != Orientation::kUncertain) {
       ++w.stats.feature_pairs_filtered;
       return;
@@ -153,64 +171,127 @@ void Collider::Impl::process_edge_edge(Worker& w, std::uint32_t e1,
   ++w.stats.feature_tests;
   Clock::time_point t0;
   if (opt.time_tests) t0 = Clock::now();
-  const CcdResult r = edge_edge_ccd(v3(pos0(a)), v3(pos0(b)), v3(pos0(c)), v3(pos0(d)), v3(pos1(a)),
-                                    v3(pos1(b)), v3(pos1(c)), v3(pos1(d)), opt.ccd);
+  const CcdResult r =
+      edge_edge_ccd(v3(A.pos0(a)), v3(A.pos0(b)), v3(B.pos0(c)), v3(B.pos0(d)), v3(A.pos1(a)),
+                    v3(A.pos1(b)), v3(B.pos1(c)), v3(B.pos1(d)), opt.ccd);
   if (opt.time_tests) w.tests_seconds += std::chrono::duration<double>(Clock::now() - t0).count();
   if (!r.hit()) return;
   Contact k;
   k.kind = ContactKind::kEdgeEdge;
-  k.nodes = {a, b, c, d};  // edges sorted (a<b, c<d) and e1 < e2 in sorted edge order
+  k.bodies = {A.body_id, B.body_id};
+  // Edges sorted (a<b, c<d); within one body e1 < e2 in sorted edge order.
+  k.nodes = {a, b, c, d};
   k.triangle = 0;
   k.at_start = r.outcome == CcdOutcome::kContactAtStart;
   k.toi = k.at_start ? 0.0 : r.toi;
-  record(w, k);
+  w.record(k);
 }
 
-// Tests the feature pairs of triangles t1 != t2 (vertex-face both ways, edge-edge; features
-// with four distinct nodes) that no other triangle pair claims: `claimed(u, v)` is true when
-// the pair (u, v) tests a shared feature pair instead of this one (exact deduplication).
+// Triangle-pair plane filter (exact contact only): true when the vertices of one triangle that
+// the other does not share stay strictly on one side of the other's plane for the whole step
+// (the error-bounded orientation cubic of the vertex-face filter, one proven sign for all of
+// them). The triangles can then meet at most in their shared vertices, so no feature pair of
+// theirs with four distinct nodes can touch (a degenerate plane makes the cubic vanish:
+// uncertain, never filtered). docs/runtime.md, "Triangle-pair plane filter".
+bool plane_separated(const Collider::Impl& A, std::uint32_t t1, const Collider::Impl& B,
+                     std::uint32_t t2) noexcept {
+  const bool same = &A == &B;
+  for (int dir = 0; dir < 2; ++dir) {
+    const Collider::Impl& XB = dir == 0 ? A : B;  // body of the vertices
+    const Collider::Impl& YB = dir == 0 ? B : A;  // body of the plane
+    const auto& X = XB.tris[dir == 0 ? t1 : t2];
+    const auto& Y = YB.tris[dir == 0 ? t2 : t1];
+    Orientation side = Orientation::kUncertain;
+    bool separated = true;
+    for (std::uint32_t v : X) {
+      if (same && (v == Y[0] || v == Y[1] || v == Y[2])) continue;
+      const Orientation o =
+          classify_orientation(YB.pos0(Y[0]), YB.pos0(Y[1]), YB.pos0(Y[2]), XB.pos0(v),
+                               YB.pos1(Y[0]), YB.pos1(Y[1]), YB.pos1(Y[2]), XB.pos1(v));
+      if (o == Orientation::kUncertain || (side != Orientation::kUncertain && o != side)) {
+        separated = false;
+        break;
+      }
+      side = o;
+    }
+    if (separated) return true;
+  }
+  return false;
+}
+
+// Tests the feature pairs of triangle t1 of A and t2 of B (t1 != t2 within one body):
+// vertex-face both ways and edge-edge, features with four distinct nodes, that no other
+// triangle pair claims: `claimed(u, v)` (u of A, v of B) is true when the pair (u, v) tests a
+// shared feature pair instead of this one (exact deduplication).
 template <typename Claimed>
-void Collider::Impl::test_features(Worker& w, std::uint32_t t1, std::uint32_t t2,
-                                   Claimed&& claimed) const noexcept {
-  const auto& A = asset->triangles[t1];
-  const auto& B = asset->triangles[t2];
+void test_features(Worker& w, const Collider::Impl& A, std::uint32_t t1, const Collider::Impl& B,
+                   std::uint32_t t2, Claimed&& claimed) noexcept {
+  const double ms = A.opt.ccd.min_separation;
+  // The plane filter runs once per pair: first thing without orientation culling (bvh and
+  // cone modes, surface-only bodies, pairs of bodies: most non-culled pairs are neighbours it
+  // drops), else lazily when the first feature pair passes its box checks (measured:
+  // docs/benchmarks.md, "Scenes and the shared core").
+  int plane = ms <= 0 ? -1 : 0;  // -1 unknown, 0 not separated, 1 separated
+  auto separated = [&]() {
+    if (plane < 0) {
+      plane = plane_separated(A, t1, B, t2) ? 1 : 0;
+      w.stats.triangle_pairs_plane_filtered += plane;
+    }
+    return plane == 1;
+  };
+  const bool same = &A == &B;
+  if ((!same || !A.orientation_mode()) && separated()) return;
+  const auto& TA = A.tris[t1];
+  const auto& TB = B.tris[t2];
   // Vertex-face, both directions.
   for (int dir = 0; dir < 2 && !w.stop; ++dir) {
-    const auto& P = dir == 0 ? A : B;
-    const auto& F = dir == 0 ? B : A;
+    const Collider::Impl& PB = dir == 0 ? A : B;  // the vertices' body
+    const Collider::Impl& FB = dir == 0 ? B : A;  // the face's body
+    const auto& P = dir == 0 ? TA : TB;
+    const auto& F = dir == 0 ? TB : TA;
     const std::uint32_t face = dir == 0 ? t2 : t1;
     for (std::uint32_t p : P) {
-      if (p == F[0] || p == F[1] || p == F[2]) continue;
-      const std::uint32_t ip = surf_index[p];
+      if (same && (p == F[0] || p == F[1] || p == F[2])) continue;
+      const std::uint32_t ip = PB.topo->surf_index[p];
       // Cheap rejections before the ownership scan (repeated inside, harmless).
-      if (!vmoved[ip] && !tmov[face]) continue;
-      if (!boxes_overlap(vbox[ip], tbox[face], opt.ccd.min_separation)) continue;
+      if (!PB.vmoved[ip] && !FB.tmov[face]) continue;
+      if (!boxes_overlap(PB.vbox[ip], FB.tbox[face], ms)) continue;
+      if (separated()) return;
       bool owner = true;
+      const auto& vt_offset = PB.topo->vt_offset;
+      const auto& vt_list = PB.topo->vt_list;
       for (std::uint32_t k = vt_offset[ip]; k < vt_offset[ip + 1] && owner; ++k)
-        if (claimed(vt_list[k], face)) owner = false;
-      if (owner) process_vertex_face(w, p, face);
+        if (dir == 0 ? claimed(vt_list[k], face) : claimed(face, vt_list[k])) owner = false;
+      if (owner) process_vertex_face(w, PB, p, FB, face);
       if (w.stop) return;
     }
   }
   // Edge-edge.
+  const auto& EA = A.topo->edges;
+  const auto& EB = B.topo->edges;
   for (std::uint32_t i = 0; i < 3; ++i) {
-    const std::uint32_t e1 = tri_edges[t1][i];
+    const std::uint32_t e1 = A.topo->tri_edges[t1][i];
     // tbox[t2] contains the boxes of t2's edges: one check rejects all three.
-    if (!boxes_overlap(ebox[e1], tbox[t2], opt.ccd.min_separation)) continue;
+    if (!boxes_overlap(A.ebox[e1], B.tbox[t2], ms)) continue;
     for (std::uint32_t j = 0; j < 3; ++j) {
-      const std::uint32_t e2 = tri_edges[t2][j];
-      const auto& E1 = edges[e1];
-      const auto& E2 = edges[e2];
-      if (E1[0] == E2[0] || E1[0] == E2[1] || E1[1] == E2[0] || E1[1] == E2[1]) continue;
-      if (!edge_boxes_overlap(e1, e2)) continue;
+      const std::uint32_t e2 = B.topo->tri_edges[t2][j];
+      const auto& E1 = EA[e1];
+      const auto& E2 = EB[e2];
+      if (same && (E1[0] == E2[0] || E1[0] == E2[1] || E1[1] == E2[0] || E1[1] == E2[1])) continue;
+      if (!edge_boxes_overlap(A, e1, B, e2)) continue;
+      if (separated()) return;
       bool owner = true;
-      for (std::uint32_t k1 = et_offset[e1]; k1 < et_offset[e1 + 1] && owner; ++k1) {
-        for (std::uint32_t k2 = et_offset[e2]; k2 < et_offset[e2 + 1] && owner; ++k2) {
-          const std::uint32_t u = et_list[k1], v = et_list[k2];
-          if (u != v && claimed(u, v)) owner = false;
+      const auto& ea_offset = A.topo->et_offset;
+      const auto& ea_list = A.topo->et_list;
+      const auto& eb_offset = B.topo->et_offset;
+      const auto& eb_list = B.topo->et_list;
+      for (std::uint32_t k1 = ea_offset[e1]; k1 < ea_offset[e1 + 1] && owner; ++k1) {
+        for (std::uint32_t k2 = eb_offset[e2]; k2 < eb_offset[e2 + 1] && owner; ++k2) {
+          const std::uint32_t u = ea_list[k1], v = eb_list[k2];
+          if ((!same || u != v) && claimed(u, v)) owner = false;
         }
       }
-      if (owner) process_edge_edge(w, e1, e2);
+      if (owner) process_edge_edge(w, A, e1, B, e2);
       if (w.stop) return;
     }
   }
@@ -220,12 +301,12 @@ void Collider::Impl::process_triangle_pair(Worker& w, std::uint32_t t1,
                                            std::uint32_t t2) const noexcept {
   if (!non_culled(t1, t2)) return;
   if (rest_mode) {
-    rest_triangle_pair(w, t1, t2);
+    rest_triangle_pair(w, *this, t1, *this, t2);
     return;
   }
   ++w.stats.triangle_pairs;
   const std::uint64_t key = pair_key(t1, t2);
-  test_features(w, t1, t2, [&](std::uint32_t u, std::uint32_t v) {
+  test_features(w, *this, t1, *this, t2, [&](std::uint32_t u, std::uint32_t v) {
     return pair_key(u, v) < key && non_culled(u, v);
   });
 }
@@ -240,9 +321,9 @@ void Collider::Impl::close_contacts(Worker& w, double toi) noexcept {
   auto add_ring = [&](const Contact& c) {
     if (c.toi != toi) return;
     for (std::uint32_t node : c.nodes) {
-      const std::uint32_t iv = surf_index[node];
-      for (std::uint32_t k = vt_offset[iv]; k < vt_offset[iv + 1]; ++k) {
-        const std::uint32_t t = vt_list[k];
+      const std::uint32_t iv = topo->surf_index[node];
+      for (std::uint32_t k = topo->vt_offset[iv]; k < topo->vt_offset[iv + 1]; ++k) {
+        const std::uint32_t t = topo->vt_list[k];
         if (!closure_mark[t]) {
           closure_mark[t] = 1;
           closure_ring.push_back(t);
@@ -261,7 +342,7 @@ void Collider::Impl::close_contacts(Worker& w, double toi) noexcept {
       ++w.stats.closure_pairs;
       const std::uint64_t key = pair_key(t1, t2);
       // Claimed: tested by the traversal (non-culled), or earlier in this closure.
-      test_features(w, t1, t2, [&](std::uint32_t u, std::uint32_t v) {
+      test_features(w, *this, t1, *this, t2, [&](std::uint32_t u, std::uint32_t v) {
         return non_culled(u, v) || (pair_key(u, v) < key && closure_mark[u] && closure_mark[v] &&
                                     orientation_culled(u, v));
       });
@@ -270,25 +351,26 @@ void Collider::Impl::close_contacts(Worker& w, double toi) noexcept {
   for (std::uint32_t t : closure_ring) closure_mark[t] = 0;
 }
 
-void Collider::Impl::leaf_pair(Worker& w, const TreeView& ta, std::uint32_t a, const TreeView& tb,
-                               std::uint32_t b) const noexcept {
+// Calls `triangle_pair(t1, t2)` for every triangle pair of leaf a of ta and leaf b of tb.
+template <typename TrianglePair>
+inline void leaf_pair(Worker& w, const TreeView& ta, std::uint32_t a, const TreeView& tb,
+                      std::uint32_t b, TrianglePair&& triangle_pair) noexcept {
   const format::BvhNode& na = ta.nodes[a];
   const format::BvhNode& nb = tb.nodes[b];
   for (std::uint32_t i = 0; i < na.count && !w.stop; ++i) {
     for (std::uint32_t j = 0; j < nb.count && !w.stop; ++j) {
-      process_triangle_pair(w, ta.leaf_tris[na.first + i], tb.leaf_tris[nb.first + j]);
+      triangle_pair(ta.leaf_tris[na.first + i], tb.leaf_tris[nb.first + j]);
     }
   }
 }
 
 // One step of a pair descent: a pair of leaves is processed, otherwise the live child pairs
 // are pushed. False when the stack has no room.
-template <typename Live>
-bool Collider::Impl::descend_pair(Worker& w, const TreeView& ta, const TreeView& tb,
-                                  const StackItem& it, Live&& live,
-                                  std::size_t& top) const noexcept {
+template <typename Live, typename TrianglePair>
+inline bool descend_pair(Worker& w, const TreeView& ta, const TreeView& tb, const StackItem& it,
+                         Live&& live, TrianglePair&& triangle_pair, std::size_t& top) noexcept {
   if (ta.nodes[it.a].count > 0 && tb.nodes[it.b].count > 0) {
-    leaf_pair(w, ta, it.a, tb, it.b);
+    leaf_pair(w, ta, it.a, tb, it.b, triangle_pair);
     return true;
   }
   if (top + 2 > w.stack.size()) return false;
@@ -296,14 +378,14 @@ bool Collider::Impl::descend_pair(Worker& w, const TreeView& ta, const TreeView&
   return true;
 }
 
-bool Collider::Impl::traverse_pair(Worker& w, const TreeView& ta,
-                                   const TreeView& tb) const noexcept {
-  // Same-tree pairs come from traverse_self; here the roots of two trees. A pair is tested
-  // (not both still, boxes overlap) before it is pushed, so popped pairs are live.
-  const double ms = opt.ccd.min_separation;
+// Traverses two different trees (of one body or of two bodies) culled by overlap only. A pair
+// is tested (not both still unless `rest`, boxes overlap) before it is pushed, so popped pairs
+// are live. False on stack overflow.
+template <typename TrianglePair>
+bool traverse_tree_pair(Worker& w, const TreeView& ta, const TreeView& tb, double ms, bool rest,
+                        TrianglePair&& triangle_pair) noexcept {
   auto live = [&](std::uint32_t a, std::uint32_t b) {
-    return (rest_mode || ta.nmov[a] != 0 || tb.nmov[b] != 0) &&
-           boxes_overlap(ta.box[a], tb.box[b], ms);
+    return (rest || ta.nmov[a] != 0 || tb.nmov[b] != 0) && boxes_overlap(ta.box[a], tb.box[b], ms);
   };
   if (!live(0, 0)) return true;
   std::size_t top = 0;
@@ -311,7 +393,43 @@ bool Collider::Impl::traverse_pair(Worker& w, const TreeView& ta,
   while (top > 0 && !w.stop) {
     const StackItem it = w.stack[--top];
     ++w.stats.node_pairs_visited;
-    if (!descend_pair(w, ta, tb, it, live, top)) return false;
+    if (!descend_pair(w, ta, tb, it, live, triangle_pair, top)) return false;
+  }
+  return true;
+}
+
+bool Collider::Impl::traverse_pair(Worker& w, const TreeView& ta,
+                                   const TreeView& tb) const noexcept {
+  return traverse_tree_pair(
+      w, ta, tb, opt.ccd.min_separation, rest_mode,
+      [&](std::uint32_t t1, std::uint32_t t2) { process_triangle_pair(w, t1, t2); });
+}
+
+bool traverse_bodies(Worker& w, const Collider::Impl& A, const Collider::Impl& B,
+                     bool rest) noexcept {
+  const double ms = rest ? 0.0 : A.opt.ccd.min_separation;
+  // A triangle pair of two bodies is non-culled when not both triangles are still and their
+  // swept boxes overlap; a feature pair is tested from the smallest (t of A, t of B) such pair.
+  auto live = [&](std::uint32_t u, std::uint32_t v) {
+    return (A.tmov[u] || B.tmov[v]) && boxes_overlap(A.tbox[u], B.tbox[v], ms);
+  };
+  auto triangle_pair = [&](std::uint32_t t1, std::uint32_t t2) {
+    if (rest) {
+      if (boxes_overlap(A.tbox[t1], B.tbox[t2], 0.0)) rest_triangle_pair(w, A, t1, B, t2);
+      return;
+    }
+    if (!live(t1, t2)) return;
+    ++w.stats.triangle_pairs;
+    test_features(w, A, t1, B, t2, [&](std::uint32_t u, std::uint32_t v) {
+      return (u < t1 || (u == t1 && v < t2)) && live(u, v);
+    });
+  };
+  const std::uint32_t na = A.tree_count(), nb = B.tree_count();
+  for (std::uint32_t i = 0; i < na && !w.stop; ++i) {
+    const TreeView ta = A.tree(i);
+    for (std::uint32_t j = 0; j < nb && !w.stop; ++j) {
+      if (!traverse_tree_pair(w, ta, B.tree(j), ms, rest, triangle_pair)) return false;
+    }
   }
   return true;
 }
@@ -335,6 +453,7 @@ bool Collider::Impl::traverse_self(Worker& w, const TreeView& t) const noexcept 
     }
     return true;
   };
+  auto self_pair = [&](std::uint32_t t1, std::uint32_t t2) { process_triangle_pair(w, t1, t2); };
   std::size_t top = 0;
   w.stack[top++] = {0, kNone};
   while (top > 0 && !w.stop) {
@@ -360,34 +479,34 @@ bool Collider::Impl::traverse_self(Worker& w, const TreeView& t) const noexcept 
       w.stack[top++] = {nd.first, kNone};
       continue;
     }
-    if (!descend_pair(w, t, t, it, live_pair, top)) return false;
+    if (!descend_pair(w, t, t, it, live_pair, self_pair, top)) return false;
   }
   return true;
 }
 
 void Collider::Impl::brute_vertex_faces(Worker& w, std::uint32_t i) const noexcept {
   // Vertex i against every triangle not containing it (swept-box overlap checked inside).
-  const std::uint32_t p = surf_nodes[i];
+  const std::uint32_t p = topo->surf_nodes[i];
   for (std::uint32_t f = 0; f < tri_count && !w.stop; ++f) {
-    const auto& F = asset->triangles[f];
+    const auto& F = tris[f];
     if (p == F[0] || p == F[1] || p == F[2]) continue;
-    process_vertex_face(w, p, f);
+    process_vertex_face(w, *this, p, *this, f);
   }
 }
 
 void Collider::Impl::brute_edge_edges(Worker& w, std::uint32_t i) const noexcept {
   // Edge i against every later edge with four distinct nodes.
-  const std::uint32_t ne = static_cast<std::uint32_t>(edges.size());
-  const auto& E1 = edges[i];
+  const std::uint32_t ne = static_cast<std::uint32_t>(topo->edges.size());
+  const auto& E1 = topo->edges[i];
   for (std::uint32_t j = i + 1; j < ne && !w.stop; ++j) {
-    const auto& E2 = edges[j];
+    const auto& E2 = topo->edges[j];
     if (E1[0] == E2[0] || E1[0] == E2[1] || E1[1] == E2[0] || E1[1] == E2[1]) continue;
-    process_edge_edge(w, i, j);
+    process_edge_edge(w, *this, i, *this, j);
   }
 }
 
 bool Collider::Impl::cluster_tasks(Worker& w, std::uint32_t c1, bool count_skips) const noexcept {
-  const std::uint32_t nc = static_cast<std::uint32_t>(asset->clusters.size());
+  const std::uint32_t nc = cluster_count();
   const TreeView v1 = cluster_view(c1);
   const bool still = !rest_mode && v1.nmov[0] == 0;
   const bool one_sign =
@@ -406,25 +525,12 @@ bool Collider::Impl::cluster_tasks(Worker& w, std::uint32_t c1, bool count_skips
   return true;
 }
 
-namespace {
-
-void add_counts(ColliderStats& to, const ColliderStats& from) noexcept {
-  to.clusters_skipped += from.clusters_skipped;
-  to.closure_pairs += from.closure_pairs;
-  to.node_pairs_visited += from.node_pairs_visited;
-  to.node_pairs_orientation_culled += from.node_pairs_orientation_culled;
-  to.triangle_pairs += from.triangle_pairs;
-  to.feature_pairs += from.feature_pairs;
-  to.feature_pairs_filtered += from.feature_pairs_filtered;
-  to.feature_tests += from.feature_tests;
-  to.contacts += from.contacts;
-}
-
-}  // namespace
-
 bool Collider::Impl::run_query(Contact* out, std::size_t out_cap) noexcept {
   const auto t_start = Clock::now();
-  for (Worker& w : workers) w.reset();
+  for (Worker& w : workers) {
+    w.reset();
+    w.qkind = qkind;
+  }
   Worker& w0 = workers[0];
   w0.out = out;
   w0.out_cap = out ? out_cap : 0;
@@ -435,11 +541,10 @@ bool Collider::Impl::run_query(Contact* out, std::size_t out_cap) noexcept {
   const bool parallel = workers.size() > 1 && out == nullptr && !rest_mode;
   (void)parallel;
   if (!stats.nothing_moved || rest_mode) {
-    const format::Asset& fa = *asset;
-    const std::uint32_t nc = static_cast<std::uint32_t>(fa.clusters.size());
-    const std::int64_t nv = static_cast<std::int64_t>(surf_nodes.size());
-    const std::int64_t ne = static_cast<std::int64_t>(edges.size());
-    if ((opt.mode == ColliderMode::kBvh || opt.mode == ColliderMode::kCone) && !rest_mode) {
+    const std::uint32_t nc = cluster_count();
+    const std::int64_t nv = static_cast<std::int64_t>(topo->surf_nodes.size());
+    const std::int64_t ne = static_cast<std::int64_t>(topo->edges.size());
+    if (global_bvh_active()) {
       if (tri_count > 0 && !traverse_self(w0, global_view())) w0.overflow = true;
     } else if (opt.mode == ColliderMode::kBrute && !rest_mode) {
 #if defined(TETSEG_HAVE_OPENMP)
@@ -508,12 +613,9 @@ bool Collider::Impl::run_query(Contact* out, std::size_t out_cap) noexcept {
     hit = hit || w.stop;
     found += w.found;
     tests_seconds += w.tests_seconds;
-    if (w.has_best && (!has || contact_less(w.best, first))) {
-      first = w.best;
-      has = true;
-    }
+    keep_earliest(has, first, w.has_best, w.best);
   }
-  const double total_ms = std::chrono::duration<double, std::milli>(Clock::now() - t_start).count();
+  const double total_ms = ms_since(t_start);
   const double tests_ms = tests_seconds * 1e3;
   stats.tests_ms += tests_ms;
   stats.traversal_ms += std::max(0.0, total_ms - tests_ms);
@@ -522,12 +624,7 @@ bool Collider::Impl::run_query(Contact* out, std::size_t out_cap) noexcept {
   out_written = w0.out_written;
   if (qkind == QueryKind::kFull && !rest_mode) {
     stats.full_traversal = true;
-    full_done = true;
-    full_found = found;
-    has_best = has;
-    best = first;
-    any_known = true;
-    any_value = found > 0;
+    cache.set_full(found, has, first);
   }
   return true;
 }

@@ -126,10 +126,10 @@ void Collider::Impl::build_cone_topology(ConeData& cd, const ConeTree& tree,
     local.clear();
     bool manifold = true;
     for (std::uint32_t k = begin[i]; k < end[i] && manifold; ++k) {
-      for (std::uint32_t e : tri_edges[tree.leaf[k]]) {
+      for (std::uint32_t e : topo->tri_edges[tree.leaf[k]]) {
         std::uint32_t inside = 0;
-        for (std::uint32_t j = et_offset[e]; j < et_offset[e + 1]; ++j)
-          inside += pos[et_list[j]] >= begin[i] && pos[et_list[j]] < end[i];
+        for (std::uint32_t j = topo->et_offset[e]; j < topo->et_offset[e + 1]; ++j)
+          inside += pos[topo->et_list[j]] >= begin[i] && pos[topo->et_list[j]] < end[i];
         if (inside == 1) local.push_back(e);
         if (inside > 2) manifold = false;
       }
@@ -139,8 +139,8 @@ void Collider::Impl::build_cone_topology(ConeData& cd, const ConeTree& tree,
       // Every boundary vertex on exactly two boundary edges, and one cycle through all edges.
       verts.clear();
       for (std::uint32_t e : local) {
-        verts.push_back(edges[e][0]);
-        verts.push_back(edges[e][1]);
+        verts.push_back(topo->edges[e][0]);
+        verts.push_back(topo->edges[e][1]);
       }
       std::sort(verts.begin(), verts.end());
       for (std::size_t v = 0; v < verts.size() && ok; v += 2)
@@ -149,14 +149,14 @@ void Collider::Impl::build_cone_topology(ConeData& cd, const ConeTree& tree,
     }
     if (ok) {
       std::size_t walked = 1;
-      std::uint32_t prev = local[0], at = edges[local[0]][1];
-      const std::uint32_t start = edges[local[0]][0];
+      std::uint32_t prev = local[0], at = topo->edges[local[0]][1];
+      const std::uint32_t start = topo->edges[local[0]][0];
       while (at != start && walked <= local.size()) {
         std::uint32_t next = kNone;
         for (std::uint32_t e : local)
-          if (e != prev && (edges[e][0] == at || edges[e][1] == at)) next = e;
+          if (e != prev && (topo->edges[e][0] == at || topo->edges[e][1] == at)) next = e;
         if (next == kNone) break;
-        at = edges[next][0] == at ? edges[next][1] : edges[next][0];
+        at = topo->edges[next][0] == at ? topo->edges[next][1] : topo->edges[next][0];
         prev = next;
         ++walked;
       }
@@ -172,9 +172,10 @@ void Collider::Impl::build_cone_topology(ConeData& cd, const ConeTree& tree,
 }
 
 void Collider::Impl::build_global_cones() {
-  cone.init(gnode_count);
+  cone.init(gbvh.count);
   std::vector<std::uint32_t> pos(tri_count, kNone);
-  build_cone_topology(cone, ConeTree{gnodes.data(), gleaf.data(), gnode_count, tri_count, 0}, pos);
+  build_cone_topology(cone, ConeTree{gbvh.nodes.data(), gbvh.leaf.data(), gbvh.count, tri_count, 0},
+                      pos);
   cone.topology_built = true;
 }
 
@@ -186,11 +187,10 @@ void Collider::Impl::update_cones() noexcept {
       return;  // angles stay wide: nothing is culled
     }
   }
-  update_cone_tree(cone, ConeTree{gnodes.data(), gleaf.data(), gnode_count, tri_count, 0});
+  update_cone_tree(cone, ConeTree{gbvh.nodes.data(), gbvh.leaf.data(), gbvh.count, tri_count, 0});
 }
 
 void Collider::Impl::update_cone_tree(ConeData& cd, const ConeTree& tree) noexcept {
-  const format::Asset& fa = *asset;
   for (std::uint32_t i = tree.count; i-- > 0;) {
     const format::BvhNode& nd = tree.nodes[i];
     V3 axis{0, 0, 1};
@@ -201,7 +201,7 @@ void Collider::Impl::update_cone_tree(ConeData& cd, const ConeTree& tree) noexce
       int m = 0;
       bool degenerate = nd.count > kMaxConeLeaf;
       for (std::uint32_t k = 0; k < nd.count && !degenerate; ++k) {
-        const auto& t = fa.triangles[tree.leaf[nd.first + k]];
+        const auto& t = tris[tree.leaf[nd.first + k]];
         const V3 u0 = sub(pos0(t[1]), pos0(t[0])), w0 = sub(pos0(t[2]), pos0(t[0]));
         const V3 u1 = sub(pos1(t[1]), pos1(t[0])), w1 = sub(pos1(t[2]), pos1(t[0]));
         const V3 a = cross(u0, w1), b = cross(u1, w0);
@@ -282,7 +282,7 @@ bool Collider::Impl::cone_self_free(const ConeData& cd, std::uint32_t node) cons
   P2 p0[kMaxContourEdges][2], p1[kMaxContourEdges][2];
   double box[kMaxContourEdges][4];
   for (std::uint32_t i = 0; i < k; ++i) {
-    const auto& e = edges[cd.bnd_edges[first + i]];
+    const auto& e = topo->edges[cd.bnd_edges[first + i]];
     for (int s = 0; s < 2; ++s) {
       p0[i][s] = project(pos0(e[s]));
       p1[i][s] = project(pos1(e[s]));
@@ -298,9 +298,9 @@ bool Collider::Impl::cone_self_free(const ConeData& cd, std::uint32_t node) cons
     return bernstein_sign(sub2(b0, a0), sub2(b1, a1), sub2(c0, a0), sub2(c1, a1), false);
   };
   for (std::uint32_t i = 0; i < k; ++i) {
-    const auto& ei = edges[cd.bnd_edges[first + i]];
+    const auto& ei = topo->edges[cd.bnd_edges[first + i]];
     for (std::uint32_t j = i + 1; j < k; ++j) {
-      const auto& ej = edges[cd.bnd_edges[first + j]];
+      const auto& ej = topo->edges[cd.bnd_edges[first + j]];
       int si = -1, sj = -1;  // shared vertex slots
       for (int a = 0; a < 2; ++a)
         for (int b = 0; b < 2; ++b)

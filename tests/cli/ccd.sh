@@ -104,4 +104,14 @@ check_frame() {
 }
 check_frame cloth-funnel 227 228
 check_frame rod-twist 3036 3037
+
+# The runtime scene path (one surface-only body) lists exactly brute force's contacts on a
+# reference frame, in the same order and with the same times.
+funnel="$data/sample-scalable-ccd-data/cloth-funnel/frames"
+if [ -d "$funnel" ]; then
+  "$tool" frames "$funnel/227.ply" "$funnel/228.ply" 2>/dev/null > "$work/scene"
+  "$tool" frames "$funnel/227.ply" "$funnel/228.ply" --brute 2>/dev/null > "$work/brute"
+  [ "$(wc -l < "$work/scene")" -eq 134 ] || fail "cloth-funnel: $(wc -l < "$work/scene") contacts, expected 134"
+  cmp -s "$work/scene" "$work/brute" || fail "cloth-funnel: scene and brute force differ"
+fi
 echo "ok"

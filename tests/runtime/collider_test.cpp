@@ -154,9 +154,9 @@ TEST_CASE("Rigid motions and zero motion report no contact", "[collider][numeric
       Collider c(scene.asset, o);
       for (std::size_t f = 0; f + 1 < frames.size(); ++f) {
         REQUIRE(c.step(frames[f].data(), frames[f + 1].data()) == ColliderStatus::kOk);
-        CHECK_FALSE(c.any_collision());
-        CHECK(c.contacts(nullptr, 0).found == 0);
-        CHECK_FALSE(c.earliest_toi().found);
+        CHECK_FALSE(any_ok(c));
+        CHECK(contacts_ok(c, nullptr, 0).found == 0);
+        CHECK_FALSE(earliest_ok(c).found);
       }
     }
   }
@@ -164,7 +164,7 @@ TEST_CASE("Rigid motions and zero motion report no contact", "[collider][numeric
     Collider c(scene.asset);
     REQUIRE(c.step(scene.rest.data(), scene.rest.data()) == ColliderStatus::kOk);
     CHECK(c.stats().nothing_moved);
-    CHECK_FALSE(c.any_collision());
+    CHECK_FALSE(any_ok(c));
     CHECK(c.stats().feature_tests == 0);
     CHECK(c.stats().node_pairs_visited == 0);
   }
@@ -175,7 +175,7 @@ TEST_CASE("Rigid motions and zero motion report no contact", "[collider][numeric
         db, 16, [](const P3& p, double t) { return bend_about_x(p, t, 2.6, 0.6, 0.9, 0.6); });
     Collider c(db.asset);
     REQUIRE(c.step(frames[0].data(), frames[1].data()) == ColliderStatus::kOk);
-    c.earliest_toi();
+    earliest_ok(c);
     CHECK(c.stats().clusters_skipped >= 1);
     const SequenceReport rep = compare_with_brute(db, frames);
     CHECK(rep.contact_frames == 1);
@@ -210,8 +210,11 @@ TEST_CASE("Invalid step input is rejected with a status", "[collider][api]") {
   CHECK(c.step(nullptr, x.data()) == ColliderStatus::kNullInput);
   x[4] = std::nan("");
   CHECK(c.step(scene.rest.data(), x.data()) == ColliderStatus::kNonFinite);
-  CHECK_FALSE(c.any_collision());
-  CHECK(c.contacts(nullptr, 0).status == ColliderStatus::kNotReady);
+  bool hit = true;
+  CHECK(c.any_collision(hit) == ColliderStatus::kNoStep);
+  CHECK_FALSE(hit);
+  ContactsResult r;
+  CHECK(c.contacts(nullptr, 0, r) == ColliderStatus::kNoStep);
   x[4] = INFINITY;
   CHECK(c.step(x.data(), scene.rest.data()) == ColliderStatus::kNonFinite);
 }
@@ -222,17 +225,17 @@ TEST_CASE("Contacts are truncated to the caller's capacity and the count is repo
   const auto frames = make_frames(scene, 3, press_poles);  // one big step through the centre
   Collider c(scene.asset);
   REQUIRE(c.step(frames[0].data(), frames[2].data()) == ColliderStatus::kOk);
-  const ContactsResult all = c.contacts(nullptr, 0);
+  const ContactsResult all = contacts_ok(c, nullptr, 0);
   REQUIRE(all.found > 3);
   std::vector<Contact> buf(2);
-  const ContactsResult r = c.contacts(buf.data(), buf.size());
+  const ContactsResult r = contacts_ok(c, buf.data(), buf.size());
   CHECK(r.found == all.found);
   CHECK(r.written == 2);
   CHECK(r.truncated());
-  const EarliestContact e = c.earliest_toi();
+  const EarliestContact e = earliest_ok(c);
   REQUIRE(e.found);
   std::vector<Contact> full(all.found);
-  const ContactsResult f = c.contacts(full.data(), full.size());
+  const ContactsResult f = contacts_ok(c, full.data(), full.size());
   REQUIRE_FALSE(f.truncated());
   CHECK(full.front().toi == e.contact.toi);
   CHECK(same_feature(full.front(), e.contact));
@@ -273,9 +276,8 @@ TEST_CASE("Degenerate chain BVHs as deep as the cluster is large are traversed c
   for (std::size_t f = 0; f + 1 < frames.size(); ++f) {
     REQUIRE(a.step(frames[f].data(), frames[f + 1].data()) == ColliderStatus::kOk);
     REQUIRE(b.step(frames[f].data(), frames[f + 1].data()) == ColliderStatus::kOk);
-    const ContactsResult ra = a.contacts(ca.data(), ca.size());
-    const ContactsResult rb = b.contacts(cb.data(), cb.size());
-    REQUIRE(ra.status == ColliderStatus::kOk);
+    const ContactsResult ra = contacts_ok(a, ca.data(), ca.size());
+    const ContactsResult rb = contacts_ok(b, cb.data(), cb.size());
     REQUIRE(ra.found == rb.found);
     for (std::size_t i = 0; i < ra.written; ++i) CHECK(same_feature(ca[i], cb[i]));
   }
@@ -297,8 +299,8 @@ TEST_CASE("A minimum separation finds contacts no later and no fewer than exact 
     for (std::size_t f = 0; f + 1 < frames.size(); ++f) {
       REQUIRE(exact.step(frames[f].data(), frames[f + 1].data()) == ColliderStatus::kOk);
       REQUIRE(near.step(frames[f].data(), frames[f + 1].data()) == ColliderStatus::kOk);
-      const ContactsResult re = exact.contacts(ce.data(), ce.size());
-      const ContactsResult rn = near.contacts(cn.data(), cn.size());
+      const ContactsResult re = contacts_ok(exact, ce.data(), ce.size());
+      const ContactsResult rn = contacts_ok(near, cn.data(), cn.size());
       REQUIRE_FALSE(rn.truncated());
       for (std::size_t i = 0; i < re.written; ++i) {
         const bool found = std::any_of(cn.begin(), cn.begin() + rn.written,
@@ -306,7 +308,7 @@ TEST_CASE("A minimum separation finds contacts no later and no fewer than exact 
         CHECK(found);
       }
       if (re.found > 0) {
-        CHECK(near.earliest_toi().contact.toi <= exact.earliest_toi().contact.toi);
+        CHECK(earliest_ok(near).contact.toi <= earliest_ok(exact).contact.toi);
         break;
       }
       near_earlier = near_earlier || rn.found > 0;

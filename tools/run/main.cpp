@@ -70,22 +70,29 @@ int run(const std::string& asset_path, const std::string& frames_path, const std
     if (st != tetseg::ColliderStatus::kOk)
       throw ToolError(kExitBadInput, frames_path,
                       "frame " + std::to_string(f) + ": " + tetseg::to_string(st));
+    tetseg::ColliderStatus qs = tetseg::ColliderStatus::kOk;
     if (query == "any") {
-      r.any = collider.any_collision();
+      qs = collider.any_collision(r.any);
     } else if (query == "earliest") {
-      const tetseg::EarliestContact e = collider.earliest_toi();
+      tetseg::EarliestContact e;
+      qs = collider.earliest_toi(e);
       r.any = e.found;
       r.has_earliest = e.found;
       r.earliest = e.contact.toi;
     } else {
-      const tetseg::ContactsResult c = collider.contacts(nullptr, 0);
-      const tetseg::EarliestContact e = collider.earliest_toi();  // reuses the traversal
+      tetseg::ContactsResult c;
+      tetseg::EarliestContact e;
+      qs = collider.contacts(nullptr, 0, c);
+      if (qs == tetseg::ColliderStatus::kOk) qs = collider.earliest_toi(e);  // reuses the traversal
       r.any = c.found > 0;
       r.has_contacts = true;
       r.contacts = c.found;
       r.has_earliest = e.found;
       r.earliest = e.contact.toi;
     }
+    if (qs != tetseg::ColliderStatus::kOk)
+      throw ToolError(kExitProcessingFailed, frames_path,
+                      "frame " + std::to_string(f) + ": query failed: " + tetseg::to_string(qs));
     total += std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
     const tetseg::ColliderStats& stats = collider.stats();
     refit += stats.refit_ms;
@@ -145,7 +152,8 @@ int main(int argc, char** argv) {
   bool json = false;
   app.add_option("asset", asset_path, "Asset file (.tetseg)")->required();
   app.add_option("frames", frames_path, "Frame-sequence file (docs/format.md)")->required();
-  app.add_option("--mode", mode, "Candidate search: rvbc (default), bvh, brute or cone (normal cones, ICCD-style)")
+  app.add_option("--mode", mode,
+                 "Candidate search: rvbc (default), bvh, brute or cone (normal cones, ICCD-style)")
       ->check(CLI::IsMember({"rvbc", "bvh", "brute", "cone"}));
   app.add_option("--query", query, "any, earliest or all (default)")
       ->check(CLI::IsMember({"any", "earliest", "all"}));

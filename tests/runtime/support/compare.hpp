@@ -9,6 +9,7 @@
 
 #include <catch2/catch.hpp>
 
+#include "runtime/support/queries.hpp"
 #include "tetseg/runtime/collider.hpp"
 #include "tetseg/testing/synthetic_scenes.hpp"
 
@@ -40,14 +41,13 @@ struct StepAnswer {
 inline StepAnswer answer(Collider& collider, const double* x0, const double* x1) {
   StepAnswer a;
   REQUIRE(collider.step(x0, x1) == ColliderStatus::kOk);
-  a.any = collider.any_collision();  // early-exit path first
+  a.any = any_ok(collider);  // early-exit path first
   std::vector<Contact> buffer(1 << 16);
-  const ContactsResult r = collider.contacts(buffer.data(), buffer.size());
-  REQUIRE(r.status == ColliderStatus::kOk);
+  const ContactsResult r = contacts_ok(collider, buffer.data(), buffer.size());
   REQUIRE_FALSE(r.truncated());
   buffer.resize(r.written);
   a.contacts = buffer;
-  a.earliest = collider.earliest_toi();
+  a.earliest = earliest_ok(collider);
   CHECK(a.any == !a.contacts.empty());
   CHECK(a.earliest.found == a.any);
   // No feature pair is reported twice (deduplication over all non-culled pairs).

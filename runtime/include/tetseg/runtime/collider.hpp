@@ -5,8 +5,9 @@
 /// allocates all of its scratch memory in the constructor, and then answers queries for each
 /// step `x(t) = (1-t) x0 + t x1`, t in [0,1], without allocating.
 ///
-/// Usage per step: `step(x0, x1)`, then any of `any_collision()`, `earliest_toi()`,
-/// `contacts()`. Queries do only the work they need and share results within a step.
+/// Usage per step: `step(x0, x1)`, then any of `any_collision(hit)`, `earliest_toi(e)`,
+/// `contacts(buffer, capacity, r)`, each returning a status. Queries do only the work they
+/// need and share results within a step.
 ///
 /// Thread safety: one `Collider` is used by one thread at a time. Several colliders may share
 /// one `Asset` (read-only) across threads. No function throws; failures are statuses.
@@ -17,6 +18,7 @@
 #include <memory>
 
 #include "tetseg/runtime/asset.hpp"
+#include "tetseg/runtime/body_shape.hpp"
 #include "tetseg/runtime/ccd.hpp"
 #include "tetseg/runtime/classify.hpp"
 
@@ -35,14 +37,18 @@ const char* to_string(ColliderMode mode) noexcept;
 /// Parses a name of `to_string`; false when unknown.
 bool parse_collider_mode(const char* name, ColliderMode& out) noexcept;
 
-/// Result of collider calls that can fail.
+/// Status of every collider and scene call. Only kOk comes with an answer: a query that does
+/// not return kOk leaves its out parameter empty, and that is not "no contact".
 enum class ColliderStatus : std::uint8_t {
   kOk = 0,
-  kNotReady,      ///< construction failed (out of memory), or no successful step yet
-  kNullInput,     ///< a position pointer is null
-  kSizeMismatch,  ///< value count differs from node_count * 3
-  kNonFinite,     ///< a position is NaN or infinite (step rejected, previous state dropped)
-  kInternal,      ///< internal limit exceeded (traversal stack); never expected
+  kNotReady,         ///< construction failed (out of memory); every call fails
+  kNullInput,        ///< a position pointer is null
+  kSizeMismatch,     ///< value count differs from node_count * 3
+  kNonFinite,        ///< a position is NaN or infinite (step rejected, previous state dropped)
+  kInternal,         ///< an internal inconsistency (never expected; not returned by the runtime)
+  kNoStep,           ///< query without a valid step (none yet, or the last one was rejected)
+  kOverflow,         ///< traversal stack exceeded (`traversal_stack` too small): answer unknown
+  kInvalidArgument,  ///< scene: unknown body id, body pair or layout
 };
 const char* to_string(ColliderStatus status) noexcept;
 
@@ -66,6 +72,9 @@ struct ColliderOptions {
   /// Time the elementary tests separately (two clock reads per test). When off, test time
   /// is counted as traversal.
   bool time_tests = true;
+  /// Traversal stack capacity in node pairs; 0 (default) sizes it from the BVH depths so that
+  /// it never overflows. A smaller value is for tests: queries then fail with kOverflow.
+  std::uint32_t traversal_stack = 0;
 };
 
 enum class ContactKind : std::uint8_t {
@@ -73,17 +82,20 @@ enum class ContactKind : std::uint8_t {
   kEdgeEdge = 1,    ///< nodes = {a, b, c, d}: edge (a, b) against edge (c, d)
 };
 
-/// One feature pair found in contact. Tet-mesh node ids. Edge-edge pairs are normalised:
-/// a < b, c < d, (a, b) < (c, d) lexicographically.
+/// One feature pair found in contact. Node ids are local to their body: `nodes[0]` (the vertex,
+/// or edge (a, b)) belongs to body `bodies[0]`, the rest (the face, or edge (c, d)) to
+/// `bodies[1]` (a `Collider` is body 0; a `Scene` numbers its bodies). Edges are normalised:
+/// a < b, c < d, and within one body (a, b) < (c, d) lexicographically.
 struct Contact {
   ContactKind kind = ContactKind::kVertexFace;
+  std::array<std::uint32_t, 2> bodies{};
   std::array<std::uint32_t, 4> nodes{};
-  std::uint32_t triangle = 0;  ///< vertex-face: the surface triangle id of the face
+  std::uint32_t triangle = 0;  ///< vertex-face: the face's triangle id (in its body)
   double toi = 1.0;            ///< lower bound on the first contact time in [0,1]
   bool at_start = false;       ///< touching at t = 0 (toi == 0)
 };
 
-/// Strict total order used for deterministic results: by toi, then kind, then nodes.
+/// Strict total order used for deterministic results: by toi, then kind, bodies, nodes.
 bool contact_less(const Contact& a, const Contact& b) noexcept;
 
 struct EarliestContact {
@@ -92,7 +104,6 @@ struct EarliestContact {
 };
 
 struct ContactsResult {
-  ColliderStatus status = ColliderStatus::kOk;
   std::size_t found = 0;    ///< contacts found in this step (all of them)
   std::size_t written = 0;  ///< min(found, capacity): written to the buffer
   bool truncated() const noexcept { return found > written; }
@@ -106,13 +117,15 @@ struct ColliderStats {
   std::uint64_t nodes_moved = 0;
   std::uint64_t triangles_positive = 0, triangles_negative = 0, triangles_uncertain = 0;
   std::uint64_t triangles_moving = 0;
-  std::uint64_t clusters_skipped = 0;    ///< intra-cluster work skipped (one sign / static)
+  std::uint64_t clusters_skipped = 0;  ///< intra-cluster work skipped (one sign / static)
   /// kRvbc: orientation-culled triangle pairs around the earliest contacts re-examined by the
   /// contact closure (docs/runtime.md)
   std::uint64_t closure_pairs = 0;
   std::uint64_t node_pairs_visited = 0;  ///< BVH node pairs popped by traversal
   std::uint64_t node_pairs_orientation_culled = 0;
-  std::uint64_t triangle_pairs = 0;          ///< non-culled triangle pairs examined
+  std::uint64_t triangle_pairs = 0;  ///< non-culled triangle pairs examined
+  /// of those, dropped by the triangle-pair plane filter (no feature pair can touch)
+  std::uint64_t triangle_pairs_plane_filtered = 0;
   std::uint64_t feature_pairs = 0;           ///< distinct feature pairs whose boxes overlap
   std::uint64_t feature_pairs_filtered = 0;  ///< of those, rejected by the coplanarity filter
   std::uint64_t feature_tests = 0;           ///< elementary tests run
@@ -126,6 +139,9 @@ struct RestCheck {
   ColliderStatus status = ColliderStatus::kOk;
   bool intersecting = false;                     ///< some pair of triangles may intersect or touch
   std::uint32_t triangle_a = 0, triangle_b = 0;  ///< a witness pair when intersecting
+  /// The witnesses' bodies: triangle_a is in bodies[0], triangle_b in bodies[1] ({0, 0} for a
+  /// Collider).
+  std::array<std::uint32_t, 2> bodies{};
 };
 
 class Collider {
@@ -133,6 +149,9 @@ class Collider {
   /// Builds the collider and allocates all scratch memory. `asset` must outlive the collider
   /// and stay unchanged. On allocation failure `status()` is kNotReady and every call fails.
   Collider(const Asset& asset, const ColliderOptions& options = {}) noexcept;
+  /// Same over a shared, prebuilt topology (`BodyShape::from_asset` or, for a surface-only
+  /// mesh, `from_triangles`: no clusters, so `kRvbc` runs as `kBvh`). Null shape: kNotReady.
+  Collider(std::shared_ptr<const BodyShape> shape, const ColliderOptions& options = {}) noexcept;
   ~Collider();
   Collider(Collider&&) noexcept;
   Collider& operator=(Collider&&) noexcept;
@@ -156,17 +175,20 @@ class Collider {
   /// Same with value_count = node_count * 3 assumed.
   ColliderStatus step(const double* x0, const double* x1) noexcept;
 
-  /// Whether any feature pair is in contact during the step. Stops at the first contact
-  /// unless a full traversal already ran. False when there is no valid step.
-  bool any_collision() noexcept;
+  /// Whether any feature pair is in contact during the step, into `hit`. Stops at the first
+  /// contact unless a full traversal already ran. Every query returns kOk with its answer,
+  /// or kNotReady / kNoStep (no valid step) / kOverflow with an empty answer (`hit` false,
+  /// `found` false, zero counts) that must not be read as "no contact".
+  [[nodiscard]] ColliderStatus any_collision(bool& hit) noexcept;
   /// The earliest contact of the step (deterministic: smallest in `contact_less`).
   /// Runs a full traversal once per step; later queries reuse it.
-  EarliestContact earliest_toi() noexcept;
+  [[nodiscard]] ColliderStatus earliest_toi(EarliestContact& out) noexcept;
   /// All contacts of the step: the first `capacity` found are written to `buffer`
   /// (caller-owned; may be null when capacity is 0), then the written part is sorted with
-  /// `contact_less`. `found` counts all of them, so truncation is visible. Runs a traversal
-  /// each call (the list is not stored).
-  ContactsResult contacts(Contact* buffer, std::size_t capacity) noexcept;
+  /// `contact_less`. `out.found` counts all of them, so truncation is visible. Runs a
+  /// traversal each call (the list is not stored).
+  [[nodiscard]] ColliderStatus contacts(Contact* buffer, std::size_t capacity,
+                                        ContactsResult& out) noexcept;
 
   /// Statistics of the current step.
   const ColliderStats& stats() const noexcept;

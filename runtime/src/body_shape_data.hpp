@@ -1,0 +1,33 @@
+#pragma once
+// Private layout of tetseg::BodyShape: immutable surface topology shared by colliders and
+// scene bodies. Not installed.
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "tetseg/format/asset.hpp"
+#include "tetseg/runtime/body_shape.hpp"
+
+namespace tetseg {
+
+struct BodyShape::Data {
+  const format::Asset* asset = nullptr;  // tet body: clusters, detectors, rest positions
+  std::uint32_t node_count = 0;
+  std::vector<format::Triangle> own_triangles;  // surface-only body (asset: its triangles)
+  const format::Triangle* triangles = nullptr;  // tri_count entries
+  std::uint32_t tri_count = 0;
+  std::vector<std::uint32_t> surf_nodes;                // surface vertex -> node id (sorted)
+  std::vector<std::uint32_t> surf_index;                // node id -> surface vertex or kNone
+  std::vector<std::uint32_t> vt_offset, vt_list;        // surface vertex -> triangles (CSR)
+  std::vector<std::array<std::uint32_t, 2>> edges;      // node ids, [0] < [1], sorted
+  std::vector<std::array<std::uint32_t, 3>> tri_edges;  // edge ids of each triangle
+  std::vector<std::uint32_t> et_offset, et_list;        // edge -> triangles (CSR)
+  std::vector<std::uint32_t> cluster_node_ntris;        // per asset BVH node
+  std::uint32_t max_depth = 0;                          // of the asset's cluster BVHs
+
+  /// Builds everything from `triangles` / `asset` (set before the call). Allocates; may throw.
+  void build();
+};
+
+}  // namespace tetseg
