@@ -259,4 +259,8 @@ void write_gmsh22(const std::string& path, const TetMesh& mesh) {
   detail::write_gmsh22_impl(path, mesh);
 }
 
+void write_gmsh41_binary(const std::string& path, const TetMesh& mesh) {
+  detail::write_gmsh41_binary_impl(path, mesh);
+}
+
 }  // namespace tetseg::preprocess

@@ -19,12 +19,6 @@ namespace tetseg::tools {
 
 namespace mesh_cli {
 
-// Shared with cmd_tetrahedralize.cpp (declared there).
-void add_meshing_options(CLI::App& cmd, preprocess::MeshingOptions& m, bool& gmsh22);
-void check_output_path(const std::string& path);
-void finish_tet_mesh(const preprocess::TetMesh& mesh, const std::string& output, bool gmsh22,
-                     const std::string& what);
-
 /// Wall-clock stage timer that prints "tetseg: <label> ... <s> s, <details>" to stderr.
 class Stage {
  public:
@@ -42,7 +36,7 @@ class Stage {
   std::chrono::steady_clock::time_point m_start;
 };
 
-void add_meshing_options(CLI::App& cmd, preprocess::MeshingOptions& m, bool& gmsh22) {
+void add_meshing_options(CLI::App& cmd, preprocess::MeshingOptions& m, MshOutput& msh) {
   cmd.add_option("--cell-size", m.cell_size,
                  "Max tet circumradius (0 = facet size; see docs/cli.md, Meshing options)")
       ->check(CLI::NonNegativeNumber);
@@ -59,7 +53,10 @@ void add_meshing_options(CLI::App& cmd, preprocess::MeshingOptions& m, bool& gms
       ->check(CLI::Range(2.0, 1000.0));
   cmd.add_flag_callback(
       "--no-optimize", [&m] { m.optimize = false; }, "Skip sliver perturbation and exudation");
-  cmd.add_flag("--gmsh22", gmsh22, "Write Gmsh 2.2 instead of 4.1 when the output is .msh");
+  CLI::Option* gmsh22 =
+      cmd.add_flag("--gmsh22", msh.gmsh22, "Write Gmsh 2.2 instead of 4.1 when the output is .msh");
+  cmd.add_flag("--binary", msh.binary, "Write binary Gmsh 4.1 when the output is .msh")
+      ->excludes(gmsh22);
 }
 
 void check_output_path(const std::string& path) {
@@ -70,9 +67,12 @@ void check_output_path(const std::string& path) {
 
 namespace {
 
-void write_one(const std::string& path, const preprocess::TetMesh& mesh, bool gmsh22) {
-  if (gmsh22 && extension_of(path) == ".msh") {
+void write_one(const std::string& path, const preprocess::TetMesh& mesh, const MshOutput& msh) {
+  const bool gmsh = extension_of(path) == ".msh";
+  if (gmsh && msh.gmsh22) {
     preprocess::write_gmsh22(path, mesh);
+  } else if (gmsh && msh.binary) {
+    preprocess::write_gmsh41_binary(path, mesh);
   } else {
     preprocess::write_tet_mesh(path, mesh);
   }
@@ -80,7 +80,8 @@ void write_one(const std::string& path, const preprocess::TetMesh& mesh, bool gm
 
 /// Writes through temporary files in the output's directory and renames them into place;
 /// on failure no temporary file is left behind.
-void write_atomic(const std::string& output, const preprocess::TetMesh& mesh, bool gmsh22) {
+void write_atomic(const std::string& output, const preprocess::TetMesh& mesh,
+                  const MshOutput& msh) {
   const std::string ext = extension_of(output);
   const std::string stem = output.substr(0, output.size() - ext.size());
   const std::string temp_stem = stem + ".tmp" + std::to_string(::getpid());
@@ -96,7 +97,7 @@ void write_atomic(const std::string& output, const preprocess::TetMesh& mesh, bo
     for (const std::string& t : temps) std::remove(t.c_str());
   };
   try {
-    write_one(temps.front(), mesh, gmsh22);
+    write_one(temps.front(), mesh, msh);
   } catch (const preprocess::OutputError& e) {
     remove_temps();
     throw preprocess::OutputError(output, e.what());
@@ -110,8 +111,8 @@ void write_atomic(const std::string& output, const preprocess::TetMesh& mesh, bo
 
 }  // namespace
 
-void finish_tet_mesh(const preprocess::TetMesh& mesh, const std::string& output, bool gmsh22,
-                     const std::string& what) {
+void finish_tet_mesh(const preprocess::TetMesh& mesh, const std::string& output,
+                     const MshOutput& msh, const std::string& what) {
   {
     Stage stage("validating " + what);
     const preprocess::Surface surface = preprocess::extract_surface(mesh);
@@ -126,7 +127,7 @@ void finish_tet_mesh(const preprocess::TetMesh& mesh, const std::string& output,
                std::to_string(surface.interior_nodes.size()) + " interior nodes");
   }
   Stage stage("writing " + base_name(output));
-  write_atomic(output, mesh, gmsh22);
+  write_atomic(output, mesh, msh);
   stage.done("");
 }
 
@@ -140,7 +141,7 @@ struct GenerateArgs {
   preprocess::ShapeOptions shape_options;
   std::vector<double> axes;
   preprocess::MeshingOptions meshing;
-  bool gmsh22 = false;
+  mesh_cli::MshOutput msh;
 };
 
 void run_generate(const GenerateArgs& args) {
@@ -153,7 +154,7 @@ void run_generate(const GenerateArgs& args) {
   const preprocess::TetMesh mesh = preprocess::generate_shape(shape, shape_options, args.meshing);
   stage.done(std::to_string(mesh.nodes.size()) + " nodes, " + std::to_string(mesh.tets.size()) +
              " tets");
-  mesh_cli::finish_tet_mesh(mesh, args.output, args.gmsh22, args.shape);
+  mesh_cli::finish_tet_mesh(mesh, args.output, args.msh, args.shape);
 }
 
 }  // namespace
@@ -175,7 +176,7 @@ void add_generate_command(CLI::App& root) {
   cmd->add_option("--axes", args->axes, "Ellipsoid semi-axes a b c")
       ->expected(3)
       ->check(CLI::PositiveNumber);
-  mesh_cli::add_meshing_options(*cmd, args->meshing, args->gmsh22);
+  mesh_cli::add_meshing_options(*cmd, args->meshing, args->msh);
   cmd->callback([args] { run_generate(*args); });
 }
 
