@@ -19,7 +19,7 @@ using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
 using FT = Kernel::FT;
 using Point = Kernel::Point_3;
 using Domain = CGAL::Labeled_mesh_domain_3<Kernel>;
-using Tr = CGAL::Mesh_triangulation_3<Domain, CGAL::Default, CGAL::Sequential_tag>::type;
+using Tr = CGAL::Mesh_triangulation_3<Domain, ExactFallbackKernel, CGAL::Sequential_tag>::type;
 using C3t3 = CGAL::Mesh_complex_3_in_triangulation_3<Tr>;
 using Criteria = CGAL::Mesh_criteria_3<Tr>;
 

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <new>
 #include <stdexcept>
 #include <string>
 
@@ -15,6 +16,21 @@ namespace {
 
 constexpr double kSurfaceDiagonalDivisor = 40.0;
 constexpr double kFacetDistanceRatio = 0.1;
+/// Meshing sizes below diagonal / kMaxDiagonalPerSize are refused (10^5 facets along the
+/// diagonal: hundreds of millions of tets, or refinement that never ends).
+constexpr double kMaxDiagonalPerSize = 1e5;
+
+double bounding_box_diagonal(const std::vector<Vec3>& points) {
+  if (points.empty()) return 0.0;
+  Vec3 lo = points.front();
+  Vec3 hi = lo;
+  for (const Vec3& p : points)
+    for (int k = 0; k < 3; ++k) {
+      lo[k] = std::min(lo[k], p[k]);
+      hi[k] = std::max(hi[k], p[k]);
+    }
+  return std::hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
+}
 
 void require_positive(double value, const char* name) {
   if (!std::isfinite(value) || value <= 0.0)
@@ -90,32 +106,81 @@ TetMesh generate_shape(Shape shape, const ShapeOptions& shape_options,
   return mesh;
 }
 
+namespace {
+
+/// Runs one CGAL Mesh_3 call; whatever CGAL throws becomes an InputError naming the file and
+/// the stage.
+TetMesh run_mesh_3_guarded(const TriangleMesh& input, const detail::Mesh3Criteria& criteria,
+                           const std::string& file) {
+  try {
+    return detail::mesh_polyhedral_surface(input, criteria);
+  } catch (const InputError&) {
+    throw;
+  } catch (const std::bad_alloc&) {
+    throw InputError(file,
+                     "tetrahedralize: out of memory in CGAL Mesh_3 (is the facet size "
+                     "much smaller than the surface?)");
+  } catch (const std::exception& e) {
+    throw InputError(file, std::string("tetrahedralize: CGAL Mesh_3 failed: ") + e.what());
+  }
+}
+
+/// The defect of the tets' boundary ("" when it is a valid closed 2-manifold): the checks of
+/// validate_tet_mesh.
+std::string boundary_defect(const TetMesh& mesh, const std::string& file) {
+  try {
+    validate_tet_mesh(mesh, extract_surface(mesh), file);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+}  // namespace
+
 TetMesh tetrahedralize(const TriangleMesh& surface, const MeshingOptions& meshing,
                        const std::string& file) {
   // Pinch points (vertices where separate fans touch) are accepted here: the domain only
-  // needs inside/outside queries, and the output is validated strictly by the caller.
+  // needs inside/outside queries, and the output is validated strictly below.
   TriangleMesh split;
   detail::SurfaceCheck check;
   check.allow_pinched_vertices = true;
   detail::validate_closed_surface(surface, file, check, &split);
   const TriangleMesh& input = split.triangles.empty() ? surface : split;
-  Vec3 lo = surface.vertices.front();
-  Vec3 hi = lo;
-  for (const Vec3& p : surface.vertices)
-    for (int k = 0; k < 3; ++k) {
-      lo[k] = std::min(lo[k], p[k]);
-      hi[k] = std::max(hi[k], p[k]);
-    }
-  const double diagonal =
-      std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
-                (hi[2] - lo[2]) * (hi[2] - lo[2]));
+  const double diagonal = bounding_box_diagonal(input.vertices);
+  // Criteria are checked before CGAL sees them: every size finite and positive, and not so
+  // small against the surface that refinement could never end (kMaxDiagonalPerSize).
   const detail::Mesh3Criteria criteria =
       resolve(meshing, default_facet_size_for_diagonal(diagonal));
-  TetMesh mesh = detail::mesh_polyhedral_surface(input, criteria);
+  if (!(diagonal > 0.0) || !std::isfinite(diagonal))
+    throw InputError(file, "tetrahedralize: the surface has no extent");
+  for (const double size : {criteria.facet_size, criteria.cell_size, criteria.facet_distance})
+    if (!(size * kMaxDiagonalPerSize >= diagonal))
+      throw InputError(file, "tetrahedralize: a meshing size is below 1/" +
+                                 std::to_string(static_cast<long>(kMaxDiagonalPerSize)) +
+                                 " of the bounding-box diagonal (" + std::to_string(diagonal) +
+                                 "); give larger --facet-size / --cell-size / --facet-distance");
+  TetMesh mesh = run_mesh_3_guarded(input, criteria, file);
   if (mesh.tets.empty())
     throw InputError(file,
                      "meshing produced no tetrahedra (is the surface closed and "
                      "larger than the facet size?)");
+  // Mesh_3 refines with its manifold option, so the boundary of the tets should be a closed
+  // 2-manifold; it is checked. If not (sliver perturbation and exudation move vertices and
+  // weights after refinement), meshing is retried once without them; if that fails too,
+  // the defect is reported.
+  std::string defect = boundary_defect(mesh, file);
+  if (!defect.empty() && criteria.optimize) {
+    detail::Mesh3Criteria plain = criteria;
+    plain.optimize = false;
+    mesh = run_mesh_3_guarded(input, plain, file);
+    const std::string retry_defect = boundary_defect(mesh, file);
+    if (retry_defect.empty()) return mesh;
+    defect += "; without optimisation: " + retry_defect;
+  }
+  if (!defect.empty())
+    throw InputError(file, "tetrahedralize: the meshed boundary is not a closed 2-manifold: " +
+                               defect + " (thin parts may need a smaller --facet-size)");
   return mesh;
 }
 
