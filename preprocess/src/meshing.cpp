@@ -139,7 +139,7 @@ std::string boundary_defect(const TetMesh& mesh, const std::string& file) {
 }  // namespace
 
 TetMesh tetrahedralize(const TriangleMesh& surface, const MeshingOptions& meshing,
-                       const std::string& file) {
+                       const std::string& file, TetrahedralizeNotes* notes) {
   // Pinch points (vertices where separate fans touch) are accepted here: the domain only
   // needs inside/outside queries, and the output is validated strictly below.
   TriangleMesh split;
@@ -175,7 +175,13 @@ TetMesh tetrahedralize(const TriangleMesh& surface, const MeshingOptions& meshin
     plain.optimize = false;
     mesh = run_mesh_3_guarded(input, plain, file);
     const std::string retry_defect = boundary_defect(mesh, file);
-    if (retry_defect.empty()) return mesh;
+    if (retry_defect.empty()) {
+      if (notes != nullptr) {
+        notes->retried_without_optimization = true;
+        notes->first_defect = defect;
+      }
+      return mesh;
+    }
     defect += "; without optimisation: " + retry_defect;
   }
   if (!defect.empty())

@@ -113,8 +113,12 @@ void run_build(const BuildArgs& args) {
       return s;
     });
     mesh = timer.run("tetrahedralize", [&](std::string& summary) {
-      TetMesh m = tetrahedralize(surface, args.meshing, args.input);
-      summary = std::to_string(m.nodes.size()) + " nodes, " + std::to_string(m.tets.size()) + " tets";
+      TetrahedralizeNotes notes;
+      TetMesh m = tetrahedralize(surface, args.meshing, args.input, &notes);
+      if (notes.retried_without_optimization)
+        mesh_cli::print_retry_note(args.input, notes.first_defect);
+      summary =
+          std::to_string(m.nodes.size()) + " nodes, " + std::to_string(m.tets.size()) + " tets";
       return m;
     });
   }

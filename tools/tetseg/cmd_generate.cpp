@@ -111,6 +111,13 @@ void write_atomic(const std::string& output, const preprocess::TetMesh& mesh,
 
 }  // namespace
 
+void print_retry_note(const std::string& file, const std::string& defect) {
+  std::fprintf(stderr,
+               "tetseg: note: %s: the optimised mesh's boundary was not a closed 2-manifold "
+               "(%s); meshed again without sliver perturbation and exudation\n",
+               base_name(file).c_str(), defect.c_str());
+}
+
 void finish_tet_mesh(const preprocess::TetMesh& mesh, const std::string& output,
                      const MshOutput& msh, const std::string& what) {
   {

@@ -34,6 +34,10 @@ void check_output_path(const std::string& path);
 void finish_tet_mesh(const preprocess::TetMesh& mesh, const std::string& output,
                      const MshOutput& msh, const std::string& what);
 
+/// Says on stderr that tetrahedralize meshed `file` again without sliver optimisation because
+/// the optimised mesh's boundary had `defect`.
+void print_retry_note(const std::string& file, const std::string& defect);
+
 }  // namespace mesh_cli
 
 }  // namespace tetseg::tools

@@ -45,14 +45,25 @@ Shape shape_from_name(const std::string& name);
 TetMesh generate_shape(Shape shape, const ShapeOptions& shape_options,
                        const MeshingOptions& meshing = {});
 
+/// What tetrahedralize did beyond one plain Mesh_3 run (see tetrahedralize).
+struct TetrahedralizeNotes {
+  bool retried_without_optimization = false;  ///< the optimised mesh's boundary was invalid
+  std::string first_defect;                   ///< that boundary's defect, when retried
+};
+
 /// Tetrahedralises a closed, manifold surface (interior nodes included). The boundary is
-/// re-meshed (Mesh_3 does not keep the input triangles). Unlike validate_closed_surface,
-/// pinch points (separate fans of triangles touching at one vertex position, common in
-/// modelled meshes) are accepted; callers should validate the resulting tet mesh. Throws InputError
-/// (naming `file`) when the surface is not usable (validate_closed_surface) or meshing yields no
-/// tets; std::invalid_argument on bad options. Same threading note as generate_shape.
+/// re-meshed (Mesh_3 does not keep the input triangles); Mesh_3 runs with its manifold option.
+/// Unlike validate_closed_surface, pinch points (separate fans of triangles touching at one
+/// vertex position, common in modelled meshes) are accepted. The result is checked like
+/// validate_tet_mesh (closed 2-manifold boundary, ...); when the optimised mesh (sliver
+/// perturbation and exudation) fails that check, meshing is retried once without
+/// optimisation and `notes` (if given) says so. Throws InputError (naming `file`; the message
+/// starts with the stage, e.g. "tetrahedralize: ...") when the surface is not usable
+/// (validate_closed_surface), a meshing size is below 1e-5 of the bounding-box diagonal,
+/// CGAL throws, meshing yields no tets, or the boundary is still invalid after the retry;
+/// std::invalid_argument on bad options. Same threading note as generate_shape.
 TetMesh tetrahedralize(const TriangleMesh& surface, const MeshingOptions& meshing,
-                       const std::string& file);
+                       const std::string& file, TetrahedralizeNotes* notes = nullptr);
 
 /// Default facet size (before `size` scaling) of a procedural shape, and for a surface of
 /// bounding-box diagonal `diagonal`: the rules behind "0 = derive".
