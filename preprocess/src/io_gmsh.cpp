@@ -247,14 +247,7 @@ TetMesh read_gmsh(const std::string& path) {
 }
 
 void write_gmsh41(const std::string& path, const TetMesh& mesh) {
-  Vec3 lo = {0, 0, 0};
-  Vec3 hi = {0, 0, 0};
-  if (!mesh.nodes.empty()) lo = hi = mesh.nodes.front();
-  for (const Vec3& p : mesh.nodes)
-    for (int k = 0; k < 3; ++k) {
-      lo[k] = std::min(lo[k], p[k]);
-      hi[k] = std::max(hi[k], p[k]);
-    }
+  const auto [lo, hi] = bounding_box(mesh.nodes);
   std::string out;
   out.reserve(256 + mesh.nodes.size() * 64 + mesh.tets.size() * 48);
   out += "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Entities\n0 0 0 1\n1";

@@ -9,6 +9,7 @@
 #include <string>
 #include <string_view>
 #include <unordered_map>
+#include <utility>
 #include <vector>
 
 #include "io_text.hpp"
@@ -195,14 +196,23 @@ struct BinaryGmsh {
     }
   }
 
-  void nodes_v41() {
+  /// The line break after a 4.1 section keyword, then its four size fields: number of
+  /// blocks, of items, minimum and maximum tag. Returns {blocks, items}; checks that the
+  /// blocks' headers (three ints and a size each) fit in the bytes left.
+  std::pair<std::uint64_t, std::uint64_t> section_header_v41(const char* blocks_what,
+                                                             const char* items_what) {
     in.line_break();
-    const std::uint64_t blocks = in.size_field(data_size, "the node block count");
-    const std::uint64_t n = in.size_field(data_size, "the node count");
-    in.size_field(data_size, "the minimum node tag");
-    in.size_field(data_size, "the maximum node tag");
+    const std::uint64_t blocks = in.size_field(data_size, blocks_what);
+    const std::uint64_t n = in.size_field(data_size, items_what);
+    in.size_field(data_size, "the minimum tag");
+    in.size_field(data_size, "the maximum tag");
+    in.need(blocks, 12 + static_cast<std::uint64_t>(data_size), "block");
+    return {blocks, n};
+  }
+
+  void nodes_v41() {
+    const auto [blocks, n] = section_header_v41("the node block count", "the node count");
     const auto tag_bytes = static_cast<std::uint64_t>(data_size);
-    in.need(blocks, 12 + tag_bytes, "node block");
     in.need(n, tag_bytes + 24, "node");
     mesh.nodes.reserve(n);
     std::uint64_t total = 0;
@@ -233,13 +243,8 @@ struct BinaryGmsh {
   }
 
   void elements_v41() {
-    in.line_break();
-    const std::uint64_t blocks = in.size_field(data_size, "the element block count");
-    const std::uint64_t n = in.size_field(data_size, "the element count");
-    in.size_field(data_size, "the minimum element tag");
-    in.size_field(data_size, "the maximum element tag");
+    const auto [blocks, n] = section_header_v41("the element block count", "the element count");
     const auto tag_bytes = static_cast<std::uint64_t>(data_size);
-    in.need(blocks, 12 + tag_bytes, "element block");
     std::uint64_t total = 0;
     for (std::uint64_t b = 0; b < blocks; ++b) {
       in.int32("an entity dimension");
@@ -342,14 +347,7 @@ TetMesh read_gmsh_binary(const std::string& path, std::string_view text, std::si
 }
 
 void write_gmsh41_binary_impl(const std::string& path, const TetMesh& mesh) {
-  Vec3 lo = {0, 0, 0};
-  Vec3 hi = {0, 0, 0};
-  if (!mesh.nodes.empty()) lo = hi = mesh.nodes.front();
-  for (const Vec3& p : mesh.nodes)
-    for (int k = 0; k < 3; ++k) {
-      lo[k] = std::min(lo[k], p[k]);
-      hi[k] = std::max(hi[k], p[k]);
-    }
+  const auto [lo, hi] = bounding_box(mesh.nodes);
   const std::size_t n = mesh.nodes.size();
   const std::size_t m = mesh.tets.size();
   std::string out;

@@ -180,6 +180,18 @@ void append_uint(std::string& out, std::uint64_t value) {
   out.append(buffer, static_cast<std::size_t>(ptr - buffer));
 }
 
+std::pair<Vec3, Vec3> bounding_box(const std::vector<Vec3>& points) {
+  Vec3 lo = {0, 0, 0};
+  Vec3 hi = {0, 0, 0};
+  if (!points.empty()) lo = hi = points.front();
+  for (const Vec3& p : points)
+    for (int k = 0; k < 3; ++k) {
+      lo[k] = std::min(lo[k], p[k]);
+      hi[k] = std::max(hi[k], p[k]);
+    }
+  return {lo, hi};
+}
+
 void write_text_file(const std::string& path, const std::string& text) {
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
   if (!out) throw OutputError(path, "cannot open file for writing");

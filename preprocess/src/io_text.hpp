@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "tetseg/preprocess/mesh.hpp"
@@ -66,6 +67,10 @@ void append_double(std::string& out, double value);
 void append_uint(std::string& out, std::uint64_t value);
 /// Appends "x y z" (append_double each, single spaces, nothing before or after).
 void append_point(std::string& out, const Vec3& p);
+
+/// Smallest and largest coordinates of `points` ({0,0,0} twice when empty): the Gmsh
+/// writers' volume entity.
+std::pair<Vec3, Vec3> bounding_box(const std::vector<Vec3>& points);
 
 /// Writes `text` to `path`; throws OutputError.
 void write_text_file(const std::string& path, const std::string& text);
