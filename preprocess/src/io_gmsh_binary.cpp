@@ -293,6 +293,20 @@ void append_f64(std::string& out, double value) {
   append_bytes(out, &value, 8);
 }
 
+/// A 4.1 $Nodes or $Elements section of one block on volume 1 holding `count` items tagged
+/// 1..count: the section's four size fields, then the block's header (dimension 3, entity 1,
+/// `kind` = parametric flag or element type, count).
+void append_one_block_header(std::string& out, std::uint64_t count, std::int32_t kind) {
+  append_size(out, 1);
+  append_size(out, count);
+  append_size(out, count > 0 ? 1 : 0);
+  append_size(out, count);
+  append_int32(out, 3);
+  append_int32(out, 1);
+  append_int32(out, kind);
+  append_size(out, count);
+}
+
 }  // namespace
 
 TetMesh read_gmsh_binary(const std::string& path, std::string_view text, std::size_t start,
@@ -362,24 +376,12 @@ void write_gmsh41_binary_impl(const std::string& path, const TetMesh& mesh) {
   append_size(out, 0);  // physical tags
   append_size(out, 0);  // bounding surfaces
   out += "\n$EndEntities\n$Nodes\n";
-  for (std::uint64_t v :
-       {std::uint64_t{1}, std::uint64_t{n}, std::uint64_t{n > 0 ? 1u : 0u}, std::uint64_t{n}})
-    append_size(out, v);
-  append_int32(out, 3);
-  append_int32(out, 1);
-  append_int32(out, 0);
-  append_size(out, n);
+  append_one_block_header(out, n, 0);  // not parametric
   for (std::size_t i = 0; i < n; ++i) append_size(out, i + 1);
   for (const Vec3& p : mesh.nodes)
     for (double c : p) append_f64(out, c);
   out += "\n$EndNodes\n$Elements\n";
-  for (std::uint64_t v :
-       {std::uint64_t{1}, std::uint64_t{m}, std::uint64_t{m > 0 ? 1u : 0u}, std::uint64_t{m}})
-    append_size(out, v);
-  append_int32(out, 3);
-  append_int32(out, 1);
-  append_int32(out, kGmshTet4);
-  append_size(out, m);
+  append_one_block_header(out, m, kGmshTet4);
   for (std::size_t i = 0; i < m; ++i) {
     append_size(out, i + 1);
     for (std::uint32_t v : mesh.tets[i]) append_size(out, std::uint64_t{v} + 1);
