@@ -6,8 +6,10 @@
 #include <CGAL/IO/polygon_soup_io.h>
 #include <CGAL/Polygon_mesh_processing/triangulate_hole.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <exception>
 #include <fstream>
 #include <iterator>
@@ -15,6 +17,8 @@
 #include <new>
 #include <sstream>
 #include <string>
+#include <string_view>
+#include <utility>
 #include <vector>
 
 #include "io_text.hpp"
@@ -32,6 +36,13 @@ using Point = Kernel::Point_3;
 using Polygon = std::vector<std::size_t>;
 using detail::parse_int;
 using detail::Tokenizer;
+
+bool host_is_little_endian() {
+  const std::uint16_t one = 1;
+  unsigned char first = 0;
+  std::memcpy(&first, &one, 1);
+  return first == 1;
+}
 
 /// Polygons with more corners than this are refused (a hostile degree would make the
 /// triangulation cubic in it).
@@ -78,45 +89,52 @@ void check_off_counts(const std::string& path, const std::string& text) {
   }
 }
 
-/// Element counts of a PLY header checked against the bytes after the header, before CGAL's
-/// reader loops over them (ASCII: at least 2 bytes per property; binary: the scalar sizes).
-void check_ply_counts(const std::string& path, const std::string& text) {
+/// One PLY property: a scalar, or a list with a count of `count_bytes` (signed or not) and
+/// items of `bytes` each.
+struct PlyProperty {
+  bool list = false;
+  std::uint64_t count_bytes = 0;
+  bool count_signed = false;
+  std::uint64_t bytes = 0;
+};
+
+struct PlyElement {
+  std::uint64_t count = 0;
+  std::vector<PlyProperty> properties;
+};
+
+/// Size in bytes and signedness of a PLY scalar type; {0, false} when unknown.
+std::pair<std::uint64_t, bool> ply_type(const std::string& type) {
+  static const std::map<std::string, std::pair<std::uint64_t, bool>> kTypes = {
+      {"char", {1, true}},  {"int8", {1, true}},    {"uchar", {1, false}},  {"uint8", {1, false}},
+      {"short", {2, true}}, {"int16", {2, true}},   {"ushort", {2, false}}, {"uint16", {2, false}},
+      {"int", {4, true}},   {"int32", {4, true}},   {"uint", {4, false}},   {"uint32", {4, false}},
+      {"float", {4, true}}, {"float32", {4, true}}, {"double", {8, true}},  {"float64", {8, true}}};
+  const auto it = kTypes.find(type);
+  return it == kTypes.end() ? std::pair<std::uint64_t, bool>{0, false} : it->second;
+}
+
+/// Walks a PLY file's header and body before CGAL's reader sees it, so that no count can make
+/// that reader allocate or loop beyond the file: element counts are checked against the bytes
+/// left, and every list's length against the bytes (binary) or tokens (ASCII) that follow.
+/// Also refuses what CGAL's reader would crash on (a property before any element).
+void check_ply_layout(const std::string& path, const std::string& text) {
   const std::size_t end = text.find("end_header");
   if (text.compare(0, 3, "ply") != 0 || end == std::string::npos)
     throw InputError(path, "not a PLY file (no 'ply' ... 'end_header' header)");
+  const std::size_t body = text.find('\n', end);
+  if (body == std::string::npos) throw InputError(path, "PLY header has no line end");
   std::istringstream header(text.substr(0, end));
-  const std::map<std::string, std::uint64_t> sizes = {
-      {"char", 1},  {"uchar", 1},   {"int8", 1},   {"uint8", 1},  {"short", 2}, {"ushort", 2},
-      {"int16", 2}, {"uint16", 2},  {"int", 4},    {"uint", 4},   {"int32", 4}, {"uint32", 4},
-      {"float", 4}, {"float32", 4}, {"double", 8}, {"float64", 8}};
-  bool ascii = false;
-  std::uint64_t needed = 0;
-  std::uint64_t count = 0;
-  std::uint64_t element_bytes = 0;
-  const std::uint64_t bytes = text.size() - end;
-  auto close_element = [&] {
-    if (count > 0 && element_bytes == 0)
-      throw InputError(path, "PLY element with items but no properties");
-    if (element_bytes > 0 && count > (bytes + 1) / element_bytes)
-      throw InputError(path, "PLY element count " + std::to_string(count) +
-                                 " exceeds what the file's bytes can hold");
-    needed += count * element_bytes;
-    if (needed > bytes + 1)
-      throw InputError(path, "PLY element counts exceed what the file's " +
-                                 std::to_string(text.size()) + " bytes can hold");
-  };
+  std::string format;
+  std::vector<PlyElement> elements;
   std::string line;
-  bool in_element = false;
   while (std::getline(header, line)) {
     std::istringstream words(line);
     std::string word;
     words >> word;
     if (word == "format") {
-      std::string kind;
-      words >> kind;
-      ascii = kind == "ascii";
+      words >> format;
     } else if (word == "element") {
-      close_element();
       std::string name;
       std::string number;
       words >> name >> number;
@@ -124,26 +142,71 @@ void check_ply_counts(const std::string& path, const std::string& text) {
       if (!parse_int(number, n) || n < 0)
         throw InputError(path, "PLY element '" + name.substr(0, 40) + "' has an invalid count '" +
                                    number.substr(0, 40) + "'");
-      count = static_cast<std::uint64_t>(n);
-      element_bytes = 0;
-      in_element = true;
+      elements.push_back({static_cast<std::uint64_t>(n), {}});
     } else if (word == "property") {
       // CGAL's reader adds a property to its last element without checking there is one.
-      if (!in_element) throw InputError(path, "PLY property before any element");
+      if (elements.empty()) throw InputError(path, "PLY property before any element");
       std::string type;
       words >> type;
+      PlyProperty property;
       if (type == "list") {
         std::string count_type;
-        words >> count_type;
-        const auto it = sizes.find(count_type);
-        element_bytes += ascii ? 2 : (it == sizes.end() ? 1 : it->second);
+        std::string item_type;
+        words >> count_type >> item_type;
+        const auto [count_bytes, count_signed] = ply_type(count_type);
+        if (count_bytes == 0 || count_bytes > 4 || count_type.find("float") == 0)
+          throw InputError(path, "PLY list with count type '" + count_type.substr(0, 20) + "'");
+        property = {true, count_bytes, count_signed, ply_type(item_type).first};
       } else {
-        const auto it = sizes.find(type);
-        element_bytes += ascii ? 2 : (it == sizes.end() ? 1 : it->second);
+        property.bytes = ply_type(type).first;
       }
+      if (property.bytes == 0) throw InputError(path, "PLY property of unknown type");
+      elements.back().properties.push_back(property);
     }
   }
-  close_element();
+  const bool ascii = format == "ascii";
+  if (!ascii && format != "binary_little_endian" && format != "binary_big_endian")
+    throw InputError(path, "PLY format '" + format.substr(0, 40) + "' is not supported");
+  const bool swap = (format == "binary_big_endian") == host_is_little_endian();
+  std::uint64_t pos = body + 1;
+  auto fail = [&](const std::string& what) {
+    throw InputError(path, "PLY body ends early or holds a bad list length (" + what + ")");
+  };
+  Tokenizer tok(path, std::string_view(text).substr(pos), '\0');
+  for (const PlyElement& element : elements) {
+    std::uint64_t min_bytes = 0;
+    for (const PlyProperty& p : element.properties)
+      min_bytes += ascii ? 2 : p.count_bytes + p.bytes;
+    if (element.count > 0 &&
+        (min_bytes == 0 || element.count > (text.size() - pos + 1) / min_bytes))
+      fail("element count " + std::to_string(element.count));
+    for (std::uint64_t i = 0; i < element.count; ++i)
+      for (const PlyProperty& p : element.properties) {
+        std::int64_t length = 1;
+        if (ascii) {
+          if (p.list) length = tok.next_int("a PLY list length");
+          if (length < 0 || static_cast<std::uint64_t>(length) > text.size() / 2)
+            fail("list length " + std::to_string(length));
+          for (std::int64_t k = 0; k < length; ++k) tok.next("a PLY value");
+          continue;
+        }
+        if (p.list) {
+          if (text.size() - pos < p.count_bytes) fail("list length cut off");
+          unsigned char raw[4] = {0, 0, 0, 0};
+          std::memcpy(raw, text.data() + pos, p.count_bytes);
+          if (swap) std::reverse(raw, raw + p.count_bytes);
+          std::uint32_t value = 0;
+          for (std::uint64_t k = p.count_bytes; k-- > 0;) value = (value << 8) | raw[k];
+          const std::uint64_t sign_bit = std::uint64_t{1} << (8 * p.count_bytes - 1);
+          if (p.count_signed && (value & sign_bit) != 0) fail("negative list length");
+          length = value;
+          pos += p.count_bytes;
+        }
+        const auto needed = static_cast<std::uint64_t>(length) * p.bytes;
+        if (needed > text.size() - pos) fail("value cut off");
+        pos += needed;
+      }
+  }
 }
 
 /// Whether reading `polygons` over `points` left anything a caller could index out of range.
@@ -188,7 +251,7 @@ TriangleMesh read_with_cgal(const std::string& path, const std::string& ext) {
   const std::string text = detail::read_file_text(path);
   if (text.empty()) throw InputError(path, "empty file");
   if (ext == ".off") check_off_counts(path, text);
-  if (ext == ".ply") check_ply_counts(path, text);
+  if (ext == ".ply") check_ply_layout(path, text);
   std::vector<Point> points;
   std::vector<Polygon> polygons;
   bool ok = false;
