@@ -45,9 +45,11 @@ void write_gmsh41_binary(const std::string& path, const TetMesh& mesh);
 /// applied). Points and lines are dropped, and vertices with exactly the same position merged
 /// (numbered in order of first use). Throws InputError naming the file when it cannot be read
 /// or holds no triangles; whatever CGAL or assimp throws (also allocation failures) becomes an
-/// InputError too. Safe on untrusted input: OFF and PLY header counts are checked against the
-/// file size before CGAL's readers size anything; NaN/Inf coordinates and out-of-range indices
-/// are refused. No validation: see validate_closed_surface.
+/// InputError too. Safe on untrusted input: before CGAL's readers size anything, OFF header
+/// counts and face lengths, and every PLY element count and list length, are checked against
+/// the bytes (or tokens) that follow; binary OFF is refused; NaN/Inf coordinates, out-of-range
+/// indices and polygons of more than 4096 corners are refused. No validation: see
+/// validate_closed_surface.
 TriangleMesh read_triangle_mesh(const std::string& path);
 
 }  // namespace tetseg::preprocess
