@@ -111,17 +111,18 @@ Criteria make_criteria(const Mesh3Criteria& c) {
 constexpr double kPerturbBoundDegrees = 10.0;
 
 template <class C3t3, class Domain, class Criteria>
-C3t3 run_mesh_3(const Domain& domain, const Criteria& criteria, bool optimize) {
+C3t3 run_mesh_3(const Domain& domain, const Criteria& criteria, const Mesh3Criteria& options) {
   namespace params = CGAL::parameters;
   CGAL::get_default_random() = CGAL::Random(0);
-  if (optimize) {
-    return CGAL::make_mesh_3<C3t3>(
-        domain, criteria, params::no_odt(), params::no_lloyd(),
-        params::perturb(params::time_limit = 0, params::sliver_bound = kPerturbBoundDegrees),
-        params::exude(params::time_limit = 0, params::sliver_bound = 0), params::manifold());
-  }
-  return CGAL::make_mesh_3<C3t3>(domain, criteria, params::no_odt(), params::no_lloyd(),
-                                 params::no_perturb(), params::no_exude(), params::manifold());
+  const auto perturb =
+      options.optimize && options.perturb
+          ? params::perturb(params::time_limit = 0, params::sliver_bound = kPerturbBoundDegrees)
+          : params::no_perturb();
+  const auto exude = options.optimize && options.exude
+                         ? params::exude(params::time_limit = 0, params::sliver_bound = 0)
+                         : params::no_exude();
+  return CGAL::make_mesh_3<C3t3>(domain, criteria, params::no_odt(), params::no_lloyd(), perturb,
+                                 exude, params::manifold());
 }
 
 }  // namespace tetseg::preprocess::detail

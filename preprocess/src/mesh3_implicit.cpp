@@ -126,7 +126,7 @@ TetMesh mesh_implicit_shape(Shape shape, const ShapeOptions& o, const Mesh3Crite
   const Domain domain = Domain::create_implicit_mesh_domain(
       f, Kernel::Sphere_3(center, bound * bound), params::relative_error_bound = 1e-6,
       params::p_rng = &rng);
-  const C3t3 c3t3 = run_mesh_3<C3t3>(domain, make_criteria<Criteria>(criteria), criteria.optimize);
+  const C3t3 c3t3 = run_mesh_3<C3t3>(domain, make_criteria<Criteria>(criteria), criteria);
   return c3t3_to_tet_mesh(c3t3);
 }
 

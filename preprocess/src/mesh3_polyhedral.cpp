@@ -40,7 +40,7 @@ TetMesh mesh_polyhedral_surface(const TriangleMesh& surface, const Mesh3Criteria
     throw std::runtime_error("surface could not be converted to a polygon mesh");
   CGAL::Random rng(0);
   const Domain domain(mesh, &rng);
-  const C3t3 c3t3 = run_mesh_3<C3t3>(domain, make_criteria<Criteria>(criteria), criteria.optimize);
+  const C3t3 c3t3 = run_mesh_3<C3t3>(domain, make_criteria<Criteria>(criteria), criteria);
   return c3t3_to_tet_mesh(c3t3);
 }
 

@@ -115,8 +115,7 @@ void run_build(const BuildArgs& args) {
     mesh = timer.run("tetrahedralize", [&](std::string& summary) {
       TetrahedralizeNotes notes;
       TetMesh m = tetrahedralize(surface, args.meshing, args.input, &notes);
-      if (notes.retried_without_optimization)
-        mesh_cli::print_retry_note(args.input, notes.first_defect);
+      if (!notes.optimization_used.empty()) mesh_cli::print_retry_note(args.input, notes);
       summary =
           std::to_string(m.nodes.size()) + " nodes, " + std::to_string(m.tets.size()) + " tets";
       return m;

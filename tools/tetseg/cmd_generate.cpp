@@ -111,11 +111,12 @@ void write_atomic(const std::string& output, const preprocess::TetMesh& mesh,
 
 }  // namespace
 
-void print_retry_note(const std::string& file, const std::string& defect) {
+void print_retry_note(const std::string& file, const preprocess::TetrahedralizeNotes& notes) {
   std::fprintf(stderr,
                "tetseg: note: %s: the optimised mesh's boundary was not a closed 2-manifold "
-               "(%s); meshed again without sliver perturbation and exudation\n",
-               base_name(file).c_str(), defect.c_str());
+               "(%s); meshed again with %s\n",
+               base_name(file).c_str(), notes.first_defect.c_str(),
+               notes.optimization_used.c_str());
 }
 
 void finish_tet_mesh(const preprocess::TetMesh& mesh, const std::string& output,

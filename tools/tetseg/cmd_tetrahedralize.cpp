@@ -38,8 +38,7 @@ void run_tetrahedralize(const TetrahedralizeArgs& args) {
   preprocess::TetrahedralizeNotes notes;
   const preprocess::TetMesh mesh =
       preprocess::tetrahedralize(surface, args.meshing, args.input, &notes);
-  if (notes.retried_without_optimization)
-    mesh_cli::print_retry_note(args.input, notes.first_defect);
+  if (!notes.optimization_used.empty()) mesh_cli::print_retry_note(args.input, notes);
   std::fprintf(stderr, "tetseg: meshing %s ... %.2f s, %zu nodes, %zu tets\n",
                base_name(args.input).c_str(), seconds_since(start), mesh.nodes.size(),
                mesh.tets.size());

@@ -34,9 +34,9 @@ void check_output_path(const std::string& path);
 void finish_tet_mesh(const preprocess::TetMesh& mesh, const std::string& output,
                      const MshOutput& msh, const std::string& what);
 
-/// Says on stderr that tetrahedralize meshed `file` again without sliver optimisation because
-/// the optimised mesh's boundary had `defect`.
-void print_retry_note(const std::string& file, const std::string& defect);
+/// Says on stderr that tetrahedralize meshed `file` again with less optimisation because the
+/// optimised mesh's boundary was invalid (`notes`).
+void print_retry_note(const std::string& file, const preprocess::TetrahedralizeNotes& notes);
 
 }  // namespace mesh_cli
 

@@ -47,8 +47,10 @@ TetMesh generate_shape(Shape shape, const ShapeOptions& shape_options,
 
 /// What tetrahedralize did beyond one plain Mesh_3 run (see tetrahedralize).
 struct TetrahedralizeNotes {
-  bool retried_without_optimization = false;  ///< the optimised mesh's boundary was invalid
-  std::string first_defect;                   ///< that boundary's defect, when retried
+  /// "" when the first mesh was valid; else the retry that gave the returned mesh:
+  /// "exudation only" or "no optimisation".
+  std::string optimization_used;
+  std::string first_defect;  ///< the first mesh's boundary defect, when retried
 };
 
 /// Tetrahedralises a closed, manifold surface (interior nodes included). The boundary is
@@ -56,12 +58,13 @@ struct TetrahedralizeNotes {
 /// Unlike validate_closed_surface, pinch points (separate fans of triangles touching at one
 /// vertex position, common in modelled meshes) are accepted. The result is checked like
 /// validate_tet_mesh (closed 2-manifold boundary, ...); when the optimised mesh (sliver
-/// perturbation and exudation) fails that check, meshing is retried once without
-/// optimisation and `notes` (if given) says so. Throws InputError (naming `file`; the message
-/// starts with the stage, e.g. "tetrahedralize: ...") when the surface is not usable
-/// (validate_closed_surface), a meshing size is below 1e-5 of the bounding-box diagonal,
-/// CGAL throws, meshing yields no tets, or the boundary is still invalid after the retry;
-/// std::invalid_argument on bad options. Same threading note as generate_shape.
+/// perturbation, then exudation) fails that check, meshing is retried with exudation only,
+/// then without optimisation, and `notes` (if given) says which mesh was returned. Throws
+/// InputError (naming `file`; the message starts with the stage, "tetrahedralize: ...") when
+/// the surface is not usable (validate_closed_surface), a meshing size is below 1e-5 of the
+/// bounding-box diagonal, CGAL throws, meshing yields no tets, or every attempt's boundary is
+/// invalid (the defects are listed); std::invalid_argument on bad options. Same threading note
+/// as generate_shape.
 TetMesh tetrahedralize(const TriangleMesh& surface, const MeshingOptions& meshing,
                        const std::string& file, TetrahedralizeNotes* notes = nullptr);
 
