@@ -6,8 +6,11 @@
 #include <new>
 #include <stdexcept>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "meshing_internal.hpp"
+#include "repair_internal.hpp"
 #include "tetseg/preprocess/surface.hpp"
 #include "validate_internal.hpp"
 
@@ -142,11 +145,20 @@ TetMesh tetrahedralize(const TriangleMesh& surface, const MeshingOptions& meshin
                        const std::string& file, TetrahedralizeNotes* notes) {
   // Pinch points (vertices where separate fans touch) are accepted here: the domain only
   // needs inside/outside queries, and the output is validated strictly below.
+  TriangleMesh repaired;
+  if (meshing.repair == MeshingOptions::Repair::kFix) {
+    repaired = surface;
+    std::vector<RepairCount> repairs = detail::repair_soup(repaired);
+    if (repaired.triangles.empty())
+      throw InputError(file, "tetrahedralize: no triangle is left after repair");
+    if (notes != nullptr) notes->repairs = std::move(repairs);
+  }
+  const TriangleMesh& source = meshing.repair == MeshingOptions::Repair::kFix ? repaired : surface;
   TriangleMesh split;
   detail::SurfaceCheck check;
   check.allow_pinched_vertices = true;
-  detail::validate_closed_surface(surface, file, check, &split);
-  const TriangleMesh& input = split.triangles.empty() ? surface : split;
+  detail::validate_closed_surface(source, file, check, &split);
+  const TriangleMesh& input = split.triangles.empty() ? source : split;
   const double diagonal = bounding_box_diagonal(input.vertices);
   // Criteria are checked before CGAL sees them: every size finite and positive, and not so
   // small against the surface that refinement could never end (kMaxDiagonalPerSize).

@@ -53,6 +53,15 @@ expect_exit 0 "tetseg: done" -- "$bin/tetseg" build cube.msh -o from_binary.tets
 expect_exit 2 "" -- "$bin/tetseg" tetrahedralize cube.off -o x.msh --binary --gmsh22
 [ ! -e x.msh ] || fail "a usage error left a mesh"
 
+# --repair fix (the default) removes a duplicated face and says so; --repair none refuses it.
+{ cat cube.off; echo "4 0 3 2 1"; } | sed 's/^8 6 0$/8 7 0/' >cube_dup.off
+expect_exit 0 "tetseg: repaired cube_dup.off: 2 duplicate triangles removed" -- \
+  "$bin/tetseg" tetrahedralize cube_dup.off -o dup.mesh --facet-size 0.25 --no-optimize
+expect_exit 3 "tetseg: error: cube_dup.off: surface has [0-9]* non-manifold edges" -- \
+  "$bin/tetseg" tetrahedralize cube_dup.off -o dup2.mesh --repair none
+[ ! -e dup2.mesh ] || fail "a refused surface left a mesh"
+expect_exit 2 "repair" -- "$bin/tetseg" build cube.off -o x.tetseg --repair bogus
+
 # Hostile variants of each kind of file: truncations, huge and negative counts, NaN, byte
 # flips. The small facet size bounds the time of those that still read.
 python3 - <<'PY'

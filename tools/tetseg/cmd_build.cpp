@@ -107,7 +107,9 @@ void run_build(const BuildArgs& args) {
   } else {
     const TriangleMesh surface = timer.run("read", [&](std::string& summary) {
       TriangleMesh s = read_triangle_mesh(args.input);
-      validate_closed_surface(s, args.input);
+      // With --repair fix, tetrahedralize validates after repairing.
+      if (args.meshing.repair == MeshingOptions::Repair::kNone)
+        validate_closed_surface(s, args.input);
       summary = std::to_string(s.vertices.size()) + " vertices, " +
                 std::to_string(s.triangles.size()) + " triangles (surface)";
       return s;
@@ -115,6 +117,7 @@ void run_build(const BuildArgs& args) {
     mesh = timer.run("tetrahedralize", [&](std::string& summary) {
       TetrahedralizeNotes notes;
       TetMesh m = tetrahedralize(surface, args.meshing, args.input, &notes);
+      mesh_cli::print_repairs(args.input, notes);
       if (!notes.optimization_used.empty()) mesh_cli::print_retry_note(args.input, notes);
       summary =
           std::to_string(m.nodes.size()) + " nodes, " + std::to_string(m.tets.size()) + " tets";
@@ -253,8 +256,10 @@ void add_build_command(CLI::App& root) {
                   "Surface input only: max surface approximation error (0: derived)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
-  cmd->add_flag("--no-optimize", [args](std::int64_t) { args->meshing.optimize = false; },
-                "Surface input only: skip sliver perturbation and exudation (faster meshing)");
+  cmd->add_flag(
+      "--no-optimize", [args](std::int64_t) { args->meshing.optimize = false; },
+      "Surface input only: skip sliver perturbation and exudation (faster meshing)");
+  mesh_cli::add_repair_option(*cmd, args->meshing);
   cmd->add_flag("--no-rest-positions", args->no_rest_positions,
                 "Do not store rest positions in the asset (smaller; tools cannot draw it)");
   cmd->add_flag("-q,--quiet", args->quiet, "No stage lines");

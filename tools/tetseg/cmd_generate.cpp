@@ -5,6 +5,7 @@
 
 #include <chrono>
 #include <cstdio>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -117,6 +118,24 @@ void print_retry_note(const std::string& file, const preprocess::TetrahedralizeN
                "(%s); meshed again with %s\n",
                base_name(file).c_str(), notes.first_defect.c_str(),
                notes.optimization_used.c_str());
+}
+
+void add_repair_option(CLI::App& cmd, preprocess::MeshingOptions& m) {
+  using Repair = preprocess::MeshingOptions::Repair;
+  const std::map<std::string, Repair> modes{{"none", Repair::kNone}, {"fix", Repair::kFix}};
+  cmd.add_option("--repair", m.repair,
+                 "Surface input: none, or fix (remove degenerate and duplicate triangles, make "
+                 "the orientation consistent; docs/cli.md)")
+      ->transform(CLI::CheckedTransformer(modes, CLI::ignore_case))
+      ->option_text("none|fix (fix)");
+}
+
+void print_repairs(const std::string& file, const preprocess::TetrahedralizeNotes& notes) {
+  if (notes.repairs.empty()) return;
+  std::string list;
+  for (const preprocess::RepairCount& r : notes.repairs)
+    list += (list.empty() ? "" : ", ") + std::to_string(r.count) + " " + r.kind;
+  std::fprintf(stderr, "tetseg: repaired %s: %s\n", base_name(file).c_str(), list.c_str());
 }
 
 void finish_tet_mesh(const preprocess::TetMesh& mesh, const std::string& output,

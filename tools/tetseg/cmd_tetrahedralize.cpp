@@ -38,6 +38,7 @@ void run_tetrahedralize(const TetrahedralizeArgs& args) {
   preprocess::TetrahedralizeNotes notes;
   const preprocess::TetMesh mesh =
       preprocess::tetrahedralize(surface, args.meshing, args.input, &notes);
+  mesh_cli::print_repairs(args.input, notes);
   if (!notes.optimization_used.empty()) mesh_cli::print_retry_note(args.input, notes);
   std::fprintf(stderr, "tetseg: meshing %s ... %.2f s, %zu nodes, %zu tets\n",
                base_name(args.input).c_str(), seconds_since(start), mesh.nodes.size(),
@@ -57,6 +58,7 @@ void add_tetrahedralize_command(CLI::App& root) {
   cmd->add_option("-o,--output", args->output, "Output tet mesh (.mesh, .node/.ele, .msh)")
       ->required();
   mesh_cli::add_meshing_options(*cmd, args->meshing, args->msh);
+  mesh_cli::add_repair_option(*cmd, args->meshing);
   cmd->callback([args] { run_tetrahedralize(*args); });
 }
 

@@ -38,6 +38,12 @@ void finish_tet_mesh(const preprocess::TetMesh& mesh, const std::string& output,
 /// optimised mesh's boundary was invalid (`notes`).
 void print_retry_note(const std::string& file, const preprocess::TetrahedralizeNotes& notes);
 
+/// Adds `--repair none|fix` (MeshingOptions::repair).
+void add_repair_option(CLI::App& cmd, preprocess::MeshingOptions& m);
+/// Prints the repairs tetrahedralize made to `file` ("tetseg: repaired x.off: 2 duplicate
+/// triangles removed, ..."), nothing when there were none.
+void print_repairs(const std::string& file, const preprocess::TetrahedralizeNotes& notes);
+
 }  // namespace mesh_cli
 
 }  // namespace tetseg::tools
