@@ -32,13 +32,6 @@ std::uint64_t nodes_of_type(std::int64_t type) {
   return 0;
 }
 
-bool host_is_little_endian() {
-  const std::uint32_t one = 1;
-  unsigned char first = 0;
-  std::memcpy(&first, &one, 1);
-  return first == 1;
-}
-
 /// Reads little- or big-endian scalars and ASCII words from the binary file.
 class ByteReader {
  public:

@@ -34,15 +34,9 @@ namespace {
 using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
 using Point = Kernel::Point_3;
 using Polygon = std::vector<std::size_t>;
+using detail::host_is_little_endian;
 using detail::parse_int;
 using detail::Tokenizer;
-
-bool host_is_little_endian() {
-  const std::uint16_t one = 1;
-  unsigned char first = 0;
-  std::memcpy(&first, &one, 1);
-  return first == 1;
-}
 
 /// Polygons with more corners than this are refused (a hostile degree would make the
 /// triangulation cubic in it).

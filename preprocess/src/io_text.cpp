@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <sstream>
 
@@ -178,6 +179,13 @@ void append_uint(std::string& out, std::uint64_t value) {
   char buffer[24];
   const auto [ptr, ec] = std::to_chars(buffer, buffer + sizeof buffer, value);
   out.append(buffer, static_cast<std::size_t>(ptr - buffer));
+}
+
+bool host_is_little_endian() {
+  const std::uint16_t one = 1;
+  unsigned char first = 0;
+  std::memcpy(&first, &one, 1);
+  return first == 1;
 }
 
 std::pair<Vec3, Vec3> bounding_box(const std::vector<Vec3>& points) {

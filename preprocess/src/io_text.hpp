@@ -72,6 +72,10 @@ void append_point(std::string& out, const Vec3& p);
 /// writers' volume entity.
 std::pair<Vec3, Vec3> bounding_box(const std::vector<Vec3>& points);
 
+/// Whether this machine stores the low byte of an integer first (binary readers swap bytes
+/// of files written the other way).
+bool host_is_little_endian();
+
 /// Writes `text` to `path`; throws OutputError.
 void write_text_file(const std::string& path, const std::string& text);
 
