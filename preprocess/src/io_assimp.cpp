@@ -1,23 +1,20 @@
-// Triangle surfaces through assimp. The only translation unit that includes assimp.
+// Triangle surfaces through assimp, for the formats CGAL does not read (glTF, FBX, 3DS, ...;
+// io_surface.cpp dispatches). The only translation unit that includes assimp.
 
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 #include <assimp/Importer.hpp>
 
 #include <cmath>
-#include <fstream>
 #include <map>
 #include <string>
 
 #include "tetseg/preprocess/io.hpp"
 
-namespace tetseg::preprocess {
+namespace tetseg::preprocess::detail {
 
-TriangleMesh read_triangle_mesh(const std::string& path) {
-  {
-    std::ifstream probe(path, std::ios::binary);
-    if (!probe) throw InputError(path, "cannot open file");
-  }
+/// Reads the triangles of every mesh of the scene (see read_triangle_mesh). Throws InputError.
+TriangleMesh read_triangle_mesh_assimp(const std::string& path) {
   Assimp::Importer importer;
   // Points and lines are dropped; everything else is flattened into world coordinates.
   importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE,
@@ -58,8 +55,7 @@ TriangleMesh read_triangle_mesh(const std::string& path) {
       mesh.triangles.push_back(tri);
     }
   }
-  if (mesh.triangles.empty()) throw InputError(path, "no triangles in file");
   return mesh;
 }
 
-}  // namespace tetseg::preprocess
+}  // namespace tetseg::preprocess::detail

@@ -1,4 +1,4 @@
-// Gmsh .msh 2.2 and 4.1 ASCII reader and writers.
+// Gmsh .msh 2.2 and 4.1 ASCII reader and writers (binary: io_gmsh_binary.cpp).
 
 #include <algorithm>
 #include <string>
@@ -204,8 +204,7 @@ TetMesh read_gmsh(const std::string& path) {
     if (section == "$MeshFormat") {
       const std::string_view version = tok.next("a format version");
       const std::int64_t file_type = tok.next_int("a file type");
-      tok.next_int("a data size");
-      if (file_type != 0) tok.fail("binary Gmsh not supported (save the mesh as ASCII)");
+      const std::int64_t data_size = tok.next_int("a data size");
       if (version == "2" || version == "2.0" || version == "2.1" || version == "2.2") {
         state.major = 2;
       } else if (version == "4.1") {
@@ -214,6 +213,9 @@ TetMesh read_gmsh(const std::string& path) {
         tok.fail("unsupported Gmsh version " + std::string(version.substr(0, 20)) +
                  " (2.2 and 4.1 are supported)");
       }
+      if (file_type == 1)
+        return read_gmsh_binary(path, text, tok.position(), state.major, data_size);
+      if (file_type != 0) tok.fail("file type must be 0 (ASCII) or 1 (binary)");
       expect_token(tok, "$EndMeshFormat");
       continue;
     }
@@ -245,14 +247,7 @@ TetMesh read_gmsh(const std::string& path) {
 }
 
 void write_gmsh41(const std::string& path, const TetMesh& mesh) {
-  Vec3 lo = {0, 0, 0};
-  Vec3 hi = {0, 0, 0};
-  if (!mesh.nodes.empty()) lo = hi = mesh.nodes.front();
-  for (const Vec3& p : mesh.nodes)
-    for (int k = 0; k < 3; ++k) {
-      lo[k] = std::min(lo[k], p[k]);
-      hi[k] = std::max(hi[k], p[k]);
-    }
+  const auto [lo, hi] = bounding_box(mesh.nodes);
   std::string out;
   out.reserve(256 + mesh.nodes.size() * 64 + mesh.tets.size() * 48);
   out += "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Entities\n0 0 0 1\n1";

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <sstream>
 
@@ -180,6 +181,25 @@ void append_uint(std::string& out, std::uint64_t value) {
   out.append(buffer, static_cast<std::size_t>(ptr - buffer));
 }
 
+bool host_is_little_endian() {
+  const std::uint16_t one = 1;
+  unsigned char first = 0;
+  std::memcpy(&first, &one, 1);
+  return first == 1;
+}
+
+std::pair<Vec3, Vec3> bounding_box(const std::vector<Vec3>& points) {
+  Vec3 lo = {0, 0, 0};
+  Vec3 hi = {0, 0, 0};
+  if (!points.empty()) lo = hi = points.front();
+  for (const Vec3& p : points)
+    for (int k = 0; k < 3; ++k) {
+      lo[k] = std::min(lo[k], p[k]);
+      hi[k] = std::max(hi[k], p[k]);
+    }
+  return {lo, hi};
+}
+
 void write_text_file(const std::string& path, const std::string& text) {
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
   if (!out) throw OutputError(path, "cannot open file for writing");
@@ -257,6 +277,10 @@ void write_tet_mesh(const std::string& path, const TetMesh& mesh) {
 
 void write_gmsh22(const std::string& path, const TetMesh& mesh) {
   detail::write_gmsh22_impl(path, mesh);
+}
+
+void write_gmsh41_binary(const std::string& path, const TetMesh& mesh) {
+  detail::write_gmsh41_binary_impl(path, mesh);
 }
 
 }  // namespace tetseg::preprocess

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "tetseg/preprocess/mesh.hpp"
@@ -31,6 +32,8 @@ class Tokenizer {
   bool at_end();
   /// Line of the last token returned (1-based).
   std::size_t line() const { return m_token_line; }
+  /// Byte offset of the read position (just after the last token returned).
+  std::size_t position() const { return m_pos; }
   /// Line the read position is on.
   std::size_t current_line() const { return m_line; }
   /// The next line holding a token, split into tokens; false at the end of the input. `line`
@@ -65,6 +68,14 @@ void append_uint(std::string& out, std::uint64_t value);
 /// Appends "x y z" (append_double each, single spaces, nothing before or after).
 void append_point(std::string& out, const Vec3& p);
 
+/// Smallest and largest coordinates of `points` ({0,0,0} twice when empty): the Gmsh
+/// writers' volume entity.
+std::pair<Vec3, Vec3> bounding_box(const std::vector<Vec3>& points);
+
+/// Whether this machine stores the low byte of an integer first (binary readers swap bytes
+/// of files written the other way).
+bool host_is_little_endian();
+
 /// Writes `text` to `path`; throws OutputError.
 void write_text_file(const std::string& path, const std::string& text);
 
@@ -78,6 +89,12 @@ void orient_consistently_negative_meshes(TetMesh& mesh);
 TetMesh read_medit(const std::string& path);
 TetMesh read_tetgen(const std::string& path);
 TetMesh read_gmsh(const std::string& path);
+/// The binary part of a Gmsh file (io_gmsh_binary.cpp): `text` is the whole file, `start` the
+/// offset just after the data-size field of $MeshFormat; `major` is 2 or 4, `data_size` the
+/// header's size_t width (4 or 8; MSH 2 uses it for nothing but doubles are 8 bytes).
+TetMesh read_gmsh_binary(const std::string& path, std::string_view text, std::size_t start,
+                         int major, std::int64_t data_size);
+void write_gmsh41_binary_impl(const std::string& path, const TetMesh& mesh);
 void write_medit(const std::string& path, const TetMesh& mesh);
 void write_tetgen(const std::string& path, const TetMesh& mesh);
 void write_gmsh41(const std::string& path, const TetMesh& mesh);

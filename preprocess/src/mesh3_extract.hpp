@@ -3,15 +3,62 @@
 // (cells in complex only, vertices compacted in order of first use, positive orientation),
 // and builds the criteria and optimisation parameters. Include only from mesh3_*.cpp.
 
+#include <CGAL/Cartesian_converter.h>
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Exact_rational.h>
 #include <CGAL/Mesh_criteria_3.h>
+#include <CGAL/Simple_cartesian.h>
 #include <CGAL/make_mesh_3.h>
 
+#include <cmath>
+#include <limits>
 #include <unordered_map>
 
 #include "meshing_internal.hpp"
 #include "vec3_math.hpp"
 
 namespace tetseg::preprocess::detail {
+
+/// Epick with one construction made robust: the power distance of a point to the power sphere
+/// of four weighted points, used by Mesh_3's sliver exuder to choose vertex weights.
+///
+/// Why: on planar parts of a surface (a cube, the pyramid of libcgal-demo) Mesh_3 puts many
+/// vertices on one plane up to rounding, and the triangulation then holds nearly flat cells
+/// whose four corners and the pumped vertex all lie on that plane. Evaluated in doubles, the
+/// power sphere's centre is a division by a determinant that rounds to zero, so the distance
+/// comes out infinite or NaN although its exact value is small (about the squared edge
+/// length). CGAL 5.5's exuder uses it unchecked: a NaN weight reaches a filtered predicate,
+/// whose exact fallback converts it with gmpq_set_d, and GMP raises SIGFPE. Here a non-finite
+/// double result is recomputed exactly (rationals) and rounded; an exact result beyond the
+/// double range (a truly far power sphere) becomes a large finite distance, and exactly
+/// coplanar corners (never in a valid triangulation) one too.
+struct ExactFallbackKernel : public CGAL::Epick {
+  struct Compute_power_distance_to_power_sphere_3 {
+    using Weighted_point_3 = CGAL::Epick::Weighted_point_3;
+    using result_type = CGAL::Epick::FT;
+    double operator()(const Weighted_point_3& p, const Weighted_point_3& q,
+                      const Weighted_point_3& r, const Weighted_point_3& s,
+                      const Weighted_point_3& t) const {
+      const double fast =
+          CGAL::Epick().compute_power_distance_to_power_sphere_3_object()(p, q, r, s, t);
+      if (std::isfinite(fast)) return fast;
+      using Exact = CGAL::Simple_cartesian<CGAL::Exact_rational>;
+      const CGAL::Cartesian_converter<CGAL::Epick, Exact> to_exact;
+      const Exact::Weighted_point_3 ep = to_exact(p), eq = to_exact(q), er = to_exact(r),
+                                    es = to_exact(s), et = to_exact(t);
+      constexpr double kFar = std::numeric_limits<double>::max() / 8;
+      if (CGAL::orientation(ep.point(), eq.point(), er.point(), es.point()) == CGAL::COPLANAR)
+        return kFar;
+      const double exact = CGAL::to_double(
+          Exact().compute_power_distance_to_power_sphere_3_object()(ep, eq, er, es, et));
+      if (!std::isfinite(exact)) return exact > 0 ? kFar : -kFar;
+      return exact;
+    }
+  };
+  Compute_power_distance_to_power_sphere_3 compute_power_distance_to_power_sphere_3_object() const {
+    return {};
+  }
+};
 
 template <class C3t3>
 TetMesh c3t3_to_tet_mesh(const C3t3& c3t3) {
@@ -56,23 +103,26 @@ Criteria make_criteria(const Mesh3Criteria& c) {
 
 /// Runs make_mesh_3 deterministically: the default random generator is reset to seed 0 and
 /// the optimisers get no time limit (their default limit is the refinement time, which would
-/// make the result depend on the machine's speed). Optimisation: sliver perturbation until
-/// every dihedral angle is at least kPerturbBoundDegrees (or nothing improves), then sliver
-/// exudation; ODT and Lloyd are off.
+/// make the result depend on the machine's speed). Refinement uses Mesh_3's manifold option:
+/// surface facets are refined until every surface vertex and edge is manifold, so the
+/// boundary of the cells in the complex is a closed 2-manifold. Optimisation: sliver
+/// perturbation until every dihedral angle is at least kPerturbBoundDegrees (or nothing
+/// improves), then sliver exudation; ODT and Lloyd are off.
 constexpr double kPerturbBoundDegrees = 10.0;
 
 template <class C3t3, class Domain, class Criteria>
-C3t3 run_mesh_3(const Domain& domain, const Criteria& criteria, bool optimize) {
+C3t3 run_mesh_3(const Domain& domain, const Criteria& criteria, const Mesh3Criteria& options) {
   namespace params = CGAL::parameters;
   CGAL::get_default_random() = CGAL::Random(0);
-  if (optimize) {
-    return CGAL::make_mesh_3<C3t3>(
-        domain, criteria, params::no_odt(), params::no_lloyd(),
-        params::perturb(params::time_limit = 0, params::sliver_bound = kPerturbBoundDegrees),
-        params::exude(params::time_limit = 0, params::sliver_bound = 0));
-  }
-  return CGAL::make_mesh_3<C3t3>(domain, criteria, params::no_odt(), params::no_lloyd(),
-                                 params::no_perturb(), params::no_exude());
+  const auto perturb =
+      options.optimize && options.perturb
+          ? params::perturb(params::time_limit = 0, params::sliver_bound = kPerturbBoundDegrees)
+          : params::no_perturb();
+  const auto exude = options.optimize && options.exude
+                         ? params::exude(params::time_limit = 0, params::sliver_bound = 0)
+                         : params::no_exude();
+  return CGAL::make_mesh_3<C3t3>(domain, criteria, params::no_odt(), params::no_lloyd(), perturb,
+                                 exude, params::manifold());
 }
 
 }  // namespace tetseg::preprocess::detail

@@ -19,7 +19,7 @@ using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
 using FT = Kernel::FT;
 using Point = Kernel::Point_3;
 using Domain = CGAL::Labeled_mesh_domain_3<Kernel>;
-using Tr = CGAL::Mesh_triangulation_3<Domain, CGAL::Default, CGAL::Sequential_tag>::type;
+using Tr = CGAL::Mesh_triangulation_3<Domain, ExactFallbackKernel, CGAL::Sequential_tag>::type;
 using C3t3 = CGAL::Mesh_complex_3_in_triangulation_3<Tr>;
 using Criteria = CGAL::Mesh_criteria_3<Tr>;
 
@@ -126,7 +126,7 @@ TetMesh mesh_implicit_shape(Shape shape, const ShapeOptions& o, const Mesh3Crite
   const Domain domain = Domain::create_implicit_mesh_domain(
       f, Kernel::Sphere_3(center, bound * bound), params::relative_error_bound = 1e-6,
       params::p_rng = &rng);
-  const C3t3 c3t3 = run_mesh_3<C3t3>(domain, make_criteria<Criteria>(criteria), criteria.optimize);
+  const C3t3 c3t3 = run_mesh_3<C3t3>(domain, make_criteria<Criteria>(criteria), criteria);
   return c3t3_to_tet_mesh(c3t3);
 }
 

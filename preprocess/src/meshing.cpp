@@ -3,10 +3,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <new>
 #include <stdexcept>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "meshing_internal.hpp"
+#include "repair_internal.hpp"
 #include "tetseg/preprocess/surface.hpp"
 #include "validate_internal.hpp"
 
@@ -15,6 +19,21 @@ namespace {
 
 constexpr double kSurfaceDiagonalDivisor = 40.0;
 constexpr double kFacetDistanceRatio = 0.1;
+/// Meshing sizes below diagonal / kMaxDiagonalPerSize are refused (10^5 facets along the
+/// diagonal: hundreds of millions of tets, or refinement that never ends).
+constexpr double kMaxDiagonalPerSize = 1e5;
+
+double bounding_box_diagonal(const std::vector<Vec3>& points) {
+  if (points.empty()) return 0.0;
+  Vec3 lo = points.front();
+  Vec3 hi = lo;
+  for (const Vec3& p : points)
+    for (int k = 0; k < 3; ++k) {
+      lo[k] = std::min(lo[k], p[k]);
+      hi[k] = std::max(hi[k], p[k]);
+    }
+  return std::hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
+}
 
 void require_positive(double value, const char* name) {
   if (!std::isfinite(value) || value <= 0.0)
@@ -81,33 +100,105 @@ TetMesh generate_shape(Shape shape, const ShapeOptions& shape_options,
   return mesh;
 }
 
+namespace {
+
+/// Runs one CGAL Mesh_3 call; whatever CGAL throws becomes an InputError naming the file and
+/// the stage.
+TetMesh run_mesh_3_guarded(const TriangleMesh& input, const detail::Mesh3Criteria& criteria,
+                           const std::string& file) {
+  try {
+    return detail::mesh_polyhedral_surface(input, criteria);
+  } catch (const InputError&) {
+    throw;
+  } catch (const std::bad_alloc&) {
+    throw InputError(file,
+                     "tetrahedralize: out of memory in CGAL Mesh_3 (is the facet size "
+                     "much smaller than the surface?)");
+  } catch (const std::exception& e) {
+    throw InputError(file, std::string("tetrahedralize: CGAL Mesh_3 failed: ") + e.what());
+  }
+}
+
+/// The defect of the tets' boundary ("" when it is a valid closed 2-manifold): the checks of
+/// validate_tet_mesh.
+std::string boundary_defect(const TetMesh& mesh, const std::string& file) {
+  try {
+    validate_tet_mesh(mesh, extract_surface(mesh), file);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+}  // namespace
+
 TetMesh tetrahedralize(const TriangleMesh& surface, const MeshingOptions& meshing,
-                       const std::string& file) {
+                       const std::string& file, TetrahedralizeNotes* notes) {
   // Pinch points (vertices where separate fans touch) are accepted here: the domain only
-  // needs inside/outside queries, and the output is validated strictly by the caller.
+  // needs inside/outside queries, and the output is validated strictly below.
+  TriangleMesh repaired;
+  if (meshing.repair == MeshingOptions::Repair::kFix) {
+    repaired = surface;
+    std::vector<RepairCount> repairs = detail::repair_soup(repaired);
+    if (repaired.triangles.empty())
+      throw InputError(file, "tetrahedralize: no triangle is left after repair");
+    if (notes != nullptr) notes->repairs = std::move(repairs);
+  }
+  const TriangleMesh& source = meshing.repair == MeshingOptions::Repair::kFix ? repaired : surface;
   TriangleMesh split;
   detail::SurfaceCheck check;
   check.allow_pinched_vertices = true;
-  detail::validate_closed_surface(surface, file, check, &split);
-  const TriangleMesh& input = split.triangles.empty() ? surface : split;
-  Vec3 lo = surface.vertices.front();
-  Vec3 hi = lo;
-  for (const Vec3& p : surface.vertices)
-    for (int k = 0; k < 3; ++k) {
-      lo[k] = std::min(lo[k], p[k]);
-      hi[k] = std::max(hi[k], p[k]);
-    }
-  const double diagonal =
-      std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
-                (hi[2] - lo[2]) * (hi[2] - lo[2]));
+  detail::validate_closed_surface(source, file, check, &split);
+  const TriangleMesh& input = split.triangles.empty() ? source : split;
+  const double diagonal = bounding_box_diagonal(input.vertices);
+  // Criteria are checked before CGAL sees them: every size finite and positive, and not so
+  // small against the surface that refinement could never end (kMaxDiagonalPerSize).
   const detail::Mesh3Criteria criteria =
       resolve(meshing, default_facet_size_for_diagonal(diagonal));
-  TetMesh mesh = detail::mesh_polyhedral_surface(input, criteria);
+  if (!(diagonal > 0.0) || !std::isfinite(diagonal))
+    throw InputError(file, "tetrahedralize: the surface has no extent");
+  for (const double size : {criteria.facet_size, criteria.cell_size, criteria.facet_distance})
+    if (!(size * kMaxDiagonalPerSize >= diagonal))
+      throw InputError(file, "tetrahedralize: a meshing size is below 1/" +
+                                 std::to_string(static_cast<long>(kMaxDiagonalPerSize)) +
+                                 " of the bounding-box diagonal (" + std::to_string(diagonal) +
+                                 "); give larger --facet-size / --cell-size / --facet-distance");
+  TetMesh mesh = run_mesh_3_guarded(input, criteria, file);
   if (mesh.tets.empty())
     throw InputError(file,
                      "meshing produced no tetrahedra (is the surface closed and "
                      "larger than the facet size?)");
-  return mesh;
+  // Mesh_3 refines with its manifold option, so the boundary of the refined tets is a closed
+  // 2-manifold; sliver perturbation can break that (it moves vertices after refinement: on
+  // rotor, homer, couplingdown and cheese it leaves non-manifold vertices or edges), and
+  // exudation alone has not been seen to. So the boundary is checked, and meshing is retried
+  // with exudation only, then with no optimisation; the first valid mesh is returned.
+  std::string defect = boundary_defect(mesh, file);
+  if (defect.empty()) return mesh;
+  std::string defects = "optimised: " + defect;
+  if (criteria.optimize) {
+    struct Retry {
+      const char* name;
+      bool exude;
+    };
+    for (const Retry& retry : {Retry{"exudation only", true}, Retry{"no optimisation", false}}) {
+      detail::Mesh3Criteria fallback = criteria;
+      fallback.perturb = false;
+      fallback.optimize = retry.exude;
+      mesh = run_mesh_3_guarded(input, fallback, file);
+      const std::string retry_defect = boundary_defect(mesh, file);
+      if (retry_defect.empty()) {
+        if (notes != nullptr) {
+          notes->optimization_used = retry.name;
+          notes->first_defect = defect;
+        }
+        return mesh;
+      }
+      defects += std::string("; ") + retry.name + ": " + retry_defect;
+    }
+  }
+  throw InputError(file, "tetrahedralize: the meshed boundary is not a closed 2-manifold (" +
+                             defects + "); thin parts may need a smaller --facet-size");
 }
 
 }  // namespace tetseg::preprocess

@@ -13,7 +13,9 @@ struct Mesh3Criteria {
   double facet_distance = 0.0;
   double cell_radius_edge_ratio = 3.0;
   double cell_size = 0.0;
-  bool optimize = true;
+  bool optimize = true;  ///< false: neither optimiser runs
+  bool perturb = true;   ///< with optimize: sliver perturbation
+  bool exude = true;     ///< with optimize: sliver exudation
 };
 
 /// Mesh_3 on the implicit function of `shape`. Returns compacted, positively oriented tets.

@@ -60,6 +60,14 @@ const std::vector<EnumName<Shape>>& enum_names<Shape>() {
   return table;
 }
 
+template <>
+const std::vector<EnumName<MeshingOptions::Repair>>& enum_names<MeshingOptions::Repair>() {
+  using Repair = MeshingOptions::Repair;
+  static const std::vector<EnumName<Repair>> table = {{"none", Repair::kNone},
+                                                      {"fix", Repair::kFix}};
+  return table;
+}
+
 Shape shape_from_name(const std::string& name) {
   Shape shape;
   if (!parse_name(name, shape)) {

@@ -120,8 +120,9 @@ ProvenanceField flag(const char* key, bool (*recorded)(const BuildOptions&),
 }
 
 template <typename Enum>
-ProvenanceField named(const char* key, Enum& (*access)(BuildOptions&)) {
-  return {key, always, [=](BuildOptions& o) { return std::string(name_of(access(o))); },
+ProvenanceField named(const char* key, bool (*recorded)(const BuildOptions&),
+                      Enum& (*access)(BuildOptions&)) {
+  return {key, recorded, [=](BuildOptions& o) { return std::string(name_of(access(o))); },
           [=](const std::string& text, BuildOptions& o) { return parse_name(text, access(o)); }};
 }
 
@@ -133,8 +134,9 @@ MeshingOptions& meshing_of(BuildOptions& o) {
 const std::vector<ProvenanceField>& provenance_fields() {
   using O = BuildOptions;
   static const std::vector<ProvenanceField> fields = {
-      named<ClusterMethod>("clusters", [](O& o) -> ClusterMethod& { return o.clusters; }),
-      named<ChargeSolver>("charge.solver", [](O& o) -> ChargeSolver& { return o.charge.solver; }),
+      named<ClusterMethod>("clusters", always, [](O& o) -> ClusterMethod& { return o.clusters; }),
+      named<ChargeSolver>("charge.solver", always,
+                          [](O& o) -> ChargeSolver& { return o.charge.solver; }),
       number<double>(
           "charge.tolerance", always, [](O& o) -> double& { return o.charge.tolerance; }, true,
           0.0),
@@ -142,7 +144,7 @@ const std::vector<ProvenanceField>& provenance_fields() {
                   [](O& o) -> int& { return o.charge.max_iterations; }),
       number<int>("charge.restart", always, [](O& o) -> int& { return o.charge.restart; }),
       named<ChargePreconditioner>(
-          "charge.preconditioner",
+          "charge.preconditioner", always,
           [](O& o) -> ChargePreconditioner& { return o.charge.preconditioner; }),
       number<double>(
           "charge.fast_theta", always, [](O& o) -> double& { return o.charge.fast_theta; }, true,
@@ -154,7 +156,7 @@ const std::vector<ProvenanceField>& provenance_fields() {
                      [](O& o) -> double& { return o.segmentation.alpha; }),
       number<double>("segmentation.beta_divisor", always,
                      [](O& o) -> double& { return o.segmentation.beta_divisor; }),
-      named<Equalization>("segmentation.equalization",
+      named<Equalization>("segmentation.equalization", always,
                           [](O& o) -> Equalization& { return o.segmentation.equalization; }),
       number<double>("segmentation.growth_bound", always,
                      [](O& o) -> double& { return o.segmentation.growth_bound; }),
@@ -163,7 +165,7 @@ const std::vector<ProvenanceField>& provenance_fields() {
       number<std::uint32_t>(
           "segmentation.min_cluster_triangles", always,
           [](O& o) -> std::uint32_t& { return o.segmentation.min_cluster_triangles; }),
-      named<DetectorStrategy>("segmentation.detector",
+      named<DetectorStrategy>("segmentation.detector", always,
                               [](O& o) -> DetectorStrategy& { return o.segmentation.detector; }),
       flag("rest_positions", always, [](O& o) -> bool& { return o.keep_rest_positions; }),
       number<double>("refine.min_visibility", refined,
@@ -189,6 +191,9 @@ const std::vector<ProvenanceField>& provenance_fields() {
       number<double>("meshing.cell_radius_edge_ratio", meshed,
                      [](O& o) -> double& { return meshing_of(o).cell_radius_edge_ratio; }),
       flag("meshing.optimize", meshed, [](O& o) -> bool& { return meshing_of(o).optimize; }),
+      named<MeshingOptions::Repair>(
+          "meshing.repair", meshed,
+          [](O& o) -> MeshingOptions::Repair& { return meshing_of(o).repair; }),
   };
   return fields;
 }

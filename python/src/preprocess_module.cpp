@@ -251,8 +251,8 @@ py::tuple build(const py::object& mesh, const py::object& source, const std::str
                 const std::string& equalization, double growth_bound, bool grow_through_marked,
                 std::uint32_t min_cluster_triangles, const std::string& detector,
                 const std::string& solver, double tolerance, double cell_size, double facet_size,
-                double facet_distance, bool optimize, bool rest_positions,
-                const py::object& on_stage) {
+                double facet_distance, bool optimize, const std::string& repair,
+                bool rest_positions, const py::object& on_stage) {
   BuildOptions options;
   options.clusters = enum_from_name<ClusterMethod>("clusters", clusters);
   check_range("refine_visibility", refine_visibility, 0.0, 1.0);
@@ -267,8 +267,7 @@ py::tuple build(const py::object& mesh, const py::object& source, const std::str
   check_range("growth_bound", growth_bound, 0.0, 1.0);
   options.segmentation.alpha = alpha;
   options.segmentation.beta_divisor = beta_divisor;
-  options.segmentation.equalization =
-      enum_from_name<Equalization>("equalization", equalization);
+  options.segmentation.equalization = enum_from_name<Equalization>("equalization", equalization);
   options.segmentation.growth_bound = growth_bound;
   options.segmentation.grow_through_marked = grow_through_marked;
   options.segmentation.min_cluster_triangles = min_cluster_triangles;
@@ -285,6 +284,7 @@ py::tuple build(const py::object& mesh, const py::object& source, const std::str
   meshing.facet_size = facet_size;
   meshing.facet_distance = facet_distance;
   meshing.optimize = optimize;
+  meshing.repair = enum_from_name<MeshingOptions::Repair>("repair", repair);
 
   Input in = input_from(mesh, source);
   std::function<void(const StageReport&)> stage_callback;
@@ -316,7 +316,9 @@ py::tuple build(const py::object& mesh, const py::object& source, const std::str
     } else {
       timer.run("read", [&](std::string& summary) {
         read_input(in);
-        validate_closed_surface(in.surface, in.source);
+        // As `tetseg build`: with repair "fix", tetrahedralize validates after repairing.
+        if (meshing.repair == MeshingOptions::Repair::kNone)
+          validate_closed_surface(in.surface, in.source);
         summary = std::to_string(in.surface.vertices.size()) + " vertices, " +
                   std::to_string(in.surface.triangles.size()) + " triangles (surface)";
         return 0;
@@ -482,11 +484,12 @@ PYBIND11_MODULE(preprocess, m) {
         py::arg("tolerance") = b.charge.tolerance, py::arg("cell_size") = meshing.cell_size,
         py::arg("facet_size") = meshing.facet_size,
         py::arg("facet_distance") = meshing.facet_distance, py::arg("optimize") = meshing.optimize,
+        py::arg("repair") = std::string(name_of(meshing.repair)),
         py::arg("rest_positions") = b.keep_rest_positions, py::arg("on_stage") = py::none(),
         "Returns (asset bytes, report dict). "
         "Runs the whole pipeline as `tetseg build` does. mesh: a tet mesh file (.mesh, "
         ".node/.ele, .msh), a closed surface file (.obj, .ply, .stl, .off, ...; tetrahedralised "
-        "first with cell_size, facet_size, facet_distance, optimize), or a pair of arrays "
+        "first with cell_size, facet_size, facet_distance, optimize, repair), or a pair of arrays "
         "(nodes (N, 3), tets (M, 4)) or (points (N, 3), triangles (M, 3)). source: the name "
         "recorded in the asset's provenance and used in messages (default: the path, or "
         "'arrays'). Every other option is the `tetseg build` option of the same name "
@@ -500,8 +503,7 @@ PYBIND11_MODULE(preprocess, m) {
         py::arg("solver") = std::string(name_of(c.solver)), py::arg("tolerance") = c.tolerance,
         py::arg("max_iterations") = c.max_iterations, py::arg("theta") = c.fast_theta,
         py::arg("order") = c.fast_order,
-        py::arg("equalize") = std::string(name_of(Equalization::kHistogram)),
-        py::arg("bins") = 256,
+        py::arg("equalize") = std::string(name_of(Equalization::kHistogram)), py::arg("bins") = 256,
         "Returns a dict. "
         "Relative charge density of a tet mesh's boundary or of a closed surface, as "
         "`tetseg charge` computes it (docs/charge.md). mesh as for build. Returns density and "

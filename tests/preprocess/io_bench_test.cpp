@@ -51,12 +51,15 @@ TEST_CASE("Benchmark: tet mesh I/O, extraction and validation", "[.bench][io-ben
   const auto dir =
       std::filesystem::temp_directory_path() / ("tetseg_io_bench_" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);
-  for (const char* name : {"b.mesh", "b.node", "b.msh", "b22.msh"}) {
+  for (const char* name : {"b.mesh", "b.node", "b.msh", "b22.msh", "bbin.msh"}) {
     const std::string path = (dir / name).string();
     const bool v22 = std::string(name) == "b22.msh";
+    const bool binary = std::string(name) == "bbin.msh";
     const double t_write = best_of(3, [&] {
       if (v22) {
         write_gmsh22(path, mesh);
+      } else if (binary) {
+        write_gmsh41_binary(path, mesh);
       } else {
         write_tet_mesh(path, mesh);
       }

@@ -1,6 +1,8 @@
 // CGAL Mesh_3 meshing: procedural shapes and closed surfaces, including real meshes from
 // Debian's libcgal-demo.
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <catch2/catch.hpp>
 #include <cmath>
@@ -203,4 +205,54 @@ TEST_CASE("Real meshes from libcgal-demo import and tetrahedralise", "[meshing][
       CHECK_THAT(e.what(), Catch::Contains("surface self-intersects"));
     }
   }
+}
+
+TEST_CASE("The simplest polygonal solids read from OFF and mesh with default options",
+          "[meshing][polygons]") {
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("tetseg_polygons_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  SECTION("The 5-vertex pyramid with a quad base (once a SIGFPE in the sliver exuder).") {
+    // CGAL's data/meshes/pyramid.off: square base at x = -1, apex at (1, 0, 0).
+    const std::string path = (dir / "pyramid.off").string();
+    std::ofstream(path) << "OFF\n5 5 0\n-1 -0.5 -0.5\n-1 -0.5 0.5\n-1 0.5 0.5\n-1 0.5 -0.5\n"
+                           "1 0 0\n3 1 0 4\n3 2 1 4\n3 3 2 4\n3 0 3 4\n4 0 1 2 3\n";
+    const TriangleMesh s = read_triangle_mesh(path);
+    CHECK(s.vertices.size() == 5);
+    CHECK(s.triangles.size() == 6);  // the quad is split in two
+    validate_closed_surface(s, path);
+    const double pyramid_volume = 1.0 * 2.0 / 3.0;
+    CHECK(std::abs(enclosed_volume(s.vertices, s.triangles)) == Approx(pyramid_volume));
+    const Checked c = check_valid(tetrahedralize(s, MeshingOptions{}, path));
+    CHECK(c.volume == Approx(pyramid_volume).epsilon(0.03));
+  }
+  SECTION("The unit cube of 6 quads.") {
+    const std::string path = (dir / "cube.off").string();
+    std::ofstream(path) << "OFF\n8 6 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n0 0 1\n1 0 1\n1 1 1\n0 1 1\n"
+                           "4 0 3 2 1\n4 4 5 6 7\n4 0 1 5 4\n4 1 2 6 5\n4 2 3 7 6\n4 3 0 4 7\n";
+    const TriangleMesh s = read_triangle_mesh(path);
+    CHECK(s.vertices.size() == 8);
+    CHECK(s.triangles.size() == 12);
+    validate_closed_surface(s, path);
+    CHECK(enclosed_volume(s.vertices, s.triangles) == Approx(1.0));
+    const Checked c = check_valid(tetrahedralize(s, MeshingOptions{}, path));
+    CHECK(c.volume == Approx(1.0).epsilon(0.03));
+    CHECK(c.lo[0] == Approx(0.0).margin(1e-9));
+    CHECK(c.hi[2] == Approx(1.0).margin(1e-9));
+  }
+  std::filesystem::remove_all(dir);
+}
+
+TEST_CASE(
+    "A real mesh whose tetrahedralisation used to be non-manifold now gives a closed "
+    "2-manifold boundary",
+    "[meshing][cgal-data][slow]") {
+  const std::string path = std::string(TETSEG_CGAL_MESH_DIR) + "/rotor_small.off";
+  if (!std::filesystem::exists(path)) {
+    WARN("CGAL demo meshes not found; skipping");
+    return;
+  }
+  const TriangleMesh s = read_triangle_mesh(path);
+  const Checked c = check_valid(tetrahedralize(s, MeshingOptions{}, path));
+  CHECK(c.volume == Approx(std::abs(enclosed_volume(s.vertices, s.triangles))).epsilon(0.05));
 }

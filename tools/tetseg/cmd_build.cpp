@@ -111,14 +111,19 @@ void run_build(const BuildArgs& args) {
   } else {
     const TriangleMesh surface = timer.run("read", [&](std::string& summary) {
       TriangleMesh s = read_triangle_mesh(args.input);
-      validate_closed_surface(s, args.input);
+      // With --repair fix, tetrahedralize validates after repairing.
+      if (args.meshing.repair == MeshingOptions::Repair::kNone)
+        validate_closed_surface(s, args.input);
       summary = std::to_string(s.vertices.size()) + " vertices, " +
                 std::to_string(s.triangles.size()) + " triangles (surface)";
       return s;
     });
     mesh = timer.run("tetrahedralize", [&](std::string& summary) {
-      TetMesh m = tetrahedralize(surface, args.meshing, args.input);
+      TetrahedralizeNotes notes;
+      TetMesh m = tetrahedralize(surface, args.meshing, args.input, &notes);
       options.meshing = args.meshing;  // recorded in the provenance
+      mesh_cli::print_repairs(args.input, notes);
+      if (!notes.optimization_used.empty()) mesh_cli::print_retry_note(args.input, notes);
       summary =
           std::to_string(m.nodes.size()) + " nodes, " + std::to_string(m.tets.size()) + " tets";
       return m;
@@ -247,6 +252,7 @@ void add_build_command(CLI::App& root) {
   cmd->add_flag(
       "--no-optimize", [args](std::int64_t) { args->meshing.optimize = false; },
       "Surface input only: skip sliver perturbation and exudation (faster meshing)");
+  mesh_cli::add_repair_option(*cmd, args->meshing);
   cmd->add_flag("--no-rest-positions", args->no_rest_positions,
                 "Do not store rest positions in the asset (smaller; tools cannot draw it)");
   cmd->add_flag("-q,--quiet", args->quiet, "No stage lines");

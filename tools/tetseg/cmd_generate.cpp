@@ -3,6 +3,7 @@
 
 #include <chrono>
 #include <cstdio>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -17,12 +18,6 @@
 namespace tetseg::tools {
 
 namespace mesh_cli {
-
-// Shared with cmd_tetrahedralize.cpp (declared there).
-void add_meshing_options(CLI::App& cmd, preprocess::MeshingOptions& m, bool& gmsh22);
-void check_output_path(const std::string& path);
-void finish_tet_mesh(const preprocess::TetMesh& mesh, const std::string& output, bool gmsh22,
-                     const std::string& what);
 
 /// Wall-clock stage timer that prints "tetseg: <label> ... <s> s, <details>" to stderr.
 class Stage {
@@ -41,7 +36,7 @@ class Stage {
   std::chrono::steady_clock::time_point m_start;
 };
 
-void add_meshing_options(CLI::App& cmd, preprocess::MeshingOptions& m, bool& gmsh22) {
+void add_meshing_options(CLI::App& cmd, preprocess::MeshingOptions& m, MshOutput& msh) {
   cmd.add_option("--cell-size", m.cell_size,
                  "Max tet circumradius (0 = facet size; see docs/cli.md, Meshing options)")
       ->check(CLI::NonNegativeNumber);
@@ -58,7 +53,10 @@ void add_meshing_options(CLI::App& cmd, preprocess::MeshingOptions& m, bool& gms
       ->check(CLI::Range(2.0, 1000.0));
   cmd.add_flag_callback(
       "--no-optimize", [&m] { m.optimize = false; }, "Skip sliver perturbation and exudation");
-  cmd.add_flag("--gmsh22", gmsh22, "Write Gmsh 2.2 instead of 4.1 when the output is .msh");
+  CLI::Option* gmsh22 =
+      cmd.add_flag("--gmsh22", msh.gmsh22, "Write Gmsh 2.2 instead of 4.1 when the output is .msh");
+  cmd.add_flag("--binary", msh.binary, "Write binary Gmsh 4.1 when the output is .msh")
+      ->excludes(gmsh22);
 }
 
 void check_output_path(const std::string& path) {
@@ -69,23 +67,27 @@ void check_output_path(const std::string& path) {
 
 namespace {
 
-void write_one(const std::string& path, const preprocess::TetMesh& mesh, bool gmsh22) {
-  if (gmsh22 && extension_of(path) == ".msh") {
+void write_one(const std::string& path, const preprocess::TetMesh& mesh, const MshOutput& msh) {
+  const bool gmsh = extension_of(path) == ".msh";
+  if (gmsh && msh.gmsh22) {
     preprocess::write_gmsh22(path, mesh);
+  } else if (gmsh && msh.binary) {
+    preprocess::write_gmsh41_binary(path, mesh);
   } else {
     preprocess::write_tet_mesh(path, mesh);
   }
 }
 
 /// Writes all files of the output (both of a TetGen pair) or none (write_files_atomic).
-void write_atomic(const std::string& output, const preprocess::TetMesh& mesh, bool gmsh22) {
+void write_atomic(const std::string& output, const preprocess::TetMesh& mesh,
+                  const MshOutput& msh) {
   const std::string ext = extension_of(output);
   const std::string stem = output.substr(0, output.size() - ext.size());
   std::vector<std::string> finals = {output};
   if (ext == ".node" || ext == ".ele") finals = {stem + ".node", stem + ".ele"};
   write_files_atomic(finals, [&](const std::vector<std::string>& temps) {
     try {
-      write_one(temps.front(), mesh, gmsh22);  // a TetGen writer finds the .ele beside the .node
+      write_one(temps.front(), mesh, msh);  // a TetGen writer finds the .ele beside the .node
     } catch (const preprocess::OutputError& e) {
       throw preprocess::OutputError(output, e.what());
     }
@@ -94,8 +96,33 @@ void write_atomic(const std::string& output, const preprocess::TetMesh& mesh, bo
 
 }  // namespace
 
-void finish_tet_mesh(const preprocess::TetMesh& mesh, const std::string& output, bool gmsh22,
-                     const std::string& what) {
+void print_retry_note(const std::string& file, const preprocess::TetrahedralizeNotes& notes) {
+  std::fprintf(stderr,
+               "tetseg: note: %s: the optimised mesh's boundary was not a closed 2-manifold "
+               "(%s); meshed again with %s\n",
+               base_name(file).c_str(), notes.first_defect.c_str(),
+               notes.optimization_used.c_str());
+}
+
+void add_repair_option(CLI::App& cmd, preprocess::MeshingOptions& m) {
+  using Repair = preprocess::MeshingOptions::Repair;
+  cmd.add_option("--repair", m.repair,
+                 "Surface input: none, or fix (remove degenerate and duplicate triangles, make "
+                 "the orientation consistent; docs/cli.md)")
+      ->transform(CLI::CheckedTransformer(preprocess::name_map<Repair>(), CLI::ignore_case))
+      ->option_text(preprocess::name_list<Repair>() + " (" + preprocess::name_of(m.repair) + ")");
+}
+
+void print_repairs(const std::string& file, const preprocess::TetrahedralizeNotes& notes) {
+  if (notes.repairs.empty()) return;
+  std::string list;
+  for (const preprocess::RepairCount& r : notes.repairs)
+    list += (list.empty() ? "" : ", ") + std::to_string(r.count) + " " + r.kind;
+  std::fprintf(stderr, "tetseg: repaired %s: %s\n", base_name(file).c_str(), list.c_str());
+}
+
+void finish_tet_mesh(const preprocess::TetMesh& mesh, const std::string& output,
+                     const MshOutput& msh, const std::string& what) {
   {
     Stage stage("validating " + what);
     const preprocess::Surface surface = preprocess::extract_surface(mesh);
@@ -110,7 +137,7 @@ void finish_tet_mesh(const preprocess::TetMesh& mesh, const std::string& output,
                std::to_string(surface.interior_nodes.size()) + " interior nodes");
   }
   Stage stage("writing " + base_name(output));
-  write_atomic(output, mesh, gmsh22);
+  write_atomic(output, mesh, msh);
   stage.done("");
 }
 
@@ -124,7 +151,7 @@ struct GenerateArgs {
   preprocess::ShapeOptions shape_options;
   std::vector<double> axes;
   preprocess::MeshingOptions meshing;
-  bool gmsh22 = false;
+  mesh_cli::MshOutput msh;
 };
 
 void run_generate(const GenerateArgs& args) {
@@ -137,7 +164,7 @@ void run_generate(const GenerateArgs& args) {
   const preprocess::TetMesh mesh = preprocess::generate_shape(shape, shape_options, args.meshing);
   stage.done(std::to_string(mesh.nodes.size()) + " nodes, " + std::to_string(mesh.tets.size()) +
              " tets");
-  mesh_cli::finish_tet_mesh(mesh, args.output, args.gmsh22, args.shape);
+  mesh_cli::finish_tet_mesh(mesh, args.output, args.msh, args.shape);
 }
 
 }  // namespace
@@ -159,7 +186,7 @@ void add_generate_command(CLI::App& root) {
   cmd->add_option("--axes", args->axes, "Ellipsoid semi-axes a b c")
       ->expected(3)
       ->check(CLI::PositiveNumber);
-  mesh_cli::add_meshing_options(*cmd, args->meshing, args->gmsh22);
+  mesh_cli::add_meshing_options(*cmd, args->meshing, args->msh);
   cmd->callback([args] { run_generate(*args); });
 }
 

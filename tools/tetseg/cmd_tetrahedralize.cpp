@@ -14,21 +14,13 @@
 
 namespace tetseg::tools {
 
-namespace mesh_cli {
-// Defined in cmd_generate.cpp.
-void add_meshing_options(CLI::App& cmd, preprocess::MeshingOptions& m, bool& gmsh22);
-void check_output_path(const std::string& path);
-void finish_tet_mesh(const preprocess::TetMesh& mesh, const std::string& output, bool gmsh22,
-                     const std::string& what);
-}  // namespace mesh_cli
-
 namespace {
 
 struct TetrahedralizeArgs {
   std::string input;
   std::string output;
   preprocess::MeshingOptions meshing;
-  bool gmsh22 = false;
+  mesh_cli::MshOutput msh;
 };
 
 double seconds_since(std::chrono::steady_clock::time_point start) {
@@ -43,11 +35,15 @@ void run_tetrahedralize(const TetrahedralizeArgs& args) {
                base_name(args.input).c_str(), seconds_since(start), surface.vertices.size(),
                surface.triangles.size());
   start = std::chrono::steady_clock::now();
-  const preprocess::TetMesh mesh = preprocess::tetrahedralize(surface, args.meshing, args.input);
+  preprocess::TetrahedralizeNotes notes;
+  const preprocess::TetMesh mesh =
+      preprocess::tetrahedralize(surface, args.meshing, args.input, &notes);
+  mesh_cli::print_repairs(args.input, notes);
+  if (!notes.optimization_used.empty()) mesh_cli::print_retry_note(args.input, notes);
   std::fprintf(stderr, "tetseg: meshing %s ... %.2f s, %zu nodes, %zu tets\n",
                base_name(args.input).c_str(), seconds_since(start), mesh.nodes.size(),
                mesh.tets.size());
-  mesh_cli::finish_tet_mesh(mesh, args.output, args.gmsh22, base_name(args.input));
+  mesh_cli::finish_tet_mesh(mesh, args.output, args.msh, base_name(args.input));
 }
 
 }  // namespace
@@ -61,7 +57,8 @@ void add_tetrahedralize_command(CLI::App& root) {
       ->required();
   cmd->add_option("-o,--output", args->output, "Output tet mesh (.mesh, .node/.ele, .msh)")
       ->required();
-  mesh_cli::add_meshing_options(*cmd, args->meshing, args->gmsh22);
+  mesh_cli::add_meshing_options(*cmd, args->meshing, args->msh);
+  mesh_cli::add_repair_option(*cmd, args->meshing);
   cmd->callback([args] { run_tetrahedralize(*args); });
 }
 

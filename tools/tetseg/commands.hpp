@@ -5,6 +5,10 @@
 /// (main maps them to exit codes). One file per subcommand: cmd_<name>.cpp.
 
 #include <CLI/CLI.hpp>
+#include <string>
+
+#include "tetseg/preprocess/mesh.hpp"
+#include "tetseg/preprocess/meshing.hpp"
 
 namespace tetseg::tools {
 
@@ -12,5 +16,34 @@ void add_generate_command(CLI::App& root);
 void add_tetrahedralize_command(CLI::App& root);
 void add_charge_command(CLI::App& root);
 void add_build_command(CLI::App& root);
+
+/// Helpers shared by the commands that write tet meshes (defined in cmd_generate.cpp).
+namespace mesh_cli {
+
+/// How a `.msh` output is written: Gmsh 4.1 ASCII by default.
+struct MshOutput {
+  bool gmsh22 = false;  ///< Gmsh 2.2 ASCII
+  bool binary = false;  ///< Gmsh 4.1 binary
+};
+
+/// Adds the Mesh_3 options (--cell-size, ...) and the .msh flags (--gmsh22, --binary).
+void add_meshing_options(CLI::App& cmd, preprocess::MeshingOptions& m, MshOutput& msh);
+/// Throws a usage error unless `path` names a tet mesh format.
+void check_output_path(const std::string& path);
+/// Validates `mesh` (exit 1 when invalid) and writes it atomically to `output`.
+void finish_tet_mesh(const preprocess::TetMesh& mesh, const std::string& output,
+                     const MshOutput& msh, const std::string& what);
+
+/// Says on stderr that tetrahedralize meshed `file` again with less optimisation because the
+/// optimised mesh's boundary was invalid (`notes`).
+void print_retry_note(const std::string& file, const preprocess::TetrahedralizeNotes& notes);
+
+/// Adds `--repair none|fix` (MeshingOptions::repair).
+void add_repair_option(CLI::App& cmd, preprocess::MeshingOptions& m);
+/// Prints the repairs tetrahedralize made to `file` ("tetseg: repaired x.off: 2 duplicate
+/// triangles removed, ..."), nothing when there were none.
+void print_repairs(const std::string& file, const preprocess::TetrahedralizeNotes& notes);
+
+}  // namespace mesh_cli
 
 }  // namespace tetseg::tools

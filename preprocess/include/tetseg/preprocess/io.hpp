@@ -10,7 +10,8 @@
 namespace tetseg::preprocess {
 
 /// Tet mesh formats by extension: MEDIT `.mesh` (ASCII), TetGen `.node`+`.ele` (give either
-/// file; the other is found beside it), Gmsh `.msh` 2.2 and 4.1 (ASCII).
+/// file; the other is found beside it), Gmsh `.msh` 2.2 and 4.1, ASCII or binary (either byte
+/// order, found by the format's endianness check; 4.1 with 4- or 8-byte size fields).
 bool is_tet_mesh_path(const std::string& path);
 
 /// Reads a tetrahedral mesh; the format follows from the extension (case-insensitive). Nodes
@@ -21,9 +22,10 @@ bool is_tet_mesh_path(const std::string& path);
 /// (a mirrored convention), two vertices of every tet are swapped; mixed orientations are
 /// left for validate_tet_mesh to report. Checks syntax, counts, index ranges and finite
 /// coordinates, not geometry. Throws InputError(path, "line N: ...") for malformed text,
-/// unexpected end of file, indices out of range, NaN/Inf, counts that do not match, binary
-/// Gmsh; "no tetrahedra in file" when there are none. Safe on untrusted input (counts are
-/// checked against the file size before reserving). Thread-safe (no shared state).
+/// unexpected end of file, indices out of range, NaN/Inf, counts that do not match (binary
+/// Gmsh: "byte N: ..." instead of a line); "no tetrahedra in file" when there are none. Safe
+/// on untrusted input (counts are checked against the bytes left before reserving or reading).
+/// Thread-safe (no shared state).
 TetMesh read_tet_mesh(const std::string& path);
 
 /// Writes a tetrahedral mesh in the format named by the extension (`.mesh`, `.node`/`.ele`,
@@ -32,12 +34,22 @@ TetMesh read_tet_mesh(const std::string& path);
 /// Throws OutputError.
 void write_tet_mesh(const std::string& path, const TetMesh& mesh);
 void write_gmsh22(const std::string& path, const TetMesh& mesh);
+/// Gmsh 4.1 binary (little-endian, 8-byte size fields): one volume entity, node and tet tags
+/// from 1. Reads back bit-exactly with read_tet_mesh. Throws OutputError.
+void write_gmsh41_binary(const std::string& path, const TetMesh& mesh);
 
-/// Reads a triangle surface through assimp (OBJ, PLY, STL, OFF, glTF, ...): polygons are
-/// triangulated, node transforms applied, points and lines dropped, and vertices with exactly
-/// the same position merged (numbered in order of first use). Coordinates pass through
-/// assimp's single-precision floats. Throws InputError when the file cannot be read or holds
-/// no triangles. No validation: see validate_closed_surface.
+/// Reads a triangle surface. OFF (ASCII), PLY, OBJ and STL go through CGAL's polygon-soup
+/// readers (double precision); polygons with more than three corners are triangulated (CGAL's
+/// hole triangulation of the polygon's outline, so non-planar quads are split sensibly). Other
+/// formats (glTF, FBX, 3DS, ...) go through assimp (single-precision floats; node transforms
+/// applied). Points and lines are dropped, and vertices with exactly the same position merged
+/// (numbered in order of first use). Throws InputError naming the file when it cannot be read
+/// or holds no triangles; whatever CGAL or assimp throws (also allocation failures) becomes an
+/// InputError too. Safe on untrusted input: before CGAL's readers size anything, OFF header
+/// counts and face lengths, and every PLY element count and list length, are checked against
+/// the bytes (or tokens) that follow; binary OFF is refused; NaN/Inf coordinates, out-of-range
+/// indices and polygons of more than 4096 corners are refused. No validation: see
+/// validate_closed_surface.
 TriangleMesh read_triangle_mesh(const std::string& path);
 
 }  // namespace tetseg::preprocess

@@ -3,7 +3,9 @@
 /// Tetrahedral meshing with CGAL Mesh_3: procedural shapes and closed surfaces. Deterministic
 /// (fixed seeds, no parallel refinement): the same input and options give the same mesh.
 
+#include <cstddef>
 #include <string>
+#include <vector>
 
 #include "tetseg/preprocess/mesh.hpp"
 
@@ -20,6 +22,14 @@ struct MeshingOptions {
   double facet_angle = 25.0;            ///< min facet angle, degrees, in (0, 30]
   double cell_radius_edge_ratio = 3.0;  ///< tet quality bound, >= 2
   bool optimize = true;  ///< sliver perturbation (10 degree bound) + exudation; no ODT/Lloyd
+  /// Surfaces only: kFix repairs the input before validation (tetrahedralize).
+  enum class Repair { kNone, kFix } repair = Repair::kFix;
+};
+
+/// One kind of repair tetrahedralize made to its input, and how many.
+struct RepairCount {
+  std::string kind;  ///< e.g. "duplicate triangles removed"
+  std::size_t count = 0;
 };
 
 /// Procedural shapes made with Mesh_3's implicit domain.
@@ -46,14 +56,34 @@ Shape shape_from_name(const std::string& name);
 TetMesh generate_shape(Shape shape, const ShapeOptions& shape_options,
                        const MeshingOptions& meshing = {});
 
-/// Tetrahedralises a closed, manifold surface (interior nodes included). The boundary is
-/// re-meshed (Mesh_3 does not keep the input triangles). Unlike validate_closed_surface,
-/// pinch points (separate fans of triangles touching at one vertex position, common in
-/// modelled meshes) are accepted; callers should validate the resulting tet mesh. Throws InputError
-/// (naming `file`) when the surface is not usable (validate_closed_surface) or meshing yields no
-/// tets; std::invalid_argument on bad options. Same threading note as generate_shape.
+/// What tetrahedralize did beyond one plain Mesh_3 run (see tetrahedralize).
+struct TetrahedralizeNotes {
+  /// "" when the first mesh was valid; else the retry that gave the returned mesh:
+  /// "exudation only" or "no optimisation".
+  std::string optimization_used;
+  std::string first_defect;          ///< the first mesh's boundary defect, when retried
+  std::vector<RepairCount> repairs;  ///< repairs of the input (MeshingOptions::repair)
+};
+
+/// Tetrahedralises a closed, manifold surface (interior nodes included). With
+/// `meshing.repair == kFix` the surface is first repaired without changing its shape:
+/// triangles with a repeated corner removed, duplicate triangles merged, orientation made
+/// consistent (flips; non-manifold vertices duplicated), unused vertices dropped; the repairs
+/// go to `notes->repairs`. Holes, self-intersections and zero-area triangles with three
+/// distinct corners are not repaired. The boundary is
+/// re-meshed (Mesh_3 does not keep the input triangles); Mesh_3 runs with its manifold option.
+/// Unlike validate_closed_surface, pinch points (separate fans of triangles touching at one
+/// vertex position, common in modelled meshes) are accepted. The result is checked like
+/// validate_tet_mesh (closed 2-manifold boundary, ...); when the optimised mesh (sliver
+/// perturbation, then exudation) fails that check, meshing is retried with exudation only,
+/// then without optimisation, and `notes` (if given) says which mesh was returned. Throws
+/// InputError (naming `file`; the message starts with the stage, "tetrahedralize: ...") when
+/// the surface is not usable (validate_closed_surface), a meshing size is below 1e-5 of the
+/// bounding-box diagonal, CGAL throws, meshing yields no tets, or every attempt's boundary is
+/// invalid (the defects are listed); std::invalid_argument on bad options. Same threading note
+/// as generate_shape.
 TetMesh tetrahedralize(const TriangleMesh& surface, const MeshingOptions& meshing,
-                       const std::string& file);
+                       const std::string& file, TetrahedralizeNotes* notes = nullptr);
 
 /// Default facet size (before `size` scaling) of a procedural shape, and for a surface of
 /// bounding-box diagonal `diagonal`: the rules behind "0 = derive".

@@ -23,7 +23,7 @@ struct EnumName {
 
 /// The table of `Enum`: every value once under its canonical name, in declaration order, then
 /// the aliases. Defined for ChargeSolver, ChargePreconditioner, Equalization, DetectorStrategy,
-/// ClusterMethod and Shape.
+/// ClusterMethod, Shape and MeshingOptions::Repair.
 template <typename Enum>
 const std::vector<EnumName<Enum>>& enum_names();
 
@@ -39,6 +39,8 @@ template <>
 const std::vector<EnumName<ClusterMethod>>& enum_names<ClusterMethod>();
 template <>
 const std::vector<EnumName<Shape>>& enum_names<Shape>();
+template <>
+const std::vector<EnumName<MeshingOptions::Repair>>& enum_names<MeshingOptions::Repair>();
 
 /// The canonical name of `value`.
 template <typename Enum>

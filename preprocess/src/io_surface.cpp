@@ -1,0 +1,316 @@
+// Triangle surfaces: OFF, PLY, OBJ and STL through CGAL's polygon-soup readers (polygons are
+// triangulated here), every other format through assimp (io_assimp.cpp). CGAL I/O only; no
+// Mesh_3 in this translation unit.
+
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/IO/polygon_soup_io.h>
+#include <CGAL/Polygon_mesh_processing/triangulate_hole.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <exception>
+#include <fstream>
+#include <iterator>
+#include <map>
+#include <new>
+#include <sstream>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include "io_text.hpp"
+#include "tetseg/preprocess/io.hpp"
+
+namespace tetseg::preprocess {
+namespace detail {
+TriangleMesh read_triangle_mesh_assimp(const std::string& path);
+}  // namespace detail
+
+namespace {
+
+using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
+using Point = Kernel::Point_3;
+using Polygon = std::vector<std::size_t>;
+using detail::host_is_little_endian;
+using detail::parse_int;
+using detail::Tokenizer;
+
+/// Polygons with more corners than this are refused (a hostile degree would make the
+/// triangulation cubic in it).
+constexpr std::size_t kMaxPolygonCorners = 4096;
+
+/// Header counts of an ASCII OFF file checked against the bytes that follow, before CGAL's
+/// reader resizes its arrays to them: a vertex needs at least 6 bytes ("0 0 0\n"), a face 8
+/// ("3 0 1 2\n"), and every face line's corner count must fit on its line.
+void check_off_counts(const std::string& path, const std::string& text) {
+  Tokenizer tok(path, text, '#');
+  const std::string_view keyword = tok.next("the OFF keyword");
+  if (keyword.size() < 3 || keyword.substr(keyword.size() - 3) != "OFF")
+    tok.fail("not an OFF file (first word '" + std::string(keyword.substr(0, 20)) + "')");
+  if (keyword.find('n') != std::string_view::npos && tok.next_int("the dimension") != 3)
+    tok.fail("only 3D OFF files are supported");
+  std::string_view first = tok.next("the vertex count");
+  if (first == "BINARY") tok.fail("binary OFF is not supported (save the surface as ASCII OFF)");
+  std::int64_t counts[3] = {0, 0, 0};
+  if (!parse_int(first, counts[0]))
+    tok.fail("expected the vertex count, got '" + std::string(first.substr(0, 40)) + "'");
+  counts[1] = tok.next_int("the face count");
+  counts[2] = tok.next_int("the edge count");
+  if (counts[0] < 0 || counts[1] < 0 || counts[2] < 0) tok.fail("negative count in the OFF header");
+  const std::uint64_t bytes = text.size();
+  const auto nv = static_cast<std::uint64_t>(counts[0]);
+  const auto nf = static_cast<std::uint64_t>(counts[1]);
+  if (nv > bytes / 6 || nf > bytes / 8 || nv * 6 + nf * 8 > bytes)
+    tok.fail("header counts " + std::to_string(nv) + " vertices, " + std::to_string(nf) +
+             " faces exceed what the file's " + std::to_string(bytes) + " bytes can hold");
+  // Each face line starts with its corner count; the rest of the line must hold that many.
+  tok.rest_of_line();
+  std::vector<std::string_view> record;
+  std::size_t line = 0;
+  for (std::uint64_t i = 0; i < nv; ++i)
+    if (!tok.next_record(record, line)) tok.fail_at(line, "unexpected end of file (vertices)");
+  for (std::uint64_t i = 0; i < nf; ++i) {
+    if (!tok.next_record(record, line)) tok.fail_at(line, "unexpected end of file (faces)");
+    std::int64_t corners = 0;
+    if (!parse_int(record[0], corners) || corners < 3 ||
+        static_cast<std::uint64_t>(corners) + 1 > record.size() ||
+        static_cast<std::uint64_t>(corners) > kMaxPolygonCorners)
+      tok.fail_at(line, "malformed face (corner count '" + std::string(record[0].substr(0, 20)) +
+                            "' with " + std::to_string(record.size() - 1) + " values after it)");
+  }
+}
+
+/// One PLY property: a scalar, or a list with a count of `count_bytes` (signed or not) and
+/// items of `bytes` each.
+struct PlyProperty {
+  bool list = false;
+  std::uint64_t count_bytes = 0;
+  bool count_signed = false;
+  std::uint64_t bytes = 0;
+};
+
+struct PlyElement {
+  std::uint64_t count = 0;
+  std::vector<PlyProperty> properties;
+};
+
+/// Size in bytes and signedness of a PLY scalar type; {0, false} when unknown.
+std::pair<std::uint64_t, bool> ply_type(const std::string& type) {
+  static const std::map<std::string, std::pair<std::uint64_t, bool>> kTypes = {
+      {"char", {1, true}},  {"int8", {1, true}},    {"uchar", {1, false}},  {"uint8", {1, false}},
+      {"short", {2, true}}, {"int16", {2, true}},   {"ushort", {2, false}}, {"uint16", {2, false}},
+      {"int", {4, true}},   {"int32", {4, true}},   {"uint", {4, false}},   {"uint32", {4, false}},
+      {"float", {4, true}}, {"float32", {4, true}}, {"double", {8, true}},  {"float64", {8, true}}};
+  const auto it = kTypes.find(type);
+  return it == kTypes.end() ? std::pair<std::uint64_t, bool>{0, false} : it->second;
+}
+
+/// Walks a PLY file's header and body before CGAL's reader sees it, so that no count can make
+/// that reader allocate or loop beyond the file: element counts are checked against the bytes
+/// left, and every list's length against the bytes (binary) or tokens (ASCII) that follow.
+/// Also refuses what CGAL's reader would crash on (a property before any element).
+void check_ply_layout(const std::string& path, const std::string& text) {
+  const std::size_t end = text.find("end_header");
+  if (text.compare(0, 3, "ply") != 0 || end == std::string::npos)
+    throw InputError(path, "not a PLY file (no 'ply' ... 'end_header' header)");
+  const std::size_t body = text.find('\n', end);
+  if (body == std::string::npos) throw InputError(path, "PLY header has no line end");
+  std::istringstream header(text.substr(0, end));
+  std::string format;
+  std::vector<PlyElement> elements;
+  std::string line;
+  while (std::getline(header, line)) {
+    std::istringstream words(line);
+    std::string word;
+    words >> word;
+    if (word == "format") {
+      words >> format;
+    } else if (word == "element") {
+      std::string name;
+      std::string number;
+      words >> name >> number;
+      std::int64_t n = -1;
+      if (!parse_int(number, n) || n < 0)
+        throw InputError(path, "PLY element '" + name.substr(0, 40) + "' has an invalid count '" +
+                                   number.substr(0, 40) + "'");
+      elements.push_back({static_cast<std::uint64_t>(n), {}});
+    } else if (word == "property") {
+      // CGAL's reader adds a property to its last element without checking there is one.
+      if (elements.empty()) throw InputError(path, "PLY property before any element");
+      std::string type;
+      words >> type;
+      PlyProperty property;
+      if (type == "list") {
+        std::string count_type;
+        std::string item_type;
+        words >> count_type >> item_type;
+        const auto [count_bytes, count_signed] = ply_type(count_type);
+        if (count_bytes == 0 || count_bytes > 4 || count_type.find("float") == 0)
+          throw InputError(path, "PLY list with count type '" + count_type.substr(0, 20) + "'");
+        property = {true, count_bytes, count_signed, ply_type(item_type).first};
+      } else {
+        property.bytes = ply_type(type).first;
+      }
+      if (property.bytes == 0) throw InputError(path, "PLY property of unknown type");
+      elements.back().properties.push_back(property);
+    }
+  }
+  const bool ascii = format == "ascii";
+  if (!ascii && format != "binary_little_endian" && format != "binary_big_endian")
+    throw InputError(path, "PLY format '" + format.substr(0, 40) + "' is not supported");
+  const bool swap = (format == "binary_big_endian") == host_is_little_endian();
+  std::uint64_t pos = body + 1;
+  auto fail = [&](const std::string& what) {
+    throw InputError(path, "PLY body ends early or holds a bad list length (" + what + ")");
+  };
+  Tokenizer tok(path, std::string_view(text).substr(pos), '\0');
+  for (const PlyElement& element : elements) {
+    std::uint64_t min_bytes = 0;
+    for (const PlyProperty& p : element.properties)
+      min_bytes += ascii ? 2 : p.count_bytes + p.bytes;
+    if (element.count > 0 &&
+        (min_bytes == 0 || element.count > (text.size() - pos + 1) / min_bytes))
+      fail("element count " + std::to_string(element.count));
+    for (std::uint64_t i = 0; i < element.count; ++i)
+      for (const PlyProperty& p : element.properties) {
+        std::int64_t length = 1;
+        if (ascii) {
+          if (p.list) length = tok.next_int("a PLY list length");
+          if (length < 0 || static_cast<std::uint64_t>(length) > text.size() / 2)
+            fail("list length " + std::to_string(length));
+          for (std::int64_t k = 0; k < length; ++k) tok.next("a PLY value");
+          continue;
+        }
+        if (p.list) {
+          if (text.size() - pos < p.count_bytes) fail("list length cut off");
+          unsigned char raw[4] = {0, 0, 0, 0};
+          std::memcpy(raw, text.data() + pos, p.count_bytes);
+          if (swap) std::reverse(raw, raw + p.count_bytes);
+          std::uint32_t value = 0;
+          for (std::uint64_t k = p.count_bytes; k-- > 0;) value = (value << 8) | raw[k];
+          const std::uint64_t sign_bit = std::uint64_t{1} << (8 * p.count_bytes - 1);
+          if (p.count_signed && (value & sign_bit) != 0) fail("negative list length");
+          length = value;
+          pos += p.count_bytes;
+        }
+        const auto needed = static_cast<std::uint64_t>(length) * p.bytes;
+        if (needed > text.size() - pos) fail("value cut off");
+        pos += needed;
+      }
+  }
+}
+
+/// Whether reading `polygons` over `points` left anything a caller could index out of range.
+void check_soup(const std::string& path, const std::vector<Point>& points,
+                const std::vector<Polygon>& polygons) {
+  for (const Point& p : points)
+    if (!std::isfinite(p.x()) || !std::isfinite(p.y()) || !std::isfinite(p.z()))
+      throw InputError(path, "vertex coordinate is not finite");
+  for (const Polygon& polygon : polygons) {
+    if (polygon.size() > kMaxPolygonCorners)
+      throw InputError(path, "polygon with " + std::to_string(polygon.size()) +
+                                 " corners (at most " + std::to_string(kMaxPolygonCorners) + ")");
+    for (std::size_t v : polygon)
+      if (v >= points.size())
+        throw InputError(path, "face refers to vertex " + std::to_string(v) + " out of range (" +
+                                   std::to_string(points.size()) + " vertices)");
+  }
+}
+
+/// Splits a polygon of n >= 4 corners into n - 2 triangles: CGAL's hole triangulation of the
+/// closed polyline (minimum area, then dihedral angles; non-planar polygons are fine), or a
+/// fan from the first corner when that finds nothing (collinear corners).
+void triangulate_polygon(const std::vector<Point>& points, const Polygon& polygon,
+                         std::vector<std::array<std::size_t, 3>>& out) {
+  std::vector<Point> polyline;
+  polyline.reserve(polygon.size());
+  for (std::size_t v : polygon) polyline.push_back(points[v]);
+  std::vector<CGAL::Triple<int, int, int>> patch;
+  CGAL::Polygon_mesh_processing::triangulate_hole_polyline(polyline, std::back_inserter(patch));
+  if (patch.size() + 2 == polygon.size()) {
+    for (const auto& t : patch)
+      out.push_back({polygon[static_cast<std::size_t>(t.first)],
+                     polygon[static_cast<std::size_t>(t.second)],
+                     polygon[static_cast<std::size_t>(t.third)]});
+    return;
+  }
+  for (std::size_t k = 1; k + 1 < polygon.size(); ++k)
+    out.push_back({polygon[0], polygon[k], polygon[k + 1]});
+}
+
+TriangleMesh read_with_cgal(const std::string& path, const std::string& ext) {
+  const std::string text = detail::read_file_text(path);
+  if (text.empty()) throw InputError(path, "empty file");
+  if (ext == ".off") check_off_counts(path, text);
+  if (ext == ".ply") check_ply_layout(path, text);
+  std::vector<Point> points;
+  std::vector<Polygon> polygons;
+  bool ok = false;
+  const auto np = CGAL::parameters::verbose(false);
+  if (ext == ".off") {
+    ok = CGAL::IO::read_OFF(path, points, polygons, np);
+  } else if (ext == ".ply") {
+    ok = CGAL::IO::read_PLY(path, points, polygons, np);
+  } else if (ext == ".obj") {
+    ok = CGAL::IO::read_OBJ(path, points, polygons, np);
+  } else {
+    ok = CGAL::IO::read_STL(path, points, polygons, np);
+  }
+  if (!ok) throw InputError(path, "malformed " + ext.substr(1) + " file (CGAL's reader failed)");
+  check_soup(path, points, polygons);
+  std::vector<std::array<std::size_t, 3>> triangles;
+  triangles.reserve(polygons.size());
+  for (const Polygon& polygon : polygons) {
+    if (polygon.size() < 3) continue;  // points and edges are dropped, as with assimp
+    if (polygon.size() == 3) {
+      triangles.push_back({polygon[0], polygon[1], polygon[2]});
+    } else {
+      triangulate_polygon(points, polygon, triangles);
+    }
+  }
+  // Vertices are merged by exact position (STL repeats corners), numbered in order of first use.
+  TriangleMesh mesh;
+  std::map<Vec3, std::uint32_t> index_of;
+  for (const auto& t : triangles) {
+    Tri tri;
+    for (std::size_t k = 0; k < 3; ++k) {
+      const Point& p = points[t[k]];
+      const auto [it, inserted] = index_of.emplace(
+          Vec3{p.x(), p.y(), p.z()}, static_cast<std::uint32_t>(mesh.vertices.size()));
+      if (inserted) mesh.vertices.push_back(it->first);
+      tri[k] = it->second;
+    }
+    mesh.triangles.push_back(tri);
+  }
+  return mesh;
+}
+
+}  // namespace
+
+TriangleMesh read_triangle_mesh(const std::string& path) {
+  {
+    std::ifstream probe(path, std::ios::binary);
+    if (!probe) throw InputError(path, "cannot open file");
+  }
+  const std::string ext = detail::lower_extension(path);
+  const bool cgal = ext == ".off" || ext == ".ply" || ext == ".obj" || ext == ".stl";
+  TriangleMesh mesh;
+  // The third-party readers may throw anything (allocation failures on hostile sizes, CGAL
+  // precondition failures); every one becomes an InputError naming the file.
+  try {
+    mesh = cgal ? read_with_cgal(path, ext) : detail::read_triangle_mesh_assimp(path);
+  } catch (const InputError&) {
+    throw;
+  } catch (const std::bad_alloc&) {
+    throw InputError(path, "reading: out of memory (sizes in the file too large?)");
+  } catch (const std::exception& e) {
+    throw InputError(path, std::string("reading: ") + e.what());
+  }
+  if (mesh.triangles.empty()) throw InputError(path, "no triangles in file");
+  return mesh;
+}
+
+}  // namespace tetseg::preprocess

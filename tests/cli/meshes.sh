@@ -1,0 +1,124 @@
+#!/usr/bin/env bash
+# Surfaces and tet meshes as users have them: polygonal OFF solids (the 5-vertex pyramid and
+# the 6-quad cube once died of SIGFPE in Mesh_3), binary Gmsh in and out, and hostile files:
+# every run exits 0 or 3, an error names the file, and a failed run leaves no output.
+# needs: preprocess
+set -euo pipefail
+source "$(dirname "${BASH_SOURCE[0]}")/common.bash"
+
+cat >pyramid.off <<'EOF'
+OFF
+5 5 0
+-1 -0.5 -0.5
+-1 -0.5  0.5
+-1 0.5  0.5
+-1 0.5  -0.5
+1 0 0
+3  1 0 4
+3  2 1 4
+3  3 2 4
+3  0 3 4
+4  0 1 2 3
+EOF
+cat >cube.off <<'EOF'
+OFF
+8 6 0
+0 0 0
+1 0 0
+1 1 0
+0 1 0
+0 0 1
+1 0 1
+1 1 1
+0 1 1
+4 0 3 2 1
+4 4 5 6 7
+4 0 1 5 4
+4 1 2 6 5
+4 2 3 7 6
+4 3 0 4 7
+EOF
+
+# The polygonal solids build with default options.
+expect_exit 0 "tetseg: done" -- "$bin/tetseg" build pyramid.off -o pyramid.tetseg --clusters single
+expect_exit 0 "tetseg: done" -- "$bin/tetseg" build cube.off -o cube.tetseg --clusters single
+"$bin/tetseg-dump" pyramid.tetseg >/dev/null
+
+# Binary Gmsh 4.1 out and back in; --binary and --gmsh22 exclude each other.
+"$bin/tetseg" tetrahedralize cube.off -o cube.msh --binary --facet-size 0.2 2>/dev/null
+head -c 20 cube.msh | grep -q '4.1 1 8' || fail "cube.msh is not binary Gmsh 4.1"
+"$bin/tetseg" tetrahedralize cube.off -o cube_ascii.msh --facet-size 0.2 2>/dev/null
+expect_exit 0 "tetseg: done" -- "$bin/tetseg" build cube.msh -o from_binary.tetseg --clusters single
+"$bin/tetseg" build cube_ascii.msh -o from_ascii.tetseg --clusters single -q
+expect_exit 2 "" -- "$bin/tetseg" tetrahedralize cube.off -o x.msh --binary --gmsh22
+[ ! -e x.msh ] || fail "a usage error left a mesh"
+
+# --repair fix (the default) removes a duplicated face and says so; --repair none refuses it.
+{ cat cube.off; echo "4 0 3 2 1"; } | sed 's/^8 6 0$/8 7 0/' >cube_dup.off
+expect_exit 0 "tetseg: repaired cube_dup.off: 2 duplicate triangles removed" -- \
+  "$bin/tetseg" tetrahedralize cube_dup.off -o dup.mesh --facet-size 0.25 --no-optimize
+expect_exit 3 "tetseg: error: cube_dup.off: surface has [0-9]* non-manifold edges" -- \
+  "$bin/tetseg" tetrahedralize cube_dup.off -o dup2.mesh --repair none
+[ ! -e dup2.mesh ] || fail "a refused surface left a mesh"
+expect_exit 2 "repair" -- "$bin/tetseg" build cube.off -o x.tetseg --repair bogus
+
+# Hostile variants of each kind of file: truncations, huge and negative counts, NaN, byte
+# flips. The small facet size bounds the time of those that still read.
+python3 - <<'PY'
+import random, struct
+random.seed(7)
+files = {"pyramid.off": open("pyramid.off", "rb").read(),
+         "cube.msh": open("cube.msh", "rb").read(),
+         "cube_ascii.msh": open("cube_ascii.msh", "rb").read()}
+ply = (b"ply\nformat binary_little_endian 1.0\nelement vertex 5\nproperty float x\n"
+       b"property float y\nproperty float z\nelement face 5\n"
+       b"property list uchar int vertex_indices\nend_header\n")
+for p in [(-1, -.5, -.5), (-1, -.5, .5), (-1, .5, .5), (-1, .5, -.5), (1, 0, 0)]:
+    ply += struct.pack("<3f", *p)
+for f in [(1, 0, 4), (2, 1, 4), (3, 2, 4), (0, 3, 4), (0, 1, 2, 3)]:
+    ply += struct.pack("<B", len(f)) + struct.pack("<%di" % len(f), *f)
+files["pyramid.ply"] = ply
+n = 0
+def emit(name, data):
+    global n
+    stem, ext = name.rsplit(".", 1)
+    open("hostile%03d_%s.%s" % (n, stem, ext), "wb").write(data)
+    n += 1
+for name, data in files.items():
+    for cut in (0, 3, len(data) // 4, len(data) // 2, len(data) - 20):
+        emit(name, data[:cut])
+    for _ in range(8):
+        d = bytearray(data)
+        for _ in range(3):
+            d[random.randrange(len(d))] = random.choice(b"09-.e \n$\x00\xff")
+        emit(name, bytes(d))
+text = files["pyramid.off"].decode()
+for bad in ("5 99999999999 0", "-5 5 0", "2147483647 5 0", "5 5 0\n-1 nan -0.5"):
+    emit("pyramid.off", text.replace("5 5 0", bad, 1).encode())
+emit("pyramid.off", text.replace("4  0 1 2 3", "2000000000  0 1 2 3").encode())
+for bad in (b"element vertex 99999999999", b"element vertex -3"):
+    emit("pyramid.ply", ply.replace(b"element vertex 5", bad))
+d = bytearray(ply)
+at = ply.index(b"end_header\n") + 11 + 4
+d[at:at + 4] = struct.pack("<f", float("nan"))
+emit("pyramid.ply", bytes(d))
+msh = files["cube.msh"]
+at = msh.index(b"$Nodes\n") + 7 + 8
+emit("cube.msh", msh[:at] + b"\xff" * 8 + msh[at + 8:])
+PY
+count=0
+for f in hostile*; do
+  count=$((count + 1))
+  set +e
+  "$bin/tetseg" build "$f" -o "$f.tetseg" --clusters single --facet-size 0.25 -q >out.txt 2>err.txt
+  code=$?
+  set -e
+  case $code in
+    0) [ -s "$f.tetseg" ] || fail "$f: exit 0 without an asset" ;;
+    3) grep -q "tetseg: error: $f: " err.txt || { cat err.txt >&2; fail "$f: message does not name the file"; }
+       [ ! -e "$f.tetseg" ] || fail "$f: a failed build left an asset" ;;
+    *) cat err.txt >&2; fail "$f: exit $code (expected 0 or 3)" ;;
+  esac
+done
+[ "$count" -ge 50 ] || fail "only $count hostile files"
+echo "meshes.sh: all checks passed ($count hostile files)"
