@@ -168,6 +168,7 @@ inline void add_counts(ColliderStats& to, const ColliderStats& from) noexcept {
   to.node_pairs_visited += from.node_pairs_visited;
   to.node_pairs_orientation_culled += from.node_pairs_orientation_culled;
   to.triangle_pairs += from.triangle_pairs;
+  to.triangle_pairs_separated += from.triangle_pairs_separated;
   to.feature_pairs += from.feature_pairs;
   to.feature_pairs_filtered += from.feature_pairs_filtered;
   to.feature_tests += from.feature_tests;

@@ -13,6 +13,7 @@
 #include <chrono>
 
 #include "collider_impl.hpp"
+#include "plane_filter.hpp"
 
 #if defined(TETSEG_HAVE_OPENMP)
 #include <omp.h>
@@ -198,6 +199,12 @@ void test_features(Worker& w, const Collider::Impl& A, std::uint32_t t1, const C
   const auto& TA = A.tris[t1];
   const auto& TB = B.tris[t2];
   const double ms = A.opt.ccd.min_separation;
+  // Every feature pair of this pair lies in two plane-separated triangles: none can touch,
+  // whichever triangle pair owns it.
+  if (ms <= 0 && plane_separated({TA, A.x0, A.x1}, {TB, B.x0, B.x1}, same)) {
+    ++w.stats.triangle_pairs_separated;
+    return;
+  }
   // Vertex-face, both directions.
   for (int dir = 0; dir < 2 && !w.stop; ++dir) {
     const Collider::Impl& PB = dir == 0 ? A : B;  // the vertices' body

@@ -122,7 +122,9 @@ struct ColliderStats {
   std::uint64_t closure_pairs = 0;
   std::uint64_t node_pairs_visited = 0;  ///< BVH node pairs popped by traversal
   std::uint64_t node_pairs_orientation_culled = 0;
-  std::uint64_t triangle_pairs = 0;          ///< non-culled triangle pairs examined
+  std::uint64_t triangle_pairs = 0;  ///< non-culled triangle pairs examined
+  /// of those, rejected by the triangle-pair plane filter (min_separation = 0 only)
+  std::uint64_t triangle_pairs_separated = 0;
   std::uint64_t feature_pairs = 0;           ///< distinct feature pairs whose boxes overlap
   std::uint64_t feature_pairs_filtered = 0;  ///< of those, rejected by the coplanarity filter
   std::uint64_t feature_tests = 0;           ///< elementary tests run
