@@ -27,7 +27,8 @@ struct SceneOptions {
   /// OpenMP inside each body's self-collision queries (as `ColliderOptions::use_openmp`);
   /// pairs of bodies are traversed serially. Results are identical either way.
   bool use_openmp = false;
-  bool time_tests = true;
+  /// As `ColliderOptions::time_tests` (off by default).
+  bool time_tests = false;
   /// Traversal stack capacity in node pairs (0: never overflows). Small values are for tests.
   std::uint32_t traversal_stack = 0;
 };
