@@ -6,30 +6,13 @@
 
 #include "common/synthetic_scenes.hpp"
 #include "runtime/support/compare.hpp"
+#include "runtime/support/waves.hpp"
 #include "tetseg/runtime/collider.hpp"
 
 using namespace tetseg;
 using namespace tetseg::test;
 
 namespace {
-
-struct Waves {
-  std::vector<std::array<double, 7>> w;  // k (3), phase, direction (3)
-  double amplitude;
-  explicit Waves(unsigned seed, double amp) : amplitude(amp) {
-    std::mt19937 rng(seed);
-    auto u = [&] { return (rng() / 4294967296.0) * 2 - 1; };
-    for (int i = 0; i < 4; ++i) w.push_back({3 * u(), 3 * u(), 3 * u(), 3 * u(), u(), u(), u()});
-  }
-  P3 operator()(const P3& p, double t) const {
-    P3 q = p;
-    for (const auto& a : w) {
-      const double s = std::sin(a[0] * p[0] + a[1] * p[1] + a[2] * p[2] + a[3]);
-      for (int k = 0; k < 3; ++k) q[k] += t * amplitude * s * a[4 + k];
-    }
-    return q;
-  }
-};
 
 Scene sphere_scene(int clusters) {
   const Surface s = sphere(1.0, 20, 11);

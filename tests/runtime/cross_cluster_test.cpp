@@ -11,6 +11,7 @@
 
 #include "common/synthetic_scenes.hpp"
 #include "runtime/support/compare.hpp"
+#include "runtime/support/waves.hpp"
 #include "tetseg/runtime/collider.hpp"
 
 using namespace tetseg;
@@ -64,24 +65,6 @@ P3 fold_capsule(const P3& p, double t, double angle) {
   const double y = p[1] + 0.25, z = p[2];
   return {p[0], -0.25 + y * std::cos(a) - z * std::sin(a), y * std::sin(a) + z * std::cos(a)};
 }
-
-struct Waves {
-  std::vector<std::array<double, 7>> w;
-  double amplitude;
-  Waves(unsigned seed, double amp) : amplitude(amp) {
-    std::mt19937 rng(seed);
-    auto u = [&] { return (rng() / 4294967296.0) * 2 - 1; };
-    for (int i = 0; i < 4; ++i) w.push_back({4 * u(), 4 * u(), 4 * u(), 3 * u(), u(), u(), u()});
-  }
-  P3 operator()(const P3& p, double t) const {
-    P3 q = p;
-    for (const auto& a : w) {
-      const double s = std::sin(a[0] * p[0] + a[1] * p[1] + a[2] * p[2] + a[3]);
-      for (int k = 0; k < 3; ++k) q[k] += t * amplitude * s * a[4 + k];
-    }
-    return q;
-  }
-};
 
 }  // namespace
 
@@ -147,7 +130,7 @@ TEST_CASE("Many small clusters under random smooth deformations agree with brute
   const Scene scene = shape == 0
                           ? sector_scene(s, 4, 0.1, {-0.4, 0.3}, {-0.7, 0.0, 0.6}, 0.3)
                           : sector_scene(s, 3, 0.2, {-1.0, 0.0, 1.0}, {-1.6, -0.5, 0.5, 1.6}, 0.15);
-  const Waves waves(seed, 0.9);
+  const Waves waves(seed, 0.9, 4.0);
   const auto frames = make_frames(scene, 12, waves);
   const SequenceReport rep = compare_with_brute(scene, frames);
   CHECK(rep.frames_compared > 0);
