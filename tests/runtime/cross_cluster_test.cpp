@@ -11,7 +11,7 @@
 
 #include "common/synthetic_scenes.hpp"
 #include "runtime/support/compare.hpp"
-#include "runtime/support/waves.hpp"
+#include "runtime/support/motions.hpp"
 #include "tetseg/runtime/collider.hpp"
 
 using namespace tetseg;
@@ -91,31 +91,15 @@ TEST_CASE("A wedge tip on a cluster boundary drooping onto another cluster agree
           "[collider][rvbc][cross][wedge]") {
   // The mushroom's rim (a wedge) droops onto its conical base; the sector boundary runs
   // through the rim vertex that touches first, and the cap and the stem are different slabs,
-  // with detectors on opposite sides of the boundary (the configuration where culling a pair
-  // by either cluster's detector alone would lose the first contact).
+  // with detectors on opposite sides of the boundary (a configuration where culling a pair by
+  // either cluster's detector alone could lose the first contact).
   const Surface s = mushroom(24);
-  std::uint32_t p = 0;
-  double best = -1;
-  for (std::uint32_t v = 0; v < s.verts.size(); ++v) {
-    const double score = std::hypot(s.verts[v][0], s.verts[v][1]) + 0.01 * s.verts[v][0];
-    if (score > best && s.verts[v][2] > 1.6) best = score, p = v;
-  }
-  const P3 tip = s.verts[p];
-  const double phi_p = std::atan2(tip[1], tip[0]);
-  const double r_p = std::hypot(tip[0], tip[1]);
   const double slant = GENERATE(-0.3, 0.05, 0.4);  // droop direction off the rim's plane
   const int sectors = GENERATE(2, 4);
   CAPTURE(slant, sectors);
-  const Scene scene = sector_scene(s, sectors, phi_p, {1.6}, {0.8, 2.1}, 0.45);
-  const auto frames = make_frames(scene, 16, [&](const P3& q, double t) {
-    const double r = std::hypot(q[0], q[1]);
-    const double arc = r_p * std::remainder(std::atan2(q[1], q[0]) - phi_p, 2 * M_PI);
-    const double d2 = (r - r_p) * (r - r_p) + (q[2] - tip[2]) * (q[2] - tip[2]);
-    const double w = std::exp(-arc * arc / 1.0 - d2 / 0.09);
-    const double dr = -1.4 * t * w / std::sqrt(2.0), dz = dr;
-    const double c = std::cos(phi_p + slant), sn = std::sin(phi_p + slant);
-    return P3{q[0] + dr * c, q[1] + dr * sn, q[2] + dz};
-  });
+  const RimDroop droop(s, slant);
+  const Scene scene = sector_scene(s, sectors, droop.phi, {1.6}, {0.8, 2.1}, 0.45);
+  const auto frames = make_frames(scene, 16, droop);
   const SequenceReport rep = compare_with_brute(scene, frames);
   REQUIRE(rep.contact_frames == 1);
   REQUIRE_FALSE(rep.first_contacts.empty());
