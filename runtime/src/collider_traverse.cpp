@@ -13,6 +13,7 @@
 #include <chrono>
 
 #include "collider_impl.hpp"
+#include "plane_filter.hpp"
 
 #if defined(TETSEG_HAVE_OPENMP)
 #include <omp.h>
@@ -187,36 +188,11 @@ void process_edge_edge(Worker& w, const Collider::Impl& A, std::uint32_t e1,
   w.record(k);
 }
 
-// Triangle-pair plane filter (exact contact only): true when the vertices of one triangle that
-// the other does not share stay strictly on one side of the other's plane for the whole step
-// (the error-bounded orientation cubic of the vertex-face filter, one proven sign for all of
-// them). The triangles can then meet at most in their shared vertices, so no feature pair of
-// theirs with four distinct nodes can touch (a degenerate plane makes the cubic vanish:
-// uncertain, never filtered). docs/runtime.md, "Triangle-pair plane filter".
+// Triangle-pair plane filter of triangle t1 of A and t2 of B (plane_filter.hpp; exact
+// contact only; docs/runtime.md, "Triangle-pair plane filter").
 bool plane_separated(const Collider::Impl& A, std::uint32_t t1, const Collider::Impl& B,
                      std::uint32_t t2) noexcept {
-  const bool same = &A == &B;
-  for (int dir = 0; dir < 2; ++dir) {
-    const Collider::Impl& XB = dir == 0 ? A : B;  // body of the vertices
-    const Collider::Impl& YB = dir == 0 ? B : A;  // body of the plane
-    const auto& X = XB.tris[dir == 0 ? t1 : t2];
-    const auto& Y = YB.tris[dir == 0 ? t2 : t1];
-    Orientation side = Orientation::kUncertain;
-    bool separated = true;
-    for (std::uint32_t v : X) {
-      if (same && (v == Y[0] || v == Y[1] || v == Y[2])) continue;
-      const Orientation o =
-          classify_orientation(YB.pos0(Y[0]), YB.pos0(Y[1]), YB.pos0(Y[2]), XB.pos0(v),
-                               YB.pos1(Y[0]), YB.pos1(Y[1]), YB.pos1(Y[2]), XB.pos1(v));
-      if (o == Orientation::kUncertain || (side != Orientation::kUncertain && o != side)) {
-        separated = false;
-        break;
-      }
-      side = o;
-    }
-    if (separated) return true;
-  }
-  return false;
+  return plane_separated({A.tris[t1], A.x0, A.x1}, {B.tris[t2], B.x0, B.x1}, &A == &B);
 }
 
 // Tests the feature pairs of triangle t1 of A and t2 of B (t1 != t2 within one body):

@@ -5,6 +5,7 @@
 #include <random>
 
 #include "runtime/support/compare.hpp"
+#include "runtime/support/motions.hpp"
 #include "tetseg/runtime/collider.hpp"
 #include "tetseg/testing/synthetic_scenes.hpp"
 
@@ -12,24 +13,6 @@ using namespace tetseg;
 using namespace tetseg::test;
 
 namespace {
-
-struct Waves {
-  std::vector<std::array<double, 7>> w;  // k (3), phase, direction (3)
-  double amplitude;
-  explicit Waves(unsigned seed, double amp) : amplitude(amp) {
-    std::mt19937 rng(seed);
-    auto u = [&] { return (rng() / 4294967296.0) * 2 - 1; };
-    for (int i = 0; i < 4; ++i) w.push_back({3 * u(), 3 * u(), 3 * u(), 3 * u(), u(), u(), u()});
-  }
-  P3 operator()(const P3& p, double t) const {
-    P3 q = p;
-    for (const auto& a : w) {
-      const double s = std::sin(a[0] * p[0] + a[1] * p[1] + a[2] * p[2] + a[3]);
-      for (int k = 0; k < 3; ++k) q[k] += t * amplitude * s * a[4 + k];
-    }
-    return q;
-  }
-};
 
 Scene sphere_scene(int clusters) {
   const Surface s = sphere(1.0, 20, 11);
@@ -100,27 +83,9 @@ TEST_CASE("A drooping mushroom rim touching its base agrees with brute force",
   const Surface s = mushroom(24);
   const Scene scene =
       make_scene(s, std::vector<std::uint32_t>(s.tris.size(), 0), {{0.0, 0.0, 0.3}});
-  // p: the rim-tip vertex (largest radius above the stem) nearest angle 0. The rim around p
-  // droops towards the conical base along the cone's normal (a smooth bump, largest at p):
-  // p is the first point to reach the base face B.
-  std::uint32_t p = 0;
-  double best = -1;
-  for (std::uint32_t v = 0; v < s.verts.size(); ++v) {
-    const double score = std::hypot(s.verts[v][0], s.verts[v][1]) + 0.01 * s.verts[v][0];
-    if (score > best && s.verts[v][2] > 1.6) best = score, p = v;
-  }
-  const P3 tip = s.verts[p];
-  const double phi_p = std::atan2(tip[1], tip[0]);
-  const double r_p = std::hypot(tip[0], tip[1]);
-  const auto frames = make_frames(scene, 16, [&](const P3& q, double t) {
-    const double r = std::hypot(q[0], q[1]);
-    const double arc = r_p * std::remainder(std::atan2(q[1], q[0]) - phi_p, 2 * M_PI);
-    const double d2 = (r - r_p) * (r - r_p) + (q[2] - tip[2]) * (q[2] - tip[2]);
-    const double w = std::exp(-arc * arc / 1.0 - d2 / 0.09);
-    const double dr = -1.4 * t * w / std::sqrt(2.0), dz = dr;
-    const double c = std::cos(phi_p + 0.05), sn = std::sin(phi_p + 0.05);
-    return P3{q[0] + dr * c, q[1] + dr * sn, q[2] + dz};
-  });
+  // The rim droops locally onto the conical base: its tip vertex is the first point to reach
+  // the base face B.
+  const auto frames = make_frames(scene, 16, RimDroop(s, 0.05));
   const SequenceReport rep = compare_with_brute(scene, frames);
   REQUIRE(rep.contact_frames == 1);
   REQUIRE_FALSE(rep.first_contacts.empty());

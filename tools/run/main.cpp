@@ -38,6 +38,7 @@ int run(const std::string& asset_path, const std::string& frames_path, const std
         const std::string& query, bool json, bool stop_at_contact, bool openmp) {
   tetseg::ColliderOptions options;
   options.use_openmp = openmp;
+  options.time_tests = true;  // the JSON reports elementary-test time separately
   if (!tetseg::parse_collider_mode(mode_name.c_str(), options.mode))
     throw ToolError(kExitUsage, "", "unknown mode '" + mode_name + "' (rvbc, bvh, brute, cone)");
   tetseg::Asset asset;

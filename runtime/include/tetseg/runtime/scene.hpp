@@ -29,7 +29,8 @@ struct SceneOptions {
   /// buffer (one pair per task, a worker with its own stack per thread, outcomes merged in
   /// pair order). Results and counts are identical to serial ones. Off by default.
   bool use_openmp = false;
-  bool time_tests = true;
+  /// As `ColliderOptions::time_tests` (off by default).
+  bool time_tests = false;
   /// Traversal stack capacity in node pairs (0: never overflows). Small values are for tests.
   std::uint32_t traversal_stack = 0;
 };

@@ -1,0 +1,106 @@
+#pragma once
+// The arithmetic of orientation_bernstein (classify.cpp), split so that the 2x2 minors of the
+// last two columns can be computed once and reused for many first columns (the triangle-pair
+// plane filter tests up to three points against one face). Not installed.
+//
+// det(u, v, w) is expanded along u: det = u.x m0 - u.y m1 + u.z m2 with the minors m of (v, w),
+// and its permanent |u.x| s0 + |u.y| s1 + |u.z| s2 with s the sums of absolute minor products.
+// Every caller evaluates the same operations in the same order, so a cached-minor result is
+// bitwise the one orientation_bernstein computes for the same points.
+
+#include <cmath>
+
+#include "tetseg/runtime/classify.hpp"
+
+namespace tetseg {
+namespace orientation_detail {
+
+// Forward error of a 3x3 determinant of rounded differences, relative to its permanent.
+// Shewchuk's orient3d bound is (7 + 56 eps) eps; 16 eps also absorbs the two additions of
+// the trilinear sums for k1 and k2 and leaves margin.
+constexpr double kEps = 1.1102230246251565e-16;  // 2^-53
+constexpr double kRelErr = 16.0 * kEps;
+// Absolute slack for gradual underflow in the products (a few subnormal ulps per operation).
+constexpr double kAbsErr = 1e-300;
+
+struct V3 {
+  double x, y, z;
+};
+
+inline V3 sub(const double* a, const double* b) noexcept {
+  return {a[0] - b[0], a[1] - b[1], a[2] - b[2]};
+}
+
+/// The 2x2 minors of columns (v, w) and the sums of their absolute products.
+struct Minors {
+  double m0, m1, m2;
+  double s0, s1, s2;
+};
+
+inline Minors minors(const V3& v, const V3& w) noexcept {
+  return {v.y * w.z - v.z * w.y,
+          v.x * w.z - v.z * w.x,
+          v.x * w.y - v.y * w.x,
+          std::fabs(v.y * w.z) + std::fabs(v.z * w.y),
+          std::fabs(v.x * w.z) + std::fabs(v.z * w.x),
+          std::fabs(v.x * w.y) + std::fabs(v.y * w.x)};
+}
+
+/// det(u, v, w) and its permanent from u and the minors of (v, w).
+inline void det_perm(const V3& u, const Minors& m, double& det, double& perm) noexcept {
+  det = u.x * m.m0 - u.y * m.m1 + u.z * m.m2;
+  perm = std::fabs(u.x) * m.s0 + std::fabs(u.y) * m.s1 + std::fabs(u.z) * m.s2;
+}
+
+/// Bernstein coefficients of det(u(t), v(t), w(t)) for linear u, v, w, from u0, u1 and the
+/// minors m_jk = minors(v_j, w_k) (j, k = start 0 / end 1 of the step).
+inline BernsteinCubic bernstein(const V3& u0, const V3& u1, const Minors& m00, const Minors& m10,
+                                const Minors& m01, const Minors& m11) noexcept {
+  BernsteinCubic r;
+  double d[3], p[3];
+  det_perm(u0, m00, r.k[0], p[0]);
+  r.err[0] = kRelErr * p[0] + kAbsErr;
+  det_perm(u1, m00, d[0], p[0]);
+  det_perm(u0, m10, d[1], p[1]);
+  det_perm(u0, m01, d[2], p[2]);
+  r.k[1] = d[0] + d[1] + d[2];
+  r.err[1] = kRelErr * (p[0] + p[1] + p[2]) + kAbsErr;
+  det_perm(u0, m11, d[0], p[0]);
+  det_perm(u1, m01, d[1], p[1]);
+  det_perm(u1, m10, d[2], p[2]);
+  r.k[2] = d[0] + d[1] + d[2];
+  r.err[2] = kRelErr * (p[0] + p[1] + p[2]) + kAbsErr;
+  det_perm(u1, m11, r.k[3], p[0]);
+  r.err[3] = kRelErr * p[0] + kAbsErr;
+  return r;
+}
+
+}  // namespace orientation_detail
+
+/// The plane of a moving triangle (a, b, c) over a step, prepared for the sides of many points:
+/// `side(p0, p1)` is bitwise `classify_orientation(a0, p0, b0, c0, a1, p1, b1, c1)`, the sign
+/// of det[p - a, b - a, c - a] = det[b - a, c - a, p - a] over the step.
+class FacePlane {
+ public:
+  FacePlane(const double* a0, const double* b0, const double* c0, const double* a1,
+            const double* b1, const double* c1) noexcept
+      : a0_(a0), a1_(a1) {
+    using namespace orientation_detail;
+    const V3 v0 = sub(b0, a0), w0 = sub(c0, a0), v1 = sub(b1, a1), w1 = sub(c1, a1);
+    m00_ = minors(v0, w0);
+    m10_ = minors(v1, w0);
+    m01_ = minors(v0, w1);
+    m11_ = minors(v1, w1);
+  }
+  Orientation side(const double* p0, const double* p1) const noexcept {
+    using namespace orientation_detail;
+    return sign_of(bernstein(sub(p0, a0_), sub(p1, a1_), m00_, m10_, m01_, m11_));
+  }
+
+ private:
+  const double* a0_;
+  const double* a1_;
+  orientation_detail::Minors m00_, m10_, m01_, m11_;
+};
+
+}  // namespace tetseg
