@@ -291,7 +291,8 @@ NearFieldSchwarz::NearFieldSchwarz(const PanelSet& panels, const ClusterTree& tr
   }
   m_set.resize(m_set_start[leaves]);
   m_rows.resize(m_rows_start[leaves]);
-  m_mean_set = static_cast<double>(m_set.size()) / static_cast<double>(std::max<std::size_t>(leaves, 1));
+  m_mean_set =
+      static_cast<double>(m_set.size()) / static_cast<double>(std::max<std::size_t>(leaves, 1));
   // Pass 2: factorise M_SS and keep the members' rows of its inverse.
 #if defined(TETSEG_HAVE_OPENMP)
 #pragma omp parallel
@@ -305,10 +306,12 @@ NearFieldSchwarz::NearFieldSchwarz(const PanelSet& panels, const ClusterTree& tr
       const std::size_t l = static_cast<std::size_t>(ll);
       const Cluster& c = tree.nodes[static_cast<std::size_t>(tree.leaves[l])];
       const auto& set = sets[l];
-      std::copy(set.begin(), set.end(), m_set.begin() + static_cast<std::ptrdiff_t>(m_set_start[l]));
+      std::copy(set.begin(), set.end(),
+                m_set.begin() + static_cast<std::ptrdiff_t>(m_set_start[l]));
       const Eigen::Index s = static_cast<Eigen::Index>(set.size());
       const Eigen::Index members = static_cast<Eigen::Index>(c.end - c.begin);
-      for (Eigen::Index a = 0; a < s; ++a) pos[set[static_cast<std::size_t>(a)]] = static_cast<std::int32_t>(a);
+      for (Eigen::Index a = 0; a < s; ++a)
+        pos[set[static_cast<std::size_t>(a)]] = static_cast<std::int32_t>(a);
       // The transpose of M_SS, so that the solve below yields rows of M_SS^-1. Single
       // precision: a preconditioner needs a few digits, and the LU is twice as fast.
       Eigen::MatrixXf at(s, s);
@@ -405,8 +408,7 @@ double exact_residual(const PanelSet& panels, const NearField& near, const std::
 namespace tetseg::preprocess::charge_detail {
 
 TwoLevelSchwarz::TwoLevelSchwarz(const PanelSet& panels, const ClusterTree& tree,
-                                 const NearField& near, std::size_t max_set,
-                                 std::size_t max_coarse)
+                                 const NearField& near, std::size_t max_set, std::size_t max_coarse)
     : m_local(panels, tree, near, max_set), m_n(panels.size()) {
   const std::size_t n = m_n;
   // Coarse clusters: the nodes at depth d (or leaves reached before), 2^d <= max_coarse.
@@ -511,8 +513,8 @@ TwoLevelSchwarz::TwoLevelSchwarz(const PanelSet& panels, const ClusterTree& tree
       for (std::size_t J = 0; J < k; ++J) out[J] = static_cast<float>(row[J]);
     }
   }
-  Eigen::MatrixXd coarse = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(k),
-                                                 static_cast<Eigen::Index>(k));
+  Eigen::MatrixXd coarse =
+      Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(k));
   for (std::size_t i = 0; i < n; ++i) {
     const float* row = m_mz.data() + i * k;
     for (std::size_t J = 0; J < k; ++J) {

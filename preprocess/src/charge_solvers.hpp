@@ -55,10 +55,10 @@ class NearFieldSchwarz {
 
  private:
   const ClusterTree& m_tree;
-  std::vector<std::size_t> m_set_start;  ///< per leaf (CSR) into m_set
-  std::vector<std::uint32_t> m_set;      ///< global ids, the leaf's members first
+  std::vector<std::size_t> m_set_start;   ///< per leaf (CSR) into m_set
+  std::vector<std::uint32_t> m_set;       ///< global ids, the leaf's members first
   std::vector<std::size_t> m_rows_start;  ///< per leaf into m_rows
-  std::vector<float> m_rows;  ///< per leaf, member a: row a of M_SS^-1 (|S| floats)
+  std::vector<float> m_rows;              ///< per leaf, member a: row a of M_SS^-1 (|S| floats)
   double m_mean_set = 0.0;
 };
 

@@ -11,7 +11,9 @@ using namespace tetseg::preprocess;
 
 namespace {
 
-TetMesh block(int n) { return tetseg::test::cube_grid(n); }
+TetMesh block(int n) {
+  return tetseg::test::cube_grid(n);
+}
 
 std::string tet_error(const TetMesh& m) {
   try {

@@ -9,10 +9,10 @@
 #include <cmath>
 #include <random>
 
-#include "tetseg/testing/synthetic_scenes.hpp"
 #include "runtime/support/compare.hpp"
 #include "runtime/support/motions.hpp"
 #include "tetseg/runtime/collider.hpp"
+#include "tetseg/testing/synthetic_scenes.hpp"
 
 using namespace tetseg;
 using namespace tetseg::test;

@@ -5,8 +5,8 @@
 #include <catch2/catch.hpp>
 #include <cmath>
 
-#include "tetseg/testing/synthetic_scenes.hpp"
 #include "tetseg/runtime/collider.hpp"
+#include "tetseg/testing/synthetic_scenes.hpp"
 
 using namespace tetseg;
 using namespace tetseg::test;

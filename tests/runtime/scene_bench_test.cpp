@@ -11,8 +11,8 @@
 #include <memory>
 #include <vector>
 
-#include "tetseg/testing/synthetic_scenes.hpp"
 #include "tetseg/runtime/scene.hpp"
+#include "tetseg/testing/synthetic_scenes.hpp"
 
 namespace {
 

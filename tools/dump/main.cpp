@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <cstdio>
 #include <fstream>
-#include <iterator>
 #include <iostream>
+#include <iterator>
 #include <map>
 #include <sstream>
 #include <unordered_map>
@@ -80,8 +80,8 @@ void print_summary(const std::string& path, const std::string& version, const As
               "rest_positive", "boundary_edges");
   for (std::size_t c = 0; c < asset.clusters.size(); ++c) {
     const auto& cluster = asset.clusters[c];
-    std::printf("  %-8zu %10u %14u %18.4f %15u\n", c, cluster.triangle_count,
-                cluster.detector_node, cluster.rest_positive_fraction, edges[c]);
+    std::printf("  %-8zu %10u %14u %18.4f %15u\n", c, cluster.triangle_count, cluster.detector_node,
+                cluster.rest_positive_fraction, edges[c]);
   }
 }
 
@@ -133,9 +133,11 @@ int main(int argc, char** argv) {
   app.add_option("asset", path, "Asset file written by `tetseg build`")->required();
   app.add_flag("--json", json, "Print JSON instead of the human summary");
   std::string vtu_path, ply_path;
-  app.add_option("--vtu", vtu_path, "Also write the surface with cluster ids, boundaries and "
+  app.add_option("--vtu", vtu_path,
+                 "Also write the surface with cluster ids, boundaries and "
                  "detector nodes as ParaView .vtu (needs rest positions)");
-  app.add_option("--ply", ply_path, "Also write the surface with cluster colours and boundary "
+  app.add_option("--ply", ply_path,
+                 "Also write the surface with cluster colours and boundary "
                  "edges as .ply (needs rest positions)");
   try {
     app.parse(argc, argv);

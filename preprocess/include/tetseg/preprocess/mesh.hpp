@@ -31,9 +31,9 @@ struct TriangleMesh {
 /// The boundary of a tet mesh: faces of exactly one tet, wound outward ((b-a)x(c-a) points
 /// out of the solid), in tet-mesh node ids.
 struct Surface {
-  std::vector<Tri> triangles;               ///< tet-mesh node ids
-  std::vector<std::uint32_t> surface_nodes; ///< sorted node ids used by triangles
-  std::vector<std::uint32_t> interior_nodes;///< sorted node ids not on the surface
+  std::vector<Tri> triangles;                 ///< tet-mesh node ids
+  std::vector<std::uint32_t> surface_nodes;   ///< sorted node ids used by triangles
+  std::vector<std::uint32_t> interior_nodes;  ///< sorted node ids not on the surface
 };
 
 /// Bad input: a file that cannot be read, is malformed, or describes an invalid mesh. The CLI

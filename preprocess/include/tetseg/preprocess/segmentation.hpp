@@ -76,21 +76,21 @@ Segmentation segment_surface(const std::vector<Vec3>& nodes, const Surface& surf
                              const SegmentationOptions& options);
 
 struct Detector {
-  std::uint32_t node = 0;               ///< interior tet-mesh node id
-  float rest_positive_fraction = 0.0f;  ///< share of the cluster's triangles positive at rest
-  std::uint32_t triangle_count = 0;     ///< triangles of the cluster
+  std::uint32_t node = 0;                ///< interior tet-mesh node id
+  float rest_positive_fraction = 0.0f;   ///< share of the cluster's triangles positive at rest
+  std::uint32_t triangle_count = 0;      ///< triangles of the cluster
   std::uint32_t positive_triangles = 0;  ///< of those, positive from `node` at rest
 };
 
 /// Candidate counts of the visibility strategy (docs/segmentation.md, "Detector nodes").
 inline constexpr std::uint32_t kDetectorNearCentroid = 24;  ///< nodes nearest the centroid
 inline constexpr std::uint32_t kDetectorNearKernel = 24;    ///< nodes nearest the kernel estimate
-inline constexpr std::uint32_t kDetectorInBox = 64;  ///< interior nodes sampled in the cluster's box
+inline constexpr std::uint32_t kDetectorInBox =
+    64;  ///< interior nodes sampled in the cluster's box
 
 /// True when `point` lies strictly on the inner side of the outward triangle's plane:
 /// det[a-o, b-o, c-o] > 0 (the triangle is "positive" from the point). Plain double arithmetic.
-bool triangle_positive_from(const std::vector<Vec3>& nodes, const Tri& triangle,
-                            const Vec3& point);
+bool triangle_positive_from(const std::vector<Vec3>& nodes, const Tri& triangle, const Vec3& point);
 
 /// Number of the cluster's triangles (ids in `triangle_ids`) that are positive from `point`:
 /// det[a-o, b-o, c-o] > 0 for outward triangles (the point lies strictly on the inner side of
