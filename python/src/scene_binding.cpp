@@ -301,9 +301,18 @@ class PyScene {
           if (!r.global && r.x0.is_none()) return body + " has no positions: call set_positions";
         }
         return "missing positions";
-      case ColliderStatus::kSizeMismatch:
-        return "a body's global range (global_offset + its node count) exceeds the rows of "
-               "the global arrays";
+      case ColliderStatus::kSizeMismatch: {
+        const std::size_t rows = m_x0.is_none() ? 0 : rows_of(m_x0);
+        for (std::size_t b = 0; b < m_bodies.size(); ++b) {
+          const BodyRecord& r = m_bodies[b];
+          if (r.global && r.global_offset + r.node_count > rows)
+            return "body " + std::to_string(b) + " reads global rows [" +
+                   std::to_string(r.global_offset) + ", " +
+                   std::to_string(r.global_offset + r.node_count) +
+                   ") but the global arrays have " + std::to_string(rows) + " rows (step(x0, x1))";
+        }
+        return "a body's global range exceeds the rows of the global arrays";
+      }
       default:
         return step_failure_detail(status);
     }
@@ -381,7 +390,7 @@ void bind_scene(py::module_& m) {
            "An empty scene. Options as tetseg::SceneOptions (docs/runtime.md): min_separation, "
            "time_tolerance and max_intervals go to the elementary tests; traversal_stack 0 "
            "never overflows (small values are for tests: queries then raise ColliderError "
-           "'traversal overflow').")
+           "'traversal stack overflow').")
       .def("add_body", &PyScene::add_body, py::arg("shape"), py::kw_only(),
            py::arg("mode") = std::string(to_string(BodyOptions{}.mode)), py::arg("still") = false,
            py::arg("self_collision") = true, py::arg("global_offset") = py::none(),
