@@ -3,14 +3,12 @@ body alone, a NumPy brute force of a body falling through a still floor, boundin
 
 import gc
 import sys
-import threading
-import time
 
 import numpy as np
 import pytest
 
 import tetseg
-from conftest import make_scene
+from conftest import contacts_while_polled, make_scene
 
 BODY_MODES = ["rvbc", "bvh", "cone"]
 
@@ -399,23 +397,7 @@ def test_gil_is_released_and_a_busy_scene_refuses_a_second_thread(bin_dir, tmp_p
     scene.add_body(tetseg.BodyShape.from_asset(asset), mode="bvh")
     scene.set_positions(0, frames[35], frames[36])
     scene.step()
-    started, result = threading.Event(), []
-
-    def query():
-        started.set()
-        result.append(len(scene.contacts()))
-
-    worker = threading.Thread(target=query)
-    worker.start()
-    started.wait()
-    refused = []
-    while worker.is_alive():
-        try:
-            scene.stats
-        except RuntimeError as error:
-            refused.append(str(error))
-        time.sleep(0.001)
-    worker.join()
+    count, refused = contacts_while_polled(scene)
     assert len(refused) >= 20, "hardly any overlap: is the GIL held during contacts()?"
     assert all("this Scene is in use by another thread" in r for r in refused)
-    assert result and result[0] > 0 and scene.stats["contacts"] > 0
+    assert count > 0 and scene.stats["contacts"] > 0
