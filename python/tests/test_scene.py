@@ -204,6 +204,13 @@ def test_global_layout_gives_the_same_contacts_as_own_arrays(dumbbell_scene):
     pad = np.zeros((3, 3))
     mixed.step(np.concatenate([pad, x0]), np.concatenate([pad, x1]))
     assert np.array_equal(mixed.contacts(), expected)
+    # Only still bodies in the global arrays: x1 is not needed.
+    still = tetseg.Scene()
+    still.add_body(tetseg.BodyShape.from_asset(asset), still=True, global_offset=0)
+    still.add_body(tetseg.BodyShape.from_triangles(floor_triangles, 4), still=True,
+                   global_offset=len(x0) + 5)
+    still.step(g0)
+    assert len(still.contacts()) == 0 and still.stats["body_pairs_skipped"] == 1
 
 
 def test_still_bodies_read_x0_only(dumbbell_scene):
