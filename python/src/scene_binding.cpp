@@ -128,6 +128,8 @@ class PyScene {
     options.still = still;
     options.self_collision = self_collision;
     if (!global_offset.is_none()) {
+      if (!py::isinstance<py::int_>(global_offset))
+        throw py::type_error("global_offset must be an int or None");
       const auto offset = global_offset.cast<std::int64_t>();
       if (offset < 0) throw py::value_error("global_offset must be >= 0 or None");
       options.global_offset = static_cast<std::size_t>(offset);
@@ -320,7 +322,7 @@ class PyScene {
 
   SceneOptions m_options;
   std::unique_ptr<Scene> m_scene;
-  std::vector<BodyRecord> m_bodies;                 // after m_scene: destroyed after it
+  std::vector<BodyRecord> m_bodies;  // released before m_scene, whose destructor reads none
   py::object m_x0 = py::none(), m_x1 = py::none();  // the global arrays of the last step
   StepQueries m_queries{"Scene", "step()"};
 };

@@ -344,6 +344,8 @@ def test_bad_input_raises(dumbbell_scene):
     assert error.value.status == "invalid argument"
     with pytest.raises(ValueError, match="global_offset"):
         scene.add_body(tetseg.BodyShape.from_asset(asset), global_offset=-1)
+    with pytest.raises(TypeError, match="global_offset"):
+        scene.add_body(tetseg.BodyShape.from_asset(asset), global_offset=1.5)
     assert scene.body_count == 1
 
 
