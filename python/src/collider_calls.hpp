@@ -1,8 +1,9 @@
 #pragma once
 /// \file
-/// The one place where the Python binding calls the C++ collider's step and queries. Each
-/// call returns a ColliderStatus; the binding raises `tetseg.ColliderError` (naming the
-/// status) on anything but kOk and never returns an answer from a failed call.
+/// The one place where the Python binding calls the C++ step and queries of a `Collider` or a
+/// `Scene` (`Engine`: both have the same calls). Each call returns a ColliderStatus; the
+/// binding raises `tetseg.ColliderError` (naming the status) on anything but kOk and never
+/// returns an answer from a failed call.
 ///
 /// The queries themselves refuse to answer without a valid step (kNoStep), so no
 /// answer of a failed call can look like "no collision".
@@ -10,31 +11,36 @@
 #include <cstddef>
 
 #include "tetseg/runtime/collider.hpp"
+#include "tetseg/runtime/scene.hpp"
 
 namespace tetseg::python {
 
-inline ColliderStatus call_step(Collider& collider, const double* x0, const double* x1,
-                                std::size_t value_count) noexcept {
-  return collider.step(x0, x1, value_count);
+template <typename Engine>
+ColliderStatus call_step(Engine& engine, const double* x0, const double* x1,
+                         std::size_t value_count) noexcept {
+  return engine.step(x0, x1, value_count);
 }
 
-inline ColliderStatus call_any_collision(Collider& collider, bool& any) noexcept {
-  return collider.any_collision(any);
+template <typename Engine>
+ColliderStatus call_any_collision(Engine& engine, bool& any) noexcept {
+  return engine.any_collision(any);
 }
 
-inline ColliderStatus call_earliest_toi(Collider& collider, EarliestContact& earliest) noexcept {
-  return collider.earliest_toi(earliest);
+template <typename Engine>
+ColliderStatus call_earliest_toi(Engine& engine, EarliestContact& earliest) noexcept {
+  return engine.earliest_toi(earliest);
 }
 
-inline ColliderStatus call_contacts(Collider& collider, Contact* buffer, std::size_t capacity,
-                                    ContactsResult& result) noexcept {
-  return collider.contacts(buffer, capacity, result);
+template <typename Engine>
+ColliderStatus call_contacts(Engine& engine, Contact* buffer, std::size_t capacity,
+                             ContactsResult& result) noexcept {
+  return engine.contacts(buffer, capacity, result);
 }
 
-inline ColliderStatus call_check_rest_intersection(Collider& collider, const double* x,
-                                                   std::size_t value_count,
-                                                   RestCheck& result) noexcept {
-  result = collider.check_rest_intersection(x, value_count);
+template <typename Engine>
+ColliderStatus call_check_rest_intersection(Engine& engine, const double* x,
+                                            std::size_t value_count, RestCheck& result) noexcept {
+  result = engine.check_rest_intersection(x, value_count);
   return result.status;
 }
 

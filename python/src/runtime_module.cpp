@@ -17,22 +17,19 @@
 
 #include "collider_calls.hpp"
 #include "python_errors.hpp"
+#include "runtime_binding.hpp"
 #include "tetseg/runtime/asset.hpp"
 #include "tetseg/runtime/collider.hpp"
 #include "tetseg/runtime/frames.hpp"
 
 namespace tetseg::python {
-namespace {
 
-using AssetPtr = std::shared_ptr<const Asset>;
-
-struct Errors {
-  py::object asset, collider, frames;
-};
 Errors& errors() {
   static Errors* e = new Errors();  // never destroyed: outlives module teardown
   return *e;
 }
+
+namespace {
 
 // ---------------------------------------------------------------------------------------
 // NumPy helpers
@@ -61,8 +58,7 @@ py::dtype record_dtype(const std::vector<std::pair<const char*, const char*>>& f
   return py::dtype(names, formats, offs, static_cast<py::ssize_t>(itemsize));
 }
 
-/// The dtype of `tetseg::Contact`, so the collider writes contacts straight into NumPy memory.
-py::dtype contact_dtype() {
+py::dtype contact_record_dtype() {
   static_assert(std::is_standard_layout_v<Contact>);
   static_assert(sizeof(ContactKind) == 1 && sizeof(bool) == 1);
   return record_dtype(
@@ -121,42 +117,8 @@ py::array vector_view(const std::vector<T>& values, const py::dtype& dtype, py::
                         asset_owner(asset));
 }
 
-/// Checks that `object` is an (node_count, 3) C-contiguous float64 array and returns its data.
-/// Raises TypeError (not an array, wrong dtype) or ValueError (shape, layout).
-const double* positions_of(const char* name, const py::handle& object, std::size_t node_count) {
-  if (!py::isinstance<py::array>(object)) {
-    throw py::type_error(std::string(name) + " must be a numpy.ndarray of float64 with shape (" +
-                         std::to_string(node_count) + ", 3), got " +
-                         std::string(py::str(py::type::handle_of(object).attr("__name__"))));
-  }
-  const auto array = py::reinterpret_borrow<py::array>(object);
-  if (!array.dtype().equal(py::dtype::of<double>())) {
-    throw py::type_error(std::string(name) + " must have dtype float64 (native byte order), got " +
-                         std::string(py::str(array.dtype())) +
-                         " (convert with numpy.ascontiguousarray(x, dtype=numpy.float64))");
-  }
-  if (array.ndim() != 2 || array.shape(0) != static_cast<py::ssize_t>(node_count) ||
-      array.shape(1) != 3) {
-    throw py::value_error(std::string(name) + " must have shape (" + std::to_string(node_count) +
-                          ", 3) (the asset's node count), got " +
-                          std::string(py::str(array.attr("shape"))));
-  }
-  const int flags = py::detail::array_proxy(array.ptr())->flags;
-  if (!(flags & py::detail::npy_api::NPY_ARRAY_C_CONTIGUOUS_) ||
-      !(flags & py::detail::npy_api::NPY_ARRAY_ALIGNED_)) {
-    throw py::value_error(std::string(name) +
-                          " must be C-contiguous and aligned (it is used in place, not copied); "
-                          "use numpy.ascontiguousarray(x)");
-  }
-  return static_cast<const double*>(array.data());
-}
-
 // ---------------------------------------------------------------------------------------
 // Assets
-
-struct PyAsset {
-  AssetPtr asset;
-};
 
 AssetPtr load_from_bytes(const py::buffer& data) {
   const py::buffer_info info = data.request();
@@ -216,20 +178,6 @@ py::dict provenance_dict(const format::Provenance& p) {
 // ---------------------------------------------------------------------------------------
 // Collider
 
-/// Refuses concurrent use of one collider from several Python threads (the GIL is released
-/// during steps and queries; a C++ Collider is single-threaded).
-class Busy {
- public:
-  explicit Busy(std::mutex& m) : m_lock(m, std::try_to_lock) {
-    if (!m_lock.owns_lock())
-      throw std::runtime_error(
-          "this Collider is in use by another thread; use one Collider per thread");
-  }
-
- private:
-  std::unique_lock<std::mutex> m_lock;
-};
-
 py::dict options_dict(const ColliderOptions& o) {
   py::dict d;
   d["mode"] = to_string(o.mode);
@@ -240,40 +188,6 @@ py::dict options_dict(const ColliderOptions& o) {
   d["use_openmp"] = o.use_openmp;
   d["check_first_step"] = o.check_first_step;
   d["time_tests"] = o.time_tests;
-  return d;
-}
-
-py::dict stats_dict(const ColliderStats& s) {
-  py::dict d;
-  d["refit_ms"] = s.refit_ms;
-  d["classify_ms"] = s.classify_ms;
-  d["traversal_ms"] = s.traversal_ms;
-  d["tests_ms"] = s.tests_ms;
-  d["cone_ms"] = s.cone_ms;
-  d["nodes_moved"] = s.nodes_moved;
-  d["triangles_positive"] = s.triangles_positive;
-  d["triangles_negative"] = s.triangles_negative;
-  d["triangles_uncertain"] = s.triangles_uncertain;
-  d["triangles_moving"] = s.triangles_moving;
-  d["clusters_skipped"] = s.clusters_skipped;
-  d["closure_pairs"] = s.closure_pairs;
-  d["node_pairs_visited"] = s.node_pairs_visited;
-  d["node_pairs_orientation_culled"] = s.node_pairs_orientation_culled;
-  d["triangle_pairs"] = s.triangle_pairs;
-  d["feature_pairs"] = s.feature_pairs;
-  d["feature_pairs_filtered"] = s.feature_pairs_filtered;
-  d["feature_tests"] = s.feature_tests;
-  d["contacts"] = s.contacts;
-  d["nothing_moved"] = s.nothing_moved;
-  d["full_traversal"] = s.full_traversal;
-  return d;
-}
-
-py::dict rest_check_dict(const RestCheck& r) {
-  py::dict d;
-  d["intersecting"] = r.intersecting;
-  d["triangle_a"] = r.triangle_a;
-  d["triangle_b"] = r.triangle_b;
   return d;
 }
 
@@ -293,9 +207,9 @@ class PyCollider {
 
   void step(const py::object& x0, const py::object& x1) {
     const std::size_t nodes = m_asset->node_count();
-    const double* p0 = positions_of("x0", x0, nodes);
-    const double* p1 = positions_of("x1", x1, nodes);
-    Busy busy(m_mutex);
+    const double* p0 = positions_of("x0", x0, nodes, "the asset's node count");
+    const double* p1 = positions_of("x1", x1, nodes, "the asset's node count");
+    Busy busy = m_queries.lock();
     // The C++ collider keeps the pointers until the next step: drop the old arrays only
     // after it stopped using them, and keep the new ones while it may read them.
     ColliderStatus status;
@@ -303,7 +217,7 @@ class PyCollider {
       py::gil_scoped_release release;
       status = call_step(*m_collider, p0, p1, nodes * 3);
     }
-    m_last_step = status;
+    m_queries.stepped(status);
     if (status != ColliderStatus::kOk) {
       m_x0 = py::none();
       m_x1 = py::none();
@@ -313,67 +227,22 @@ class PyCollider {
     m_x1 = x1;
   }
 
-  bool any_collision() {
-    Busy busy(m_mutex);
-    bool any = false;
-    ColliderStatus status;
-    {
-      py::gil_scoped_release release;
-      status = call_any_collision(*m_collider, any);
-    }
-    check_query("any_collision", status);
-    return any;
-  }
-
-  py::object earliest_toi() {
-    Busy busy(m_mutex);
-    EarliestContact earliest;
-    ColliderStatus status;
-    {
-      py::gil_scoped_release release;
-      status = call_earliest_toi(*m_collider, earliest);
-    }
-    check_query("earliest_toi", status);
-    if (!earliest.found) return py::none();
-    py::array one(contact_dtype(), std::vector<py::ssize_t>{1});
-    std::memcpy(one.mutable_data(), &earliest.contact, sizeof(Contact));
-    return one[py::int_(0)];
-  }
-
-  py::array contacts() {
-    Busy busy(m_mutex);
-    std::size_t capacity = m_contacts_capacity;
-    for (int attempt = 0; attempt < 3; ++attempt) {
-      py::array out(contact_dtype(), std::vector<py::ssize_t>{static_cast<py::ssize_t>(capacity)});
-      auto* buffer = static_cast<Contact*>(out.mutable_data());
-      ContactsResult result;
-      ColliderStatus status;
-      {
-        py::gil_scoped_release release;
-        status = call_contacts(*m_collider, buffer, capacity, result);
-      }
-      check_query("contacts", status);
-      if (!result.truncated()) {
-        out.resize({static_cast<py::ssize_t>(result.written)});
-        return out;
-      }
-      capacity = result.found;  // a deterministic step finds the same contacts again
-      m_contacts_capacity = capacity;
-    }
-    raise_status(errors().collider, "contacts", to_string(ColliderStatus::kInternal),
-                 "the contact count changed between two traversals of one step");
-  }
+  bool any_collision() { return m_queries.any_collision(*m_collider); }
+  py::object earliest_toi() { return m_queries.earliest_toi(*m_collider); }
+  py::array contacts() { return m_queries.contacts(*m_collider); }
 
   py::dict check_rest_intersection(const py::object& x) {
     const std::size_t nodes = m_asset->node_count();
-    const double* p = positions_of("x", x, nodes);
-    Busy busy(m_mutex);
+    const double* p = positions_of("x", x, nodes, "the asset's node count");
+    Busy busy = m_queries.lock();
     RestCheck result;
     ColliderStatus status;
     {
       py::gil_scoped_release release;
       status = call_check_rest_intersection(*m_collider, p, nodes * 3, result);
     }
+    m_queries.invalidated(
+        "check_rest_intersection reused the step scratch: call step(x0, x1) again");
     if (status != ColliderStatus::kOk)
       raise_status(errors().collider, "check_rest_intersection", to_string(status),
                    step_failure_detail(status));
@@ -381,11 +250,11 @@ class PyCollider {
   }
 
   py::dict stats() {
-    Busy busy(m_mutex);
+    Busy busy = m_queries.lock();
     return stats_dict(m_collider->stats());
   }
   py::dict rest_intersection() {
-    Busy busy(m_mutex);
+    Busy busy = m_queries.lock();
     return rest_check_dict(m_collider->rest_intersection());
   }
   py::dict options() const { return options_dict(m_collider->options()); }
@@ -393,7 +262,7 @@ class PyCollider {
   const py::object& asset() const { return m_asset_object; }
 
   const char* triangle_class(std::size_t triangle) {
-    Busy busy(m_mutex);
+    Busy busy = m_queries.lock();
     if (triangle >= m_asset->triangle_count())
       throw py::index_error("triangle " + std::to_string(triangle) + " out of range (" +
                             std::to_string(m_asset->triangle_count()) + " triangles)");
@@ -409,36 +278,11 @@ class PyCollider {
   }
 
  private:
-  static std::string step_failure_detail(ColliderStatus status) {
-    switch (status) {
-      case ColliderStatus::kNonFinite:
-        return "a position of a surface or detector node is NaN or infinite (step rejected)";
-      case ColliderStatus::kSizeMismatch:
-        return "position count differs from node_count * 3";
-      default:
-        return "";
-    }
-  }
-
-  void check_query(const char* what, ColliderStatus status) const {
-    if (status == ColliderStatus::kOk) return;
-    std::string detail;
-    if (m_last_step != ColliderStatus::kOk) {
-      detail = m_last_step == ColliderStatus::kNotReady
-                   ? "no step yet: call step(x0, x1) first"
-                   : std::string("the last step failed (") + to_string(m_last_step) +
-                         "): call step(x0, x1) with valid positions first";
-    }
-    raise_status(errors().collider, what, to_string(status), detail);
-  }
-
   py::object m_asset_object;  // the Python Asset: the binding's reference keeps it alive
   AssetPtr m_asset;
   std::unique_ptr<Collider> m_collider;             // declared after m_asset: destroyed before it
   py::object m_x0 = py::none(), m_x1 = py::none();  // arrays the collider reads this step
-  ColliderStatus m_last_step = ColliderStatus::kNotReady;
-  std::size_t m_contacts_capacity = 256;
-  std::mutex m_mutex;
+  StepQueries m_queries{"Collider", "step(x0, x1)"};
 };
 
 ColliderOptions make_options(const std::string& mode, double min_separation, double time_tolerance,
@@ -480,6 +324,47 @@ py::array read_frames_array(const py::object& path_like) {
 }
 
 }  // namespace
+
+py::dtype contact_dtype() {
+  return contact_record_dtype();
+}
+
+py::dict stats_dict(const ColliderStats& s) {
+  py::dict d;
+  d["refit_ms"] = s.refit_ms;
+  d["classify_ms"] = s.classify_ms;
+  d["traversal_ms"] = s.traversal_ms;
+  d["tests_ms"] = s.tests_ms;
+  d["cone_ms"] = s.cone_ms;
+  d["nodes_moved"] = s.nodes_moved;
+  d["triangles_positive"] = s.triangles_positive;
+  d["triangles_negative"] = s.triangles_negative;
+  d["triangles_uncertain"] = s.triangles_uncertain;
+  d["triangles_moving"] = s.triangles_moving;
+  d["clusters_skipped"] = s.clusters_skipped;
+  d["closure_pairs"] = s.closure_pairs;
+  d["node_pairs_visited"] = s.node_pairs_visited;
+  d["node_pairs_orientation_culled"] = s.node_pairs_orientation_culled;
+  d["triangle_pairs"] = s.triangle_pairs;
+  d["triangle_pairs_plane_filtered"] = s.triangle_pairs_plane_filtered;
+  d["feature_pairs"] = s.feature_pairs;
+  d["feature_pairs_filtered"] = s.feature_pairs_filtered;
+  d["feature_tests"] = s.feature_tests;
+  d["contacts"] = s.contacts;
+  d["nothing_moved"] = s.nothing_moved;
+  d["full_traversal"] = s.full_traversal;
+  return d;
+}
+
+py::dict rest_check_dict(const RestCheck& r) {
+  py::dict d;
+  d["intersecting"] = r.intersecting;
+  d["triangle_a"] = r.triangle_a;
+  d["triangle_b"] = r.triangle_b;
+  d["bodies"] = py::make_tuple(r.bodies[0], r.bodies[1]);
+  return d;
+}
+
 }  // namespace tetseg::python
 
 PYBIND11_MODULE(_runtime, m) {
@@ -673,4 +558,6 @@ PYBIND11_MODULE(_runtime, m) {
       .def("triangle_class", &PyCollider::triangle_class, py::arg("triangle"),
            "Orientation class of a surface triangle in the current step (rvbc mode): "
            "'positive', 'negative' or 'uncertain'. For diagnostics.");
+
+  bind_scene(m);
 }

@@ -9,6 +9,8 @@ PYTHONPATH                <build>/python, or nothing after `pip install`
 import json
 import os
 import subprocess
+import threading
+import time
 from pathlib import Path
 
 import numpy as np
@@ -84,3 +86,26 @@ def tetseg_run_json(bin_dir, asset, frames, mode, query="all"):
     out = run_tool(bin_dir, "tetseg-run", asset, frames, "--mode", mode, "--query", query,
                    "--json")
     return json.loads(out)
+
+
+def contacts_while_polled(engine):
+    """Runs engine.contacts() on a thread while this thread reads engine.stats in a loop.
+    Returns (the contact count, the messages of the RuntimeErrors the reads got)."""
+    started, result, refused = threading.Event(), [], []
+
+    def query():
+        started.set()
+        result.append(len(engine.contacts()))
+
+    worker = threading.Thread(target=query)
+    worker.start()
+    started.wait()
+    while worker.is_alive():
+        try:
+            engine.stats
+        except RuntimeError as error:
+            refused.append(str(error))
+        time.sleep(0.001)
+    worker.join()
+    assert result, "contacts() failed on the worker thread"
+    return result[0], refused

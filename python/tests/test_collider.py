@@ -100,7 +100,11 @@ def test_options_and_stats(dumbbell):
     collider.any_collision()
     stats = collider.stats
     assert stats["nodes_moved"] > 0 and stats["tests_ms"] == 0.0
-    assert collider.check_rest_intersection(frames[0])["intersecting"] is False
+    assert collider.check_rest_intersection(frames[0]) == {
+        "intersecting": False, "triangle_a": 0, "triangle_b": 0, "bodies": (0, 0)}
+    with pytest.raises(tetseg.ColliderError, match="reused the step scratch") as error:
+        collider.any_collision()  # the check invalidated the step
+    assert error.value.status == "no valid step"
     assert set(stats) >= {"refit_ms", "traversal_ms", "feature_tests", "contacts", "full_traversal"}
     defaults = tetseg.Collider(tetseg.load_asset(asset_path)).options
     assert defaults["mode"] == "rvbc" and defaults["max_intervals"] == 2048

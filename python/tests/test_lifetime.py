@@ -3,14 +3,13 @@
 import gc
 import sys
 import threading
-import time
 import tracemalloc
 
 import numpy as np
 import pytest
 
 import tetseg
-from conftest import make_scene
+from conftest import contacts_while_polled, make_scene
 
 
 @pytest.fixture(scope="module")
@@ -121,26 +120,10 @@ def test_gil_is_released_and_a_busy_collider_refuses_a_second_thread(bin_dir, tm
     collider = tetseg.Collider(tetseg.load_asset(asset_path), mode="bvh")
     frames = tetseg.read_frames(frames_path)
     collider.step(frames[35], frames[36])
-    started, result = threading.Event(), []
-
-    def query():
-        started.set()
-        result.append(len(collider.contacts()))
-
-    worker = threading.Thread(target=query)
-    worker.start()
-    started.wait()
-    refused = []
-    while worker.is_alive():
-        try:
-            collider.stats
-        except RuntimeError as error:
-            refused.append(str(error))
-        time.sleep(0.001)
-    worker.join()
+    count, refused = contacts_while_polled(collider)
     # Each refusal is a moment this thread ran while the other was inside contacts(). With
     # the GIL held in C++ there are only a few (while the binding runs Python code).
     assert len(refused) >= 20, "hardly any overlap: is the GIL held during contacts()?"
     assert all("in use by another thread" in r for r in refused)
-    assert result and result[0] > 0
+    assert count > 0
     assert collider.stats["contacts"] > 0  # usable again
