@@ -176,6 +176,9 @@ ColliderStatus Scene::set_positions(std::uint32_t body, const double* x0, const 
   if (value_count != std::size_t(b.core->node_count) * 3) return ColliderStatus::kSizeMismatch;
   b.own_x0 = x0;
   b.own_x1 = x1;
+  // The current step read the old arrays: queries now need a new step (never an answer
+  // from positions the caller may have released).
+  s.have_step = false;
   return ColliderStatus::kOk;
 }
 

@@ -517,7 +517,13 @@ TEST_CASE("Scene queries report failures as statuses, never as no contact", "[sc
     CHECK(hit);
     CHECK(own.set_positions(1, b1[0].data(), b1[2].data(), 5) == ColliderStatus::kSizeMismatch);
     CHECK(own.set_positions(7, b1[0].data(), b1[2].data(), 5) == ColliderStatus::kInvalidArgument);
+    // New positions end the step: no answer from the arrays the step read.
+    REQUIRE(own.set_positions(1, b1[0].data(), b1[2].data(), b1[0].size()) == ColliderStatus::kOk);
+    require_queries(own, ColliderStatus::kNoStep);
+    REQUIRE(own.step() == ColliderStatus::kOk);
+    require_queries(own, ColliderStatus::kOk);
     REQUIRE(own.set_positions(1, b1[0].data(), nullptr, b1[0].size()) == ColliderStatus::kOk);
+    require_queries(own, ColliderStatus::kNoStep);
     CHECK(own.step() == ColliderStatus::kNullInput);
     require_queries(own, ColliderStatus::kNoStep);
     std::vector<double> bad = b1[2];

@@ -90,7 +90,8 @@ class Scene {
   /// be node_count * 3; x1 may be null for a still body. The scene keeps the pointers for
   /// the following steps: the arrays must stay valid until replaced or the scene is gone.
   /// Checked at `step` (kNullInput, kNonFinite); kInvalidArgument for an unknown body or a
-  /// body of the global layout, kSizeMismatch for a wrong count.
+  /// body of the global layout, kSizeMismatch for a wrong count. Ends the current step:
+  /// queries answer kNoStep until the next `step`.
   ColliderStatus set_positions(std::uint32_t body, const double* x0, const double* x1,
                                std::size_t value_count) noexcept;
 
