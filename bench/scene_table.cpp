@@ -95,8 +95,8 @@ DescribedScene read_scene(const std::string& name, const std::string& path) {
         throw fail("expected 'obstacle NODES TRIANGLES'");
       for (std::size_t t = 0; t < tris; ++t) {
         std::array<std::uint32_t, 3> tri{};
-        if (!next(words) || !(words >> tri[0] >> tri[1] >> tri[2]))
-          throw fail("expected a triangle 'A B C'");
+        if (!next(words)) throw fail("unexpected end: expected a triangle 'A B C'");
+        if (!(words >> tri[0] >> tri[1] >> tri[2])) throw fail("expected a triangle 'A B C'");
         b.triangles.push_back(tri);
       }
       std::vector<std::uint32_t> flat;
