@@ -7,6 +7,7 @@
 // how many steps were compared.
 // Links the runtime only. Timings: each step is run `--repeat` times and the fastest run of
 // the step is kept (robust to the shared cores of a CI machine); the mean is over steps.
+// tetseg-bench scene: scene_table.hpp.
 
 #include <time.h>
 
@@ -20,6 +21,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "scene_table.hpp"
 #include "tetseg/runtime/asset.hpp"
 #include "tetseg/runtime/collider.hpp"
 #include "tetseg/runtime/frames.hpp"
@@ -388,9 +390,29 @@ int main(int argc, char** argv) {
   std::string check_asset, check_frames;
   c->add_option("asset", check_asset, "Asset file")->required();
   c->add_option("frames", check_frames, "Frame-sequence file")->required();
+  CLI::App* sc = app.add_subcommand(
+      "scene",
+      "Scene table: stage times, body pairs, contacts and missed contacts over scenes "
+      "written by tetseg-sim --scene");
+  tetseg::bench::SceneTableOptions scene_options;
+  sc->add_option("scenes", scene_options.scenes, "NAME DESCRIPTION, repeated per scene")
+      ->required();
+  sc->add_option("--stride", scene_options.stride, "Step from frame f to f + stride (default 1)")
+      ->check(CLI::Range(std::size_t(1), std::size_t(1000)));
+  sc->add_option("--max-steps", scene_options.max_steps, "Use at most this many steps per scene")
+      ->check(CLI::PositiveNumber);
+  sc->add_option("--repeat", scene_options.repeat, "Runs per step; the fastest is kept (default 3)")
+      ->check(CLI::Range(1, 100));
+  sc->add_flag("--merged", scene_options.merged,
+               "Also time all surfaces merged into one body in bvh mode");
+  sc->add_flag("--no-truth{false}", scene_options.truth,
+               "Skip brute force and the comparison (timings only)");
+  sc->add_flag("--expect-clean", scene_options.expect_clean,
+               "Exit 1 when a frame intersects or brute force finds a contact in a step");
   try {
     app.parse(argc, argv);
     if (c->parsed()) return check(check_asset, check_frames);
+    if (sc->parsed()) return tetseg::bench::scene_table(scene_options);
     return table(scenes, modes, stride, max_steps, repeat, openmp, json, !no_truth, time_tests);
   } catch (const CLI::ParseError& e) {
     const int code = app.exit(e);

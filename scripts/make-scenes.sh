@@ -2,11 +2,17 @@
 # Generates the benchmark scenes of docs/benchmarks.md ("Table I", "Cluster refinement"): pawn,
 # dumbbell, and the libcgal-demo elephant, armadillo and dino, each an asset (default options)
 # plus a tetseg-sim frame sequence of a soft drop onto the ground, and the same mesh's assets
-# with the other cluster methods (NAME-charge.tetseg, NAME-single.tetseg). Outputs go to
-# OUT_DIR (default BUILD_DIR/scenes), never into the repository.
+# with the other cluster methods (NAME-charge.tetseg, NAME-single.tetseg); then the scenes with
+# several bodies ("Scenes"): a pile of soft balls dropped into a bin, two characters dropped
+# on each other, a soft pancake draped over a still sphere, each a frame sequence plus a scene
+# description for `tetseg-bench scene` (NAME.tsscene). Outputs go to OUT_DIR (default
+# BUILD_DIR/scenes), never into the repository.
 #
 #   scripts/make-scenes.sh [BUILD_DIR] [OUT_DIR]      (BUILD_DIR default: ./build)
 #
+# Environment: TETSEG_SCENES=multibody makes only the scenes with several bodies;
+# TETSEG_PILE_BALLS=N (default 8) balls in the pile, in layers of four (16: the pile of
+# docs/benchmarks.md, about 3 minutes more).
 # Needs tetseg and tetseg-sim built in BUILD_DIR (Release). A few minutes on 2 cores.
 set -euo pipefail
 repo=$(cd "$(dirname "$0")/.." && pwd)
@@ -31,6 +37,7 @@ scene() {  # scene NAME SIM-OPTIONS...  (NAME.mesh exists)
   echo "make-scenes: $name: $(cat "$name.sim.json")" >&2
 }
 
+if [ "${TETSEG_SCENES:-all}" != multibody ]; then
 # Pawn: 5275 nodes, 4942 surface triangles (paper: 3454 vertices, 5130 faces); tilted so it
 # falls on its side and the collar bends onto the head and base.
 "$tetseg" generate pawn -o pawn.mesh 2>/dev/null
@@ -65,4 +72,43 @@ tar xzf /usr/share/doc/libcgal-dev/data.tar.gz -O data/meshes/dino.off > dino.of
 scene dino --frames 200 --drop 0.3 --tilt-x 90 --tilt-y 30 --edge-compliance 2e-5 \
   --iterations 3
 
-echo "make-scenes: done: $out/{pawn,dumbbell,elephant,armadillo,dino}{,-charge,-single}.tetseg and .tsf" >&2
+fi
+
+multibody() {  # multibody NAME SIM-OPTIONS...: NAME.tsf and NAME.tsscene
+  local name=$1; shift
+  echo "make-scenes: $name: simulating" >&2
+  "$sim" -o "$name.tsf" --scene "$name.tsscene" --json "$@" > "$name.sim.json"
+  echo "make-scenes: $name: $(cat "$name.sim.json")" >&2
+}
+
+# Pile: soft balls of radius 0.15 (tetseg generate sphere --size 0.6: 1544 nodes) dropped in
+# layers of four, staggered, into a still bin open at the top (its floor just below the
+# ground, so the ground plane carries the pile and the walls hold it).
+balls=${TETSEG_PILE_BALLS:-8}
+"$tetseg" generate sphere --radius 0.15 --size 0.6 -o ball.mesh 2>/dev/null
+"$tetseg" build ball.mesh -o ball.tetseg -q
+pile=()
+for ((i = 0; i < balls; ++i)); do
+  layer=$((i / 4))
+  pile+=(--body "ball.mesh,ball.tetseg,$(python3 -c "
+l, c = $layer, $i % 4
+j = 0.05 if l % 2 else -0.05
+print('%g,%g,%g' % (0.1 + 0.4 * l, (-0.2 if c % 2 == 0 else 0.2) + j, (-0.2 if c < 2 else 0.2) - j))")")
+done
+multibody "pile$balls" "${pile[@]}" --bin=-0.45,-0.45,-0.05,0.45,0.45,0.8 --frames 90
+
+# Two characters: a soft dumbbell dropped lengthwise onto the upright pawn, off centre.
+[ -f pawn.mesh ] || "$tetseg" generate pawn -o pawn.mesh 2>/dev/null
+[ -f dumbbell.mesh ] || "$tetseg" generate dumbbell -o dumbbell.mesh 2>/dev/null
+[ -f pawn.tetseg ] || "$tetseg" build pawn.mesh -o pawn.tetseg -q
+[ -f dumbbell.tetseg ] || "$tetseg" build dumbbell.mesh -o dumbbell.tetseg -q
+multibody characters --body pawn.mesh,pawn.tetseg,0,0,0 \
+  --body dumbbell.mesh,dumbbell.tetseg,1.9,0.25,0.1 --frames 120 --edge-compliance 5e-4
+
+# Drape: a soft pancake (ellipsoid 0.6 x 0.6 x 0.06) falling onto a still sphere of radius 0.3.
+"$tetseg" generate ellipsoid --axes 0.6 0.6 0.06 -o pancake.mesh 2>/dev/null
+"$tetseg" build pancake.mesh -o pancake.tetseg -q
+multibody drape --body pancake.mesh,pancake.tetseg,0.7,0,0 --sphere=0,0,0.35,0.3 --frames 120 \
+  --edge-compliance 2e-3
+
+echo "make-scenes: done: $out/{pawn,dumbbell,elephant,armadillo,dino}{,-charge,-single}.tetseg and .tsf, {pile$balls,characters,drape}.tsscene and .tsf" >&2

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <stdexcept>
 
 namespace tetseg::tools {
@@ -18,14 +19,6 @@ double tet_volume(const double* a, const double* b, const double* c, const doubl
   return (u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0]) +
           u[2] * (v[0] * w[1] - v[1] * w[0])) /
          6.0;
-}
-
-tetseg::ColliderOptions collider_options(const SimOptions& o) {
-  tetseg::ColliderOptions c;
-  c.mode = o.collider_mode;
-  c.time_tests = false;
-  c.use_openmp = false;
-  return c;
 }
 
 }  // namespace
@@ -55,22 +48,16 @@ std::vector<double> place_above_ground(const std::vector<preprocess::Vec3>& node
   return x;
 }
 
-SoftBody::SoftBody(const preprocess::TetMesh& mesh, const tetseg::Asset& asset,
-                   const std::vector<double>& start, const SimOptions& options,
-                   const std::string& what)
-    : m_opt(options), m_collider(asset, collider_options(options)) {
+SoftBody::SoftBody(const preprocess::TetMesh& mesh, const std::vector<double>& start,
+                   const SimOptions& options, const std::string& what)
+    : m_opt(options) {
   if (!(options.frame_dt > 0) || options.substeps == 0 || options.iterations == 0 ||
       options.up_axis < 0 || options.up_axis > 2 || !(options.friction >= 0) ||
       !(options.density > 0) || !(options.edge_compliance >= 0) ||
       !(options.volume_compliance >= 0) || !(options.damping >= 0))
     throw InputError(what, "simulation option out of range");
   m_node_count = mesh.nodes.size();
-  if (asset.node_count() != m_node_count)
-    throw InputError(what, "the asset has " + std::to_string(asset.node_count()) +
-                               " nodes, the tet mesh " + std::to_string(m_node_count));
   if (start.size() != m_node_count * 3) throw InputError(what, "start position count mismatch");
-  if (m_collider.status() != tetseg::ColliderStatus::kOk)
-    throw InputError(what, "cannot create the collider");
 
   // Masses (lumped tet volumes), rest volumes, unique edges in sorted order.
   m_tets = mesh.tets;
@@ -103,24 +90,9 @@ SoftBody::SoftBody(const preprocess::TetMesh& mesh, const tetseg::Asset& asset,
   m_x = start;
   m_x_prev = start;
   m_v.assign(m_node_count * 3, 0.0);
-  m_frozen.assign(m_node_count, 0);
-  m_contacts.resize(std::max<std::size_t>(1, options.contact_capacity));
-  const tetseg::RestCheck rc = m_collider.check_rest_intersection(m_x.data(), m_x.size());
-  if (rc.status != tetseg::ColliderStatus::kOk)
-    throw InputError(what, std::string("start check failed: ") + tetseg::to_string(rc.status));
-  if (rc.intersecting)
-    throw InputError(what, "the start surface self-intersects (triangles " +
-                               std::to_string(rc.triangle_a) + " and " +
-                               std::to_string(rc.triangle_b) + ")");
 }
 
-void SoftBody::advance_frame() {
-  const double h = m_opt.frame_dt / m_opt.substeps;
-  for (std::uint32_t s = 0; s < m_opt.substeps; ++s) substep(h);
-}
-
-void SoftBody::substep(double h) {
-  ++m_counters.substeps;
+void SoftBody::predict(double h, SimCounters& counters) {
   const int up = m_opt.up_axis;
   const double damp = std::max(0.0, 1.0 - m_opt.damping * h);
   m_x_prev = m_x;
@@ -133,9 +105,21 @@ void SoftBody::substep(double h) {
     }
   }
   for (std::uint32_t it = 0; it < m_opt.iterations; ++it) solve_constraints(h);
-  apply_ground();
-  if (m_opt.self_contact) resolve_self_contact();
+  apply_ground(counters);
+}
+
+void SoftBody::finish(double h) {
   for (std::size_t i = 0; i < m_x.size(); ++i) m_v[i] = (m_x[i] - m_x_prev[i]) / h;
+}
+
+bool SoftBody::freeze(std::uint32_t n) {
+  double* p = m_x.data() + std::size_t(n) * 3;
+  const double* q = m_x_prev.data() + std::size_t(n) * 3;
+  if (p[0] == q[0] && p[1] == q[1] && p[2] == q[2]) return false;
+  p[0] = q[0];
+  p[1] = q[1];
+  p[2] = q[2];
+  return true;
 }
 
 void SoftBody::solve_constraints(double h) {
@@ -183,14 +167,14 @@ void SoftBody::solve_constraints(double h) {
   }
 }
 
-void SoftBody::apply_ground() {
+void SoftBody::apply_ground(SimCounters& counters) {
   const int up = m_opt.up_axis;
   const int t1 = (up + 1) % 3, t2 = (up + 2) % 3;
   for (std::size_t i = 0; i < m_node_count; ++i) {
     double* p = m_x.data() + i * 3;
     const double pen = m_opt.ground - p[up];
     if (!(pen > 0)) continue;
-    ++m_counters.ground_contacts;
+    ++counters.ground_contacts;
     p[up] = m_opt.ground;
     // Coulomb friction on the tangential displacement of the substep (position-based).
     const double* q = m_x_prev.data() + i * 3;
@@ -208,43 +192,153 @@ void SoftBody::apply_ground() {
   }
 }
 
-void SoftBody::resolve_self_contact() {
+struct Simulation::Body {
+  std::unique_ptr<SoftBody> soft;  // null for an obstacle
+  Obstacle obstacle;
+  std::string what;
+};
+
+Simulation::Simulation(const SimOptions& options)
+    : m_opt(options), m_scene(tetseg::SceneOptions{}) {
+  m_contacts.resize(std::max<std::size_t>(1, options.contact_capacity));
+}
+
+Simulation::~Simulation() = default;
+
+void Simulation::add_body(const preprocess::TetMesh& mesh, const tetseg::Asset& asset,
+                          const std::vector<double>& start, const std::string& what) {
+  if (asset.node_count() != mesh.nodes.size())
+    throw InputError(what, "the asset has " + std::to_string(asset.node_count()) +
+                               " nodes, the tet mesh " + std::to_string(mesh.nodes.size()));
+  Body b;
+  b.soft = std::make_unique<SoftBody>(mesh, start, m_opt, what);
+  b.what = what;
+  const std::shared_ptr<const tetseg::BodyShape> shape = tetseg::BodyShape::from_asset(asset);
+  if (!shape) throw InputError(what, "cannot build the body's surface topology");
+  tetseg::BodyOptions o;
+  o.mode = m_opt.collider_mode;
+  if (m_scene.add_body(shape, o) != tetseg::ColliderStatus::kOk)
+    throw InputError(what, "cannot add the body to the scene (mode " +
+                               std::string(tetseg::to_string(m_opt.collider_mode)) + ")");
+  m_bodies.push_back(std::move(b));
+}
+
+void Simulation::add_obstacle(Obstacle obstacle, const std::string& what) {
+  const std::size_t nodes = obstacle.positions.size() / 3;
+  std::vector<std::uint32_t> flat;
+  for (const auto& t : obstacle.triangles) flat.insert(flat.end(), t.begin(), t.end());
+  const std::shared_ptr<const tetseg::BodyShape> shape = tetseg::BodyShape::from_triangles(
+      flat.data(), obstacle.triangles.size(), static_cast<std::uint32_t>(nodes));
+  if (!shape || obstacle.positions.size() != nodes * 3)
+    throw InputError(what, "invalid obstacle triangles");
+  tetseg::BodyOptions o;
+  o.still = true;
+  o.self_collision = false;
+  if (m_scene.add_body(shape, o) != tetseg::ColliderStatus::kOk)
+    throw InputError(what, "cannot add the obstacle to the scene");
+  Body b;
+  b.obstacle = std::move(obstacle);
+  b.what = what;
+  m_bodies.push_back(std::move(b));
+}
+
+void Simulation::set_positions() {
+  for (std::uint32_t i = 0; i < m_bodies.size(); ++i) {
+    const Body& b = m_bodies[i];
+    const tetseg::ColliderStatus st =
+        b.soft ? m_scene.set_positions(i, b.soft->previous().data(), b.soft->positions().data(),
+                                       b.soft->positions().size())
+               : m_scene.set_positions(i, b.obstacle.positions.data(), nullptr,
+                                       b.obstacle.positions.size());
+    if (st != tetseg::ColliderStatus::kOk)
+      throw std::runtime_error(std::string("scene positions failed: ") + tetseg::to_string(st));
+  }
+}
+
+void Simulation::check_start() {
+  set_positions();
+  const tetseg::RestCheck rc = m_scene.check_rest_intersection();
+  if (rc.status != tetseg::ColliderStatus::kOk)
+    throw InputError(m_bodies.empty() ? "" : m_bodies[0].what,
+                     std::string("start check failed: ") + tetseg::to_string(rc.status));
+  if (!rc.intersecting) return;
+  const Body& a = m_bodies[rc.bodies[0]];
+  const Body& b = m_bodies[rc.bodies[1]];
+  if (rc.bodies[0] == rc.bodies[1])
+    throw InputError(a.what, "the start surface self-intersects (triangles " +
+                                 std::to_string(rc.triangle_a) + " and " +
+                                 std::to_string(rc.triangle_b) + ")");
+  throw InputError(a.what, "the start surface touches body " + std::to_string(rc.bodies[1]) + " (" +
+                               b.what + ")");
+}
+
+void Simulation::advance_frame() {
+  const double h = m_opt.frame_dt / m_opt.substeps;
+  for (std::uint32_t s = 0; s < m_opt.substeps; ++s) substep(h);
+}
+
+void Simulation::substep(double h) {
+  ++m_counters.substeps;
+  for (Body& b : m_bodies)
+    if (b.soft) b.soft->predict(h, m_counters);
+  if (m_opt.self_contact) resolve_contacts();
+  for (Body& b : m_bodies)
+    if (b.soft) b.soft->finish(h);
+}
+
+void Simulation::resolve_contacts() {
   std::uint32_t rounds = 0;
   bool first = true;
   for (;;) {
-    const tetseg::ColliderStatus st = m_collider.step(m_x_prev.data(), m_x.data(), m_x.size());
+    set_positions();
+    const tetseg::ColliderStatus st = m_scene.step();
     if (st != tetseg::ColliderStatus::kOk)
-      throw std::runtime_error(std::string("collider step failed: ") + tetseg::to_string(st));
+      throw std::runtime_error(std::string("scene step failed: ") + tetseg::to_string(st));
     ++rounds;
     ++m_counters.query_rounds;
     bool hit = false;
     tetseg::ContactsResult r;
-    tetseg::ColliderStatus qs = m_collider.any_collision(hit);
+    tetseg::ColliderStatus qs = m_scene.any_collision(hit);
     if (qs == tetseg::ColliderStatus::kOk && hit)
-      qs = m_collider.contacts(m_contacts.data(), m_contacts.size(), r);
+      qs = m_scene.contacts(m_contacts.data(), m_contacts.size(), r);
     if (qs != tetseg::ColliderStatus::kOk)
-      throw std::runtime_error(std::string("collider query failed: ") + tetseg::to_string(qs));
+      throw std::runtime_error(std::string("scene query failed: ") + tetseg::to_string(qs));
     if (!hit) break;
     if (first) ++m_counters.substeps_with_contact;
     first = false;
     m_counters.contacts_resolved += r.found;
     bool progress = false;
     for (std::size_t c = 0; c < r.written; ++c) {
-      for (std::uint32_t n : m_contacts[c].nodes) {
-        double* p = m_x.data() + std::size_t(n) * 3;
-        const double* q = m_x_prev.data() + std::size_t(n) * 3;
-        if (p[0] == q[0] && p[1] == q[1] && p[2] == q[2]) continue;
-        p[0] = q[0];
-        p[1] = q[1];
-        p[2] = q[2];
-        ++m_counters.nodes_frozen;
-        progress = true;
+      const tetseg::Contact& k = m_contacts[c];
+      if (k.bodies[0] != k.bodies[1]) ++m_counters.body_contacts;
+      // Vertex-face: node 0 in bodies[0], 1..3 in bodies[1]; edge-edge: 0..1 and 2..3.
+      const int split = k.kind == tetseg::ContactKind::kVertexFace ? 1 : 2;
+      for (int j = 0; j < 4; ++j) {
+        SoftBody* soft = m_bodies[k.bodies[j < split ? 0 : 1]].soft.get();
+        if (soft && soft->freeze(k.nodes[j])) {
+          ++m_counters.nodes_frozen;
+          progress = true;
+        }
       }
     }
-    // A contact always has a moving node, so progress holds; guard against a broken collider.
-    if (!progress) throw std::runtime_error("self-contact response made no progress");
+    // A contact always has a moving node, so progress holds; guard against a broken scene.
+    if (!progress) throw std::runtime_error("contact response made no progress");
   }
   m_counters.max_rounds = std::max(m_counters.max_rounds, rounds);
+}
+
+void Simulation::append_positions(std::vector<double>& out) const {
+  for (const Body& b : m_bodies) {
+    const std::vector<double>& x = b.soft ? b.soft->positions() : b.obstacle.positions;
+    out.insert(out.end(), x.begin(), x.end());
+  }
+}
+
+std::size_t Simulation::node_count() const noexcept {
+  std::size_t n = 0;
+  for (const Body& b : m_bodies)
+    n += b.soft ? b.soft->node_count() : b.obstacle.positions.size() / 3;
+  return n;
 }
 
 }  // namespace tetseg::tools

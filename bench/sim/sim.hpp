@@ -1,18 +1,20 @@
 #pragma once
 /// \file
-/// `tetseg-sim`'s engine: a deterministic XPBD soft body (edge-length and tet-volume
+/// `tetseg-sim`'s engine: deterministic XPBD soft bodies (edge-length and tet-volume
 /// constraints, Macklin et al. "small steps"), gravity, a ground plane with Coulomb friction,
-/// and self-contact made safe with the runtime's own continuous queries (docs/simulation.md).
+/// still obstacles, and contact made safe with the runtime's own continuous scene queries
+/// (docs/simulation.md).
 ///
-/// Self-contact rule: every substep `x_prev -> x_new` is checked with a `tetseg::Collider` on
-/// the object's asset. While it reports contacts, the nodes of every reported contact are
+/// Contact rule: every substep `x_prev -> x_new` of all bodies is checked with a
+/// `tetseg::Scene` (the bodies' assets, still obstacles as surface-only bodies). While it
+/// reports contacts, the moving nodes of every reported contact are
 /// frozen for the substep (position back to `x_prev`, velocity zero: a rigid impact zone with
 /// zero motion) and the step is queried again. A contact needs a moving node, so each round
 /// freezes at least one more node and the loop ends; the final substep is collision-free, so
 /// from an intersection-free start every state stays intersection-free.
 ///
 /// Deterministic: fixed constraint order, no threads, no randomness; two runs with the same
-/// inputs produce bit-identical positions. Not thread-safe (one `SoftBody` per thread).
+/// inputs produce bit-identical positions. Not thread-safe (one `Simulation` per thread).
 
 #include <array>
 #include <cstddef>
@@ -23,6 +25,7 @@
 #include "tetseg/preprocess/mesh.hpp"
 #include "tetseg/runtime/asset.hpp"
 #include "tetseg/runtime/collider.hpp"
+#include "tetseg/runtime/scene.hpp"
 
 namespace tetseg::tools {
 
@@ -40,7 +43,7 @@ struct SimOptions {
   double damping = 0.5;           ///< linear velocity damping per second, >= 0
   tetseg::ColliderMode collider_mode = tetseg::ColliderMode::kRvbc;
   std::size_t contact_capacity = 1 << 14;  ///< contacts read per query round
-  bool self_contact = true;  ///< false: no self-contact handling (for tests and comparisons)
+  bool self_contact = true;  ///< false: no contact handling at all (for tests and comparisons)
 };
 
 /// Totals over a run.
@@ -48,35 +51,38 @@ struct SimCounters {
   std::uint64_t substeps = 0;
   std::uint64_t substeps_with_contact = 0;  ///< substeps whose first query found contacts
   std::uint64_t contacts_resolved = 0;      ///< contacts reported by all query rounds
-  std::uint64_t query_rounds = 0;           ///< collider queries (>= substeps)
-  std::uint64_t nodes_frozen = 0;           ///< node freezes by the self-contact response
+  std::uint64_t body_contacts = 0;          ///< of those, contacts between two bodies
+  std::uint64_t query_rounds = 0;           ///< scene queries (>= substeps)
+  std::uint64_t nodes_frozen = 0;           ///< node freezes by the contact response
   std::uint64_t ground_contacts = 0;        ///< node-substeps clamped to the ground
   std::uint32_t max_rounds = 0;             ///< most query rounds in one substep
 };
 
-/// One soft body. Node ids are the tet mesh's and the asset's (they must agree).
+/// One soft body's dynamics (no contact handling: `Simulation` does that for all bodies).
+/// Node ids are the tet mesh's.
 class SoftBody {
  public:
-  /// `mesh`: positively oriented tets; `asset`: built from the same mesh (same node count),
-  /// must outlive the body. `start`: initial positions (node_count * 3), e.g. the mesh moved
-  /// above the ground. Throws preprocess::InputError (file = `what`) when the mesh and asset
-  /// disagree, a tet is degenerate, options are out of range, or the start surface
-  /// self-intersects (checked with `Collider::check_rest_intersection`).
-  SoftBody(const preprocess::TetMesh& mesh, const tetseg::Asset& asset,
-           const std::vector<double>& start, const SimOptions& options, const std::string& what);
+  /// `mesh`: positively oriented tets. `start`: initial positions (node_count * 3), e.g. the
+  /// mesh moved above the ground. Throws preprocess::InputError (file = `what`) when a tet is
+  /// degenerate, options are out of range or the start has the wrong size.
+  SoftBody(const preprocess::TetMesh& mesh, const std::vector<double>& start,
+           const SimOptions& options, const std::string& what);
 
-  /// Advances one frame (`options.substeps` substeps). Throws std::runtime_error if the
-  /// collider fails (never expected).
-  void advance_frame();
-  /// Current positions, node_count * 3 doubles.
+  /// Substep, first part: `x_prev = x`, gravity and damping, constraint sweeps, ground.
+  void predict(double h, SimCounters& counters);
+  /// Substep, last part: velocities from the accepted positions.
+  void finish(double h);
+  /// Puts node `n` back to `x_prev` (zero velocity this substep); false when it did not move.
+  bool freeze(std::uint32_t n);
+
+  std::size_t node_count() const noexcept { return m_node_count; }
+  /// Current positions and those at the start of the substep, node_count * 3 doubles.
   const std::vector<double>& positions() const noexcept { return m_x; }
-  const SimCounters& counters() const noexcept { return m_counters; }
+  const std::vector<double>& previous() const noexcept { return m_x_prev; }
 
  private:
-  void substep(double h);
   void solve_constraints(double h);
-  void apply_ground();
-  void resolve_self_contact();
+  void apply_ground(SimCounters& counters);
 
   SimOptions m_opt;
   std::size_t m_node_count = 0;
@@ -86,9 +92,55 @@ class SoftBody {
   std::vector<double> m_tet_rest;  // rest volumes
   std::vector<double> m_inv_mass;
   std::vector<double> m_x, m_x_prev, m_v;
-  tetseg::Collider m_collider;
+};
+
+/// A still obstacle: a triangle mesh (surface only) that never moves.
+struct Obstacle {
+  std::vector<double> positions;  ///< node_count * 3
+  std::vector<std::array<std::uint32_t, 3>> triangles;
+};
+
+/// Several soft bodies and still obstacles in one `tetseg::Scene`. Contact rule: every substep
+/// `x_prev -> x` of all bodies is queried over the whole scene (self-contact of each soft body,
+/// every pair of bodies; obstacles have no self-collision and two obstacles are never tested).
+/// While it reports contacts, the soft-body nodes of every reported contact are frozen (see
+/// the file comment) and the scene is queried again; the accepted substep is collision-free.
+/// Bodies are numbered in order of addition (soft bodies and obstacles alike), which is also
+/// their order in `positions()`.
+class Simulation {
+ public:
+  explicit Simulation(const SimOptions& options);
+  ~Simulation();
+
+  /// Adds a soft body. `asset` (built from `mesh`, same node count) must outlive the
+  /// simulation. Throws preprocess::InputError (file = `what`) as `SoftBody`, or when the asset
+  /// and mesh disagree.
+  void add_body(const preprocess::TetMesh& mesh, const tetseg::Asset& asset,
+                const std::vector<double>& start, const std::string& what);
+  /// Adds a still obstacle. Throws InputError (file = `what`) on invalid triangles.
+  void add_obstacle(Obstacle obstacle, const std::string& what);
+  /// Checks the start state (no soft body touches itself, no two bodies touch); throws
+  /// InputError naming the bodies' `what` otherwise. Call once, after adding every body.
+  void check_start();
+
+  /// Advances one frame (`options.substeps` substeps). Throws std::runtime_error if the scene
+  /// fails (never expected).
+  void advance_frame();
+  /// Positions of all bodies in order of addition (appended to `out`).
+  void append_positions(std::vector<double>& out) const;
+  std::size_t node_count() const noexcept;
+  const SimCounters& counters() const noexcept { return m_counters; }
+
+ private:
+  struct Body;
+  void substep(double h);
+  void resolve_contacts();
+  void set_positions();
+
+  SimOptions m_opt;
+  std::vector<Body> m_bodies;
+  tetseg::Scene m_scene;
   std::vector<tetseg::Contact> m_contacts;
-  std::vector<std::uint8_t> m_frozen;
   SimCounters m_counters;
 };
 

@@ -18,6 +18,7 @@
 #include "support/allocation_probe.hpp"
 #include "tetseg/runtime/ccd.hpp"
 #include "tetseg/runtime/scene.hpp"
+#include "tetseg/testing/scene_oracle.hpp"
 #include "tetseg/testing/synthetic_scenes.hpp"
 
 using tetseg::BodyOptions;
@@ -28,7 +29,7 @@ using tetseg::Contact;
 using tetseg::ContactKind;
 using tetseg::ContactsResult;
 using tetseg::EarliestContact;
-using tetseg::Vec3d;
+using tetseg::test::box_surface;
 using tetseg::test::P3;
 using tetseg::test::Surface;
 
@@ -86,46 +87,6 @@ TestBody surface_body(const Surface& s, int frames, const Map& map) {
   return b;
 }
 
-/// Closed box [lo, hi] with n x n quads (two triangles each) per face, wound outward.
-Surface box_surface(const P3& lo, const P3& hi, int n) {
-  Surface s;
-  std::map<std::array<int, 3>, std::uint32_t> index;
-  auto vertex = [&](std::array<int, 3> g) {
-    auto it = index.find(g);
-    if (it != index.end()) return it->second;
-    P3 p;
-    for (int k = 0; k < 3; ++k) p[k] = lo[k] + (hi[k] - lo[k]) * g[k] / n;
-    s.verts.push_back(p);
-    return index[g] = static_cast<std::uint32_t>(s.verts.size() - 1);
-  };
-  for (int axis = 0; axis < 3; ++axis) {
-    const int u = (axis + 1) % 3, v = (axis + 2) % 3;
-    for (int side = 0; side <= n; side += n) {
-      for (int i = 0; i < n; ++i) {
-        for (int j = 0; j < n; ++j) {
-          std::array<std::uint32_t, 4> q;
-          const int di[4] = {0, 1, 1, 0}, dj[4] = {0, 0, 1, 1};
-          for (int c = 0; c < 4; ++c) {
-            std::array<int, 3> g{};
-            g[axis] = side;
-            g[u] = i + di[c];
-            g[v] = j + dj[c];
-            q[c] = vertex(g);
-          }
-          if (side == n) {
-            s.tris.push_back({q[0], q[1], q[2]});
-            s.tris.push_back({q[0], q[2], q[3]});
-          } else {
-            s.tris.push_back({q[0], q[2], q[1]});
-            s.tris.push_back({q[0], q[3], q[2]});
-          }
-        }
-      }
-    }
-  }
-  return s;
-}
-
 Map translate(const P3& from, const P3& to) {
   return [from, to](const P3& p, double t) {
     return P3{p[0] + from[0] + t * (to[0] - from[0]), p[1] + from[1] + t * (to[1] - from[1]),
@@ -149,107 +110,18 @@ std::string describe(const Contact& c) {
   return s + " toi " + std::to_string(c.toi);
 }
 
-Vec3d at(const std::vector<double>& x, std::uint32_t n) {
-  return {x[3 * n], x[3 * n + 1], x[3 * n + 2]};
-}
-
-/// The oracle: every feature pair with four distinct nodes of the scene (within a body when
-/// its self-collision is on, and across every pair of bodies), skipping only pairs whose four
-/// nodes are all still (the documented rule) and pairs whose swept boxes are disjoint.
+/// The oracle (tetseg/testing/scene_oracle.hpp) over step f of `bodies`.
 std::vector<Contact> brute_contacts(const std::vector<TestBody>& bodies, int f) {
-  struct Features {
-    std::vector<std::uint32_t> verts;
-    std::vector<std::array<std::uint32_t, 2>> edges;
-  };
-  std::vector<Features> feats(bodies.size());
+  std::vector<tetseg::test::OracleBody> oracle(bodies.size());
   for (std::size_t i = 0; i < bodies.size(); ++i) {
-    std::set<std::uint32_t> v;
-    std::set<std::array<std::uint32_t, 2>> e;
-    for (const auto& t : bodies[i].tris) {
-      for (int k = 0; k < 3; ++k) {
-        v.insert(t[k]);
-        e.insert({std::min(t[k], t[(k + 1) % 3]), std::max(t[k], t[(k + 1) % 3])});
-      }
-    }
-    feats[i].verts.assign(v.begin(), v.end());
-    feats[i].edges.assign(e.begin(), e.end());
+    const TestBody& b = bodies[i];
+    oracle[i].tris = b.tris.data();
+    oracle[i].triangle_count = b.tris.size();
+    oracle[i].x0 = b.frames[b.still ? 0 : f].data();
+    oracle[i].x1 = b.frames[b.still ? 0 : f + 1].data();
+    oracle[i].self = b.self;
   }
-  auto x0 = [&](std::size_t b) -> const std::vector<double>& {
-    return bodies[b].frames[bodies[b].still ? 0 : f];
-  };
-  auto x1 = [&](std::size_t b) -> const std::vector<double>& {
-    return bodies[b].frames[bodies[b].still ? 0 : f + 1];
-  };
-  auto still = [&](std::size_t b, std::uint32_t n) { return at(x0(b), n) == at(x1(b), n); };
-  auto box_apart = [&](std::initializer_list<std::pair<std::size_t, std::uint32_t>> a,
-                       std::initializer_list<std::pair<std::size_t, std::uint32_t>> b) {
-    for (int k = 0; k < 3; ++k) {
-      double alo = INFINITY, ahi = -INFINITY, blo = INFINITY, bhi = -INFINITY;
-      for (auto [body, n] : a) {
-        for (double c : {x0(body)[3 * n + k], x1(body)[3 * n + k]}) {
-          alo = std::min(alo, c);
-          ahi = std::max(ahi, c);
-        }
-      }
-      for (auto [body, n] : b) {
-        for (double c : {x0(body)[3 * n + k], x1(body)[3 * n + k]}) {
-          blo = std::min(blo, c);
-          bhi = std::max(bhi, c);
-        }
-      }
-      if (alo > bhi || blo > ahi) return true;
-    }
-    return false;
-  };
-  std::vector<Contact> out;
-  auto add = [&](ContactKind kind, std::uint32_t ba, std::uint32_t bb,
-                 std::array<std::uint32_t, 4> nodes, std::uint32_t tri, tetseg::CcdResult r) {
-    if (!r.hit()) return;
-    Contact c;
-    c.kind = kind;
-    c.bodies = {ba, bb};
-    c.nodes = nodes;
-    c.triangle = tri;
-    c.at_start = r.outcome == tetseg::CcdOutcome::kContactAtStart;
-    c.toi = c.at_start ? 0.0 : r.toi;
-    out.push_back(c);
-  };
-  const std::uint32_t n = static_cast<std::uint32_t>(bodies.size());
-  for (std::uint32_t i = 0; i < n; ++i) {
-    for (std::uint32_t j = 0; j < n; ++j) {
-      if (i == j && !bodies[i].self) continue;
-      // Vertex of body i against triangle of body j.
-      for (std::uint32_t p : feats[i].verts) {
-        for (std::uint32_t t = 0; t < bodies[j].tris.size(); ++t) {
-          const auto& F = bodies[j].tris[t];
-          if (i == j && (p == F[0] || p == F[1] || p == F[2])) continue;
-          if (still(i, p) && still(j, F[0]) && still(j, F[1]) && still(j, F[2])) continue;
-          if (box_apart({{i, p}}, {{j, F[0]}, {j, F[1]}, {j, F[2]}})) continue;
-          add(ContactKind::kVertexFace, i, j, {p, F[0], F[1], F[2]}, t,
-              tetseg::vertex_face_ccd(at(x0(i), p), at(x0(j), F[0]), at(x0(j), F[1]),
-                                      at(x0(j), F[2]), at(x1(i), p), at(x1(j), F[0]),
-                                      at(x1(j), F[1]), at(x1(j), F[2])));
-        }
-      }
-      if (j < i) continue;
-      // Edge of body i against edge of body j (i <= j; within a body each pair once).
-      for (std::size_t a = 0; a < feats[i].edges.size(); ++a) {
-        for (std::size_t b = i == j ? a + 1 : 0; b < feats[j].edges.size(); ++b) {
-          const auto& E = feats[i].edges[a];
-          const auto& G = feats[j].edges[b];
-          if (i == j && (E[0] == G[0] || E[0] == G[1] || E[1] == G[0] || E[1] == G[1])) continue;
-          if (still(i, E[0]) && still(i, E[1]) && still(j, G[0]) && still(j, G[1])) continue;
-          if (box_apart({{i, E[0]}, {i, E[1]}}, {{j, G[0]}, {j, G[1]}})) continue;
-          add(ContactKind::kEdgeEdge, i, j, {E[0], E[1], G[0], G[1]}, 0,
-              tetseg::edge_edge_ccd(at(x0(i), E[0]), at(x0(i), E[1]), at(x0(j), G[0]),
-                                    at(x0(j), G[1]), at(x1(i), E[0]), at(x1(i), E[1]),
-                                    at(x1(j), G[0]), at(x1(j), G[1])));
-        }
-      }
-    }
-  }
-  std::sort(out.begin(), out.end(), tetseg::contact_less);
-  return out;
+  return tetseg::test::scene_brute_contacts(oracle);
 }
 
 /// Builds the runtime scene over `bodies`; with `global`, all positions come from one array

@@ -1,0 +1,187 @@
+#pragma once
+/// \file
+/// The brute-force truth over a whole scene, independent of the runtime's culling: every
+/// feature pair with four distinct nodes (vertex against triangle, edge against edge, within a
+/// body with self-collision on and across every pair of bodies) through the elementary tests of
+/// ccd.hpp only. Pairs whose four nodes are all still are skipped (the documented scene rule);
+/// a plain sort-and-sweep on swept feature boxes (exact box overlap, nothing else) keeps it
+/// affordable on large scenes. Shared by the runtime tests and `tetseg-bench scene`.
+/// Also the closed and open boxes used as still obstacles.
+
+#include <algorithm>
+#include <array>
+#include <cstdint>
+#include <map>
+#include <vector>
+
+#include "tetseg/runtime/ccd.hpp"
+#include "tetseg/runtime/collider.hpp"
+#include "tetseg/testing/synthetic_scenes.hpp"
+
+namespace tetseg::test {
+
+/// One body of the oracle: triangles over local node ids and its positions at both ends of
+/// the step (node_count * 3 doubles each; x1 == x0 for a still body).
+struct OracleBody {
+  const std::array<std::uint32_t, 3>* tris = nullptr;
+  std::size_t triangle_count = 0;
+  const double* x0 = nullptr;
+  const double* x1 = nullptr;
+  bool self = true;  ///< test the body against itself
+};
+
+/// All contacts of the step, sorted by `contact_less`, named as the runtime names them
+/// (bodies[0] <= bodies[1] for edge pairs; edges normalised).
+inline std::vector<Contact> scene_brute_contacts(const std::vector<OracleBody>& bodies) {
+  enum Kind : std::uint8_t { kVertex, kEdge, kTriangle };
+  struct Item {
+    double lo[3], hi[3];
+    std::uint32_t body;
+    Kind kind;
+    std::uint32_t id;  // triangle id (kTriangle), else unused
+    std::array<std::uint32_t, 3> nodes;
+    bool moving;
+  };
+  std::vector<Item> items;
+  auto point = [&](std::uint32_t b, std::uint32_t n, bool end) {
+    const double* x = (end ? bodies[b].x1 : bodies[b].x0) + std::size_t(n) * 3;
+    return Vec3d{x[0], x[1], x[2]};
+  };
+  auto add_item = [&](std::uint32_t b, Kind kind, std::uint32_t id,
+                      std::array<std::uint32_t, 3> nodes, int count) {
+    Item it{};
+    it.body = b;
+    it.kind = kind;
+    it.id = id;
+    it.nodes = nodes;
+    it.moving = false;
+    for (int k = 0; k < 3; ++k) {
+      it.lo[k] = INFINITY;
+      it.hi[k] = -INFINITY;
+    }
+    for (int c = 0; c < count; ++c) {
+      const Vec3d p0 = point(b, nodes[c], false), p1 = point(b, nodes[c], true);
+      if (!(p0 == p1)) it.moving = true;
+      for (int k = 0; k < 3; ++k) {
+        it.lo[k] = std::min({it.lo[k], p0[k], p1[k]});
+        it.hi[k] = std::max({it.hi[k], p0[k], p1[k]});
+      }
+    }
+    items.push_back(it);
+  };
+  for (std::uint32_t b = 0; b < bodies.size(); ++b) {
+    std::vector<std::uint32_t> verts;
+    std::vector<std::array<std::uint32_t, 2>> edges;
+    for (std::size_t t = 0; t < bodies[b].triangle_count; ++t) {
+      const auto& T = bodies[b].tris[t];
+      add_item(b, kTriangle, static_cast<std::uint32_t>(t), T, 3);
+      for (int k = 0; k < 3; ++k) {
+        verts.push_back(T[k]);
+        edges.push_back({std::min(T[k], T[(k + 1) % 3]), std::max(T[k], T[(k + 1) % 3])});
+      }
+    }
+    std::sort(verts.begin(), verts.end());
+    verts.erase(std::unique(verts.begin(), verts.end()), verts.end());
+    std::sort(edges.begin(), edges.end());
+    edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+    for (std::uint32_t v : verts) add_item(b, kVertex, 0, {v, v, v}, 1);
+    for (const auto& e : edges) add_item(b, kEdge, 0, {e[0], e[1], e[1]}, 2);
+  }
+  std::sort(items.begin(), items.end(),
+            [](const Item& a, const Item& b) { return a.lo[0] < b.lo[0]; });
+
+  std::vector<Contact> out;
+  auto add = [&](ContactKind kind, std::uint32_t ba, std::uint32_t bb,
+                 std::array<std::uint32_t, 4> nodes, std::uint32_t tri, CcdResult r) {
+    if (!r.hit()) return;
+    Contact c;
+    c.kind = kind;
+    c.bodies = {ba, bb};
+    c.nodes = nodes;
+    c.triangle = tri;
+    c.at_start = r.outcome == CcdOutcome::kContactAtStart;
+    c.toi = c.at_start ? 0.0 : r.toi;
+    out.push_back(c);
+  };
+  auto vertex_face = [&](const Item& v, const Item& f) {
+    const std::uint32_t p = v.nodes[0];
+    const auto& F = f.nodes;
+    if (v.body == f.body && (p == F[0] || p == F[1] || p == F[2])) return;
+    add(ContactKind::kVertexFace, v.body, f.body, {p, F[0], F[1], F[2]}, f.id,
+        vertex_face_ccd(point(v.body, p, false), point(f.body, F[0], false),
+                        point(f.body, F[1], false), point(f.body, F[2], false),
+                        point(v.body, p, true), point(f.body, F[0], true),
+                        point(f.body, F[1], true), point(f.body, F[2], true)));
+  };
+  auto edge_edge = [&](const Item* e, const Item* g) {
+    if (e->body > g->body ||
+        (e->body == g->body && std::array<std::uint32_t, 2>{e->nodes[0], e->nodes[1]} >
+                                   std::array<std::uint32_t, 2>{g->nodes[0], g->nodes[1]}))
+      std::swap(e, g);
+    const std::uint32_t a = e->nodes[0], b = e->nodes[1], c = g->nodes[0], d = g->nodes[1];
+    if (e->body == g->body && (a == c || a == d || b == c || b == d)) return;
+    add(ContactKind::kEdgeEdge, e->body, g->body, {a, b, c, d}, 0,
+        edge_edge_ccd(point(e->body, a, false), point(e->body, b, false), point(g->body, c, false),
+                      point(g->body, d, false), point(e->body, a, true), point(e->body, b, true),
+                      point(g->body, c, true), point(g->body, d, true)));
+  };
+  for (std::size_t i = 0; i < items.size(); ++i) {
+    const Item& A = items[i];
+    for (std::size_t j = i + 1; j < items.size() && items[j].lo[0] <= A.hi[0]; ++j) {
+      const Item& B = items[j];
+      if (!A.moving && !B.moving) continue;  // all four nodes still
+      if (A.body == B.body && !bodies[A.body].self) continue;
+      if (A.lo[1] > B.hi[1] || B.lo[1] > A.hi[1] || A.lo[2] > B.hi[2] || B.lo[2] > A.hi[2])
+        continue;
+      if (A.kind == kVertex && B.kind == kTriangle) vertex_face(A, B);
+      if (A.kind == kTriangle && B.kind == kVertex) vertex_face(B, A);
+      if (A.kind == kEdge && B.kind == kEdge) edge_edge(&A, &B);
+    }
+  }
+  std::sort(out.begin(), out.end(), contact_less);
+  return out;
+}
+
+/// Closed box [lo, hi] with n x n quads (two triangles each) per face, wound outward; with
+/// `open_side` in 0..2 the face at hi along that axis is left out (a bin open at the top).
+inline Surface box_surface(const P3& lo, const P3& hi, int n, int open_side = -1) {
+  Surface s;
+  std::map<std::array<int, 3>, std::uint32_t> index;
+  auto vertex = [&](std::array<int, 3> g) {
+    auto it = index.find(g);
+    if (it != index.end()) return it->second;
+    P3 p;
+    for (int k = 0; k < 3; ++k) p[k] = lo[k] + (hi[k] - lo[k]) * g[k] / n;
+    s.verts.push_back(p);
+    return index[g] = static_cast<std::uint32_t>(s.verts.size() - 1);
+  };
+  for (int axis = 0; axis < 3; ++axis) {
+    const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+    for (int side = 0; side <= n; side += n) {
+      if (axis == open_side && side == n) continue;
+      for (int i = 0; i < n; ++i) {
+        for (int j = 0; j < n; ++j) {
+          std::array<std::uint32_t, 4> q;
+          const int di[4] = {0, 1, 1, 0}, dj[4] = {0, 0, 1, 1};
+          for (int c = 0; c < 4; ++c) {
+            std::array<int, 3> g{};
+            g[axis] = side;
+            g[u] = i + di[c];
+            g[v] = j + dj[c];
+            q[c] = vertex(g);
+          }
+          if (side == n) {
+            s.tris.push_back({q[0], q[1], q[2]});
+            s.tris.push_back({q[0], q[2], q[3]});
+          } else {
+            s.tris.push_back({q[0], q[2], q[1]});
+            s.tris.push_back({q[0], q[3], q[2]});
+          }
+        }
+      }
+    }
+  }
+  return s;
+}
+
+}  // namespace tetseg::test
