@@ -17,6 +17,7 @@
 #include "tetseg/format/asset.hpp"
 #include "tetseg/format/asset_io.hpp"
 #include "tetseg/runtime/asset.hpp"
+#include "tetseg/runtime/median_bvh.hpp"
 
 namespace tetseg::test {
 
@@ -126,46 +127,23 @@ inline Surface mushroom(int segments) {
   return revolve(p, segments, 0.0);
 }
 
-/// A median-split BVH over `tris` (global ids) by centroid, written into the asset's layout:
-/// `order` receives the leaf order, `nodes` the nodes (children after parents).
-inline void build_bvh(const Surface& s, std::vector<std::uint32_t> tris, std::uint32_t leaf_size,
-                      std::vector<std::uint32_t>& order, std::vector<format::BvhNode>& nodes) {
-  struct Item {
-    std::uint32_t node, begin, end;
-  };
-  auto centroid = [&](std::uint32_t t, int k) {
-    return (s.verts[s.tris[t][0]][k] + s.verts[s.tris[t][1]][k] + s.verts[s.tris[t][2]][k]) / 3;
-  };
-  nodes.assign(1, {});
-  std::vector<Item> stack = {{0, 0, static_cast<std::uint32_t>(tris.size())}};
-  while (!stack.empty()) {
-    const Item it = stack.back();
-    stack.pop_back();
-    if (it.end - it.begin <= leaf_size) {
-      nodes[it.node] = {it.begin, 0, it.end - it.begin};
-      continue;
-    }
-    int axis = 0;
-    double lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300};
-    for (std::uint32_t i = it.begin; i < it.end; ++i)
-      for (int k = 0; k < 3; ++k) {
-        lo[k] = std::min(lo[k], centroid(tris[i], k));
-        hi[k] = std::max(hi[k], centroid(tris[i], k));
-      }
-    for (int k = 1; k < 3; ++k)
-      if (hi[k] - lo[k] > hi[axis] - lo[axis]) axis = k;
-    const std::uint32_t mid = it.begin + (it.end - it.begin) / 2;
-    std::nth_element(
-        tris.begin() + it.begin, tris.begin() + mid, tris.begin() + it.end,
-        [&](std::uint32_t a, std::uint32_t b) { return centroid(a, axis) < centroid(b, axis); });
-    const std::uint32_t left = static_cast<std::uint32_t>(nodes.size());
-    nodes.push_back({});
-    nodes.push_back({});
-    nodes[it.node] = {left, left + 1, 0};
-    stack.push_back({left + 1, mid, it.end});
-    stack.push_back({left, it.begin, mid});
-  }
+/// The runtime's median-split BVH (median_bvh.hpp) over `tris` (global ids) by centroid, in
+/// the asset's layout: `order` receives the leaf order, `nodes` the nodes.
+inline void build_bvh(const Surface& s, const std::vector<std::uint32_t>& tris,
+                      std::uint32_t leaf_size, std::vector<std::uint32_t>& order,
+                      std::vector<format::BvhNode>& nodes) {
+  std::vector<double> centroids(s.tris.size() * 3);
+  for (std::uint32_t t : tris)
+    for (int k = 0; k < 3; ++k)
+      centroids[std::size_t(t) * 3 + k] =
+          (s.verts[s.tris[t][0]][k] + s.verts[s.tris[t][1]][k] + s.verts[s.tris[t][2]][k]) / 3;
   order = tris;
+  nodes.assign(tris.empty() ? 0 : 2 * tris.size() - 1, {});
+  MedianBvhTask stack[kMedianBvhStack];
+  const std::uint32_t count =
+      build_median_bvh(centroids.data(), order.data(), static_cast<std::uint32_t>(order.size()),
+                       std::max<std::uint32_t>(leaf_size, 1), nodes.data(), stack, kMedianBvhStack);
+  nodes.resize(count);
 }
 
 /// A valid but degenerate BVH: a chain whose depth equals the triangle count (each inner node
