@@ -22,6 +22,8 @@ constexpr double kFacetDistanceRatio = 0.1;
 /// Meshing sizes below diagonal / kMaxDiagonalPerSize are refused (10^5 facets along the
 /// diagonal: hundreds of millions of tets, or refinement that never ends).
 constexpr double kMaxDiagonalPerSize = 1e5;
+/// The smallest --wrap-alpha and --wrap-offset, as fractions of the diagonal.
+constexpr double kMinWrapFraction = 1e-4;
 
 double bounding_box_diagonal(const std::vector<Vec3>& points) {
   if (points.empty()) return 0.0;
@@ -130,26 +132,10 @@ std::string boundary_defect(const TetMesh& mesh, const std::string& file) {
   return "";
 }
 
-}  // namespace
-
-TetMesh tetrahedralize(const TriangleMesh& surface, const MeshingOptions& meshing,
-                       const std::string& file, TetrahedralizeNotes* notes) {
-  // Pinch points (vertices where separate fans touch) are accepted here: the domain only
-  // needs inside/outside queries, and the output is validated strictly below.
-  TriangleMesh repaired;
-  if (meshing.repair == MeshingOptions::Repair::kFix) {
-    repaired = surface;
-    std::vector<RepairCount> repairs = detail::repair_soup(repaired);
-    if (repaired.triangles.empty())
-      throw InputError(file, "tetrahedralize: no triangle is left after repair");
-    if (notes != nullptr) notes->repairs = std::move(repairs);
-  }
-  const TriangleMesh& source = meshing.repair == MeshingOptions::Repair::kFix ? repaired : surface;
-  TriangleMesh split;
-  detail::SurfaceCheck check;
-  check.allow_pinched_vertices = true;
-  detail::validate_closed_surface(source, file, check, &split);
-  const TriangleMesh& input = split.triangles.empty() ? source : split;
+/// Mesh_3 on a closed surface (pinch points allowed), checked, with the retries of
+/// tetrahedralize; notes.optimization_used and notes.first_defect say which mesh was returned.
+TetMesh mesh_closed_surface(const TriangleMesh& input, const MeshingOptions& meshing,
+                            const std::string& file, TetrahedralizeNotes& notes) {
   const double diagonal = bounding_box_diagonal(input.vertices);
   // Criteria are checked before CGAL sees them: every size finite and positive, and not so
   // small against the surface that refinement could never end (kMaxDiagonalPerSize).
@@ -188,10 +174,8 @@ TetMesh tetrahedralize(const TriangleMesh& surface, const MeshingOptions& meshin
       mesh = run_mesh_3_guarded(input, fallback, file);
       const std::string retry_defect = boundary_defect(mesh, file);
       if (retry_defect.empty()) {
-        if (notes != nullptr) {
-          notes->optimization_used = retry.name;
-          notes->first_defect = defect;
-        }
+        notes.optimization_used = retry.name;
+        notes.first_defect = defect;
         return mesh;
       }
       defects += std::string("; ") + retry.name + ": " + retry_defect;
@@ -199,6 +183,119 @@ TetMesh tetrahedralize(const TriangleMesh& surface, const MeshingOptions& meshin
   }
   throw InputError(file, "tetrahedralize: the meshed boundary is not a closed 2-manifold (" +
                              defects + "); thin parts may need a smaller --facet-size");
+}
+
+}  // namespace
+
+namespace {
+
+/// Area and enclosed volume (divergence theorem; for a closed, outward surface) of `s`.
+std::pair<double, double> area_and_volume(const TriangleMesh& s) {
+  double area = 0.0, volume = 0.0;
+  for (const Tri& t : s.triangles) {
+    const Vec3& a = s.vertices[t[0]];
+    const Vec3& b = s.vertices[t[1]];
+    const Vec3& c = s.vertices[t[2]];
+    const Vec3 u{b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+    const Vec3 v{c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+    const Vec3 n{u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
+    area += 0.5 * std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    volume += (a[0] * n[0] + a[1] * n[1] + a[2] * n[2]) / 6.0;
+  }
+  return {area, volume};
+}
+
+/// A wrap whose volume is below kThinShell x offset x area is taken for a thin shell: the
+/// wrap went through a hole wider than alpha and wrapped both sides of the input (its volume
+/// is then about offset x area; a solid's is far more). Mesh_3 cannot fill such a shell.
+constexpr double kThinShell = 4.0;
+/// Alpha is doubled at most this many times while the wrap is a thin shell.
+constexpr int kMaxAlphaDoublings = 6;
+
+/// The alpha wrap of `surface` (`--repair wrap`), sizes relative to its bounding-box diagonal;
+/// while it is a thin shell, alpha is doubled (up to the whole diagonal), counted in
+/// `doublings`.
+TriangleMesh wrapped_surface(const TriangleMesh& surface, const MeshingOptions& meshing,
+                             const std::string& file, std::size_t& doublings) {
+  if (!(meshing.wrap_alpha >= kMinWrapFraction && meshing.wrap_alpha <= 1.0))
+    throw std::invalid_argument("wrap alpha must be in [1e-4, 1] (a fraction of the diagonal)");
+  if (!(meshing.wrap_offset >= kMinWrapFraction && meshing.wrap_offset <= 1.0))
+    throw std::invalid_argument("wrap offset must be in [1e-4, 1] (a fraction of the diagonal)");
+  if (surface.triangles.empty()) throw InputError(file, "tetrahedralize: surface has no triangles");
+  const double diagonal = bounding_box_diagonal(surface.vertices);
+  if (!(diagonal > 0.0) || !std::isfinite(diagonal))
+    throw InputError(file, "tetrahedralize: the surface has no extent");
+  const double offset = meshing.wrap_offset * diagonal;
+  try {
+    double alpha = meshing.wrap_alpha * diagonal;
+    doublings = 0;
+    for (;;) {
+      TriangleMesh wrap = detail::alpha_wrap(surface, alpha, offset);
+      const auto [area, volume] = area_and_volume(wrap);
+      if (volume >= kThinShell * offset * area || doublings == kMaxAlphaDoublings ||
+          alpha >= diagonal)
+        return wrap;
+      alpha = std::min(2.0 * alpha, diagonal);
+      ++doublings;
+    }
+  } catch (const std::bad_alloc&) {
+    throw InputError(file,
+                     "tetrahedralize: out of memory in CGAL alpha wrapping (is --wrap-alpha "
+                     "much smaller than the surface?)");
+  } catch (const std::exception& e) {
+    throw InputError(file, std::string("tetrahedralize: CGAL alpha wrapping failed: ") + e.what());
+  }
+}
+
+}  // namespace
+
+TetMesh tetrahedralize(const TriangleMesh& surface, const MeshingOptions& meshing,
+                       const std::string& file, TetrahedralizeNotes* notes) {
+  TetrahedralizeNotes local_notes;
+  TetrahedralizeNotes& out_notes = notes != nullptr ? *notes : local_notes;
+  using Repair = MeshingOptions::Repair;
+  TriangleMesh changed;  // the repaired or wrapped surface, when the input is not used as is
+  if (meshing.repair == Repair::kFix) {
+    changed = surface;
+    out_notes.repairs = detail::repair_soup(changed);
+    if (changed.triangles.empty())
+      throw InputError(file, "tetrahedralize: no triangle is left after repair");
+  } else if (meshing.repair == Repair::kWrap) {
+    std::size_t doublings = 0;
+    changed = wrapped_surface(surface, meshing, file, doublings);
+    out_notes.repairs = {
+        {"surface replaced by an alpha wrap of this many triangles", changed.triangles.size()}};
+    if (doublings > 0)
+      out_notes.repairs.push_back({"alpha doublings as the wrap was a thin shell", doublings});
+  }
+  const TriangleMesh& source = meshing.repair == Repair::kNone ? surface : changed;
+  // Pinch points (vertices where separate fans touch) are accepted here: the domain only
+  // needs inside/outside queries, and the output is validated strictly below.
+  TriangleMesh split;
+  detail::SurfaceCheck check;
+  check.allow_pinched_vertices = true;
+  try {
+    detail::validate_closed_surface(source, file, check, &split);
+  } catch (const InputError& e) {
+    if (meshing.repair != Repair::kFix) throw;
+    throw InputError(file, std::string(e.what()) +
+                               ", left after --repair fix; --repair wrap makes a closed surface "
+                               "of any input (docs/cli.md)");
+  }
+  const TriangleMesh& input = split.triangles.empty() ? source : split;
+  TetMesh mesh = mesh_closed_surface(input, meshing, file, out_notes);
+  // What a repair cost: distances between the input and the boundary of the tets.
+  if (!out_notes.repairs.empty()) {
+    const Surface boundary = extract_surface(mesh);
+    TriangleMesh meshed{mesh.nodes, boundary.triangles};
+    const double diagonal = bounding_box_diagonal(surface.vertices);
+    const auto [there, back] = detail::hausdorff_distances(surface, meshed);
+    if (there >= 0.0 && diagonal > 0.0) {
+      out_notes.hausdorff_input_to_mesh = there / diagonal;
+      out_notes.hausdorff_mesh_to_input = back / diagonal;
+    }
+  }
+  return mesh;
 }
 
 }  // namespace tetseg::preprocess

@@ -41,7 +41,7 @@ std::vector<RepairCount> repair_soup(TriangleMesh& mesh) {
     }
     polygons.push_back({t[0], t[1], t[2]});
   }
-  record("degenerate triangles removed (a repeated corner)", degenerate);
+  record("triangles with a repeated corner removed", degenerate);
   // Two triangles on the same three vertices, in either orientation, are one face.
   record("duplicate triangles removed",
          pmp::merge_duplicate_polygons_in_polygon_soup(points, polygons));
