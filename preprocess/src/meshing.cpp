@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <new>
 #include <stdexcept>
 #include <string>
@@ -108,15 +109,28 @@ namespace {
 /// the stage.
 TetMesh run_mesh_3_guarded(const TriangleMesh& input, const detail::Mesh3Criteria& criteria,
                            const std::string& file) {
+  // CGAL 5.5 writes dump-bug.mesh and dump-bug.binary.cgal to the working directory when a
+  // Mesh_3 assertion fails (Refine_facets_3.h, "already inserted on surface"); those it made
+  // here are removed, so that a failed run leaves no file.
+  const char* const dumps[] = {"dump-bug.mesh", "dump-bug.binary.cgal"};
+  bool dumped_before[2];
+  for (int i = 0; i < 2; ++i) dumped_before[i] = std::filesystem::exists(dumps[i]);
+  const auto remove_new_dumps = [&] {
+    std::error_code ignored;
+    for (int i = 0; i < 2; ++i)
+      if (!dumped_before[i]) std::filesystem::remove(dumps[i], ignored);
+  };
   try {
     return detail::mesh_polyhedral_surface(input, criteria);
   } catch (const InputError&) {
+    remove_new_dumps();
     throw;
   } catch (const std::bad_alloc&) {
     throw InputError(file,
                      "tetrahedralize: out of memory in CGAL Mesh_3 (is the facet size "
                      "much smaller than the surface?)");
   } catch (const std::exception& e) {
+    remove_new_dumps();
     throw InputError(file, std::string("tetrahedralize: CGAL Mesh_3 failed: ") + e.what());
   }
 }
@@ -209,14 +223,52 @@ std::pair<double, double> area_and_volume(const TriangleMesh& s) {
 /// wrap went through a hole wider than alpha and wrapped both sides of the input (its volume
 /// is then about offset x area; a solid's is far more). Mesh_3 cannot fill such a shell.
 constexpr double kThinShell = 4.0;
-/// Alpha is doubled at most this many times while the wrap is a thin shell.
+/// With --repair wrap, alpha is doubled at most this many times (see tetrahedralize).
 constexpr int kMaxAlphaDoublings = 6;
 
-/// The alpha wrap of `surface` (`--repair wrap`), sizes relative to its bounding-box diagonal;
-/// while it is a thin shell, alpha is doubled (up to the whole diagonal), counted in
-/// `doublings`.
+bool is_thin_shell(const TriangleMesh& wrap, double offset) {
+  const auto [area, volume] = area_and_volume(wrap);
+  return volume < kThinShell * offset * area;
+}
+
+/// The alpha wrap of `surface` (`--repair wrap`) with alpha `alpha` and the offset of
+/// `meshing`, both fractions of the bounding-box diagonal `diagonal`.
 TriangleMesh wrapped_surface(const TriangleMesh& surface, const MeshingOptions& meshing,
-                             const std::string& file, std::size_t& doublings) {
+                             double alpha, double diagonal, const std::string& file) {
+  try {
+    return detail::alpha_wrap(surface, alpha * diagonal, meshing.wrap_offset * diagonal);
+  } catch (const std::bad_alloc&) {
+    throw InputError(file,
+                     "tetrahedralize: out of memory in CGAL alpha wrapping (is --wrap-alpha "
+                     "much smaller than the surface?)");
+  } catch (const std::exception& e) {
+    throw InputError(file, std::string("tetrahedralize: CGAL alpha wrapping failed: ") + e.what());
+  }
+}
+
+/// Validation (pinch points accepted: the domain only needs inside/outside queries, and the
+/// output is validated strictly) and Mesh_3 of a surface; after --repair fix, what is left is
+/// named with a pointer to wrap.
+TetMesh validate_and_mesh(const TriangleMesh& source, const MeshingOptions& meshing,
+                          const std::string& file, TetrahedralizeNotes& notes) {
+  TriangleMesh split;
+  detail::SurfaceCheck check;
+  check.allow_pinched_vertices = true;
+  try {
+    detail::validate_closed_surface(source, file, check, &split);
+  } catch (const InputError& e) {
+    if (meshing.repair != MeshingOptions::Repair::kFix) throw;
+    throw InputError(file, std::string(e.what()) +
+                               ", left after --repair fix; --repair wrap makes a closed surface "
+                               "of any input (docs/cli.md)");
+  }
+  return mesh_closed_surface(split.triangles.empty() ? source : split, meshing, file, notes);
+}
+
+/// --repair wrap: wraps and meshes; while the wrap is a thin shell or does not mesh (thin
+/// parts), alpha is doubled (at most kMaxAlphaDoublings times, up to the whole diagonal).
+TetMesh wrap_and_mesh(const TriangleMesh& surface, const MeshingOptions& meshing,
+                      const std::string& file, TetrahedralizeNotes& notes) {
   if (!(meshing.wrap_alpha >= kMinWrapFraction && meshing.wrap_alpha <= 1.0))
     throw std::invalid_argument("wrap alpha must be in [1e-4, 1] (a fraction of the diagonal)");
   if (!(meshing.wrap_offset >= kMinWrapFraction && meshing.wrap_offset <= 1.0))
@@ -225,25 +277,26 @@ TriangleMesh wrapped_surface(const TriangleMesh& surface, const MeshingOptions& 
   const double diagonal = bounding_box_diagonal(surface.vertices);
   if (!(diagonal > 0.0) || !std::isfinite(diagonal))
     throw InputError(file, "tetrahedralize: the surface has no extent");
-  const double offset = meshing.wrap_offset * diagonal;
-  try {
-    double alpha = meshing.wrap_alpha * diagonal;
-    doublings = 0;
-    for (;;) {
-      TriangleMesh wrap = detail::alpha_wrap(surface, alpha, offset);
-      const auto [area, volume] = area_and_volume(wrap);
-      if (volume >= kThinShell * offset * area || doublings == kMaxAlphaDoublings ||
-          alpha >= diagonal)
-        return wrap;
-      alpha = std::min(2.0 * alpha, diagonal);
-      ++doublings;
+  double alpha = meshing.wrap_alpha;
+  for (std::size_t doublings = 0;; ++doublings) {
+    const bool last = doublings == kMaxAlphaDoublings || alpha >= 1.0;
+    const TriangleMesh wrap = wrapped_surface(surface, meshing, alpha, diagonal, file);
+    if (last || !is_thin_shell(wrap, meshing.wrap_offset * diagonal)) {
+      try {
+        TetMesh mesh = validate_and_mesh(wrap, meshing, file, notes);
+        notes.repairs = {
+            {"surface replaced by an alpha wrap of this many triangles", wrap.triangles.size()}};
+        if (doublings > 0)
+          notes.repairs.push_back(
+              {"alpha doublings as the wrap was a thin shell or did not mesh", doublings});
+        return mesh;
+      } catch (const InputError& e) {
+        if (last)
+          throw InputError(file, std::string(e.what()) + " (meshing the alpha wrap, alpha " +
+                                     std::to_string(alpha) + " of the diagonal)");
+      }
     }
-  } catch (const std::bad_alloc&) {
-    throw InputError(file,
-                     "tetrahedralize: out of memory in CGAL alpha wrapping (is --wrap-alpha "
-                     "much smaller than the surface?)");
-  } catch (const std::exception& e) {
-    throw InputError(file, std::string("tetrahedralize: CGAL alpha wrapping failed: ") + e.what());
+    alpha = std::min(2.0 * alpha, 1.0);
   }
 }
 
@@ -254,36 +307,18 @@ TetMesh tetrahedralize(const TriangleMesh& surface, const MeshingOptions& meshin
   TetrahedralizeNotes local_notes;
   TetrahedralizeNotes& out_notes = notes != nullptr ? *notes : local_notes;
   using Repair = MeshingOptions::Repair;
-  TriangleMesh changed;  // the repaired or wrapped surface, when the input is not used as is
+  TetMesh mesh;
   if (meshing.repair == Repair::kFix) {
-    changed = surface;
-    out_notes.repairs = detail::repair_soup(changed);
-    if (changed.triangles.empty())
+    TriangleMesh fixed = surface;
+    out_notes.repairs = detail::repair_soup(fixed);
+    if (fixed.triangles.empty())
       throw InputError(file, "tetrahedralize: no triangle is left after repair");
+    mesh = validate_and_mesh(fixed, meshing, file, out_notes);
   } else if (meshing.repair == Repair::kWrap) {
-    std::size_t doublings = 0;
-    changed = wrapped_surface(surface, meshing, file, doublings);
-    out_notes.repairs = {
-        {"surface replaced by an alpha wrap of this many triangles", changed.triangles.size()}};
-    if (doublings > 0)
-      out_notes.repairs.push_back({"alpha doublings as the wrap was a thin shell", doublings});
+    mesh = wrap_and_mesh(surface, meshing, file, out_notes);
+  } else {
+    mesh = validate_and_mesh(surface, meshing, file, out_notes);
   }
-  const TriangleMesh& source = meshing.repair == Repair::kNone ? surface : changed;
-  // Pinch points (vertices where separate fans touch) are accepted here: the domain only
-  // needs inside/outside queries, and the output is validated strictly below.
-  TriangleMesh split;
-  detail::SurfaceCheck check;
-  check.allow_pinched_vertices = true;
-  try {
-    detail::validate_closed_surface(source, file, check, &split);
-  } catch (const InputError& e) {
-    if (meshing.repair != Repair::kFix) throw;
-    throw InputError(file, std::string(e.what()) +
-                               ", left after --repair fix; --repair wrap makes a closed surface "
-                               "of any input (docs/cli.md)");
-  }
-  const TriangleMesh& input = split.triangles.empty() ? source : split;
-  TetMesh mesh = mesh_closed_surface(input, meshing, file, out_notes);
   // What a repair cost: distances between the input and the boundary of the tets.
   if (!out_notes.repairs.empty()) {
     const Surface boundary = extract_surface(mesh);
