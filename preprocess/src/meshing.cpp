@@ -266,7 +266,8 @@ TetMesh validate_and_mesh(const TriangleMesh& source, const MeshingOptions& mesh
 }
 
 /// --repair wrap: wraps and meshes; while the wrap is a thin shell or does not mesh (thin
-/// parts), alpha is doubled (at most kMaxAlphaDoublings times, up to the whole diagonal).
+/// parts), alpha is doubled (at most kMaxAlphaDoublings times, up to the whole diagonal). A
+/// wrap still thin at the end is refused before Mesh_3 (which is slow on thin shells).
 TetMesh wrap_and_mesh(const TriangleMesh& surface, const MeshingOptions& meshing,
                       const std::string& file, TetrahedralizeNotes& notes) {
   if (!(meshing.wrap_alpha >= kMinWrapFraction && meshing.wrap_alpha <= 1.0))
@@ -281,7 +282,14 @@ TetMesh wrap_and_mesh(const TriangleMesh& surface, const MeshingOptions& meshing
   for (std::size_t doublings = 0;; ++doublings) {
     const bool last = doublings == kMaxAlphaDoublings || alpha >= 1.0;
     const TriangleMesh wrap = wrapped_surface(surface, meshing, alpha, diagonal, file);
-    if (last || !is_thin_shell(wrap, meshing.wrap_offset * diagonal)) {
+    const bool thin = is_thin_shell(wrap, meshing.wrap_offset * diagonal);
+    if (last && thin)
+      throw InputError(file,
+                       "tetrahedralize: the input encloses no volume: its alpha wrap is a "
+                       "thin shell even with alpha " +
+                           std::to_string(alpha) +
+                           " of the diagonal (a flat or open sheet has no inside to fill)");
+    if (!thin) {
       try {
         TetMesh mesh = validate_and_mesh(wrap, meshing, file, notes);
         notes.repairs = {

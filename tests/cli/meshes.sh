@@ -83,6 +83,11 @@ grep -q '"surface replaced by an alpha wrap of this many triangles": [1-9]' hole
 "$bin/tetseg-dump" holed.tetseg | grep -q 'meshing.wrap_alpha *0.5' ||
   fail "the provenance lacks the wrap options"
 expect_exit 2 "wrap-alpha" -- "$bin/tetseg" build holed.off -o x.tetseg --repair wrap --wrap-alpha 0
+# A flat sheet encloses nothing: wrap says so at once (Mesh_3 never sees the thin shell).
+printf 'OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n' >sheet.off
+expect_exit 3 "tetseg: error: sheet.off: tetrahedralize: the input encloses no volume" -- \
+  "$bin/tetseg" build sheet.off -o sheet.tetseg --repair wrap
+[ ! -e sheet.tetseg ] && [ ! -e dump-bug.mesh ] || fail "a refused sheet left a file"
 
 # Hostile variants of each kind of file: truncations, huge and negative counts, NaN, byte
 # flips. The small facet size bounds the time of those that still read.
