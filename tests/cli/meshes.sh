@@ -70,11 +70,25 @@ grep -q '"hausdorff": {"input_to_mesh": ' dup.json || fail "the report lacks the
 "$bin/tetseg-dump" dup.tetseg | grep -q 'repairs.duplicate_triangles_removed *2' ||
   fail "the provenance lacks the repair"
 
-# A hole: fix names it and points to wrap; wrap (alpha larger than the hole) closes it.
+# A small hole: fix fills it; a tube with 2 x 80 border edges (over fix's 64): fix names it and
+# points to wrap; wrap (alpha larger than the hole) closes a hole.
 sed -e 's/^8 6 0$/8 5 0/' -e '/^4 2 3 7 6$/d' cube.off >holed.off
-expect_exit 3 "tetseg: error: holed.off: surface is not closed (4 border edges.*left after --repair fix; --repair wrap" -- \
-  "$bin/tetseg" build holed.off -o holed.tetseg --clusters single
-[ ! -e holed.tetseg ] || fail "a refused surface left an asset"
+expect_exit 0 "tetseg: repaired holed.off: 1 holes filled" -- \
+  "$bin/tetseg" build holed.off -o filled.tetseg --clusters single --facet-size 0.25 --no-optimize
+python3 -c '
+import math
+n = 80
+print("OFF\n%d %d 0" % (2 * n, 2 * n))
+for z in (0, 2):
+    for i in range(n):
+        print(0.5 * math.cos(2 * math.pi * i / n), 0.5 * math.sin(2 * math.pi * i / n), z)
+for i in range(n):
+    j = (i + 1) % n
+    print(3, i, j, j + n)
+    print(3, i, j + n, i + n)' >tube.off
+expect_exit 3 "tetseg: error: tube.off: surface is not closed (160 border edges.*left after --repair fix; --repair wrap" -- \
+  "$bin/tetseg" build tube.off -o tube.tetseg --clusters single
+[ ! -e tube.tetseg ] || fail "a refused surface left an asset"
 expect_exit 0 "tetseg: repaired holed.off: [0-9]* surface replaced by an alpha wrap" -- \
   "$bin/tetseg" build holed.off -o holed.tetseg --clusters single --repair wrap --wrap-alpha 0.5 \
   --facet-size 0.2 --no-optimize --report holed.json
