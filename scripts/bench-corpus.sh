@@ -94,7 +94,8 @@ else:
         errors = [l for l in stderr.splitlines() if l.startswith("tetseg: error:")]
         lines = errors or stderr.strip().splitlines() or [""]
         message = lines[-1]
-        message = message.replace("tetseg: error: ", "").replace("\t", " ")[:160]
+        message = message.replace("tetseg: error: ", "").replace(mesh + ": ", "")
+        message = message.replace("\t", " ")[:200]
         m = re.match(r"[^:]+: (tetrahedralize|read):", message)
         if m:
             stage = m.group(1)

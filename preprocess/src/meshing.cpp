@@ -14,6 +14,7 @@
 #include "repair_internal.hpp"
 #include "tetseg/preprocess/surface.hpp"
 #include "validate_internal.hpp"
+#include "vec3_math.hpp"
 
 namespace tetseg::preprocess {
 namespace {
@@ -208,13 +209,10 @@ std::pair<double, double> area_and_volume(const TriangleMesh& s) {
   double area = 0.0, volume = 0.0;
   for (const Tri& t : s.triangles) {
     const Vec3& a = s.vertices[t[0]];
-    const Vec3& b = s.vertices[t[1]];
-    const Vec3& c = s.vertices[t[2]];
-    const Vec3 u{b[0] - a[0], b[1] - a[1], b[2] - a[2]};
-    const Vec3 v{c[0] - a[0], c[1] - a[1], c[2] - a[2]};
-    const Vec3 n{u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
-    area += 0.5 * std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-    volume += (a[0] * n[0] + a[1] * n[1] + a[2] * n[2]) / 6.0;
+    const Vec3 n =
+        detail::cross(detail::sub(s.vertices[t[1]], a), detail::sub(s.vertices[t[2]], a));
+    area += 0.5 * detail::norm(n);
+    volume += detail::dot(a, n) / 6.0;
   }
   return {area, volume};
 }

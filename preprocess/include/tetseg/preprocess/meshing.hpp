@@ -78,12 +78,15 @@ struct TetrahedralizeNotes {
 /// Tetrahedralises a closed, manifold surface (interior nodes included). With
 /// `meshing.repair == kFix` the surface is first repaired without changing its shape:
 /// triangles with a repeated corner removed, duplicate triangles merged, orientation made
-/// consistent (flips; non-manifold vertices duplicated), unused vertices dropped; the repairs
-/// go to `notes->repairs`. Holes, self-intersections and zero-area triangles with three
-/// distinct corners are not repaired: the error then ends by suggesting `--repair wrap`.
-/// With kWrap the surface is replaced by its CGAL alpha wrap (wrap_alpha, wrap_offset), which
-/// is closed, manifold and free of self-intersections for any soup. When the input was
-/// changed, `notes` gets the Hausdorff distances between input and meshed boundary. The boundary is
+/// consistent (flips; non-manifold vertices duplicated), unused vertices dropped, holes of at
+/// most 64 border edges filled; the repairs go to `notes->repairs`. Larger holes,
+/// self-intersections, several components and zero-area triangles with three distinct corners
+/// are not repaired: the error then ends by suggesting `--repair wrap`. With kWrap the surface
+/// is replaced by its CGAL alpha wrap (wrap_alpha, wrap_offset), which is closed, manifold and
+/// free of self-intersections for any soup; while that wrap is a thin shell or does not mesh,
+/// alpha is doubled (at most 6 times); a wrap still thin with alpha = the diagonal is refused
+/// (the input encloses no volume). When a repair changed the input, `notes` gets the Hausdorff
+/// distances between input and meshed boundary. The boundary is
 /// re-meshed (Mesh_3 does not keep the input triangles); Mesh_3 runs with its manifold option.
 /// Unlike validate_closed_surface, pinch points (separate fans of triangles touching at one
 /// vertex position, common in modelled meshes) are accepted. The result is checked like
