@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <new>
 #include <stdexcept>
 #include <string>
@@ -13,6 +14,7 @@
 #include "repair_internal.hpp"
 #include "tetseg/preprocess/surface.hpp"
 #include "validate_internal.hpp"
+#include "vec3_math.hpp"
 
 namespace tetseg::preprocess {
 namespace {
@@ -22,6 +24,8 @@ constexpr double kFacetDistanceRatio = 0.1;
 /// Meshing sizes below diagonal / kMaxDiagonalPerSize are refused (10^5 facets along the
 /// diagonal: hundreds of millions of tets, or refinement that never ends).
 constexpr double kMaxDiagonalPerSize = 1e5;
+/// The smallest --wrap-alpha and --wrap-offset, as fractions of the diagonal.
+constexpr double kMinWrapFraction = 1e-4;
 
 double bounding_box_diagonal(const std::vector<Vec3>& points) {
   if (points.empty()) return 0.0;
@@ -106,15 +110,28 @@ namespace {
 /// the stage.
 TetMesh run_mesh_3_guarded(const TriangleMesh& input, const detail::Mesh3Criteria& criteria,
                            const std::string& file) {
+  // CGAL 5.5 writes dump-bug.mesh and dump-bug.binary.cgal to the working directory when a
+  // Mesh_3 assertion fails (Refine_facets_3.h, "already inserted on surface"); those it made
+  // here are removed, so that a failed run leaves no file.
+  const char* const dumps[] = {"dump-bug.mesh", "dump-bug.binary.cgal"};
+  bool dumped_before[2];
+  for (int i = 0; i < 2; ++i) dumped_before[i] = std::filesystem::exists(dumps[i]);
+  const auto remove_new_dumps = [&] {
+    std::error_code ignored;
+    for (int i = 0; i < 2; ++i)
+      if (!dumped_before[i]) std::filesystem::remove(dumps[i], ignored);
+  };
   try {
     return detail::mesh_polyhedral_surface(input, criteria);
   } catch (const InputError&) {
+    remove_new_dumps();
     throw;
   } catch (const std::bad_alloc&) {
     throw InputError(file,
                      "tetrahedralize: out of memory in CGAL Mesh_3 (is the facet size "
                      "much smaller than the surface?)");
   } catch (const std::exception& e) {
+    remove_new_dumps();
     throw InputError(file, std::string("tetrahedralize: CGAL Mesh_3 failed: ") + e.what());
   }
 }
@@ -130,26 +147,10 @@ std::string boundary_defect(const TetMesh& mesh, const std::string& file) {
   return "";
 }
 
-}  // namespace
-
-TetMesh tetrahedralize(const TriangleMesh& surface, const MeshingOptions& meshing,
-                       const std::string& file, TetrahedralizeNotes* notes) {
-  // Pinch points (vertices where separate fans touch) are accepted here: the domain only
-  // needs inside/outside queries, and the output is validated strictly below.
-  TriangleMesh repaired;
-  if (meshing.repair == MeshingOptions::Repair::kFix) {
-    repaired = surface;
-    std::vector<RepairCount> repairs = detail::repair_soup(repaired);
-    if (repaired.triangles.empty())
-      throw InputError(file, "tetrahedralize: no triangle is left after repair");
-    if (notes != nullptr) notes->repairs = std::move(repairs);
-  }
-  const TriangleMesh& source = meshing.repair == MeshingOptions::Repair::kFix ? repaired : surface;
-  TriangleMesh split;
-  detail::SurfaceCheck check;
-  check.allow_pinched_vertices = true;
-  detail::validate_closed_surface(source, file, check, &split);
-  const TriangleMesh& input = split.triangles.empty() ? source : split;
+/// Mesh_3 on a closed surface (pinch points allowed), checked, with the retries of
+/// tetrahedralize; notes.optimization_used and notes.first_defect say which mesh was returned.
+TetMesh mesh_closed_surface(const TriangleMesh& input, const MeshingOptions& meshing,
+                            const std::string& file, TetrahedralizeNotes& notes) {
   const double diagonal = bounding_box_diagonal(input.vertices);
   // Criteria are checked before CGAL sees them: every size finite and positive, and not so
   // small against the surface that refinement could never end (kMaxDiagonalPerSize).
@@ -188,10 +189,8 @@ TetMesh tetrahedralize(const TriangleMesh& surface, const MeshingOptions& meshin
       mesh = run_mesh_3_guarded(input, fallback, file);
       const std::string retry_defect = boundary_defect(mesh, file);
       if (retry_defect.empty()) {
-        if (notes != nullptr) {
-          notes->optimization_used = retry.name;
-          notes->first_defect = defect;
-        }
+        notes.optimization_used = retry.name;
+        notes.first_defect = defect;
         return mesh;
       }
       defects += std::string("; ") + retry.name + ": " + retry_defect;
@@ -199,6 +198,145 @@ TetMesh tetrahedralize(const TriangleMesh& surface, const MeshingOptions& meshin
   }
   throw InputError(file, "tetrahedralize: the meshed boundary is not a closed 2-manifold (" +
                              defects + "); thin parts may need a smaller --facet-size");
+}
+
+}  // namespace
+
+namespace {
+
+/// Area and enclosed volume (divergence theorem; for a closed, outward surface) of `s`.
+std::pair<double, double> area_and_volume(const TriangleMesh& s) {
+  double area = 0.0, volume = 0.0;
+  for (const Tri& t : s.triangles) {
+    const Vec3& a = s.vertices[t[0]];
+    const Vec3 n =
+        detail::cross(detail::sub(s.vertices[t[1]], a), detail::sub(s.vertices[t[2]], a));
+    area += 0.5 * detail::norm(n);
+    volume += detail::dot(a, n) / 6.0;
+  }
+  return {area, volume};
+}
+
+/// A wrap whose volume is below kThinShell x offset x area is taken for a thin shell: the
+/// wrap went through a hole wider than alpha and wrapped both sides of the input (its volume
+/// is then about offset x area; a solid's is far more). Mesh_3 cannot fill such a shell.
+constexpr double kThinShell = 4.0;
+/// With --repair wrap, alpha is doubled at most this many times (see tetrahedralize).
+constexpr int kMaxAlphaDoublings = 6;
+
+bool is_thin_shell(const TriangleMesh& wrap, double offset) {
+  const auto [area, volume] = area_and_volume(wrap);
+  return volume < kThinShell * offset * area;
+}
+
+/// The alpha wrap of `surface` (`--repair wrap`) with alpha `alpha` and the offset of
+/// `meshing`, both fractions of the bounding-box diagonal `diagonal`.
+TriangleMesh wrapped_surface(const TriangleMesh& surface, const MeshingOptions& meshing,
+                             double alpha, double diagonal, const std::string& file) {
+  try {
+    return detail::alpha_wrap(surface, alpha * diagonal, meshing.wrap_offset * diagonal);
+  } catch (const std::bad_alloc&) {
+    throw InputError(file,
+                     "tetrahedralize: out of memory in CGAL alpha wrapping (is --wrap-alpha "
+                     "much smaller than the surface?)");
+  } catch (const std::exception& e) {
+    throw InputError(file, std::string("tetrahedralize: CGAL alpha wrapping failed: ") + e.what());
+  }
+}
+
+/// Validation (pinch points accepted: the domain only needs inside/outside queries, and the
+/// output is validated strictly) and Mesh_3 of a surface; after --repair fix, what is left is
+/// named with a pointer to wrap.
+TetMesh validate_and_mesh(const TriangleMesh& source, const MeshingOptions& meshing,
+                          const std::string& file, TetrahedralizeNotes& notes) {
+  TriangleMesh split;
+  detail::SurfaceCheck check;
+  check.allow_pinched_vertices = true;
+  try {
+    detail::validate_closed_surface(source, file, check, &split);
+  } catch (const InputError& e) {
+    if (meshing.repair != MeshingOptions::Repair::kFix) throw;
+    throw InputError(file, std::string(e.what()) +
+                               ", left after --repair fix; --repair wrap makes a closed surface "
+                               "of any input (docs/cli.md)");
+  }
+  return mesh_closed_surface(split.triangles.empty() ? source : split, meshing, file, notes);
+}
+
+/// --repair wrap: wraps and meshes; while the wrap is a thin shell or does not mesh (thin
+/// parts), alpha is doubled (at most kMaxAlphaDoublings times, up to the whole diagonal). A
+/// wrap still thin at the end is refused before Mesh_3 (which is slow on thin shells).
+TetMesh wrap_and_mesh(const TriangleMesh& surface, const MeshingOptions& meshing,
+                      const std::string& file, TetrahedralizeNotes& notes) {
+  if (!(meshing.wrap_alpha >= kMinWrapFraction && meshing.wrap_alpha <= 1.0))
+    throw std::invalid_argument("wrap alpha must be in [1e-4, 1] (a fraction of the diagonal)");
+  if (!(meshing.wrap_offset >= kMinWrapFraction && meshing.wrap_offset <= 1.0))
+    throw std::invalid_argument("wrap offset must be in [1e-4, 1] (a fraction of the diagonal)");
+  if (surface.triangles.empty()) throw InputError(file, "tetrahedralize: surface has no triangles");
+  const double diagonal = bounding_box_diagonal(surface.vertices);
+  if (!(diagonal > 0.0) || !std::isfinite(diagonal))
+    throw InputError(file, "tetrahedralize: the surface has no extent");
+  double alpha = meshing.wrap_alpha;
+  for (std::size_t doublings = 0;; ++doublings) {
+    const bool last = doublings == kMaxAlphaDoublings || alpha >= 1.0;
+    const TriangleMesh wrap = wrapped_surface(surface, meshing, alpha, diagonal, file);
+    const bool thin = is_thin_shell(wrap, meshing.wrap_offset * diagonal);
+    if (last && thin)
+      throw InputError(file,
+                       "tetrahedralize: the input encloses no volume: its alpha wrap is a "
+                       "thin shell even with alpha " +
+                           std::to_string(alpha) +
+                           " of the diagonal (a flat or open sheet has no inside to fill)");
+    if (!thin) {
+      try {
+        TetMesh mesh = validate_and_mesh(wrap, meshing, file, notes);
+        notes.repairs = {
+            {"surface replaced by an alpha wrap of this many triangles", wrap.triangles.size()}};
+        if (doublings > 0)
+          notes.repairs.push_back(
+              {"alpha doublings as the wrap was a thin shell or did not mesh", doublings});
+        return mesh;
+      } catch (const InputError& e) {
+        if (last)
+          throw InputError(file, std::string(e.what()) + " (meshing the alpha wrap, alpha " +
+                                     std::to_string(alpha) + " of the diagonal)");
+      }
+    }
+    alpha = std::min(2.0 * alpha, 1.0);
+  }
+}
+
+}  // namespace
+
+TetMesh tetrahedralize(const TriangleMesh& surface, const MeshingOptions& meshing,
+                       const std::string& file, TetrahedralizeNotes* notes) {
+  TetrahedralizeNotes local_notes;
+  TetrahedralizeNotes& out_notes = notes != nullptr ? *notes : local_notes;
+  using Repair = MeshingOptions::Repair;
+  TetMesh mesh;
+  if (meshing.repair == Repair::kFix) {
+    TriangleMesh fixed = surface;
+    out_notes.repairs = detail::repair_soup(fixed);
+    if (fixed.triangles.empty())
+      throw InputError(file, "tetrahedralize: no triangle is left after repair");
+    mesh = validate_and_mesh(fixed, meshing, file, out_notes);
+  } else if (meshing.repair == Repair::kWrap) {
+    mesh = wrap_and_mesh(surface, meshing, file, out_notes);
+  } else {
+    mesh = validate_and_mesh(surface, meshing, file, out_notes);
+  }
+  // What a repair cost: distances between the input and the boundary of the tets.
+  if (!out_notes.repairs.empty()) {
+    const Surface boundary = extract_surface(mesh);
+    TriangleMesh meshed{mesh.nodes, boundary.triangles};
+    const double diagonal = bounding_box_diagonal(surface.vertices);
+    const auto [there, back] = detail::hausdorff_distances(surface, meshed);
+    if (there >= 0.0 && diagonal > 0.0) {
+      out_notes.hausdorff_input_to_mesh = there / diagonal;
+      out_notes.hausdorff_mesh_to_input = back / diagonal;
+    }
+  }
+  return mesh;
 }
 
 }  // namespace tetseg::preprocess

@@ -63,8 +63,8 @@ const std::vector<EnumName<Shape>>& enum_names<Shape>() {
 template <>
 const std::vector<EnumName<MeshingOptions::Repair>>& enum_names<MeshingOptions::Repair>() {
   using Repair = MeshingOptions::Repair;
-  static const std::vector<EnumName<Repair>> table = {{"none", Repair::kNone},
-                                                      {"fix", Repair::kFix}};
+  static const std::vector<EnumName<Repair>> table = {
+      {"none", Repair::kNone}, {"fix", Repair::kFix}, {"wrap", Repair::kWrap}};
   return table;
 }
 

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <limits>
 #include <numeric>
 #include <sstream>
@@ -57,6 +58,9 @@ bool refined(const BuildOptions& o) {
 }
 bool meshed(const BuildOptions& o) {
   return o.meshing.has_value();
+}
+bool wrapped(const BuildOptions& o) {
+  return o.meshing.has_value() && o.meshing->repair == MeshingOptions::Repair::kWrap;
 }
 
 bool parse_double(const std::string& text, double& value) {
@@ -194,8 +198,20 @@ const std::vector<ProvenanceField>& provenance_fields() {
       named<MeshingOptions::Repair>(
           "meshing.repair", meshed,
           [](O& o) -> MeshingOptions::Repair& { return meshing_of(o).repair; }),
+      number<double>("meshing.wrap_alpha", wrapped,
+                     [](O& o) -> double& { return meshing_of(o).wrap_alpha; }),
+      number<double>("meshing.wrap_offset", wrapped,
+                     [](O& o) -> double& { return meshing_of(o).wrap_offset; }),
   };
   return fields;
+}
+
+/// Repairs are recorded as "repairs.<kind>" = count, the kind's spaces as underscores.
+constexpr const char* kRepairPrefix = "repairs.";
+
+std::string swap_characters(std::string text, char from, char to) {
+  std::replace(text.begin(), text.end(), from, to);
+  return text;
 }
 
 }  // namespace
@@ -206,6 +222,10 @@ std::vector<std::pair<std::string, std::string>> provenance_options(const BuildO
   for (const ProvenanceField& field : provenance_fields()) {
     if (field.recorded(options)) out.emplace_back(field.key, field.write(copy));
   }
+  if (options.meshing)
+    for (const RepairCount& repair : options.repairs)
+      out.emplace_back(kRepairPrefix + swap_characters(repair.kind, ' ', '_'),
+                       std::to_string(repair.count));
   std::sort(out.begin(), out.end());
   return out;
 }
@@ -214,6 +234,16 @@ bool options_from_provenance(const std::vector<std::pair<std::string, std::strin
                              BuildOptions& options, std::string* error) {
   options = BuildOptions{};
   for (const auto& [key, value] : recorded) {
+    if (key.rfind(kRepairPrefix, 0) == 0) {
+      const std::string kind = swap_characters(key.substr(std::strlen(kRepairPrefix)), '_', ' ');
+      std::uint32_t count = 0;  // counts of triangles and vertices, which fit 32 bits
+      if (kind.empty() || !parse_integer(value, count)) {
+        if (error) *error = "bad repair record " + key + ": '" + value + "'";
+        return false;
+      }
+      options.repairs.push_back({kind, count});
+      continue;
+    }
     const auto& fields = provenance_fields();
     const auto field = std::find_if(fields.begin(), fields.end(),
                                     [&](const ProvenanceField& f) { return key == f.key; });

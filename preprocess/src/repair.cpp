@@ -1,10 +1,18 @@
 // Shape-keeping repairs of a triangle soup before meshing (`--repair fix`): degenerate and
-// duplicate triangles, isolated vertices, orientation. CGAL polygon-soup processing only.
+// duplicate triangles, isolated vertices, orientation (CGAL polygon-soup processing), small
+// holes (CGAL hole filling with fairing, which needs Eigen).
 
+#define CGAL_EIGEN3_ENABLED 1
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Polygon_mesh_processing/border.h>
 #include <CGAL/Polygon_mesh_processing/orient_polygon_soup.h>
+#include <CGAL/Polygon_mesh_processing/polygon_mesh_to_polygon_soup.h>
+#include <CGAL/Polygon_mesh_processing/polygon_soup_to_polygon_mesh.h>
 #include <CGAL/Polygon_mesh_processing/repair_polygon_soup.h>
+#include <CGAL/Polygon_mesh_processing/triangulate_hole.h>
+#include <CGAL/Surface_mesh.h>
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <string>
@@ -19,6 +27,46 @@ namespace {
 using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
 using Point = Kernel::Point_3;
 using Polygon = std::array<std::size_t, 3>;
+
+/// Holes with at most this many border edges are filled (docs/cli.md).
+constexpr std::size_t kMaxHoleBorderEdges = 64;
+
+/// Fills every hole of the oriented soup with at most kMaxHoleBorderEdges border edges
+/// (triangulated, refined, faired: CGAL triangulate_refine_and_fair_hole; when fairing fails
+/// the refined patch is kept). Returns the number of holes filled; the soup is rewritten
+/// only when one was.
+std::size_t fill_small_holes(std::vector<Point>& points, std::vector<Polygon>& polygons) {
+  namespace pmp = CGAL::Polygon_mesh_processing;
+  using Mesh = CGAL::Surface_mesh<Point>;
+  if (!pmp::is_polygon_soup_a_polygon_mesh(polygons)) return 0;
+  Mesh mesh;
+  pmp::polygon_soup_to_polygon_mesh(points, polygons, mesh);
+  std::vector<Mesh::Halfedge_index> borders;
+  pmp::extract_boundary_cycles(mesh, std::back_inserter(borders));
+  std::size_t filled = 0;
+  for (const Mesh::Halfedge_index h : borders) {
+    std::size_t edges = 0;
+    for (Mesh::Halfedge_index e : CGAL::halfedges_around_face(h, mesh)) {
+      (void)e;
+      if (++edges > kMaxHoleBorderEdges) break;
+    }
+    if (edges > kMaxHoleBorderEdges) continue;
+    std::vector<Mesh::Face_index> patch;
+    std::vector<Mesh::Vertex_index> added;
+    pmp::triangulate_refine_and_fair_hole(mesh, h, std::back_inserter(patch),
+                                          std::back_inserter(added));
+    if (!patch.empty()) ++filled;
+  }
+  if (filled == 0) return 0;
+  std::vector<Point> new_points;
+  std::vector<std::vector<std::size_t>> new_polygons;
+  pmp::polygon_mesh_to_polygon_soup(mesh, new_points, new_polygons);
+  points = std::move(new_points);
+  polygons.clear();
+  for (const std::vector<std::size_t>& p : new_polygons)
+    if (p.size() == 3) polygons.push_back({p[0], p[1], p[2]});
+  return filled;
+}
 
 }  // namespace
 
@@ -41,7 +89,7 @@ std::vector<RepairCount> repair_soup(TriangleMesh& mesh) {
     }
     polygons.push_back({t[0], t[1], t[2]});
   }
-  record("degenerate triangles removed (a repeated corner)", degenerate);
+  record("triangles with a repeated corner removed", degenerate);
   // Two triangles on the same three vertices, in either orientation, are one face.
   record("duplicate triangles removed",
          pmp::merge_duplicate_polygons_in_polygon_soup(points, polygons));
@@ -62,6 +110,13 @@ std::vector<RepairCount> repair_soup(TriangleMesh& mesh) {
     }
   record("triangles flipped to agree with their neighbours", flipped);
   record("non-manifold vertices duplicated", points.size() - vertices_before);
+  // Vertices no triangle uses are counted before hole filling renumbers them.
+  std::vector<char> used(points.size(), 0);
+  for (const Polygon& polygon : polygons)
+    for (std::size_t v : polygon) used[v] = 1;
+  record("isolated vertices removed",
+         static_cast<std::size_t>(std::count(used.begin(), used.end(), 0)));
+  record("holes filled", fill_small_holes(points, polygons));
   // Vertices no triangle uses any more are dropped (ids renumbered in order).
   std::vector<std::uint32_t> new_id(points.size(), UINT32_MAX);
   TriangleMesh repaired;
@@ -78,8 +133,6 @@ std::vector<RepairCount> repair_soup(TriangleMesh& mesh) {
     }
     repaired.triangles.push_back(tri);
   }
-  // Every duplicated vertex is used, so the vertices left out were isolated ones.
-  record("isolated vertices removed", points.size() - repaired.vertices.size());
   mesh = std::move(repaired);
   return repairs;
 }

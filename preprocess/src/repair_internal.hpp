@@ -1,6 +1,9 @@
 #pragma once
-// Private: the soup repairs of `--repair fix` (repair.cpp, CGAL polygon-soup processing).
+// Private: the soup repairs of `--repair fix` (repair.cpp, CGAL polygon-soup processing), the
+// alpha wrap of `--repair wrap` (alpha_wrap.cpp) and the distance they cost
+// (surface_distance.cpp).
 
+#include <utility>
 #include <vector>
 
 #include "tetseg/preprocess/meshing.hpp"
@@ -13,5 +16,15 @@ namespace tetseg::preprocess::detail {
 /// duplicated), unused vertices dropped. Returns the repairs made (kind, count; kinds with a
 /// zero count are left out). Vertex ids are renumbered in order of first use.
 std::vector<RepairCount> repair_soup(TriangleMesh& mesh);
+
+/// CGAL 3D alpha wrapping of the triangle soup `soup` (any defects; at least one triangle),
+/// with absolute `alpha` and `offset` (> 0): a closed, 2-manifold, self-intersection-free
+/// surface enclosing the soup at about `offset` from it. May throw what CGAL throws.
+TriangleMesh alpha_wrap(const TriangleMesh& soup, double alpha, double offset);
+
+/// Approximate Hausdorff distances (CGAL approximate_Hausdorff_distance, sampling vertices,
+/// edges and faces with a fixed seed) from `a` to `b` and from `b` to `a`, absolute; the
+/// soups may have any defects; {-1, -1} when either has no usable triangle.
+std::pair<double, double> hausdorff_distances(const TriangleMesh& a, const TriangleMesh& b);
 
 }  // namespace tetseg::preprocess::detail

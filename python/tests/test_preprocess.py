@@ -173,7 +173,7 @@ def test_bad_meshes_raise_clear_errors(pp, sphere_mesh, tmp_path):
         pp.build((nodes, inverted))
     open_surface = (nodes, np.array([[0, 1, 2], [0, 2, 3]]))
     with pytest.raises(pp.InputError, match="not closed"):
-        pp.build(open_surface)
+        pp.build(open_surface, repair="none")
     with pytest.raises(ValueError, match="outside"):
         pp.build((nodes, tets.astype(np.int64) - 1))
     with pytest.raises(TypeError, match="integer array"):

@@ -62,6 +62,47 @@ expect_exit 3 "tetseg: error: cube_dup.off: surface has [0-9]* non-manifold edge
 [ ! -e dup2.mesh ] || fail "a refused surface left a mesh"
 expect_exit 2 "repair" -- "$bin/tetseg" build cube.off -o x.tetseg --repair bogus
 
+# The repairs go to the report and the provenance.
+"$bin/tetseg" build cube_dup.off -o dup.tetseg --clusters single --facet-size 0.25 -q \
+  --report dup.json
+grep -q '"duplicate triangles removed": 2' dup.json || fail "the report lacks the repair"
+grep -q '"hausdorff": {"input_to_mesh": ' dup.json || fail "the report lacks the distance"
+"$bin/tetseg-dump" dup.tetseg | grep -q 'repairs.duplicate_triangles_removed *2' ||
+  fail "the provenance lacks the repair"
+
+# A small hole: fix fills it; a tube with 2 x 80 border edges (over fix's 64): fix names it and
+# points to wrap; wrap (alpha larger than the hole) closes a hole.
+sed -e 's/^8 6 0$/8 5 0/' -e '/^4 2 3 7 6$/d' cube.off >holed.off
+expect_exit 0 "tetseg: repaired holed.off: 1 holes filled" -- \
+  "$bin/tetseg" build holed.off -o filled.tetseg --clusters single --facet-size 0.25 --no-optimize
+python3 -c '
+import math
+n = 80
+print("OFF\n%d %d 0" % (2 * n, 2 * n))
+for z in (0, 2):
+    for i in range(n):
+        print(0.5 * math.cos(2 * math.pi * i / n), 0.5 * math.sin(2 * math.pi * i / n), z)
+for i in range(n):
+    j = (i + 1) % n
+    print(3, i, j, j + n)
+    print(3, i, j + n, i + n)' >tube.off
+expect_exit 3 "tetseg: error: tube.off: surface is not closed (160 border edges.*left after --repair fix; --repair wrap" -- \
+  "$bin/tetseg" build tube.off -o tube.tetseg --clusters single
+[ ! -e tube.tetseg ] || fail "a refused surface left an asset"
+expect_exit 0 "tetseg: repaired holed.off: [0-9]* surface replaced by an alpha wrap" -- \
+  "$bin/tetseg" build holed.off -o holed.tetseg --clusters single --repair wrap --wrap-alpha 0.5 \
+  --facet-size 0.2 --no-optimize --report holed.json
+grep -q '"surface replaced by an alpha wrap of this many triangles": [1-9]' holed.json ||
+  fail "the report lacks the wrap"
+"$bin/tetseg-dump" holed.tetseg | grep -q 'meshing.wrap_alpha *0.5' ||
+  fail "the provenance lacks the wrap options"
+expect_exit 2 "wrap-alpha" -- "$bin/tetseg" build holed.off -o x.tetseg --repair wrap --wrap-alpha 0
+# A flat sheet encloses nothing: wrap says so at once (Mesh_3 never sees the thin shell).
+printf 'OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n' >sheet.off
+expect_exit 3 "tetseg: error: sheet.off: tetrahedralize: the input encloses no volume" -- \
+  "$bin/tetseg" build sheet.off -o sheet.tetseg --repair wrap
+[ ! -e sheet.tetseg ] && [ ! -e dump-bug.mesh ] || fail "a refused sheet left a file"
+
 # Hostile variants of each kind of file: truncations, huge and negative counts, NaN, byte
 # flips. The small facet size bounds the time of those that still read.
 python3 - <<'PY'

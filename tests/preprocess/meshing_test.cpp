@@ -149,11 +149,13 @@ TEST_CASE("A closed surface is filled with valid tets of the same volume", "[mes
     const Checked c = check_valid(tetrahedralize(s, m, "sphere"));
     CHECK(c.volume == Approx(input_volume).epsilon(0.02));
   }
-  SECTION("An open surface is refused before meshing.") {
+  SECTION("An open surface is refused before meshing (without repair).") {
     TriangleMesh open = s;
     open.triangles.pop_back();
     try {
-      tetrahedralize(open, MeshingOptions{}, "open.obj");
+      MeshingOptions m;
+      m.repair = MeshingOptions::Repair::kNone;
+      tetrahedralize(open, m, "open.obj");
       FAIL("meshed an open surface");
     } catch (const InputError& e) {
       CHECK(e.file() == "open.obj");

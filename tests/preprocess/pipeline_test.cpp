@@ -181,6 +181,44 @@ TEST_CASE("An asset rebuilt from its provenance is byte-identical", "[pipeline][
                                     "ball.off", recovered, report);
     CHECK(tetseg::format::write_asset(first) == tetseg::format::write_asset(second));
   }
+  SECTION("A wrapped surface: the wrap options and the repairs are recorded and read back.") {
+    tetseg::preprocess::TriangleMesh surface = tetseg::test::icosphere(3);
+    surface.triangles.pop_back();  // a hole, which only the wrap closes
+    MeshingOptions meshing;
+    meshing.facet_size = 0.3;
+    meshing.optimize = false;
+    meshing.repair = MeshingOptions::Repair::kWrap;
+    meshing.wrap_alpha = 0.25;
+    TetrahedralizeNotes notes;
+    const TetMesh mesh = tetrahedralize(surface, meshing, "holed.off", &notes);
+    REQUIRE(notes.repairs.size() == 1);
+    BuildOptions options;
+    options.clusters = ClusterMethod::kSingle;
+    options.meshing = meshing;
+    options.repairs = notes.repairs;
+    BuildReport report;
+    const auto asset = build_asset(mesh, "holed.off", options, report);
+    const auto& recorded = asset.provenance.options;
+    auto value_of = [&](const std::string& key) {
+      for (const auto& [k, v] : recorded)
+        if (k == key) return v;
+      return std::string("(absent)");
+    };
+    CHECK(value_of("meshing.repair") == "wrap");
+    CHECK(value_of("meshing.wrap_alpha") == "0.25");
+    CHECK(value_of("meshing.wrap_offset") == "0.002");
+    CHECK(value_of("repairs.surface_replaced_by_an_alpha_wrap_of_this_many_triangles") ==
+          std::to_string(notes.repairs[0].count));
+    BuildOptions recovered;
+    std::string error;
+    REQUIRE(options_from_provenance(recorded, recovered, &error));
+    REQUIRE(recovered.meshing.has_value());
+    CHECK(recovered.meshing->repair == MeshingOptions::Repair::kWrap);
+    CHECK(recovered.meshing->wrap_alpha == 0.25);
+    REQUIRE(recovered.repairs.size() == 1);
+    CHECK(recovered.repairs[0].kind == notes.repairs[0].kind);
+    CHECK(recovered.repairs[0].count == notes.repairs[0].count);
+  }
 }
 
 TEST_CASE("Provenance options that cannot be read back are refused", "[pipeline][provenance]") {
@@ -195,6 +233,7 @@ TEST_CASE("Provenance options that cannot be read back are refused", "[pipeline]
   CHECK(options.charge.fast_order == -2);  // read as written; compute_charge judges it
   CHECK_FALSE(options_from_provenance({{"colour", "blue"}}, options, &error));
   CHECK(error == "unknown option colour: 'blue'");
+  CHECK_FALSE(options_from_provenance({{"repairs.holes_filled", "some"}}, options, &error));
   REQUIRE(options_from_provenance({{"segmentation.alpha", "0.05"}}, options, &error));
   CHECK(options.segmentation.alpha == 0.05);
   CHECK(options.segmentation.beta_divisor == 400.0);  // not named: the default

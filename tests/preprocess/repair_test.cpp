@@ -1,12 +1,15 @@
-// `--repair fix` (MeshingOptions::Repair::kFix): each repair on a small generated defect of a
-// cube, checked against the same input with repairs off, and the result validated.
+// `--repair fix` (MeshingOptions::Repair::kFix) and `--repair wrap` (kWrap): each repair on a
+// small generated defect, checked against the same input with repairs off, the result validated
+// (closed, 2-manifold, no self-intersection) and its volume compared with the exact one.
 
 #include <catch2/catch.hpp>
+#include <cmath>
 #include <string>
 #include <utility>
 
 #include "tetseg/preprocess/meshing.hpp"
 #include "tetseg/preprocess/surface.hpp"
+#include "tetseg/testing/charge_shapes.hpp"
 
 using namespace tetseg::preprocess;
 
@@ -37,8 +40,10 @@ std::size_t count_of(const TetrahedralizeNotes& notes, const std::string& kind) 
 }
 
 /// Meshes `s` with repairs on (must succeed, valid, volume 1) and off (must fail with
-/// `unrepaired_error`); returns the repairs.
-TetrahedralizeNotes fixed_and_refused(const TriangleMesh& s, const std::string& unrepaired_error) {
+/// `unrepaired_error`); returns the repairs. `holed`: the input lacks part of the cube, so
+/// the mesh-to-input distance is not checked here.
+TetrahedralizeNotes fixed_and_refused(const TriangleMesh& s, const std::string& unrepaired_error,
+                                      bool holed = false) {
   try {
     tetrahedralize(s, coarse(MeshingOptions::Repair::kNone), "defect.off");
     FAIL("the defect was meshed without repair");
@@ -49,7 +54,44 @@ TetrahedralizeNotes fixed_and_refused(const TriangleMesh& s, const std::string& 
   const TetMesh m = tetrahedralize(s, coarse(MeshingOptions::Repair::kFix), "defect.off", &notes);
   validate_tet_mesh(m, extract_surface(m), "repaired");
   CHECK(total_tet_volume(m) == Approx(1.0).epsilon(0.02));
+  // The repairs kept the shape: what is left is Mesh_3's rounding of the cube's corners and
+  // edges (no feature protection; facet distance 0.025, here about 0.035 of the diagonal).
+  CHECK(notes.hausdorff_input_to_mesh >= 0.0);
+  CHECK(notes.hausdorff_input_to_mesh < 0.05);
+  if (!holed) CHECK(notes.hausdorff_mesh_to_input < 0.05);
   return notes;
+}
+
+/// An open tube about z: radius 0.5, z in [0, 2], `segments` around, no caps.
+TriangleMesh open_cylinder(std::uint32_t segments) {
+  TriangleMesh m;
+  const double pi = std::acos(-1.0);
+  for (int ring = 0; ring <= 4; ++ring)
+    for (std::uint32_t i = 0; i < segments; ++i) {
+      const double a = 2.0 * pi * i / segments;
+      m.vertices.push_back({0.5 * std::cos(a), 0.5 * std::sin(a), 0.5 * ring});
+    }
+  for (std::uint32_t ring = 0; ring < 4; ++ring)
+    for (std::uint32_t i = 0; i < segments; ++i) {
+      const std::uint32_t a = ring * segments + i;
+      const std::uint32_t b = ring * segments + (i + 1) % segments;
+      m.triangles.push_back({a, b, b + segments});
+      m.triangles.push_back({a, b + segments, a + segments});
+    }
+  return m;
+}
+
+/// Meshes `s` wrapped (alpha `alpha` of the diagonal); the result must be valid.
+TetMesh wrapped(const TriangleMesh& s, double alpha, TetrahedralizeNotes& notes) {
+  MeshingOptions m = coarse(MeshingOptions::Repair::kWrap);
+  m.facet_size = 0.15;
+  m.wrap_alpha = alpha;
+  const TetMesh mesh = tetrahedralize(s, m, "defect.off", &notes);
+  validate_tet_mesh(mesh, extract_surface(mesh), "wrapped");
+  REQUIRE(notes.repairs.size() == 1);
+  CHECK(notes.repairs[0].kind.find("alpha wrap") != std::string::npos);
+  CHECK(notes.repairs[0].count > 0);
+  return mesh;
 }
 
 }  // namespace
@@ -82,5 +124,74 @@ TEST_CASE("Shape-keeping repairs fix small defects and say what they did", "[mes
     const TetrahedralizeNotes notes = fixed_and_refused(s, "zero-area triangle");
     CHECK(count_of(notes, "repeated corner") == 1);
     CHECK(count_of(notes, "isolated vertices removed") == 1);
+  }
+}
+
+TEST_CASE("Fix fills small holes, names what it cannot repair and points to wrap",
+          "[meshing][repair]") {
+  SECTION("A cube with a triangle missing is closed again.") {
+    TriangleMesh s = cube();
+    s.triangles.erase(s.triangles.begin());  // a hole: three border edges
+    const TetrahedralizeNotes notes = fixed_and_refused(s, "not closed (3 border edges", true);
+    CHECK(count_of(notes, "holes filled") == 1);
+    // The patch is farthest from the input at the missing triangle's incentre (see below).
+    CHECK(notes.hausdorff_mesh_to_input ==
+          Approx((2.0 - std::sqrt(2.0)) / 2.0 / std::sqrt(3.0)).margin(0.015));
+  }
+  SECTION("Two holes of 80 border edges, over the limit of 64, are left and named.") {
+    try {
+      tetrahedralize(open_cylinder(80), coarse(MeshingOptions::Repair::kFix), "tube.off");
+      FAIL("an open tube was meshed by fix");
+    } catch (const InputError& e) {
+      CHECK_THAT(e.what(), Catch::Contains("not closed (160 border edges, first between vertices"));
+      CHECK_THAT(e.what(), Catch::Contains("--repair wrap"));
+      CHECK(e.file() == "tube.off");
+    }
+  }
+}
+
+TEST_CASE("Wrap closes holes, open surfaces and self-intersections", "[meshing][repair][wrap]") {
+  TetrahedralizeNotes notes;
+  SECTION("A cube with a triangle missing: an alpha larger than the hole closes it.") {
+    TriangleMesh s = cube();
+    s.triangles.erase(s.triangles.begin());
+    const TetMesh m = wrapped(s, 0.5, notes);
+    // The wrap lies just outside the input (offset 0.002 of the diagonal).
+    CHECK(total_tet_volume(m) == Approx(1.0).epsilon(0.05));
+    CHECK(notes.hausdorff_input_to_mesh < 0.05);
+    // The patch over the hole is farthest from the input at the incentre of the missing
+    // right triangle (legs 1): the inradius (2 - sqrt 2) / 2 over the diagonal sqrt 3.
+    CHECK(notes.hausdorff_mesh_to_input ==
+          Approx((2.0 - std::sqrt(2.0)) / 2.0 / std::sqrt(3.0)).margin(0.015));
+  }
+  SECTION("An open cylinder: wrapped into a capped one.") {
+    const TetMesh m = wrapped(open_cylinder(48), 0.3, notes);
+    const double pi = std::acos(-1.0);
+    const double prism = 48 * 0.5 * 0.25 * std::sin(2 * pi / 48) * 2.0;  // the 48-gon prism
+    CHECK(total_tet_volume(m) == Approx(prism).epsilon(0.06));
+  }
+  SECTION("Two interpenetrating spheres: fix refuses, wrap makes their union.") {
+    TriangleMesh s = tetseg::test::icosphere(6);
+    const TriangleMesh other = tetseg::test::icosphere(6);
+    const std::uint32_t base = static_cast<std::uint32_t>(s.vertices.size());
+    for (Vec3 p : other.vertices) s.vertices.push_back({p[0] + 1.0, p[1], p[2]});
+    for (const Tri& t : other.triangles)
+      s.triangles.push_back({t[0] + base, t[1] + base, t[2] + base});
+    try {
+      tetrahedralize(s, coarse(MeshingOptions::Repair::kFix), "spheres.off");
+      FAIL("two crossing spheres were meshed by fix");
+    } catch (const InputError& e) {
+      CHECK_THAT(e.what(), Catch::Contains("2 connected components"));
+      CHECK_THAT(e.what(), Catch::Contains("--repair wrap"));
+    }
+    const TetMesh m = wrapped(s, 0.02, notes);
+    // Union of two unit balls 1 apart: 2 (4/3 pi) - pi (4 + 1)(2 - 1)^2 / 12.
+    const double pi = std::acos(-1.0);
+    const double exact = 8.0 * pi / 3.0 - 5.0 * pi / 12.0;
+    CHECK(total_tet_volume(m) == Approx(exact).epsilon(0.05));
+    // The input inside the union is farthest from the wrap at each sphere's centre, which
+    // lies on the other sphere: distance 1, over the diagonal sqrt(3^2 + 2^2 + 2^2).
+    CHECK(notes.hausdorff_input_to_mesh == Approx(1.0 / std::sqrt(17.0)).margin(0.01));
+    CHECK(notes.hausdorff_mesh_to_input < 0.02);
   }
 }

@@ -38,7 +38,8 @@ void print_stage(const StageReport& stage, bool quiet) {
 }
 
 std::string report_json(const BuildArgs& args, const BuildReport& report,
-                        const format::Asset& asset, std::size_t asset_bytes, double total) {
+                        const TetrahedralizeNotes& notes, const format::Asset& asset,
+                        std::size_t asset_bytes, double total) {
   std::ostringstream out;
   out.precision(9);
   out << "{\n  \"input\": \"" << json_escape(args.input) << "\",\n";
@@ -71,6 +72,20 @@ std::string report_json(const BuildArgs& args, const BuildReport& report,
         << ", \"assembly_seconds\": " << c.assembly_seconds
         << ", \"solve_seconds\": " << c.solve_seconds << "},\n";
   }
+  // Surface input: what the repair changed and what it cost (docs/cli.md, "Repair").
+  if (!is_tet_mesh_path(args.input)) {
+    out << "  \"repairs\": {";
+    for (std::size_t i = 0; i < notes.repairs.size(); ++i)
+      out << (i ? ", " : "") << '"' << json_escape(notes.repairs[i].kind)
+          << "\": " << notes.repairs[i].count;
+    out << "},\n";
+    if (notes.hausdorff_input_to_mesh >= 0.0)
+      out << "  \"hausdorff\": {\"input_to_mesh\": " << notes.hausdorff_input_to_mesh
+          << ", \"mesh_to_input\": " << notes.hausdorff_mesh_to_input
+          << ", \"relative_to\": \"input bounding-box diagonal\"},\n";
+    if (!notes.optimization_used.empty())
+      out << "  \"meshing_retry\": \"" << json_escape(notes.optimization_used) << "\",\n";
+  }
   out << "  \"clusters\": [";
   for (std::size_t c = 0; c < asset.clusters.size(); ++c) {
     out << (c ? ",\n    " : "\n    ") << "{\"triangles\": " << asset.clusters[c].triangle_count
@@ -101,6 +116,7 @@ void run_build(const BuildArgs& args) {
   BuildOptions options = args.options;
   options.keep_rest_positions = !args.no_rest_positions;
   TetMesh mesh;
+  TetrahedralizeNotes notes;
   if (is_tet_mesh_path(args.input)) {
     mesh = timer.run("read", [&](std::string& summary) {
       TetMesh m = read_tet_mesh(args.input);
@@ -119,9 +135,9 @@ void run_build(const BuildArgs& args) {
       return s;
     });
     mesh = timer.run("tetrahedralize", [&](std::string& summary) {
-      TetrahedralizeNotes notes;
       TetMesh m = tetrahedralize(surface, args.meshing, args.input, &notes);
-      options.meshing = args.meshing;  // recorded in the provenance
+      options.meshing = args.meshing;  // recorded in the provenance, with the repairs
+      options.repairs = notes.repairs;
       mesh_cli::print_repairs(args.input, notes);
       if (!notes.optimization_used.empty()) mesh_cli::print_retry_note(args.input, notes);
       summary =
@@ -139,7 +155,8 @@ void run_build(const BuildArgs& args) {
   });
   const double total = std::chrono::duration<double>(Clock::now() - start).count();
   if (!args.report_path.empty()) {
-    write_file_atomic(args.report_path, report_json(args, report, asset, bytes.size(), total));
+    write_file_atomic(args.report_path,
+                      report_json(args, report, notes, asset, bytes.size(), total));
   }
   if (!args.quiet) {
     // Clusters no interior node sees well cost run time in every frame: say which, and why.

@@ -107,10 +107,21 @@ void print_retry_note(const std::string& file, const preprocess::TetrahedralizeN
 void add_repair_option(CLI::App& cmd, preprocess::MeshingOptions& m) {
   using Repair = preprocess::MeshingOptions::Repair;
   cmd.add_option("--repair", m.repair,
-                 "Surface input: none, or fix (remove degenerate and duplicate triangles, make "
-                 "the orientation consistent; docs/cli.md)")
+                 "Surface input: none; fix (remove degenerate and duplicate triangles, make "
+                 "the orientation consistent); or wrap (replace the surface by its alpha wrap: "
+                 "closed and manifold for any input; docs/cli.md)")
       ->transform(CLI::CheckedTransformer(preprocess::name_map<Repair>(), CLI::ignore_case))
       ->option_text(preprocess::name_list<Repair>() + " (" + preprocess::name_of(m.repair) + ")");
+  cmd.add_option("--wrap-alpha", m.wrap_alpha,
+                 "--repair wrap: gaps narrower than this fraction of the bounding-box diagonal "
+                 "are closed")
+      ->check(CLI::Range(1e-4, 1.0))
+      ->capture_default_str();
+  cmd.add_option("--wrap-offset", m.wrap_offset,
+                 "--repair wrap: distance of the wrap from the input, as a fraction of the "
+                 "bounding-box diagonal")
+      ->check(CLI::Range(1e-4, 1.0))
+      ->capture_default_str();
 }
 
 void print_repairs(const std::string& file, const preprocess::TetrahedralizeNotes& notes) {
@@ -119,6 +130,12 @@ void print_repairs(const std::string& file, const preprocess::TetrahedralizeNote
   for (const preprocess::RepairCount& r : notes.repairs)
     list += (list.empty() ? "" : ", ") + std::to_string(r.count) + " " + r.kind;
   std::fprintf(stderr, "tetseg: repaired %s: %s\n", base_name(file).c_str(), list.c_str());
+  if (notes.hausdorff_input_to_mesh >= 0.0)
+    std::fprintf(stderr,
+                 "tetseg: note: %s: Hausdorff distance between input and meshed surface: %.3g "
+                 "(input to mesh), %.3g (mesh to input), of the bounding-box diagonal\n",
+                 base_name(file).c_str(), notes.hausdorff_input_to_mesh,
+                 notes.hausdorff_mesh_to_input);
 }
 
 void finish_tet_mesh(const preprocess::TetMesh& mesh, const std::string& output,

@@ -22,13 +22,18 @@ struct MeshingOptions {
   double facet_angle = 25.0;            ///< min facet angle, degrees, in (0, 30]
   double cell_radius_edge_ratio = 3.0;  ///< tet quality bound, >= 2
   bool optimize = true;  ///< sliver perturbation (10 degree bound) + exudation; no ODT/Lloyd
-  /// Surfaces only: kFix repairs the input before validation (tetrahedralize).
-  enum class Repair { kNone, kFix } repair = Repair::kFix;
+  /// Surfaces only: kFix repairs the input before validation; kWrap replaces it by its alpha
+  /// wrap (tetrahedralize).
+  enum class Repair { kNone, kFix, kWrap } repair = Repair::kFix;
+  /// kWrap: alpha (the size of the gaps the wrap does not enter) and offset (its distance
+  /// from the input), as fractions of the input's bounding-box diagonal; > 0.
+  double wrap_alpha = 0.02;
+  double wrap_offset = 0.002;
 };
 
 /// One kind of repair tetrahedralize made to its input, and how many.
 struct RepairCount {
-  std::string kind;  ///< e.g. "duplicate triangles removed"
+  std::string kind;  ///< e.g. "duplicate triangles removed" (words and spaces only)
   std::size_t count = 0;
 };
 
@@ -63,14 +68,25 @@ struct TetrahedralizeNotes {
   std::string optimization_used;
   std::string first_defect;          ///< the first mesh's boundary defect, when retried
   std::vector<RepairCount> repairs;  ///< repairs of the input (MeshingOptions::repair)
+  /// When a repair changed the input or it was wrapped: approximate Hausdorff distances
+  /// between the input triangles and the boundary of the returned tets, relative to the
+  /// input's bounding-box diagonal (input to mesh, mesh to input); -1 when not measured.
+  double hausdorff_input_to_mesh = -1.0;
+  double hausdorff_mesh_to_input = -1.0;
 };
 
 /// Tetrahedralises a closed, manifold surface (interior nodes included). With
 /// `meshing.repair == kFix` the surface is first repaired without changing its shape:
 /// triangles with a repeated corner removed, duplicate triangles merged, orientation made
-/// consistent (flips; non-manifold vertices duplicated), unused vertices dropped; the repairs
-/// go to `notes->repairs`. Holes, self-intersections and zero-area triangles with three
-/// distinct corners are not repaired. The boundary is
+/// consistent (flips; non-manifold vertices duplicated), unused vertices dropped, holes of at
+/// most 64 border edges filled; the repairs go to `notes->repairs`. Larger holes,
+/// self-intersections, several components and zero-area triangles with three distinct corners
+/// are not repaired: the error then ends by suggesting `--repair wrap`. With kWrap the surface
+/// is replaced by its CGAL alpha wrap (wrap_alpha, wrap_offset), which is closed, manifold and
+/// free of self-intersections for any soup; while that wrap is a thin shell or does not mesh,
+/// alpha is doubled (at most 6 times); a wrap still thin with alpha = the diagonal is refused
+/// (the input encloses no volume). When a repair changed the input, `notes` gets the Hausdorff
+/// distances between input and meshed boundary. The boundary is
 /// re-meshed (Mesh_3 does not keep the input triangles); Mesh_3 runs with its manifold option.
 /// Unlike validate_closed_surface, pinch points (separate fans of triangles touching at one
 /// vertex position, common in modelled meshes) are accepted. The result is checked like

@@ -36,6 +36,9 @@ struct BuildOptions {
   /// Set when the tet mesh was made from the source surface by tetrahedralize with these
   /// options; only recorded (provenance keys meshing.*), so that the asset can be rebuilt.
   std::optional<MeshingOptions> meshing;
+  /// With `meshing`: the repairs tetrahedralize made (TetrahedralizeNotes::repairs), recorded
+  /// as provenance keys "repairs.<kind, spaces as underscores>" = count.
+  std::vector<RepairCount> repairs;
 };
 
 /// One finished stage: its name, wall time and a short human summary.

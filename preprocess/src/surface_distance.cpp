@@ -1,0 +1,62 @@
+// Approximate Hausdorff distances between two triangle surfaces (CGAL Polygon Mesh
+// Processing): what a repair or a wrap cost.
+
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Polygon_mesh_processing/distance.h>
+#include <CGAL/Polygon_mesh_processing/orient_polygon_soup.h>
+#include <CGAL/Polygon_mesh_processing/polygon_soup_to_polygon_mesh.h>
+#include <CGAL/Polygon_mesh_processing/repair_polygon_soup.h>
+#include <CGAL/Surface_mesh.h>
+
+#include <algorithm>
+#include <array>
+#include <utility>
+#include <vector>
+
+#include "repair_internal.hpp"
+
+namespace tetseg::preprocess::detail {
+namespace {
+
+using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
+using Point = Kernel::Point_3;
+using Mesh = CGAL::Surface_mesh<Point>;
+
+/// The soup as a polygon mesh with the same triangles: degenerate and duplicate triangles
+/// dropped, orientation made consistent and non-manifold vertices duplicated (CGAL), which
+/// leaves the point set covered unchanged.
+Mesh as_polygon_mesh(const TriangleMesh& soup) {
+  namespace pmp = CGAL::Polygon_mesh_processing;
+  std::vector<Point> points;
+  points.reserve(soup.vertices.size());
+  for (const Vec3& p : soup.vertices) points.emplace_back(p[0], p[1], p[2]);
+  std::vector<std::vector<std::size_t>> polygons;
+  polygons.reserve(soup.triangles.size());
+  for (const Tri& t : soup.triangles) polygons.push_back({t[0], t[1], t[2]});
+  pmp::repair_polygon_soup(points, polygons);
+  pmp::orient_polygon_soup(points, polygons);
+  Mesh mesh;
+  pmp::polygon_soup_to_polygon_mesh(points, polygons, mesh);
+  return mesh;
+}
+
+}  // namespace
+
+std::pair<double, double> hausdorff_distances(const TriangleMesh& a, const TriangleMesh& b) {
+  namespace pmp = CGAL::Polygon_mesh_processing;
+  const Mesh mesh_a = as_polygon_mesh(a);
+  const Mesh mesh_b = as_polygon_mesh(b);
+  if (mesh_a.is_empty() || mesh_b.is_empty()) return {-1.0, -1.0};
+  // Vertices, edges and random points on the faces (at least kFaceSamples, or one per
+  // vertex) are sampled; a fixed seed makes the figures reproducible.
+  constexpr std::size_t kFaceSamples = 10000;
+  auto sampling = [&](const Mesh& m) {
+    return CGAL::parameters::random_seed(1).number_of_points_on_faces(
+        std::max<std::size_t>(kFaceSamples, m.number_of_vertices()));
+  };
+  return {
+      pmp::approximate_Hausdorff_distance<CGAL::Sequential_tag>(mesh_a, mesh_b, sampling(mesh_a)),
+      pmp::approximate_Hausdorff_distance<CGAL::Sequential_tag>(mesh_b, mesh_a, sampling(mesh_b))};
+}
+
+}  // namespace tetseg::preprocess::detail
