@@ -251,8 +251,8 @@ py::tuple build(const py::object& mesh, const py::object& source, const std::str
                 const std::string& equalization, double growth_bound, bool grow_through_marked,
                 std::uint32_t min_cluster_triangles, const std::string& detector,
                 const std::string& solver, double tolerance, double cell_size, double facet_size,
-                double facet_distance, bool optimize, const std::string& repair,
-                bool rest_positions, const py::object& on_stage) {
+                double facet_distance, bool optimize, const std::string& repair, double wrap_alpha,
+                double wrap_offset, bool rest_positions, const py::object& on_stage) {
   BuildOptions options;
   options.clusters = enum_from_name<ClusterMethod>("clusters", clusters);
   check_range("refine_visibility", refine_visibility, 0.0, 1.0);
@@ -285,6 +285,10 @@ py::tuple build(const py::object& mesh, const py::object& source, const std::str
   meshing.facet_distance = facet_distance;
   meshing.optimize = optimize;
   meshing.repair = enum_from_name<MeshingOptions::Repair>("repair", repair);
+  check_range("wrap_alpha", wrap_alpha, 1e-4, 1.0);
+  check_range("wrap_offset", wrap_offset, 1e-4, 1.0);
+  meshing.wrap_alpha = wrap_alpha;
+  meshing.wrap_offset = wrap_offset;
 
   Input in = input_from(mesh, source);
   std::function<void(const StageReport&)> stage_callback;
@@ -324,8 +328,10 @@ py::tuple build(const py::object& mesh, const py::object& source, const std::str
         return 0;
       });
       in.tet_mesh = timer.run("tetrahedralize", [&](std::string& summary) {
-        TetMesh m = tetrahedralize(in.surface, meshing, in.source);
+        TetrahedralizeNotes notes;
+        TetMesh m = tetrahedralize(in.surface, meshing, in.source, &notes);
         options.meshing = meshing;  // recorded in the provenance, as by `tetseg build`
+        options.repairs = notes.repairs;
         summary =
             std::to_string(m.nodes.size()) + " nodes, " + std::to_string(m.tets.size()) + " tets";
         return m;
@@ -485,11 +491,13 @@ PYBIND11_MODULE(preprocess, m) {
         py::arg("facet_size") = meshing.facet_size,
         py::arg("facet_distance") = meshing.facet_distance, py::arg("optimize") = meshing.optimize,
         py::arg("repair") = std::string(name_of(meshing.repair)),
+        py::arg("wrap_alpha") = meshing.wrap_alpha, py::arg("wrap_offset") = meshing.wrap_offset,
         py::arg("rest_positions") = b.keep_rest_positions, py::arg("on_stage") = py::none(),
         "Returns (asset bytes, report dict). "
         "Runs the whole pipeline as `tetseg build` does. mesh: a tet mesh file (.mesh, "
         ".node/.ele, .msh), a closed surface file (.obj, .ply, .stl, .off, ...; tetrahedralised "
-        "first with cell_size, facet_size, facet_distance, optimize, repair), or a pair of arrays "
+        "first with cell_size, facet_size, facet_distance, optimize, repair, wrap_alpha, "
+        "wrap_offset), or a pair of arrays "
         "(nodes (N, 3), tets (M, 4)) or (points (N, 3), triangles (M, 3)). source: the name "
         "recorded in the asset's provenance and used in messages (default: the path, or "
         "'arrays'). Every other option is the `tetseg build` option of the same name "

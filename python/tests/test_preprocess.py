@@ -174,6 +174,8 @@ def test_bad_meshes_raise_clear_errors(pp, sphere_mesh, tmp_path):
     open_surface = (nodes, np.array([[0, 1, 2], [0, 2, 3]]))
     with pytest.raises(pp.InputError, match="not closed"):
         pp.build(open_surface, repair="none")
+    with pytest.raises(ValueError, match="wrap_alpha must be in"):
+        pp.build(open_surface, repair="wrap", wrap_alpha=0)
     with pytest.raises(ValueError, match="outside"):
         pp.build((nodes, tets.astype(np.int64) - 1))
     with pytest.raises(TypeError, match="integer array"):
@@ -192,3 +194,19 @@ def test_preprocess_module_carries_the_gpl_code(pp):
     # Positive control for test_runtime_package_does_not_load_preprocess.
     assert b"CGAL" in open(pp.__file__, "rb").read()
     assert "GPL" in pp.__doc__
+
+
+def test_wrap_repair_is_recorded_in_the_provenance(pp):
+    """repair="wrap" meshes the alpha wrap of the input; the wrap options reach the
+    provenance, as with `tetseg build --repair wrap` (an open box is refused without repair)."""
+    import tetseg
+    corners = np.array([[x, y, z] for z in (0, 1) for y in (0, 1) for x in (0, 1)], float)
+    quads = [(0, 2, 3, 1), (0, 1, 5, 4), (1, 3, 7, 5), (3, 2, 6, 7), (2, 0, 4, 6), (4, 5, 7, 6)]
+    triangles = np.array([t for a, b, c, d in quads for t in ((a, b, c), (a, c, d))])
+    with pytest.raises(pp.InputError, match="not closed"):
+        pp.build((corners, triangles[:-2]), repair="none")  # no top
+    data, report = pp.build((corners, triangles), repair="wrap", wrap_alpha=0.1, cell_size=0.2)
+    provenance = tetseg.load_asset(data).provenance["options"]
+    assert provenance["meshing.repair"] == "wrap"
+    assert float(provenance["meshing.wrap_alpha"]) == 0.1
+    assert report["counts"]["surface_triangles"] > 12  # the wrap, not the 12 input triangles

@@ -20,7 +20,7 @@ def build(mesh: _Mesh, *, source: Optional[str] = ..., clusters: str = ...,
           min_cluster_triangles: int = ..., detector: str = ..., solver: str = ...,
           tolerance: float = ..., cell_size: float = ..., facet_size: float = ...,
           facet_distance: float = ..., optimize: bool = ..., repair: str = ...,
-          rest_positions: bool = ...,
+          wrap_alpha: float = ..., wrap_offset: float = ..., rest_positions: bool = ...,
           on_stage: Optional[Callable[[str, float, str], Any]] = ...) -> Tuple[bytes, dict]: ...
 def charge(mesh: _Mesh, *, source: Optional[str] = ..., solver: str = ...,
            tolerance: float = ..., max_iterations: int = ..., theta: float = ...,
