@@ -94,7 +94,15 @@ void Collider::Impl::construct(std::shared_ptr<const BodyShape> sh, const Collid
   if (opt.use_openmp) threads = static_cast<std::size_t>(std::max(1, omp_get_max_threads()));
 #endif
   workers.resize(threads);
-  for (Worker& w : workers) w.stack.resize(stack_size);
+  const bool plane_cache = opt.mode != ColliderMode::kBrute && opt.ccd.min_separation <= 0;
+  for (Worker& w : workers) {
+    w.stack.resize(stack_size);
+    if (plane_cache) {
+      w.plane_owner = this;
+      w.plane.resize(tri_count);
+      w.plane_step.assign(tri_count, 0);
+    }
+  }
 
   // Per-step scratch.
   vmoved.assign(nv, 0);
@@ -126,6 +134,7 @@ void Collider::Impl::construct(std::shared_ptr<const BodyShape> sh, const Collid
 ColliderStatus Collider::Impl::begin_step(const double* p0, const double* p1,
                                           std::size_t count) noexcept {
   have_step = false;
+  ++step_serial;
   stats = ColliderStats{};
   cache = QueryCache{};
   if (ctor_status != ColliderStatus::kOk) return ColliderStatus::kNotReady;

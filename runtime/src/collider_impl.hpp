@@ -11,6 +11,7 @@
 
 #include "body_shape_data.hpp"
 #include "normal_cone.hpp"
+#include "orientation_terms.hpp"
 #include "tetseg/runtime/classify.hpp"
 #include "tetseg/runtime/collider.hpp"
 #include "tetseg/runtime/median_bvh.hpp"
@@ -143,6 +144,12 @@ struct Worker {
   bool rest_hit = false;
   std::uint32_t rest_a = 0, rest_b = 0;
   QueryKind qkind = QueryKind::kFull;
+  // Lazy per-step cache of the plane minors of the owning collider's triangles (plane filter):
+  // entry t is valid when plane_step[t] == the collider's step_serial. Sized at construction,
+  // used only by the collider `plane_owner` (empty and null for scene workers).
+  const void* plane_owner = nullptr;
+  std::vector<FacePlaneMinors> plane;
+  std::vector<std::uint64_t> plane_step;
   /// Counts a contact: stops the traversal for kAny, else keeps the earliest and fills `out`.
   void record(const Contact& c) noexcept;
   void reset() noexcept {
@@ -264,6 +271,7 @@ struct Collider::Impl {
   const double* x0 = nullptr;
   const double* x1 = nullptr;
   bool have_step = false;
+  std::uint64_t step_serial = 0;  // counts begin_step calls (validates the workers' plane caches)
   bool first_step_done = false;
   bool rest_mode = false;            // check_rest_intersection: static positions, no still rule
   std::vector<std::uint8_t> vmoved;  // per surface vertex

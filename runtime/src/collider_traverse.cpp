@@ -190,9 +190,27 @@ void process_edge_edge(Worker& w, const Collider::Impl& A, std::uint32_t e1,
 
 // Triangle-pair plane filter of triangle t1 of A and t2 of B (plane_filter.hpp; exact
 // contact only; docs/runtime.md, "Triangle-pair plane filter").
-bool plane_separated(const Collider::Impl& A, std::uint32_t t1, const Collider::Impl& B,
+// Within one body whose own worker `w` runs the traversal, each triangle's plane minors are
+// computed once per step, at first use, in w's cache; else per pair. Same answer either way
+// (bitwise: the same operations in the same order).
+bool plane_separated(Worker& w, const Collider::Impl& A, std::uint32_t t1, const Collider::Impl& B,
                      std::uint32_t t2) noexcept {
-  return plane_separated({A.tris[t1], A.x0, A.x1}, {B.tris[t2], B.x0, B.x1}, &A == &B);
+  const bool same = &A == &B;
+  const bool cache = same && w.plane_owner == &A;
+  auto cached = [&](std::uint32_t t) {
+    if (w.plane_step[t] != A.step_serial) {
+      const auto& f = A.tris[t];
+      w.plane[t] = FacePlaneMinors::of(A.pos0(f[0]), A.pos0(f[1]), A.pos0(f[2]), A.pos1(f[0]),
+                                       A.pos1(f[1]), A.pos1(f[2]));
+      w.plane_step[t] = A.step_serial;
+    }
+    return &w.plane[t];
+  };
+  MovingTriangle m1{A.tris[t1], A.x0, A.x1, cache ? cached(t1) : nullptr};
+  MovingTriangle m2{B.tris[t2], B.x0, B.x1};
+  if (nodes_strictly_on_one_side(m1, m2, same)) return true;  // plane_separated, in two steps
+  if (cache) m2.minors = cached(t2);
+  return nodes_strictly_on_one_side(m2, m1, same);
 }
 
 // Tests the feature pairs of triangle t1 of A and t2 of B (t1 != t2 within one body):
@@ -210,7 +228,7 @@ void test_features(Worker& w, const Collider::Impl& A, std::uint32_t t1, const C
   int plane = ms <= 0 ? -1 : 0;  // -1 unknown, 0 not separated, 1 separated
   auto separated = [&]() {
     if (plane < 0) {
-      plane = plane_separated(A, t1, B, t2) ? 1 : 0;
+      plane = plane_separated(w, A, t1, B, t2) ? 1 : 0;
       w.stats.triangle_pairs_plane_filtered += plane;
     }
     return plane == 1;
