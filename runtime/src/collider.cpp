@@ -119,6 +119,9 @@ void Collider::Impl::construct(std::shared_ptr<const BodyShape> sh, const Collid
   nunc.assign(nn, 0);
   nmov.assign(nn, 0);
 
+  skip_adjacent = uses_global_bvh();
+  if (skip_adjacent) build_orphan_sets();
+
   // kBvh topology storage (built from rest positions now when available, else on the first
   // step or rest check, without allocating).
   if (uses_global_bvh() || !asset) {

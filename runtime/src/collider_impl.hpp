@@ -281,7 +281,13 @@ struct Collider::Impl {
   std::vector<std::uint8_t> emov;  // per edge: an end node moved
   std::vector<std::uint8_t> tcls;  // Orientation
   std::vector<std::uint8_t> tmov;
-  std::vector<Box> nbox;  // per asset BVH node
+  // Whole-surface modes (bvh, cone, surface-only bodies): triangle pairs that share a node are
+  // not candidates; the feature pairs only such pairs hold (orphan sets, built at construction)
+  // are tested directly every step (docs/runtime.md, "Adjacent triangle pairs").
+  bool skip_adjacent = false;
+  std::vector<std::array<std::uint32_t, 2>> orphan_vf;  // (node, triangle)
+  std::vector<std::array<std::uint32_t, 2>> orphan_ee;  // (edge, edge), first < second
+  std::vector<Box> nbox;                                // per asset BVH node
   std::vector<std::uint32_t> nneg, nunc, nmov;
   std::vector<Worker> workers;
   // Contact closure scratch (capacity tri_count, reserved at construction).
@@ -333,6 +339,10 @@ struct Collider::Impl {
   bool traverse_pair(Worker& w, const TreeView& ta, const TreeView& tb) const noexcept;
   void brute_vertex_faces(Worker& w, std::uint32_t i) const noexcept;
   void brute_edge_edges(Worker& w, std::uint32_t i) const noexcept;
+  /// Builds orphan_vf / orphan_ee from the topology (construction; allocates, may throw).
+  void build_orphan_sets();
+  /// Tests every orphan feature pair (filters, then the elementary test).
+  void test_orphans(Worker& w) const noexcept;
   /// Intra-cluster work of cluster c1 and its pairs with every cluster c2 > c1.
   bool cluster_tasks(Worker& w, std::uint32_t c1, bool count_skips) const noexcept;
   TreeView cluster_view(std::uint32_t c) const noexcept;

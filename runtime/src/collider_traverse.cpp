@@ -32,6 +32,12 @@ inline Vec3d v3(const double* p) noexcept {
   return {p[0], p[1], p[2]};
 }
 
+inline bool share_node(const format::Triangle& a, const format::Triangle& b) noexcept {
+  for (std::uint32_t n : a)
+    if (n == b[0] || n == b[1] || n == b[2]) return true;
+  return false;
+}
+
 }  // namespace
 
 TreeView Collider::Impl::cluster_view(std::uint32_t c) const noexcept {
@@ -77,7 +83,65 @@ bool Collider::Impl::non_culled(std::uint32_t t1, std::uint32_t t2) const noexce
     const std::uint8_t c = tcls[t1];
     if (c != kUnc && c == tcls[t2]) return false;
   }
+  if (skip_adjacent && !rest_mode && share_node(tris[t1], tris[t2])) return false;
   return true;
+}
+
+void Collider::Impl::build_orphan_sets() {
+  const BodyShape::Data& T = *topo;
+  orphan_vf.clear();
+  orphan_ee.clear();
+  std::vector<std::uint32_t> near, candidates;
+  // Appends the triangles sharing a node with triangle t (t included).
+  auto gather_near = [&](std::uint32_t t) {
+    for (std::uint32_t n : tris[t]) {
+      const std::uint32_t i = T.surf_index[n];
+      near.insert(near.end(), T.vt_list.begin() + T.vt_offset[i],
+                  T.vt_list.begin() + T.vt_offset[i + 1]);
+    }
+  };
+  auto sort_unique = [](std::vector<std::uint32_t>& v) {
+    std::sort(v.begin(), v.end());
+    v.erase(std::unique(v.begin(), v.end()), v.end());
+  };
+  // Vertex-face (p, F), p not in F: every triangle around p shares a node with F. Such an F
+  // shares a node with a triangle around p, so it is among their neighbours.
+  for (std::uint32_t ip = 0; ip < T.surf_nodes.size(); ++ip) {
+    const std::uint32_t p = T.surf_nodes[ip];
+    near.clear();
+    for (std::uint32_t k = T.vt_offset[ip]; k < T.vt_offset[ip + 1]; ++k) gather_near(T.vt_list[k]);
+    sort_unique(near);
+    for (std::uint32_t f : near) {
+      const auto& F = tris[f];
+      if (p == F[0] || p == F[1] || p == F[2]) continue;
+      bool all_adjacent = true;
+      for (std::uint32_t k = T.vt_offset[ip]; k < T.vt_offset[ip + 1] && all_adjacent; ++k)
+        all_adjacent = share_node(tris[T.vt_list[k]], F);
+      if (all_adjacent) orphan_vf.push_back({p, f});
+    }
+  }
+  // Edge-edge (e1, e2), four distinct nodes: every triangle around e1 shares a node with every
+  // triangle around e2. e2 is an edge of a triangle sharing a node with one around e1.
+  const std::uint32_t ne = static_cast<std::uint32_t>(T.edges.size());
+  for (std::uint32_t e1 = 0; e1 < ne; ++e1) {
+    near.clear();
+    for (std::uint32_t k = T.et_offset[e1]; k < T.et_offset[e1 + 1]; ++k) gather_near(T.et_list[k]);
+    candidates.clear();
+    for (std::uint32_t t : near)
+      for (std::uint32_t e2 : T.tri_edges[t])
+        if (e2 > e1) candidates.push_back(e2);
+    sort_unique(candidates);
+    const auto& E1 = T.edges[e1];
+    for (std::uint32_t e2 : candidates) {
+      const auto& E2 = T.edges[e2];
+      if (E1[0] == E2[0] || E1[0] == E2[1] || E1[1] == E2[0] || E1[1] == E2[1]) continue;
+      bool all_adjacent = true;
+      for (std::uint32_t k1 = T.et_offset[e1]; k1 < T.et_offset[e1 + 1] && all_adjacent; ++k1)
+        for (std::uint32_t k2 = T.et_offset[e2]; k2 < T.et_offset[e2 + 1] && all_adjacent; ++k2)
+          all_adjacent = share_node(tris[T.et_list[k1]], tris[T.et_list[k2]]);
+      if (all_adjacent) orphan_ee.push_back({e1, e2});
+    }
+  }
 }
 
 bool Collider::Impl::orientation_culled(std::uint32_t t1, std::uint32_t t2) const noexcept {
@@ -478,6 +542,13 @@ bool Collider::Impl::traverse_self(Worker& w, const TreeView& t) const noexcept 
   return true;
 }
 
+void Collider::Impl::test_orphans(Worker& w) const noexcept {
+  for (std::size_t i = 0; i < orphan_vf.size() && !w.stop; ++i)
+    process_vertex_face(w, *this, orphan_vf[i][0], *this, orphan_vf[i][1]);
+  for (std::size_t i = 0; i < orphan_ee.size() && !w.stop; ++i)
+    process_edge_edge(w, *this, orphan_ee[i][0], *this, orphan_ee[i][1]);
+}
+
 void Collider::Impl::brute_vertex_faces(Worker& w, std::uint32_t i) const noexcept {
   // Vertex i against every triangle not containing it (swept-box overlap checked inside).
   const std::uint32_t p = topo->surf_nodes[i];
@@ -540,6 +611,7 @@ bool Collider::Impl::run_query(Contact* out, std::size_t out_cap) noexcept {
     const std::int64_t ne = static_cast<std::int64_t>(topo->edges.size());
     if (global_bvh_active()) {
       if (tri_count > 0 && !traverse_self(w0, global_view())) w0.overflow = true;
+      if (skip_adjacent && !rest_mode && !w0.overflow) test_orphans(w0);
     } else if (opt.mode == ColliderMode::kBrute && !rest_mode) {
 #if defined(TETSEG_HAVE_OPENMP)
       if (parallel) {
