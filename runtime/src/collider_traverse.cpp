@@ -364,6 +364,14 @@ void Collider::Impl::process_triangle_pair(Worker& w, std::uint32_t t1,
   }
   ++w.stats.triangle_pairs;
   const std::uint64_t key = pair_key(t1, t2);
+  if (skip_adjacent) {
+    // Static ownership (whole-surface modes): the smallest node-disjoint pair holding a feature
+    // pair owns it, whatever its boxes (docs/runtime.md, "Adjacent triangle pairs").
+    test_features(w, *this, t1, *this, t2, [&](std::uint32_t u, std::uint32_t v) {
+      return pair_key(u, v) < key && !share_node(tris[u], tris[v]);
+    });
+    return;
+  }
   test_features(w, *this, t1, *this, t2, [&](std::uint32_t u, std::uint32_t v) {
     return pair_key(u, v) < key && non_culled(u, v);
   });
