@@ -46,6 +46,7 @@ struct TreeView {
   const format::BvhNode* nodes = nullptr;
   const std::uint32_t* leaf_tris = nullptr;  // global triangle ids in leaf order
   const Box* box = nullptr;
+  const Box* tri_box = nullptr;  // swept box of each triangle (by global id), this step
   const std::uint32_t* ntris = nullptr;
   const std::uint32_t* nneg = nullptr;  // null: no orientation culling
   const std::uint32_t* nunc = nullptr;

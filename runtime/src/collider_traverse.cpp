@@ -46,6 +46,7 @@ TreeView Collider::Impl::cluster_view(std::uint32_t c) const noexcept {
   v.nodes = asset->bvh_nodes.data() + cl.bvh_offset;
   v.leaf_tris = asset->cluster_triangles.data() + cl.triangle_offset;
   v.box = nbox.data() + cl.bvh_offset;
+  v.tri_box = tbox.data();
   v.ntris = topo->cluster_node_ntris.data() + cl.bvh_offset;
   v.nmov = nmov.data() + cl.bvh_offset;
   if (orientation_mode()) {
@@ -60,6 +61,7 @@ TreeView Collider::Impl::global_view() const noexcept {
   v.nodes = gbvh.nodes.data();
   v.leaf_tris = gbvh.leaf.data();
   v.box = gbvh.box.data();
+  v.tri_box = tbox.data();
   v.ntris = gbvh.ntris.data();
   v.nmov = gbvh.mov.data();
   if (opt.mode == ColliderMode::kCone && !rest_mode) v.cone = &cone;
@@ -417,16 +419,19 @@ void Collider::Impl::close_contacts(Worker& w, double toi) noexcept {
   for (std::uint32_t t : closure_ring) closure_mark[t] = 0;
 }
 
-// Calls `triangle_pair(t1, t2)` for every triangle pair of leaf a of ta and leaf b of tb.
+// Calls `triangle_pair(t1, t2)` for every triangle pair of leaf a of ta and leaf b of tb
+// except those whose t1's swept box misses leaf b's box (margin ms): their triangle boxes are
+// disjoint too, which every triangle-pair predicate rejects.
 template <typename TrianglePair>
 inline void leaf_pair(Worker& w, const TreeView& ta, std::uint32_t a, const TreeView& tb,
-                      std::uint32_t b, TrianglePair&& triangle_pair) noexcept {
+                      std::uint32_t b, double ms, TrianglePair&& triangle_pair) noexcept {
   const format::BvhNode& na = ta.nodes[a];
   const format::BvhNode& nb = tb.nodes[b];
   for (std::uint32_t i = 0; i < na.count && !w.stop; ++i) {
-    for (std::uint32_t j = 0; j < nb.count && !w.stop; ++j) {
-      triangle_pair(ta.leaf_tris[na.first + i], tb.leaf_tris[nb.first + j]);
-    }
+    const std::uint32_t t1 = ta.leaf_tris[na.first + i];
+    if (nb.count > 1 && !boxes_overlap(ta.tri_box[t1], tb.box[b], ms)) continue;
+    for (std::uint32_t j = 0; j < nb.count && !w.stop; ++j)
+      triangle_pair(t1, tb.leaf_tris[nb.first + j]);
   }
 }
 
@@ -434,9 +439,10 @@ inline void leaf_pair(Worker& w, const TreeView& ta, std::uint32_t a, const Tree
 // are pushed. False when the stack has no room.
 template <typename Live, typename TrianglePair>
 inline bool descend_pair(Worker& w, const TreeView& ta, const TreeView& tb, const StackItem& it,
-                         Live&& live, TrianglePair&& triangle_pair, std::size_t& top) noexcept {
+                         double ms, Live&& live, TrianglePair&& triangle_pair,
+                         std::size_t& top) noexcept {
   if (ta.nodes[it.a].count > 0 && tb.nodes[it.b].count > 0) {
-    leaf_pair(w, ta, it.a, tb, it.b, triangle_pair);
+    leaf_pair(w, ta, it.a, tb, it.b, ms, triangle_pair);
     return true;
   }
   if (top + 2 > w.stack.size()) return false;
@@ -459,7 +465,7 @@ bool traverse_tree_pair(Worker& w, const TreeView& ta, const TreeView& tb, doubl
   while (top > 0 && !w.stop) {
     const StackItem it = w.stack[--top];
     ++w.stats.node_pairs_visited;
-    if (!descend_pair(w, ta, tb, it, live, triangle_pair, top)) return false;
+    if (!descend_pair(w, ta, tb, it, ms, live, triangle_pair, top)) return false;
   }
   return true;
 }
@@ -545,7 +551,7 @@ bool Collider::Impl::traverse_self(Worker& w, const TreeView& t) const noexcept 
       w.stack[top++] = {nd.first, kNone};
       continue;
     }
-    if (!descend_pair(w, t, t, it, live_pair, self_pair, top)) return false;
+    if (!descend_pair(w, t, t, it, ms, live_pair, self_pair, top)) return false;
   }
   return true;
 }
