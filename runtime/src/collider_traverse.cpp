@@ -288,9 +288,8 @@ void test_features(Worker& w, const Collider::Impl& A, std::uint32_t t1, const C
                    std::uint32_t t2, Claimed&& claimed) noexcept {
   const double ms = A.opt.ccd.min_separation;
   // The plane filter runs once per pair: first thing without orientation culling (bvh and
-  // cone modes, surface-only bodies, pairs of bodies: most non-culled pairs are neighbours it
-  // drops), else lazily when the first feature pair passes its box checks (measured:
-  // docs/benchmarks.md, "Scenes and the shared core").
+  // cone modes, surface-only bodies, pairs of bodies), else lazily when the first feature pair
+  // passes its box checks (measured both ways per mode: docs/benchmarks.md, "Per-pair work").
   int plane = ms <= 0 ? -1 : 0;  // -1 unknown, 0 not separated, 1 separated
   auto separated = [&]() {
     if (plane < 0) {
