@@ -250,9 +250,9 @@ void Collider::Impl::refit_and_classify() noexcept {
   for (std::int64_t t = 0; t < nt; ++t) {
     const auto& tri = tris[t];
     const std::uint32_t o = asset->clusters[asset->triangle_cluster[t]].detector_node;
-    tcls[t] = static_cast<std::uint8_t>(classify_orientation(pos0(o), pos0(tri[0]), pos0(tri[1]),
-                                                             pos0(tri[2]), pos1(o), pos1(tri[0]),
-                                                             pos1(tri[1]), pos1(tri[2])));
+    tcls[t] = static_cast<std::uint8_t>(orientation_of(pos0(o), pos0(tri[0]), pos0(tri[1]),
+                                                       pos0(tri[2]), pos1(o), pos1(tri[0]),
+                                                       pos1(tri[1]), pos1(tri[2])));
   }
   std::uint64_t count[3] = {0, 0, 0};
   for (std::uint32_t t = 0; t < tri_count; ++t) ++count[tcls[t]];

@@ -185,8 +185,8 @@ void process_vertex_face(Worker& w, const Collider::Impl& P, std::uint32_t p,
   ++w.stats.feature_pairs;
   if (ms <= 0) {
     // Coplanarity cubic det[b-a, c-a, p-a] with a proven strict sign: never coplanar.
-    const Orientation o = classify_orientation(F.pos0(f[0]), F.pos0(f[1]), F.pos0(f[2]), P.pos0(p),
-                                               F.pos1(f[0]), F.pos1(f[1]), F.pos1(f[2]), P.pos1(p));
+    const Orientation o = orientation_of(F.pos0(f[0]), F.pos0(f[1]), F.pos0(f[2]), P.pos0(p),
+                                         F.pos1(f[0]), F.pos1(f[1]), F.pos1(f[2]), P.pos1(p));
     if (o != Orientation::kUncertain) {
       ++w.stats.feature_pairs_filtered;
       return;
@@ -228,8 +228,8 @@ void process_edge_edge(Worker& w, const Collider::Impl& A, std::uint32_t e1,
   ++w.stats.feature_pairs;
   if (ms <= 0) {
     // det[b-a, d-c, c-a] = det[b-a, d-a, c-a]: orientation of (a; b, d, c).
-    const Orientation o = classify_orientation(A.pos0(a), A.pos0(b), B.pos0(d), B.pos0(c),
-                                               A.pos1(a), A.pos1(b), B.pos1(d), B.pos1(c));
+    const Orientation o = orientation_of(A.pos0(a), A.pos0(b), B.pos0(d), B.pos0(c), A.pos1(a),
+                                         A.pos1(b), B.pos1(d), B.pos1(c));
     if (o != Orientation::kUncertain) {
       ++w.stats.feature_pairs_filtered;
       return;
