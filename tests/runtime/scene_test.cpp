@@ -15,10 +15,10 @@
 #include <tuple>
 #include <vector>
 
+#include "tetseg/testing/synthetic_scenes.hpp"
 #include "support/allocation_probe.hpp"
 #include "tetseg/runtime/ccd.hpp"
 #include "tetseg/runtime/scene.hpp"
-#include "tetseg/testing/synthetic_scenes.hpp"
 
 using tetseg::BodyOptions;
 using tetseg::BodyShape;
