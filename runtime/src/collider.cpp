@@ -94,7 +94,15 @@ void Collider::Impl::construct(std::shared_ptr<const BodyShape> sh, const Collid
   if (opt.use_openmp) threads = static_cast<std::size_t>(std::max(1, omp_get_max_threads()));
 #endif
   workers.resize(threads);
-  for (Worker& w : workers) w.stack.resize(stack_size);
+  const bool plane_cache = opt.mode != ColliderMode::kBrute && opt.ccd.min_separation <= 0;
+  for (Worker& w : workers) {
+    w.stack.resize(stack_size);
+    if (plane_cache) {
+      w.plane_owner = this;
+      w.plane.resize(tri_count);
+      w.plane_step.assign(tri_count, 0);
+    }
+  }
 
   // Per-step scratch.
   vmoved.assign(nv, 0);
@@ -111,6 +119,9 @@ void Collider::Impl::construct(std::shared_ptr<const BodyShape> sh, const Collid
   nunc.assign(nn, 0);
   nmov.assign(nn, 0);
 
+  skip_adjacent = uses_global_bvh();
+  if (skip_adjacent) build_orphan_sets();
+
   // kBvh topology storage (built from rest positions now when available, else on the first
   // step or rest check, without allocating).
   if (uses_global_bvh() || !asset) {
@@ -126,6 +137,7 @@ void Collider::Impl::construct(std::shared_ptr<const BodyShape> sh, const Collid
 ColliderStatus Collider::Impl::begin_step(const double* p0, const double* p1,
                                           std::size_t count) noexcept {
   have_step = false;
+  ++step_serial;
   stats = ColliderStats{};
   cache = QueryCache{};
   if (ctor_status != ColliderStatus::kOk) return ColliderStatus::kNotReady;
@@ -238,9 +250,9 @@ void Collider::Impl::refit_and_classify() noexcept {
   for (std::int64_t t = 0; t < nt; ++t) {
     const auto& tri = tris[t];
     const std::uint32_t o = asset->clusters[asset->triangle_cluster[t]].detector_node;
-    tcls[t] = static_cast<std::uint8_t>(classify_orientation(pos0(o), pos0(tri[0]), pos0(tri[1]),
-                                                             pos0(tri[2]), pos1(o), pos1(tri[0]),
-                                                             pos1(tri[1]), pos1(tri[2])));
+    tcls[t] = static_cast<std::uint8_t>(orientation_of(pos0(o), pos0(tri[0]), pos0(tri[1]),
+                                                       pos0(tri[2]), pos1(o), pos1(tri[0]),
+                                                       pos1(tri[1]), pos1(tri[2])));
   }
   std::uint64_t count[3] = {0, 0, 0};
   for (std::uint32_t t = 0; t < tri_count; ++t) ++count[tcls[t]];

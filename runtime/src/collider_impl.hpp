@@ -11,6 +11,7 @@
 
 #include "body_shape_data.hpp"
 #include "normal_cone.hpp"
+#include "orientation_terms.hpp"
 #include "tetseg/runtime/classify.hpp"
 #include "tetseg/runtime/collider.hpp"
 #include "tetseg/runtime/median_bvh.hpp"
@@ -45,6 +46,7 @@ struct TreeView {
   const format::BvhNode* nodes = nullptr;
   const std::uint32_t* leaf_tris = nullptr;  // global triangle ids in leaf order
   const Box* box = nullptr;
+  const Box* tri_box = nullptr;  // swept box of each triangle (by global id), this step
   const std::uint32_t* ntris = nullptr;
   const std::uint32_t* nneg = nullptr;  // null: no orientation culling
   const std::uint32_t* nunc = nullptr;
@@ -143,6 +145,12 @@ struct Worker {
   bool rest_hit = false;
   std::uint32_t rest_a = 0, rest_b = 0;
   QueryKind qkind = QueryKind::kFull;
+  // Lazy per-step cache of the plane minors of the owning collider's triangles (plane filter):
+  // entry t is valid when plane_step[t] == the collider's step_serial. Sized at construction,
+  // used only by the collider `plane_owner` (empty and null for scene workers).
+  const void* plane_owner = nullptr;
+  std::vector<FacePlaneMinors> plane;
+  std::vector<std::uint64_t> plane_step;
   /// Counts a contact: stops the traversal for kAny, else keeps the earliest and fills `out`.
   void record(const Contact& c) noexcept;
   void reset() noexcept {
@@ -264,6 +272,7 @@ struct Collider::Impl {
   const double* x0 = nullptr;
   const double* x1 = nullptr;
   bool have_step = false;
+  std::uint64_t step_serial = 0;  // counts begin_step calls (validates the workers' plane caches)
   bool first_step_done = false;
   bool rest_mode = false;            // check_rest_intersection: static positions, no still rule
   std::vector<std::uint8_t> vmoved;  // per surface vertex
@@ -273,7 +282,13 @@ struct Collider::Impl {
   std::vector<std::uint8_t> emov;  // per edge: an end node moved
   std::vector<std::uint8_t> tcls;  // Orientation
   std::vector<std::uint8_t> tmov;
-  std::vector<Box> nbox;  // per asset BVH node
+  // Whole-surface modes (bvh, cone, surface-only bodies): triangle pairs that share a node are
+  // not candidates; the feature pairs only such pairs hold (orphan sets, built at construction)
+  // are tested directly every step (docs/runtime.md, "Adjacent triangle pairs").
+  bool skip_adjacent = false;
+  std::vector<std::array<std::uint32_t, 2>> orphan_vf;  // (node, triangle)
+  std::vector<std::array<std::uint32_t, 2>> orphan_ee;  // (edge, edge), first < second
+  std::vector<Box> nbox;                                // per asset BVH node
   std::vector<std::uint32_t> nneg, nunc, nmov;
   std::vector<Worker> workers;
   // Contact closure scratch (capacity tri_count, reserved at construction).
@@ -325,6 +340,10 @@ struct Collider::Impl {
   bool traverse_pair(Worker& w, const TreeView& ta, const TreeView& tb) const noexcept;
   void brute_vertex_faces(Worker& w, std::uint32_t i) const noexcept;
   void brute_edge_edges(Worker& w, std::uint32_t i) const noexcept;
+  /// Builds orphan_vf / orphan_ee from the topology (construction; allocates, may throw).
+  void build_orphan_sets();
+  /// Tests every orphan feature pair (filters, then the elementary test).
+  void test_orphans(Worker& w) const noexcept;
   /// Intra-cluster work of cluster c1 and its pairs with every cluster c2 > c1.
   bool cluster_tasks(Worker& w, std::uint32_t c1, bool count_skips) const noexcept;
   TreeView cluster_view(std::uint32_t c) const noexcept;

@@ -32,6 +32,12 @@ inline Vec3d v3(const double* p) noexcept {
   return {p[0], p[1], p[2]};
 }
 
+inline bool share_node(const format::Triangle& a, const format::Triangle& b) noexcept {
+  for (std::uint32_t n : a)
+    if (n == b[0] || n == b[1] || n == b[2]) return true;
+  return false;
+}
+
 }  // namespace
 
 TreeView Collider::Impl::cluster_view(std::uint32_t c) const noexcept {
@@ -40,6 +46,7 @@ TreeView Collider::Impl::cluster_view(std::uint32_t c) const noexcept {
   v.nodes = asset->bvh_nodes.data() + cl.bvh_offset;
   v.leaf_tris = asset->cluster_triangles.data() + cl.triangle_offset;
   v.box = nbox.data() + cl.bvh_offset;
+  v.tri_box = tbox.data();
   v.ntris = topo->cluster_node_ntris.data() + cl.bvh_offset;
   v.nmov = nmov.data() + cl.bvh_offset;
   if (orientation_mode()) {
@@ -54,6 +61,7 @@ TreeView Collider::Impl::global_view() const noexcept {
   v.nodes = gbvh.nodes.data();
   v.leaf_tris = gbvh.leaf.data();
   v.box = gbvh.box.data();
+  v.tri_box = tbox.data();
   v.ntris = gbvh.ntris.data();
   v.nmov = gbvh.mov.data();
   if (opt.mode == ColliderMode::kCone && !rest_mode) v.cone = &cone;
@@ -77,7 +85,65 @@ bool Collider::Impl::non_culled(std::uint32_t t1, std::uint32_t t2) const noexce
     const std::uint8_t c = tcls[t1];
     if (c != kUnc && c == tcls[t2]) return false;
   }
+  if (skip_adjacent && !rest_mode && share_node(tris[t1], tris[t2])) return false;
   return true;
+}
+
+void Collider::Impl::build_orphan_sets() {
+  const BodyShape::Data& T = *topo;
+  orphan_vf.clear();
+  orphan_ee.clear();
+  std::vector<std::uint32_t> near, candidates;
+  // Appends the triangles sharing a node with triangle t (t included).
+  auto gather_near = [&](std::uint32_t t) {
+    for (std::uint32_t n : tris[t]) {
+      const std::uint32_t i = T.surf_index[n];
+      near.insert(near.end(), T.vt_list.begin() + T.vt_offset[i],
+                  T.vt_list.begin() + T.vt_offset[i + 1]);
+    }
+  };
+  auto sort_unique = [](std::vector<std::uint32_t>& v) {
+    std::sort(v.begin(), v.end());
+    v.erase(std::unique(v.begin(), v.end()), v.end());
+  };
+  // Vertex-face (p, F), p not in F: every triangle around p shares a node with F. Such an F
+  // shares a node with a triangle around p, so it is among their neighbours.
+  for (std::uint32_t ip = 0; ip < T.surf_nodes.size(); ++ip) {
+    const std::uint32_t p = T.surf_nodes[ip];
+    near.clear();
+    for (std::uint32_t k = T.vt_offset[ip]; k < T.vt_offset[ip + 1]; ++k) gather_near(T.vt_list[k]);
+    sort_unique(near);
+    for (std::uint32_t f : near) {
+      const auto& F = tris[f];
+      if (p == F[0] || p == F[1] || p == F[2]) continue;
+      bool all_adjacent = true;
+      for (std::uint32_t k = T.vt_offset[ip]; k < T.vt_offset[ip + 1] && all_adjacent; ++k)
+        all_adjacent = share_node(tris[T.vt_list[k]], F);
+      if (all_adjacent) orphan_vf.push_back({p, f});
+    }
+  }
+  // Edge-edge (e1, e2), four distinct nodes: every triangle around e1 shares a node with every
+  // triangle around e2. e2 is an edge of a triangle sharing a node with one around e1.
+  const std::uint32_t ne = static_cast<std::uint32_t>(T.edges.size());
+  for (std::uint32_t e1 = 0; e1 < ne; ++e1) {
+    near.clear();
+    for (std::uint32_t k = T.et_offset[e1]; k < T.et_offset[e1 + 1]; ++k) gather_near(T.et_list[k]);
+    candidates.clear();
+    for (std::uint32_t t : near)
+      for (std::uint32_t e2 : T.tri_edges[t])
+        if (e2 > e1) candidates.push_back(e2);
+    sort_unique(candidates);
+    const auto& E1 = T.edges[e1];
+    for (std::uint32_t e2 : candidates) {
+      const auto& E2 = T.edges[e2];
+      if (E1[0] == E2[0] || E1[0] == E2[1] || E1[1] == E2[0] || E1[1] == E2[1]) continue;
+      bool all_adjacent = true;
+      for (std::uint32_t k1 = T.et_offset[e1]; k1 < T.et_offset[e1 + 1] && all_adjacent; ++k1)
+        for (std::uint32_t k2 = T.et_offset[e2]; k2 < T.et_offset[e2 + 1] && all_adjacent; ++k2)
+          all_adjacent = share_node(tris[T.et_list[k1]], tris[T.et_list[k2]]);
+      if (all_adjacent) orphan_ee.push_back({e1, e2});
+    }
+  }
 }
 
 bool Collider::Impl::orientation_culled(std::uint32_t t1, std::uint32_t t2) const noexcept {
@@ -119,8 +185,8 @@ void process_vertex_face(Worker& w, const Collider::Impl& P, std::uint32_t p,
   ++w.stats.feature_pairs;
   if (ms <= 0) {
     // Coplanarity cubic det[b-a, c-a, p-a] with a proven strict sign: never coplanar.
-    const Orientation o = classify_orientation(F.pos0(f[0]), F.pos0(f[1]), F.pos0(f[2]), P.pos0(p),
-                                               F.pos1(f[0]), F.pos1(f[1]), F.pos1(f[2]), P.pos1(p));
+    const Orientation o = orientation_of(F.pos0(f[0]), F.pos0(f[1]), F.pos0(f[2]), P.pos0(p),
+                                         F.pos1(f[0]), F.pos1(f[1]), F.pos1(f[2]), P.pos1(p));
     if (o != Orientation::kUncertain) {
       ++w.stats.feature_pairs_filtered;
       return;
@@ -162,8 +228,8 @@ void process_edge_edge(Worker& w, const Collider::Impl& A, std::uint32_t e1,
   ++w.stats.feature_pairs;
   if (ms <= 0) {
     // det[b-a, d-c, c-a] = det[b-a, d-a, c-a]: orientation of (a; b, d, c).
-    const Orientation o = classify_orientation(A.pos0(a), A.pos0(b), B.pos0(d), B.pos0(c),
-                                               A.pos1(a), A.pos1(b), B.pos1(d), B.pos1(c));
+    const Orientation o = orientation_of(A.pos0(a), A.pos0(b), B.pos0(d), B.pos0(c), A.pos1(a),
+                                         A.pos1(b), B.pos1(d), B.pos1(c));
     if (o != Orientation::kUncertain) {
       ++w.stats.feature_pairs_filtered;
       return;
@@ -190,9 +256,27 @@ void process_edge_edge(Worker& w, const Collider::Impl& A, std::uint32_t e1,
 
 // Triangle-pair plane filter of triangle t1 of A and t2 of B (plane_filter.hpp; exact
 // contact only; docs/runtime.md, "Triangle-pair plane filter").
-bool plane_separated(const Collider::Impl& A, std::uint32_t t1, const Collider::Impl& B,
+// Within one body whose own worker `w` runs the traversal, each triangle's plane minors are
+// computed once per step, at first use, in w's cache; else per pair. Same answer either way
+// (bitwise: the same operations in the same order).
+bool plane_separated(Worker& w, const Collider::Impl& A, std::uint32_t t1, const Collider::Impl& B,
                      std::uint32_t t2) noexcept {
-  return plane_separated({A.tris[t1], A.x0, A.x1}, {B.tris[t2], B.x0, B.x1}, &A == &B);
+  const bool same = &A == &B;
+  const bool cache = same && w.plane_owner == &A;
+  auto cached = [&](std::uint32_t t) {
+    if (w.plane_step[t] != A.step_serial) {
+      const auto& f = A.tris[t];
+      w.plane[t] = FacePlaneMinors::of(A.pos0(f[0]), A.pos0(f[1]), A.pos0(f[2]), A.pos1(f[0]),
+                                       A.pos1(f[1]), A.pos1(f[2]));
+      w.plane_step[t] = A.step_serial;
+    }
+    return &w.plane[t];
+  };
+  MovingTriangle m1{A.tris[t1], A.x0, A.x1, cache ? cached(t1) : nullptr};
+  MovingTriangle m2{B.tris[t2], B.x0, B.x1};
+  if (nodes_strictly_on_one_side(m1, m2, same)) return true;  // plane_separated, in two steps
+  if (cache) m2.minors = cached(t2);
+  return nodes_strictly_on_one_side(m2, m1, same);
 }
 
 // Tests the feature pairs of triangle t1 of A and t2 of B (t1 != t2 within one body):
@@ -204,13 +288,12 @@ void test_features(Worker& w, const Collider::Impl& A, std::uint32_t t1, const C
                    std::uint32_t t2, Claimed&& claimed) noexcept {
   const double ms = A.opt.ccd.min_separation;
   // The plane filter runs once per pair: first thing without orientation culling (bvh and
-  // cone modes, surface-only bodies, pairs of bodies: most non-culled pairs are neighbours it
-  // drops), else lazily when the first feature pair passes its box checks (measured:
-  // docs/benchmarks.md, "Scenes and the shared core").
+  // cone modes, surface-only bodies, pairs of bodies), else lazily when the first feature pair
+  // passes its box checks (measured both ways per mode: docs/benchmarks.md, "Per-pair work").
   int plane = ms <= 0 ? -1 : 0;  // -1 unknown, 0 not separated, 1 separated
   auto separated = [&]() {
     if (plane < 0) {
-      plane = plane_separated(A, t1, B, t2) ? 1 : 0;
+      plane = plane_separated(w, A, t1, B, t2) ? 1 : 0;
       w.stats.triangle_pairs_plane_filtered += plane;
     }
     return plane == 1;
@@ -282,6 +365,14 @@ void Collider::Impl::process_triangle_pair(Worker& w, std::uint32_t t1,
   }
   ++w.stats.triangle_pairs;
   const std::uint64_t key = pair_key(t1, t2);
+  if (skip_adjacent) {
+    // Static ownership (whole-surface modes): the smallest node-disjoint pair holding a feature
+    // pair owns it, whatever its boxes (docs/runtime.md, "Adjacent triangle pairs").
+    test_features(w, *this, t1, *this, t2, [&](std::uint32_t u, std::uint32_t v) {
+      return pair_key(u, v) < key && !share_node(tris[u], tris[v]);
+    });
+    return;
+  }
   test_features(w, *this, t1, *this, t2, [&](std::uint32_t u, std::uint32_t v) {
     return pair_key(u, v) < key && non_culled(u, v);
   });
@@ -327,16 +418,19 @@ void Collider::Impl::close_contacts(Worker& w, double toi) noexcept {
   for (std::uint32_t t : closure_ring) closure_mark[t] = 0;
 }
 
-// Calls `triangle_pair(t1, t2)` for every triangle pair of leaf a of ta and leaf b of tb.
+// Calls `triangle_pair(t1, t2)` for every triangle pair of leaf a of ta and leaf b of tb
+// except those whose t1's swept box misses leaf b's box (margin ms): their triangle boxes are
+// disjoint too, which every triangle-pair predicate rejects.
 template <typename TrianglePair>
 inline void leaf_pair(Worker& w, const TreeView& ta, std::uint32_t a, const TreeView& tb,
-                      std::uint32_t b, TrianglePair&& triangle_pair) noexcept {
+                      std::uint32_t b, double ms, TrianglePair&& triangle_pair) noexcept {
   const format::BvhNode& na = ta.nodes[a];
   const format::BvhNode& nb = tb.nodes[b];
   for (std::uint32_t i = 0; i < na.count && !w.stop; ++i) {
-    for (std::uint32_t j = 0; j < nb.count && !w.stop; ++j) {
-      triangle_pair(ta.leaf_tris[na.first + i], tb.leaf_tris[nb.first + j]);
-    }
+    const std::uint32_t t1 = ta.leaf_tris[na.first + i];
+    if (nb.count > 1 && !boxes_overlap(ta.tri_box[t1], tb.box[b], ms)) continue;
+    for (std::uint32_t j = 0; j < nb.count && !w.stop; ++j)
+      triangle_pair(t1, tb.leaf_tris[nb.first + j]);
   }
 }
 
@@ -344,9 +438,10 @@ inline void leaf_pair(Worker& w, const TreeView& ta, std::uint32_t a, const Tree
 // are pushed. False when the stack has no room.
 template <typename Live, typename TrianglePair>
 inline bool descend_pair(Worker& w, const TreeView& ta, const TreeView& tb, const StackItem& it,
-                         Live&& live, TrianglePair&& triangle_pair, std::size_t& top) noexcept {
+                         double ms, Live&& live, TrianglePair&& triangle_pair,
+                         std::size_t& top) noexcept {
   if (ta.nodes[it.a].count > 0 && tb.nodes[it.b].count > 0) {
-    leaf_pair(w, ta, it.a, tb, it.b, triangle_pair);
+    leaf_pair(w, ta, it.a, tb, it.b, ms, triangle_pair);
     return true;
   }
   if (top + 2 > w.stack.size()) return false;
@@ -369,7 +464,7 @@ bool traverse_tree_pair(Worker& w, const TreeView& ta, const TreeView& tb, doubl
   while (top > 0 && !w.stop) {
     const StackItem it = w.stack[--top];
     ++w.stats.node_pairs_visited;
-    if (!descend_pair(w, ta, tb, it, live, triangle_pair, top)) return false;
+    if (!descend_pair(w, ta, tb, it, ms, live, triangle_pair, top)) return false;
   }
   return true;
 }
@@ -455,9 +550,16 @@ bool Collider::Impl::traverse_self(Worker& w, const TreeView& t) const noexcept 
       w.stack[top++] = {nd.first, kNone};
       continue;
     }
-    if (!descend_pair(w, t, t, it, live_pair, self_pair, top)) return false;
+    if (!descend_pair(w, t, t, it, ms, live_pair, self_pair, top)) return false;
   }
   return true;
+}
+
+void Collider::Impl::test_orphans(Worker& w) const noexcept {
+  for (std::size_t i = 0; i < orphan_vf.size() && !w.stop; ++i)
+    process_vertex_face(w, *this, orphan_vf[i][0], *this, orphan_vf[i][1]);
+  for (std::size_t i = 0; i < orphan_ee.size() && !w.stop; ++i)
+    process_edge_edge(w, *this, orphan_ee[i][0], *this, orphan_ee[i][1]);
 }
 
 void Collider::Impl::brute_vertex_faces(Worker& w, std::uint32_t i) const noexcept {
@@ -522,6 +624,7 @@ bool Collider::Impl::run_query(Contact* out, std::size_t out_cap) noexcept {
     const std::int64_t ne = static_cast<std::int64_t>(topo->edges.size());
     if (global_bvh_active()) {
       if (tri_count > 0 && !traverse_self(w0, global_view())) w0.overflow = true;
+      if (skip_adjacent && !rest_mode && !w0.overflow) test_orphans(w0);
     } else if (opt.mode == ColliderMode::kBrute && !rest_mode) {
 #if defined(TETSEG_HAVE_OPENMP)
       if (parallel) {

@@ -13,8 +13,9 @@
 // is a simple curve, so each point of the plane has at most one preimage (the count equals
 // the winding number of the boundary image): the patch is embedded at every t and no two
 // distinct points of it touch, i.e. no feature pair inside it (four distinct nodes) makes
-// contact. Pairs across nodes are traversed as in the kBvh mode, and adjacent triangle pairs
-// are never skipped outside culled nodes, so the same elementary tests find every contact.
+// contact. Pairs across nodes are traversed as in the kBvh mode (triangle pairs sharing a
+// node skipped there, their orphan feature pairs tested every step: docs/runtime.md, "Adjacent
+// triangle pairs"), so the same elementary tests find every contact.
 // (2) is checked conservatively per pair of boundary edges: non-adjacent edges must have
 // disjoint swept 2D boxes or be separated by the line of one of them for the whole step
 // (quadratic Bernstein coefficients of the side test with a strict sign); adjacent edges must

@@ -75,7 +75,57 @@ inline BernsteinCubic bernstein(const V3& u0, const V3& u1, const Minors& m00, c
   return r;
 }
 
+/// The sign of a cubic proven by its four Bernstein coefficients (sign_of in classify.cpp).
+inline Orientation sign(const BernsteinCubic& c) noexcept {
+  // Written so that NaN coefficients or bounds fail every comparison: uncertain.
+  bool positive = true, negative = true;
+  for (int i = 0; i < 4; ++i) {
+    positive = positive && (c.k[i] > c.err[i]);
+    negative = negative && (c.k[i] < -c.err[i]);
+  }
+  if (positive) return Orientation::kPositive;
+  if (negative) return Orientation::kNegative;
+  return Orientation::kUncertain;
+}
+
+/// orientation_bernstein, inline.
+inline BernsteinCubic cubic(const double* o0, const double* a0, const double* b0, const double* c0,
+                            const double* o1, const double* a1, const double* b1,
+                            const double* c1) noexcept {
+  const V3 v0 = sub(b0, o0), w0 = sub(c0, o0), v1 = sub(b1, o1), w1 = sub(c1, o1);
+  return bernstein(sub(a0, o0), sub(a1, o1), minors(v0, w0), minors(v1, w0), minors(v0, w1),
+                   minors(v1, w1));
+}
+
 }  // namespace orientation_detail
+
+/// classify_orientation, inline (the runtime's hot loops: classification, feature filters).
+inline Orientation orientation_of(const double* o0, const double* a0, const double* b0,
+                                  const double* c0, const double* o1, const double* a1,
+                                  const double* b1, const double* c1) noexcept {
+  using namespace orientation_detail;
+  return sign(cubic(o0, a0, b0, c0, o1, a1, b1, c1));
+}
+
+/// The four minor sets of a moving triangle's edge vectors b - a, c - a (start, end and
+/// crossed): everything of its plane that does not depend on the point tested. A collider
+/// computes them once per triangle and step (refit) and shares them read-only.
+struct FacePlaneMinors {
+  orientation_detail::Minors m00, m10, m01, m11;
+  static FacePlaneMinors of(const double* a0, const double* b0, const double* c0, const double* a1,
+                            const double* b1, const double* c1) noexcept {
+    using namespace orientation_detail;
+    const V3 v0 = sub(b0, a0), w0 = sub(c0, a0), v1 = sub(b1, a1), w1 = sub(c1, a1);
+    return {minors(v0, w0), minors(v1, w0), minors(v0, w1), minors(v1, w1)};
+  }
+  /// Bitwise `classify_orientation(a0, p0, b0, c0, a1, p1, b1, c1)` for the triangle (a, b, c)
+  /// these minors were computed from: the sign of det[b - a, c - a, p - a] over the step.
+  Orientation side(const double* a0, const double* a1, const double* p0,
+                   const double* p1) const noexcept {
+    using namespace orientation_detail;
+    return sign(bernstein(sub(p0, a0), sub(p1, a1), m00, m10, m01, m11));
+  }
+};
 
 /// The plane of a moving triangle (a, b, c) over a step, prepared for the sides of many points:
 /// `side(p0, p1)` is bitwise `classify_orientation(a0, p0, b0, c0, a1, p1, b1, c1)`, the sign
@@ -84,23 +134,15 @@ class FacePlane {
  public:
   FacePlane(const double* a0, const double* b0, const double* c0, const double* a1,
             const double* b1, const double* c1) noexcept
-      : a0_(a0), a1_(a1) {
-    using namespace orientation_detail;
-    const V3 v0 = sub(b0, a0), w0 = sub(c0, a0), v1 = sub(b1, a1), w1 = sub(c1, a1);
-    m00_ = minors(v0, w0);
-    m10_ = minors(v1, w0);
-    m01_ = minors(v0, w1);
-    m11_ = minors(v1, w1);
-  }
+      : a0_(a0), a1_(a1), minors_(FacePlaneMinors::of(a0, b0, c0, a1, b1, c1)) {}
   Orientation side(const double* p0, const double* p1) const noexcept {
-    using namespace orientation_detail;
-    return sign_of(bernstein(sub(p0, a0_), sub(p1, a1_), m00_, m10_, m01_, m11_));
+    return minors_.side(a0_, a1_, p0, p1);
   }
 
  private:
   const double* a0_;
   const double* a1_;
-  orientation_detail::Minors m00_, m10_, m01_, m11_;
+  FacePlaneMinors minors_;
 };
 
 }  // namespace tetseg

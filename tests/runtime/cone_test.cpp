@@ -9,6 +9,7 @@
 #include <catch2/catch.hpp>
 
 #include "support/compare.hpp"
+#include "tetseg/runtime/body_shape.hpp"
 #include "tetseg/runtime/collider.hpp"
 #include "tetseg/testing/synthetic_scenes.hpp"
 
@@ -114,6 +115,45 @@ TEST_CASE("Normal-cone mode lists every contact of two poles meeting head on",
   const auto frames = make_frames(scene, 16, press_poles_head_on);
   const ConeReport r = compare_cone(scene, frames);
   CHECK(r.contact_steps == 1);
+}
+
+TEST_CASE("Whole-surface modes find contacts of feature pairs held only by adjacent triangles",
+          "[collider][cone][orphan]") {
+  // A tetrahedron's surface: every two of its triangles share a node, so bvh and cone examine
+  // no triangle pair and every feature pair (a vertex against the opposite face, two opposite
+  // edges) is an orphan, tested directly. Motions: the apex pushed through the base, and the
+  // tetrahedron flattened until two opposite edges cross.
+  const std::uint32_t tris[] = {0, 2, 1, 0, 1, 3, 1, 2, 3, 2, 0, 3};
+  const auto shape = BodyShape::from_triangles(tris, 4, 4);
+  REQUIRE(shape);
+  const std::vector<double> start = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0.3, 0.3, 1};
+  const std::vector<std::vector<double>> ends = {
+      {0, 0, 0, 1, 0, 0, 0, 1, 0, 0.25, 0.3, -1},        // apex through the base
+      {0, 0, 0, 1, 0, 0, 0.1, 1, 0.2, 0.9, 0.8, -0.6}};  // edge 2-3 crosses edge 0-1
+  for (const auto& end : ends) {
+    std::vector<StepAnswer> answers;
+    for (ColliderMode mode : {ColliderMode::kBrute, ColliderMode::kBvh, ColliderMode::kCone}) {
+      ColliderOptions options;
+      options.mode = mode;
+      Collider collider(shape, options);
+      REQUIRE(collider.status() == ColliderStatus::kOk);
+      answers.push_back(answer(collider, start.data(), end.data()));
+      if (mode != ColliderMode::kBrute) CHECK(collider.stats().triangle_pairs == 0);
+    }
+    const StepAnswer& b = answers[0];
+    REQUIRE(b.any);
+    for (std::size_t m = 1; m < answers.size(); ++m) {
+      const StepAnswer& a = answers[m];
+      CAPTURE(m);
+      REQUIRE(a.contacts.size() == b.contacts.size());
+      for (std::size_t i = 0; i < b.contacts.size(); ++i) {
+        CAPTURE(describe(b.contacts[i]));
+        CHECK(same_feature(a.contacts[i], b.contacts[i]));
+        CHECK(a.contacts[i].toi == b.contacts[i].toi);
+      }
+      CHECK(a.earliest.contact.toi == b.earliest.contact.toi);
+    }
+  }
 }
 
 }  // namespace tetseg::test
