@@ -188,8 +188,8 @@ class PyScene {
     }
     check(m_scene->set_positions(b, p0, p1, std::size_t(record.node_count) * 3), "set_positions",
           "");
-    // The scene reads them at every step until replaced. The current step still reads the
-    // arrays it started with (now unreferenced): no query before the next step.
+    // The scene reads them at every step until replaced. set_positions ends the current step
+    // (the runtime answers kNoStep); the binding names the reason in its error.
     record.x0 = x0;
     record.x1 = x1;
     m_queries.invalidated("set_positions gave new positions: call step() first");
