@@ -273,7 +273,7 @@ void add_build_command(CLI::App& root) {
   cmd->add_flag("--no-rest-positions", args->no_rest_positions,
                 "Do not store rest positions in the asset (smaller; tools cannot draw it)");
   cmd->add_flag("-q,--quiet", args->quiet, "No stage lines");
-  cmd->callback([args] { run_build(*args); });
+  cmd->callback([args] { run_naming_file(args->input, [&] { run_build(*args); }); });
 }
 
 }  // namespace tetseg::tools

@@ -271,7 +271,7 @@ void add_charge_command(CLI::App& root) {
       ->option_text(preprocess::name_list<preprocess::Equalization>() + " (histogram)");
   cmd->add_option("--bins", args->bins, "Histogram bins")->check(CLI::Range(1, 1 << 20));
   cmd->add_option("--report", args->report, "Write a JSON report (solver, iterations, times)");
-  cmd->callback([args] { run_charge(*args); });
+  cmd->callback([args] { run_naming_file(args->input, [&] { run_charge(*args); }); });
 }
 
 }  // namespace tetseg::tools

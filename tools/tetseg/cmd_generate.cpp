@@ -204,7 +204,7 @@ void add_generate_command(CLI::App& root) {
       ->expected(3)
       ->check(CLI::PositiveNumber);
   mesh_cli::add_meshing_options(*cmd, args->meshing, args->msh);
-  cmd->callback([args] { run_generate(*args); });
+  cmd->callback([args] { run_naming_file(args->output, [&] { run_generate(*args); }); });
 }
 
 }  // namespace tetseg::tools

@@ -59,7 +59,7 @@ void add_tetrahedralize_command(CLI::App& root) {
       ->required();
   mesh_cli::add_meshing_options(*cmd, args->meshing, args->msh);
   mesh_cli::add_repair_option(*cmd, args->meshing);
-  cmd->callback([args] { run_tetrahedralize(*args); });
+  cmd->callback([args] { run_naming_file(args->input, [&] { run_tetrahedralize(*args); }); });
 }
 
 }  // namespace tetseg::tools

@@ -5,10 +5,13 @@
 /// (main maps them to exit codes). One file per subcommand: cmd_<name>.cpp.
 
 #include <CLI/CLI.hpp>
+#include <exception>
+#include <new>
 #include <string>
 
 #include "tetseg/preprocess/mesh.hpp"
 #include "tetseg/preprocess/meshing.hpp"
+#include "tool_support.hpp"
 
 namespace tetseg::tools {
 
@@ -16,6 +19,28 @@ void add_generate_command(CLI::App& root);
 void add_tetrahedralize_command(CLI::App& root);
 void add_charge_command(CLI::App& root);
 void add_build_command(CLI::App& root);
+
+/// Runs `command`. An exception that names no file (a CGAL, Eigen or assimp failure, out of
+/// memory) becomes ToolError(kExitProcessingFailed) naming `file`, so a failure of any stage
+/// names the input it failed on; ToolError, InputError, OutputError and CLI errors pass as is.
+template <typename Command>
+void run_naming_file(const std::string& file, Command&& command) {
+  try {
+    command();
+  } catch (const ToolError&) {
+    throw;
+  } catch (const preprocess::InputError&) {
+    throw;
+  } catch (const preprocess::OutputError&) {
+    throw;
+  } catch (const CLI::Error&) {
+    throw;
+  } catch (const std::bad_alloc&) {
+    throw ToolError(kExitProcessingFailed, file, "out of memory");
+  } catch (const std::exception& e) {
+    throw ToolError(kExitProcessingFailed, file, std::string("processing failed: ") + e.what());
+  }
+}
 
 /// Helpers shared by the commands that write tet meshes (defined in cmd_generate.cpp).
 namespace mesh_cli {
