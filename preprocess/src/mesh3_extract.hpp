@@ -12,6 +12,7 @@
 
 #include <cmath>
 #include <limits>
+#include <string>
 #include <unordered_map>
 
 #include "meshing_internal.hpp"
@@ -121,8 +122,15 @@ C3t3 run_mesh_3(const Domain& domain, const Criteria& criteria, const Mesh3Crite
   const auto exude = options.optimize && options.exude
                          ? params::exude(params::time_limit = 0, params::sliver_bound = 0)
                          : params::no_exude();
-  return CGAL::make_mesh_3<C3t3>(domain, criteria, params::no_odt(), params::no_lloyd(), perturb,
-                                 exude, params::manifold());
+  CGAL::Mesh_error_code error = CGAL::CGAL_MESH_3_NO_ERROR;
+  C3t3 c3t3 = CGAL::make_mesh_3<C3t3>(
+      domain, criteria, params::no_odt(), params::no_lloyd(), perturb, exude, params::manifold(),
+      params::mesh_3_options(params::maximal_number_of_vertices = options.max_vertices,
+                             params::pointer_to_error_code = &error));
+  if (error == CGAL::CGAL_MESH_3_MAXIMAL_NUMBER_OF_VERTICES_REACHED)
+    throw MeshingBudgetExceeded("refinement reached " + std::to_string(options.max_vertices) +
+                                " vertices without meeting the criteria");
+  return c3t3;
 }
 
 }  // namespace tetseg::preprocess::detail

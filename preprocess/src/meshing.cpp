@@ -24,6 +24,13 @@ constexpr double kFacetDistanceRatio = 0.1;
 /// Meshing sizes below diagonal / kMaxDiagonalPerSize are refused (10^5 facets along the
 /// diagonal: hundreds of millions of tets, or refinement that never ends).
 constexpr double kMaxDiagonalPerSize = 1e5;
+/// Vertex budget of Mesh_3 on a surface: kBudgetFactor times the vertices of a mesh with the
+/// criteria's sizes filling the bounding-box diagonal's cube, (D/cell)^3 + 6 (D/facet)^2, and
+/// at least kMinBudget. Real meshes use under 2 % of it at default sizes (elephant 2.4k
+/// vertices, cube_quad 11k of 589k). It stops runaway refinement; it cannot stop a loop that
+/// inserts nothing (colored_tetra.ply, docs/benchmarks.md).
+constexpr double kBudgetFactor = 8.0;
+constexpr double kMinBudget = 200000.0;
 /// The smallest --wrap-alpha and --wrap-offset, as fractions of the diagonal.
 constexpr double kMinWrapFraction = 1e-4;
 
@@ -106,6 +113,13 @@ TetMesh generate_shape(Shape shape, const ShapeOptions& shape_options,
 
 namespace {
 
+std::size_t vertex_budget(const detail::Mesh3Criteria& criteria, double diagonal) {
+  const double per_cell = diagonal / criteria.cell_size;
+  const double per_facet = diagonal / criteria.facet_size;
+  const double estimate = per_cell * per_cell * per_cell + 6.0 * per_facet * per_facet;
+  return static_cast<std::size_t>(std::min(std::max(kBudgetFactor * estimate, kMinBudget), 1e12));
+}
+
 /// Runs one CGAL Mesh_3 call; whatever CGAL throws becomes an InputError naming the file and
 /// the stage.
 TetMesh run_mesh_3_guarded(const TriangleMesh& input, const detail::Mesh3Criteria& criteria,
@@ -126,6 +140,12 @@ TetMesh run_mesh_3_guarded(const TriangleMesh& input, const detail::Mesh3Criteri
   } catch (const InputError&) {
     remove_new_dumps();
     throw;
+  } catch (const detail::MeshingBudgetExceeded& e) {
+    remove_new_dumps();
+    throw InputError(file, std::string("tetrahedralize: CGAL Mesh_3 did not converge: ") +
+                               e.what() +
+                               " (sharp corners or needle-thin parts that its manifold "
+                               "refinement cannot resolve); try --repair wrap");
   } catch (const std::bad_alloc&) {
     throw InputError(file,
                      "tetrahedralize: out of memory in CGAL Mesh_3 (is the facet size "
@@ -154,8 +174,7 @@ TetMesh mesh_closed_surface(const TriangleMesh& input, const MeshingOptions& mes
   const double diagonal = bounding_box_diagonal(input.vertices);
   // Criteria are checked before CGAL sees them: every size finite and positive, and not so
   // small against the surface that refinement could never end (kMaxDiagonalPerSize).
-  const detail::Mesh3Criteria criteria =
-      resolve(meshing, default_facet_size_for_diagonal(diagonal));
+  detail::Mesh3Criteria criteria = resolve(meshing, default_facet_size_for_diagonal(diagonal));
   if (!(diagonal > 0.0) || !std::isfinite(diagonal))
     throw InputError(file, "tetrahedralize: the surface has no extent");
   for (const double size : {criteria.facet_size, criteria.cell_size, criteria.facet_distance})
@@ -164,6 +183,7 @@ TetMesh mesh_closed_surface(const TriangleMesh& input, const MeshingOptions& mes
                                  std::to_string(static_cast<long>(kMaxDiagonalPerSize)) +
                                  " of the bounding-box diagonal (" + std::to_string(diagonal) +
                                  "); give larger --facet-size / --cell-size / --facet-distance");
+  criteria.max_vertices = vertex_budget(criteria, diagonal);
   TetMesh mesh = run_mesh_3_guarded(input, criteria, file);
   if (mesh.tets.empty())
     throw InputError(file,

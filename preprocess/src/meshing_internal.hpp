@@ -2,6 +2,9 @@
 // Private interface between meshing.cpp (options, rules; no CGAL) and the two CGAL Mesh_3
 // translation units (mesh3_implicit.cpp, mesh3_polyhedral.cpp).
 
+#include <cstddef>
+#include <stdexcept>
+
 #include "tetseg/preprocess/meshing.hpp"
 
 namespace tetseg::preprocess::detail {
@@ -16,6 +19,16 @@ struct Mesh3Criteria {
   bool optimize = true;  ///< false: neither optimiser runs
   bool perturb = true;   ///< with optimize: sliver perturbation
   bool exude = true;     ///< with optimize: sliver exudation
+  /// Refinement stops and MeshingBudgetExceeded is thrown once the triangulation has this
+  /// many vertices (0: no limit). Mesh_3's manifold refinement does not always terminate
+  /// (sharp corners without feature protection); the budget turns that into an error.
+  std::size_t max_vertices = 0;
+};
+
+/// Thrown by the Mesh_3 calls when refinement reached Mesh3Criteria::max_vertices.
+class MeshingBudgetExceeded : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
 };
 
 /// Mesh_3 on the implicit function of `shape`. Returns compacted, positively oriented tets.
