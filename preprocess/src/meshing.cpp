@@ -336,7 +336,7 @@ TetMesh tetrahedralize(const TriangleMesh& surface, const MeshingOptions& meshin
   TetMesh mesh;
   if (meshing.repair == Repair::kFix) {
     TriangleMesh fixed = surface;
-    out_notes.repairs = detail::repair_soup(fixed);
+    out_notes.repairs = detail::repair_soup(fixed, meshing.keep_largest_component);
     if (fixed.triangles.empty())
       throw InputError(file, "tetrahedralize: no triangle is left after repair");
     mesh = validate_and_mesh(fixed, meshing, file, out_notes);

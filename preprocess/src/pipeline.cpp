@@ -59,6 +59,9 @@ bool refined(const BuildOptions& o) {
 bool meshed(const BuildOptions& o) {
   return o.meshing.has_value();
 }
+bool largest_component_kept(const BuildOptions& o) {
+  return o.meshing.has_value() && o.meshing->keep_largest_component;
+}
 bool wrapped(const BuildOptions& o) {
   return o.meshing.has_value() && o.meshing->repair == MeshingOptions::Repair::kWrap;
 }
@@ -198,6 +201,8 @@ const std::vector<ProvenanceField>& provenance_fields() {
       named<MeshingOptions::Repair>(
           "meshing.repair", meshed,
           [](O& o) -> MeshingOptions::Repair& { return meshing_of(o).repair; }),
+      flag("meshing.keep_largest_component", largest_component_kept,
+           [](O& o) -> bool& { return meshing_of(o).keep_largest_component; }),
       number<double>("meshing.wrap_alpha", wrapped,
                      [](O& o) -> double& { return meshing_of(o).wrap_alpha; }),
       number<double>("meshing.wrap_offset", wrapped,

@@ -14,6 +14,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <utility>
@@ -68,9 +69,53 @@ std::size_t fill_small_holes(std::vector<Point>& points, std::vector<Polygon>& p
   return filled;
 }
 
+/// Keeps the triangles of the edge-connected component of largest area (ties broken by a
+/// fixed rule, so the result is deterministic). Returns the number of components removed.
+std::size_t keep_largest_component(const std::vector<Point>& points,
+                                   std::vector<Polygon>& polygons) {
+  // Union-find over triangles; two triangles are joined when they share an edge.
+  std::vector<std::size_t> parent(polygons.size());
+  for (std::size_t i = 0; i < parent.size(); ++i) parent[i] = i;
+  const auto root = [&parent](std::size_t i) {
+    while (parent[i] != i) i = parent[i] = parent[parent[i]];
+    return i;
+  };
+  std::vector<std::pair<std::pair<std::size_t, std::size_t>, std::size_t>> edges;
+  edges.reserve(3 * polygons.size());
+  for (std::size_t t = 0; t < polygons.size(); ++t)
+    for (std::size_t k = 0; k < 3; ++k) {
+      const std::size_t a = polygons[t][k];
+      const std::size_t b = polygons[t][(k + 1) % 3];
+      edges.push_back({{std::min(a, b), std::max(a, b)}, t});
+    }
+  std::sort(edges.begin(), edges.end());
+  for (std::size_t i = 1; i < edges.size(); ++i)
+    if (edges[i].first == edges[i - 1].first)
+      parent[root(edges[i].second)] = root(edges[i - 1].second);
+  std::vector<double> area(polygons.size(), 0.0);
+  for (std::size_t t = 0; t < polygons.size(); ++t) {
+    const Point& a = points[polygons[t][0]];
+    const Point& b = points[polygons[t][1]];
+    const Point& c = points[polygons[t][2]];
+    area[root(t)] += std::sqrt(CGAL::cross_product(b - a, c - a).squared_length()) / 2.0;
+  }
+  std::size_t kept = 0;
+  std::size_t components = 0;
+  for (std::size_t t = 0; t < polygons.size(); ++t) {
+    if (root(t) != t) continue;
+    if (components++ == 0 || area[t] > area[kept]) kept = t;
+  }
+  if (components <= 1) return 0;
+  std::vector<Polygon> largest;
+  for (std::size_t t = 0; t < polygons.size(); ++t)
+    if (root(t) == kept) largest.push_back(polygons[t]);
+  polygons = std::move(largest);
+  return components - 1;
+}
+
 }  // namespace
 
-std::vector<RepairCount> repair_soup(TriangleMesh& mesh) {
+std::vector<RepairCount> repair_soup(TriangleMesh& mesh, bool keep_largest) {
   namespace pmp = CGAL::Polygon_mesh_processing;
   std::vector<RepairCount> repairs;
   auto record = [&repairs](const char* kind, std::size_t count) {
@@ -117,6 +162,8 @@ std::vector<RepairCount> repair_soup(TriangleMesh& mesh) {
   record("isolated vertices removed",
          static_cast<std::size_t>(std::count(used.begin(), used.end(), 0)));
   record("holes filled", fill_small_holes(points, polygons));
+  if (keep_largest && !polygons.empty())
+    record("smaller components removed", keep_largest_component(points, polygons));
   // Vertices no triangle uses any more are dropped (ids renumbered in order).
   std::vector<std::uint32_t> new_id(points.size(), UINT32_MAX);
   TriangleMesh repaired;

@@ -13,9 +13,11 @@ namespace tetseg::preprocess::detail {
 /// Repairs that keep the shape, in this order: triangles with a repeated corner removed,
 /// duplicate triangles (same three vertices, either orientation) merged, orientation made
 /// consistent (CGAL orient_polygon_soup: triangles flipped, non-manifold vertices
-/// duplicated), unused vertices dropped. Returns the repairs made (kind, count; kinds with a
-/// zero count are left out). Vertex ids are renumbered in order of first use.
-std::vector<RepairCount> repair_soup(TriangleMesh& mesh);
+/// duplicated), small holes filled, with `keep_largest_component` every edge-connected
+/// component but the one of largest area removed, unused vertices dropped. Returns the
+/// repairs made (kind, count; kinds with a zero count are left out). Vertex ids are
+/// renumbered in order of first use.
+std::vector<RepairCount> repair_soup(TriangleMesh& mesh, bool keep_largest_component = false);
 
 /// CGAL 3D alpha wrapping of the triangle soup `soup` (any defects; at least one triangle),
 /// with absolute `alpha` and `offset` (> 0): a closed, 2-manifold, self-intersection-free

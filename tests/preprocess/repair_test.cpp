@@ -195,3 +195,25 @@ TEST_CASE("Wrap closes holes, open surfaces and self-intersections", "[meshing][
     CHECK(notes.hausdorff_mesh_to_input < 0.02);
   }
 }
+
+TEST_CASE("--keep-largest-component drops floating debris and keeps the largest part", "[meshing][repair]") {
+  // A small cube (side 0.2) listed first, then the unit cube 2 units away: the kept component
+  // must be the unit cube by area, not the first one.
+  TriangleMesh s;
+  const TriangleMesh unit = cube();
+  for (const Vec3& p : unit.vertices)
+    s.vertices.push_back({0.2 * p[0] - 3.0, 0.2 * p[1], 0.2 * p[2]});
+  s.triangles = unit.triangles;
+  const std::uint32_t base = static_cast<std::uint32_t>(s.vertices.size());
+  for (const Vec3& p : unit.vertices) s.vertices.push_back(p);
+  for (const Tri& t : unit.triangles)
+    s.triangles.push_back({t[0] + base, t[1] + base, t[2] + base});
+  MeshingOptions options = coarse(MeshingOptions::Repair::kFix);
+  options.keep_largest_component = true;
+  TetrahedralizeNotes notes;
+  const TetMesh m = tetrahedralize(s, options, "debris.off", &notes);
+  validate_tet_mesh(m, extract_surface(m), "kept");
+  CHECK(count_of(notes, "smaller components removed") == 1);
+  CHECK(total_tet_volume(m) == Approx(1.0).epsilon(0.02));
+  for (const Vec3& p : m.nodes) CHECK(p[0] > -0.1);  // nothing of the debris is left
+}

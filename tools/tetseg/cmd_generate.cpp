@@ -112,6 +112,9 @@ void add_repair_option(CLI::App& cmd, preprocess::MeshingOptions& m) {
                  "closed and manifold for any input; docs/cli.md)")
       ->transform(CLI::CheckedTransformer(preprocess::name_map<Repair>(), CLI::ignore_case))
       ->option_text(preprocess::name_list<Repair>() + " (" + preprocess::name_of(m.repair) + ")");
+  cmd.add_flag("--keep-largest-component", m.keep_largest_component,
+               "--repair fix: keep only the connected component of largest area (drops "
+               "floating debris and stray parts)");
   cmd.add_option("--wrap-alpha", m.wrap_alpha,
                  "--repair wrap: gaps narrower than this fraction of the bounding-box diagonal "
                  "are closed")

@@ -29,6 +29,10 @@ struct MeshingOptions {
   /// from the input), as fractions of the input's bounding-box diagonal; > 0.
   double wrap_alpha = 0.02;
   double wrap_offset = 0.002;
+  /// kFix: after the other repairs, keep only the edge-connected component of largest area
+  /// (drops floating debris and stray parts); off by default, since several closed
+  /// components are a valid input.
+  bool keep_largest_component = false;
 };
 
 /// One kind of repair tetrahedralize made to its input, and how many.
