@@ -245,7 +245,27 @@ bool all_finite(const Vec3d* const* points, int count) noexcept {
   return true;
 }
 
-enum class Depth { kFilter, kFull };
+/// How much of a test to run on an interval. kFilter: boxes and the coplanarity cubic (the
+/// cheap pre-filter). kFull: every exclusion test. kCoplanarOnly: boxes and the coplanarity
+/// cubic, for an interval inside one where every inside condition was proven positive (the
+/// point strictly inside the edge planes, the closest-point parameters of both edges strictly
+/// inside (0,1)): there the other tests cannot exclude anything (their conditions are proven
+/// false), and contact happens exactly where the cubic vanishes. Any subset of the tests is
+/// sound (each is a necessary condition of contact); this one only drops useless work.
+enum class Depth { kFilter, kFull, kCoplanarOnly };
+
+/// Outcome of one interval: excluded, or open (with `inside` when every inside condition is
+/// proven strictly positive on it, so that its sub-intervals need only kCoplanarOnly).
+struct IntervalOutcome {
+  bool excluded = false;
+  bool inside = false;
+};
+
+/// True when every Bernstein sum is proven strictly positive (the polynomial > 0 on T).
+template <class I, int N>
+bool positive(const Sums<I, N>& raw) noexcept {
+  return range_of(raw).lo > 0.0;
+}
 
 /// The four points of a query at the ends of the time interval [ta, tb]: x[i][0] at ta,
 /// x[i][1] at tb.
@@ -265,34 +285,39 @@ struct VertexFaceTest {
   Separation sep;
 
   template <class I>
-  bool excluded(double ta, double tb, Depth depth) const noexcept {
+  IntervalOutcome check(double ta, double tb, Depth depth) const noexcept {
     Vec<I> x[4][2];
     positions_at<I>(x0, x1, ta, tb, x);
-    if (boxes_disjoint<I>(x, 1, x + 1, 3, sep)) return true;
+    if (boxes_disjoint<I>(x, 1, x + 1, 3, sep)) return {true, false};
 
     const Slot<I> u = difference(x[2], x[1]);  // b - a
     const Slot<I> v = difference(x[3], x[1]);  // c - a
     const Slot<I> w = difference(x[0], x[1]);  // p - a
     const double n2 = sep.zero() ? 0.0 : cross_norm2_upper(u, v);
     const Sums<I, 3> f = trilinear(u, v, w);
-    if (away_from_zero(f, sep, n2)) return true;
-    if (depth == Depth::kFilter) return false;
+    if (away_from_zero(f, sep, n2)) return {true, false};
+    if (depth != Depth::kFull) return {false, depth == Depth::kCoplanarOnly};
 
     // Edge planes (through an edge, perpendicular to the triangle): inside needs
     // n . ((b-a) x (p-a)) >= 0 and the two others.
     const Sums<I, 4> e_ab = quadrilinear(u, v, u, w);
-    if (below_minus_delta(e_ab, sep, sep.zero() ? 0.0 : mul_up(n2, norm2_upper(u)))) return true;
+    if (below_minus_delta(e_ab, sep, sep.zero() ? 0.0 : mul_up(n2, norm2_upper(u))))
+      return {true, false};
     const Slot<I> cb = difference(x[3], x[2]);
     const Slot<I> pb = difference(x[0], x[2]);
     const Sums<I, 4> e_bc = quadrilinear(u, v, cb, pb);
-    if (below_minus_delta(e_bc, sep, sep.zero() ? 0.0 : mul_up(n2, norm2_upper(cb)))) return true;
+    if (below_minus_delta(e_bc, sep, sep.zero() ? 0.0 : mul_up(n2, norm2_upper(cb))))
+      return {true, false};
     const Slot<I> ac = difference(x[1], x[3]);
     const Slot<I> pc = difference(x[0], x[3]);
     const Sums<I, 4> e_ca = quadrilinear(u, v, ac, pc);
-    if (below_minus_delta(e_ca, sep, sep.zero() ? 0.0 : mul_up(n2, norm2_upper(ac)))) return true;
-    if (!sep.zero()) return false;
-    return negative_where_coplanar(e_ab, f) || negative_where_coplanar(e_bc, f) ||
-           negative_where_coplanar(e_ca, f);
+    if (below_minus_delta(e_ca, sep, sep.zero() ? 0.0 : mul_up(n2, norm2_upper(ac))))
+      return {true, false};
+    const bool inside = positive(e_ab) && positive(e_bc) && positive(e_ca);
+    if (!sep.zero()) return {false, inside};
+    return {negative_where_coplanar(e_ab, f) || negative_where_coplanar(e_bc, f) ||
+                negative_where_coplanar(e_ca, f),
+            inside};
   }
 };
 
@@ -303,18 +328,18 @@ struct EdgeEdgeTest {
   Separation sep;
 
   template <class I>
-  bool excluded(double ta, double tb, Depth depth) const noexcept {
+  IntervalOutcome check(double ta, double tb, Depth depth) const noexcept {
     Vec<I> x[4][2];
     positions_at<I>(x0, x1, ta, tb, x);
-    if (boxes_disjoint<I>(x, 2, x + 2, 2, sep)) return true;
+    if (boxes_disjoint<I>(x, 2, x + 2, 2, sep)) return {true, false};
 
     const Slot<I> ba = difference(x[1], x[0]);
     const Slot<I> dc = difference(x[3], x[2]);
     const Slot<I> ca = difference(x[2], x[0]);
     const double n2 = sep.zero() ? 0.0 : cross_norm2_upper(ba, dc);
     const Sums<I, 3> f = trilinear(ba, dc, ca);
-    if (away_from_zero(f, sep, n2)) return true;
-    if (depth == Depth::kFilter) return false;
+    if (away_from_zero(f, sep, n2)) return {true, false};
+    if (depth != Depth::kFull) return {false, depth == Depth::kCoplanarOnly};
 
     // Planes through one edge containing the common normal n = (b-a) x (d-c): the other edge
     // strictly beyond one of them (by delta) cannot touch. With N = |n|^2:
@@ -322,16 +347,16 @@ struct EdgeEdgeTest {
     // u = h1/N in [0,1]); h3 = ((c-a) x (b-a)).n, h4 = ((b-a) x (d-a)).n, h3 + h4 = N.
     const double dc2 = sep.zero() ? 0.0 : mul_up(n2, norm2_upper(dc));
     const Sums<I, 4> h1 = quadrilinear(ca, dc, ba, dc);
-    if (below_minus_delta(h1, sep, dc2)) return true;
+    if (below_minus_delta(h1, sep, dc2)) return {true, false};
     const Slot<I> bc = difference(x[1], x[2]);
     const Sums<I, 4> h2 = quadrilinear(bc, dc, ba, dc);
-    if (below_minus_delta(h2, sep, dc2)) return true;
+    if (below_minus_delta(h2, sep, dc2)) return {true, false};
     const double ba2 = sep.zero() ? 0.0 : mul_up(n2, norm2_upper(ba));
     const Sums<I, 4> h3 = quadrilinear(ca, ba, ba, dc);
-    if (below_minus_delta(h3, sep, ba2)) return true;
+    if (below_minus_delta(h3, sep, ba2)) return {true, false};
     const Slot<I> da = difference(x[3], x[0]);
     const Sums<I, 4> h4 = quadrilinear(ba, da, ba, dc);
-    if (below_minus_delta(h4, sep, ba2)) return true;
+    if (below_minus_delta(h4, sep, ba2)) return {true, false};
 
     // Planes containing one edge and turned towards an endpoint of the other (decide parallel
     // and coplanar edges, where n vanishes): m = (b-a) x ((b-a) x (c-a)) puts c at
@@ -340,7 +365,7 @@ struct EdgeEdgeTest {
     // separation: c's distance to line ab, |(b-a) x (c-a)| / |b-a|, and d's, |(d-a).m| / |m|,
     // must both exceed delta. Same with the roles of the edges swapped.
     const Slot<I> ac = difference(x[0], x[2]);
-    if (separated_by_edge_plane(da, ba, ca) || separated_by_edge_plane(bc, dc, ac)) return true;
+    if (separated_by_edge_plane(da, ba, ca) || separated_by_edge_plane(bc, dc, ac)) return {true, false};
 
     // End caps (decide parallel edges): both points of one edge beyond the plane through an
     // endpoint of the other, perpendicular to it.
@@ -351,20 +376,24 @@ struct EdgeEdgeTest {
     const Slot<I> bd = difference(x[1], x[3]);
     // cap at a: (c-a).(a-b) > delta |a-b| and (d-a).(a-b) > delta |a-b|.
     if (above_delta(bilinear(ca, ab), sep, ab2) && above_delta(bilinear(da, ab), sep, ab2))
-      return true;
+      return {true, false};
     // cap at b: (c-b).(b-a), (d-b).(b-a), i.e. (b-c).(a-b), (b-d).(a-b).
     if (above_delta(bilinear(bc, ab), sep, ab2) && above_delta(bilinear(bd, ab), sep, ab2))
-      return true;
+      return {true, false};
     // cap at c: (a-c).(c-d), (b-c).(c-d).
     if (above_delta(bilinear(ac, cd), sep, cd2) && above_delta(bilinear(bc, cd), sep, cd2))
-      return true;
+      return {true, false};
     // cap at d: (a-d).(d-c), (b-d).(d-c), i.e. (d-a).(c-d), (d-b).(c-d).
     if (above_delta(bilinear(da, cd), sep, cd2) &&
         above_delta(bilinear(difference(x[3], x[1]), cd), sep, cd2))
-      return true;
-    if (!sep.zero()) return false;
-    return negative_where_coplanar(h1, f) || negative_where_coplanar(h2, f) ||
-           negative_where_coplanar(h3, f) || negative_where_coplanar(h4, f);
+      return {true, false};
+    // Both closest-point parameters strictly inside (0,1) on all of T (then |n| > 0): the
+    // edges touch exactly where the coplanarity cubic vanishes.
+    const bool inside = positive(h1) && positive(h2) && positive(h3) && positive(h4);
+    if (!sep.zero()) return {false, inside};
+    return {negative_where_coplanar(h1, f) || negative_where_coplanar(h2, f) ||
+                negative_where_coplanar(h3, f) || negative_where_coplanar(h4, f),
+            inside};
   }
 
   /// Plane through the edge with direction e (from point o), normal e x (e x (near - o)):
@@ -391,6 +420,7 @@ double clamp_tolerance(double tol) noexcept {
 
 struct Item {
   double ta, tb;
+  Depth depth;  ///< kFull, or kCoplanarOnly inside an interval with the inside proven
 };
 
 template <class Test>
@@ -403,8 +433,8 @@ CcdResult run_bisection(const Test& test, const CcdOptions& options) noexcept {
   }
   const bool exact_contact = test.sep.zero();
   result.intervals = 1;
-  if (!test.template excluded<Iv>(0.0, 0.0, Depth::kFull) &&
-      !(exact_contact && test.template excluded<Dd>(0.0, 0.0, Depth::kFull))) {
+  if (!test.template check<Iv>(0.0, 0.0, Depth::kFull).excluded &&
+      !(exact_contact && test.template check<Dd>(0.0, 0.0, Depth::kFull).excluded)) {
     result.outcome = CcdOutcome::kContactAtStart;
     result.toi = 0.0;
     return result;
@@ -413,7 +443,7 @@ CcdResult run_bisection(const Test& test, const CcdOptions& options) noexcept {
   const std::uint32_t max_intervals = std::max<std::uint32_t>(options.max_intervals, 1);
   Item stack[kStackSize];
   int top = 0;
-  stack[top++] = {0.0, 1.0};
+  stack[top++] = {0.0, 1.0, Depth::kFull};
   // Once a leaf has needed double-double to be excluded, the query is near-degenerate (the
   // primitives graze within rounding of doubles): from then on double-double is tried on
   // every interval doubles cannot exclude, before splitting it.
@@ -421,13 +451,15 @@ CcdResult run_bisection(const Test& test, const CcdOptions& options) noexcept {
   while (top > 0) {
     const Item item = stack[--top];
     ++result.intervals;
-    if (test.template excluded<Iv>(item.ta, item.tb, Depth::kFull)) continue;
-    if (near_degenerate && test.template excluded<Dd>(item.ta, item.tb, Depth::kFull)) continue;
+    const IntervalOutcome outcome = test.template check<Iv>(item.ta, item.tb, item.depth);
+    if (outcome.excluded) continue;
+    if (near_degenerate && test.template check<Dd>(item.ta, item.tb, item.depth).excluded)
+      continue;
     const double tm = 0.5 * item.ta + 0.5 * item.tb;
     if (item.tb - item.ta <= tol || result.intervals >= max_intervals || top + 2 > kStackSize ||
         !(tm > item.ta && tm < item.tb)) {
       if (exact_contact && !near_degenerate && result.intervals < max_intervals &&
-          test.template excluded<Dd>(item.ta, item.tb, Depth::kFull)) {
+          test.template check<Dd>(item.ta, item.tb, item.depth).excluded) {
         near_degenerate = true;
         continue;
       }
@@ -435,8 +467,9 @@ CcdResult run_bisection(const Test& test, const CcdOptions& options) noexcept {
       result.toi = item.ta;
       return result;
     }
-    stack[top++] = {tm, item.tb};
-    stack[top++] = {item.ta, tm};
+    const Depth child = outcome.inside ? Depth::kCoplanarOnly : Depth::kFull;
+    stack[top++] = {tm, item.tb, child};
+    stack[top++] = {item.ta, tm, child};
   }
   return result;
 }
@@ -446,7 +479,7 @@ CcdResult run_bisection(const Test& test, const CcdOptions& options) noexcept {
 template <typename Test>
 bool filter_may_hit(const Test& test) noexcept {
   if (!all_finite(test.x0, 4) || !all_finite(test.x1, 4)) return true;
-  return !test.template excluded<Iv>(0.0, 1.0, Depth::kFilter);
+  return !test.template check<Iv>(0.0, 1.0, Depth::kFilter).excluded;
 }
 
 }  // namespace
