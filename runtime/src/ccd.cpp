@@ -93,38 +93,35 @@ Sums<I, 2> bilinear(const Slot<I>& w1, const Slot<I>& w2) noexcept {
            dot(w1.v[1], w2.v[1])}};
 }
 
-/// (w1 x w2) . w3 (degree 3).
+/// w1 x w2 (degree 2) as Bernstein sums of vectors: c[k] sums the cross products of the ends
+/// i + j = k. Forms that share a cross product compute it once.
 template <class I>
-Sums<I, 3> trilinear(const Slot<I>& w1, const Slot<I>& w2, const Slot<I>& w3) noexcept {
-  Sums<I, 3> sum{{make<I>(0), make<I>(0), make<I>(0), make<I>(0)}};
-  for (int i = 0; i < 2; ++i) {
-    for (int j = 0; j < 2; ++j) {
-      const Vec<I> c = cross(w1.v[i], w2.v[j]);
-      for (int k = 0; k < 2; ++k) sum.s[i + j + k] = sum.s[i + j + k] + dot(c, w3.v[k]);
-    }
-  }
-  return sum;
+struct CrossSums {
+  Vec<I> c[3];
+};
+
+template <class I>
+CrossSums<I> cross_sums(const Slot<I>& w1, const Slot<I>& w2) noexcept {
+  const Vec<I> mixed0 = cross(w1.v[0], w2.v[1]);
+  const Vec<I> mixed1 = cross(w1.v[1], w2.v[0]);
+  return {{cross(w1.v[0], w2.v[0]),
+           {mixed0.x + mixed1.x, mixed0.y + mixed1.y, mixed0.z + mixed1.z},
+           cross(w1.v[1], w2.v[1])}};
 }
 
-/// (w1 x w2) . (w3 x w4) (degree 4).
+/// (w1 x w2) . w3 (degree 3), with n = w1 x w2.
 template <class I>
-Sums<I, 4> quadrilinear(const Slot<I>& w1, const Slot<I>& w2, const Slot<I>& w3,
-                        const Slot<I>& w4) noexcept {
-  Vec<I> left[2][2];
-  Vec<I> right[2][2];
-  for (int i = 0; i < 2; ++i) {
-    for (int j = 0; j < 2; ++j) {
-      left[i][j] = cross(w1.v[i], w2.v[j]);
-      right[i][j] = cross(w3.v[i], w4.v[j]);
-    }
-  }
-  Sums<I, 4> sum{{make<I>(0), make<I>(0), make<I>(0), make<I>(0), make<I>(0)}};
-  for (int i = 0; i < 2; ++i)
-    for (int j = 0; j < 2; ++j)
-      for (int k = 0; k < 2; ++k)
-        for (int l = 0; l < 2; ++l)
-          sum.s[i + j + k + l] = sum.s[i + j + k + l] + dot(left[i][j], right[k][l]);
-  return sum;
+Sums<I, 3> trilinear(const CrossSums<I>& n, const Slot<I>& w3) noexcept {
+  return {{dot(n.c[0], w3.v[0]), dot(n.c[0], w3.v[1]) + dot(n.c[1], w3.v[0]),
+           dot(n.c[1], w3.v[1]) + dot(n.c[2], w3.v[0]), dot(n.c[2], w3.v[1])}};
+}
+
+/// (w1 x w2) . (w3 x w4) (degree 4), with l = w1 x w2 and r = w3 x w4.
+template <class I>
+Sums<I, 4> quadrilinear(const CrossSums<I>& l, const CrossSums<I>& r) noexcept {
+  return {{dot(l.c[0], r.c[0]), dot(l.c[0], r.c[1]) + dot(l.c[1], r.c[0]),
+           dot(l.c[0], r.c[2]) + dot(l.c[1], r.c[1]) + dot(l.c[2], r.c[0]),
+           dot(l.c[1], r.c[2]) + dot(l.c[2], r.c[1]), dot(l.c[2], r.c[2])}};
 }
 
 /// Mid value of an enclosure, as a double.
@@ -294,23 +291,24 @@ struct VertexFaceTest {
     const Slot<I> v = difference(x[3], x[1]);  // c - a
     const Slot<I> w = difference(x[0], x[1]);  // p - a
     const double n2 = sep.zero() ? 0.0 : cross_norm2_upper(u, v);
-    const Sums<I, 3> f = trilinear(u, v, w);
+    const CrossSums<I> n = cross_sums(u, v);
+    const Sums<I, 3> f = trilinear(n, w);
     if (away_from_zero(f, sep, n2)) return {true, false};
     if (depth != Depth::kFull) return {false, depth == Depth::kCoplanarOnly};
 
     // Edge planes (through an edge, perpendicular to the triangle): inside needs
     // n . ((b-a) x (p-a)) >= 0 and the two others.
-    const Sums<I, 4> e_ab = quadrilinear(u, v, u, w);
+    const Sums<I, 4> e_ab = quadrilinear(n, cross_sums(u, w));
     if (below_minus_delta(e_ab, sep, sep.zero() ? 0.0 : mul_up(n2, norm2_upper(u))))
       return {true, false};
     const Slot<I> cb = difference(x[3], x[2]);
     const Slot<I> pb = difference(x[0], x[2]);
-    const Sums<I, 4> e_bc = quadrilinear(u, v, cb, pb);
+    const Sums<I, 4> e_bc = quadrilinear(n, cross_sums(cb, pb));
     if (below_minus_delta(e_bc, sep, sep.zero() ? 0.0 : mul_up(n2, norm2_upper(cb))))
       return {true, false};
     const Slot<I> ac = difference(x[1], x[3]);
     const Slot<I> pc = difference(x[0], x[3]);
-    const Sums<I, 4> e_ca = quadrilinear(u, v, ac, pc);
+    const Sums<I, 4> e_ca = quadrilinear(n, cross_sums(ac, pc));
     if (below_minus_delta(e_ca, sep, sep.zero() ? 0.0 : mul_up(n2, norm2_upper(ac))))
       return {true, false};
     const bool inside = positive(e_ab) && positive(e_bc) && positive(e_ca);
@@ -337,7 +335,8 @@ struct EdgeEdgeTest {
     const Slot<I> dc = difference(x[3], x[2]);
     const Slot<I> ca = difference(x[2], x[0]);
     const double n2 = sep.zero() ? 0.0 : cross_norm2_upper(ba, dc);
-    const Sums<I, 3> f = trilinear(ba, dc, ca);
+    const CrossSums<I> n = cross_sums(ba, dc);
+    const Sums<I, 3> f = trilinear(n, ca);
     if (away_from_zero(f, sep, n2)) return {true, false};
     if (depth != Depth::kFull) return {false, depth == Depth::kCoplanarOnly};
 
@@ -346,16 +345,20 @@ struct EdgeEdgeTest {
     // h1 = ((c-a) x (d-c)).n, h2 = ((b-c) x (d-c)).n, h1 + h2 = N (closest point on ab at
     // u = h1/N in [0,1]); h3 = ((c-a) x (b-a)).n, h4 = ((b-a) x (d-a)).n, h3 + h4 = N.
     const double dc2 = sep.zero() ? 0.0 : mul_up(n2, norm2_upper(dc));
-    const Sums<I, 4> h1 = quadrilinear(ca, dc, ba, dc);
+    const CrossSums<I> left1 = cross_sums(ca, dc);
+    const Sums<I, 4> h1 = quadrilinear(left1, n);
     if (below_minus_delta(h1, sep, dc2)) return {true, false};
     const Slot<I> bc = difference(x[1], x[2]);
-    const Sums<I, 4> h2 = quadrilinear(bc, dc, ba, dc);
+    const CrossSums<I> left2 = cross_sums(bc, dc);
+    const Sums<I, 4> h2 = quadrilinear(left2, n);
     if (below_minus_delta(h2, sep, dc2)) return {true, false};
     const double ba2 = sep.zero() ? 0.0 : mul_up(n2, norm2_upper(ba));
-    const Sums<I, 4> h3 = quadrilinear(ca, ba, ba, dc);
+    const CrossSums<I> left3 = cross_sums(ca, ba);
+    const Sums<I, 4> h3 = quadrilinear(left3, n);
     if (below_minus_delta(h3, sep, ba2)) return {true, false};
     const Slot<I> da = difference(x[3], x[0]);
-    const Sums<I, 4> h4 = quadrilinear(ba, da, ba, dc);
+    const CrossSums<I> left4 = cross_sums(ba, da);
+    const Sums<I, 4> h4 = quadrilinear(left4, n);
     if (below_minus_delta(h4, sep, ba2)) return {true, false};
 
     // Planes containing one edge and turned towards an endpoint of the other (decide parallel
@@ -364,8 +367,12 @@ struct EdgeEdgeTest {
     // (d-a).m = ((d-a) x (b-a)).((b-a) x (c-a)) < 0, the plane separates the edges. With a
     // separation: c's distance to line ab, |(b-a) x (c-a)| / |b-a|, and d's, |(d-a).m| / |m|,
     // must both exceed delta. Same with the roles of the edges swapped.
+    // (d-a) x (b-a) = left4 negated and (b-a) x (c-a) = left3 negated; (b-c) x (d-c) = left2
+    // and (d-c) x (a-c) = left1.
     const Slot<I> ac = difference(x[0], x[2]);
-    if (separated_by_edge_plane(da, ba, ca) || separated_by_edge_plane(bc, dc, ac)) return {true, false};
+    if (separated_by_edge_plane(left4, left3, ba, ca) ||
+        separated_by_edge_plane(left2, left1, dc, ac))
+      return {true, false};
 
     // End caps (decide parallel edges): both points of one edge beyond the plane through an
     // endpoint of the other, perpendicular to it.
@@ -398,15 +405,16 @@ struct EdgeEdgeTest {
 
   /// Plane through the edge with direction e (from point o), normal e x (e x (near - o)):
   /// true when far - o and near - o are both strictly (by delta) on the near side.
+  /// far_e = (far - o) x e and e_near = e x (near - o), or both negated.
   template <class I>
-  bool separated_by_edge_plane(const Slot<I>& far_o, const Slot<I>& e,
-                               const Slot<I>& near_o) const noexcept {
-    const Sums<I, 4> far_side = quadrilinear(far_o, e, e, near_o);
+  bool separated_by_edge_plane(const CrossSums<I>& far_e, const CrossSums<I>& e_near,
+                               const Slot<I>& e, const Slot<I>& near_o) const noexcept {
+    const Sums<I, 4> far_side = quadrilinear(far_e, e_near);
     if (sep.zero()) return range_of(far_side).hi < 0.0;
     const Range far_range = value_range(far_side);
     if (!(far_range.hi < 0.0)) return false;
     const double e2 = norm2_upper(e);
-    const Range near2 = value_range(quadrilinear(e, near_o, e, near_o));  // |e x (near-o)|^2
+    const Range near2 = value_range(quadrilinear(e_near, e_near));  // |e x (near-o)|^2
     if (!(near2.lo > 0.0) || !(mul_down(near2.lo, 1.0) > mul_up(sep.delta2, e2))) return false;
     return mul_down(far_range.hi, far_range.hi) >
            mul_up(sep.delta2, mul_up(e2, cross_norm2_upper(e, near_o)));
@@ -453,8 +461,7 @@ CcdResult run_bisection(const Test& test, const CcdOptions& options) noexcept {
     ++result.intervals;
     const IntervalOutcome outcome = test.template check<Iv>(item.ta, item.tb, item.depth);
     if (outcome.excluded) continue;
-    if (near_degenerate && test.template check<Dd>(item.ta, item.tb, item.depth).excluded)
-      continue;
+    if (near_degenerate && test.template check<Dd>(item.ta, item.tb, item.depth).excluded) continue;
     const double tm = 0.5 * item.ta + 0.5 * item.tb;
     if (item.tb - item.ta <= tol || result.intervals >= max_intervals || top + 2 > kStackSize ||
         !(tm > item.ta && tm < item.tb)) {
