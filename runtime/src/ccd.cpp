@@ -282,7 +282,8 @@ struct VertexFaceTest {
   Separation sep;
 
   template <class I>
-  IntervalOutcome check(double ta, double tb, Depth depth) const noexcept {
+  IntervalOutcome check(double ta, double tb, Depth depth,
+                        Sums<I, 3>* coplanarity = nullptr) const noexcept {
     Vec<I> x[4][2];
     positions_at<I>(x0, x1, ta, tb, x);
     if (boxes_disjoint<I>(x, 1, x + 1, 3, sep)) return {true, false};
@@ -293,6 +294,7 @@ struct VertexFaceTest {
     const double n2 = sep.zero() ? 0.0 : cross_norm2_upper(u, v);
     const CrossSums<I> n = cross_sums(u, v);
     const Sums<I, 3> f = trilinear(n, w);
+    if (coplanarity != nullptr) *coplanarity = f;
     if (away_from_zero(f, sep, n2)) return {true, false};
     if (depth != Depth::kFull) return {false, depth == Depth::kCoplanarOnly};
 
@@ -326,7 +328,8 @@ struct EdgeEdgeTest {
   Separation sep;
 
   template <class I>
-  IntervalOutcome check(double ta, double tb, Depth depth) const noexcept {
+  IntervalOutcome check(double ta, double tb, Depth depth,
+                        Sums<I, 3>* coplanarity = nullptr) const noexcept {
     Vec<I> x[4][2];
     positions_at<I>(x0, x1, ta, tb, x);
     if (boxes_disjoint<I>(x, 2, x + 2, 2, sep)) return {true, false};
@@ -337,6 +340,7 @@ struct EdgeEdgeTest {
     const double n2 = sep.zero() ? 0.0 : cross_norm2_upper(ba, dc);
     const CrossSums<I> n = cross_sums(ba, dc);
     const Sums<I, 3> f = trilinear(n, ca);
+    if (coplanarity != nullptr) *coplanarity = f;
     if (away_from_zero(f, sep, n2)) return {true, false};
     if (depth != Depth::kFull) return {false, depth == Depth::kCoplanarOnly};
 
@@ -426,9 +430,46 @@ double clamp_tolerance(double tol) noexcept {
   return min_nan(tol, 1.0);
 }
 
+/// Bernstein coefficients (not sums) of the coplanarity cubic on an interval.
+struct Cubic {
+  Iv b[4];
+};
+
+Cubic cubic_of(const Sums<Iv, 3>& f) noexcept {
+  return {{f.s[0], divide(f.s[1], 3.0), divide(f.s[2], 3.0), f.s[3]}};
+}
+
+Iv average(Iv a, Iv b) noexcept {
+  return (a + b) * exact(0.5);
+}
+
+/// De Casteljau at the midpoint: the cubic's coefficients on both halves (rigorous: each
+/// coefficient of a half is an average of averages of the enclosed coefficients).
+void split(const Cubic& c, Cubic& left, Cubic& right) noexcept {
+  const Iv b01 = average(c.b[0], c.b[1]);
+  const Iv b12 = average(c.b[1], c.b[2]);
+  const Iv b23 = average(c.b[2], c.b[3]);
+  const Iv b012 = average(b01, b12);
+  const Iv b123 = average(b12, b23);
+  const Iv mid = average(b012, b123);
+  left = {{c.b[0], b01, b012, mid}};
+  right = {{mid, b123, b23, c.b[3]}};
+}
+
+/// True when the cubic is proven of one sign on its interval.
+bool one_sign(const Cubic& c) noexcept {
+  const Sums<Iv, 3> sums{{c.b[0], c.b[1], c.b[2], c.b[3]}};
+  const Range r = range_of(sums);
+  return r.lo > 0.0 || r.hi < 0.0;
+}
+
 struct Item {
   double ta, tb;
-  Depth depth;  ///< kFull, or kCoplanarOnly inside an interval with the inside proven
+  /// kFull, or kCoplanarOnly inside an interval with the inside proven. Exact contact only:
+  /// then `cubic` holds the coplanarity cubic's coefficients on [ta, tb], subdivided from the
+  /// interval where the inside was proven, and the test is its sign (no recomputation).
+  Depth depth;
+  Cubic cubic;
 };
 
 template <class Test>
@@ -451,7 +492,7 @@ CcdResult run_bisection(const Test& test, const CcdOptions& options) noexcept {
   const std::uint32_t max_intervals = std::max<std::uint32_t>(options.max_intervals, 1);
   Item stack[kStackSize];
   int top = 0;
-  stack[top++] = {0.0, 1.0, Depth::kFull};
+  stack[top++] = {0.0, 1.0, Depth::kFull, {}};
   // Once a leaf has needed double-double to be excluded, the query is near-degenerate (the
   // primitives graze within rounding of doubles): from then on double-double is tried on
   // every interval doubles cannot exclude, before splitting it.
@@ -459,7 +500,13 @@ CcdResult run_bisection(const Test& test, const CcdOptions& options) noexcept {
   while (top > 0) {
     const Item item = stack[--top];
     ++result.intervals;
-    const IntervalOutcome outcome = test.template check<Iv>(item.ta, item.tb, item.depth);
+    const bool subdivided = exact_contact && item.depth == Depth::kCoplanarOnly;
+    Sums<Iv, 3> f{};
+    IntervalOutcome outcome{};
+    if (subdivided)
+      outcome = {one_sign(item.cubic), true};
+    else
+      outcome = test.template check<Iv>(item.ta, item.tb, item.depth, &f);
     if (outcome.excluded) continue;
     if (near_degenerate && test.template check<Dd>(item.ta, item.tb, item.depth).excluded) continue;
     const double tm = 0.5 * item.ta + 0.5 * item.tb;
@@ -475,8 +522,10 @@ CcdResult run_bisection(const Test& test, const CcdOptions& options) noexcept {
       return result;
     }
     const Depth child = outcome.inside ? Depth::kCoplanarOnly : Depth::kFull;
-    stack[top++] = {tm, item.tb, child};
-    stack[top++] = {item.ta, tm, child};
+    Cubic left{}, right{};
+    if (exact_contact && outcome.inside) split(subdivided ? item.cubic : cubic_of(f), left, right);
+    stack[top++] = {tm, item.tb, child, right};
+    stack[top++] = {item.ta, tm, child, left};
   }
   return result;
 }
