@@ -124,5 +124,9 @@ if [ -d "$funnel" ]; then
   "$tool" frames "$funnel/227.ply" "$funnel/228.ply" --brute 2>/dev/null > "$work/brute"
   [ "$(wc -l < "$work/scene")" -eq 134 ] || fail "cloth-funnel: $(wc -l < "$work/scene") contacts, expected 134"
   cmp -s "$work/scene" "$work/brute" || fail "cloth-funnel: scene and brute force differ"
+  # The sort-and-sweep baseline: the data README's AABB candidate counts, the same contacts.
+  "$tool" frames "$funnel/227.ply" "$funnel/228.ply" --sweep 2>"$work/err" > "$work/sweep"
+  grep -q "sort and sweep: 7319 VF + 33770 EE candidates" "$work/err" || fail "sweep: $(cat "$work/err")"
+  cmp -s "$work/scene" "$work/sweep" || fail "cloth-funnel: scene and sort and sweep differ"
 fi
 echo "ok"
