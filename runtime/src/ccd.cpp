@@ -481,13 +481,9 @@ CcdResult run_bisection(const Test& test, const CcdOptions& options) noexcept {
     return result;
   }
   const bool exact_contact = test.sep.zero();
-  result.intervals = 1;
-  if (!test.template check<Iv>(0.0, 0.0, Depth::kFull).excluded &&
-      !(exact_contact && test.template check<Dd>(0.0, 0.0, Depth::kFull).excluded)) {
-    result.outcome = CcdOutcome::kContactAtStart;
-    result.toi = 0.0;
-    return result;
-  }
+  // The start t = 0 is tested once the whole step could not be excluded: a step excluded as
+  // a whole has no contact at t = 0 either, and most queries end there.
+  bool start_tested = false;
   const double tol = clamp_tolerance(options.time_tolerance);
   const std::uint32_t max_intervals = std::max<std::uint32_t>(options.max_intervals, 1);
   Item stack[kStackSize];
@@ -509,6 +505,16 @@ CcdResult run_bisection(const Test& test, const CcdOptions& options) noexcept {
       outcome = test.template check<Iv>(item.ta, item.tb, item.depth, &f);
     if (outcome.excluded) continue;
     if (near_degenerate && test.template check<Dd>(item.ta, item.tb, item.depth).excluded) continue;
+    if (!start_tested) {
+      start_tested = true;
+      ++result.intervals;
+      if (!test.template check<Iv>(0.0, 0.0, Depth::kFull).excluded &&
+          !(exact_contact && test.template check<Dd>(0.0, 0.0, Depth::kFull).excluded)) {
+        result.outcome = CcdOutcome::kContactAtStart;
+        result.toi = 0.0;
+        return result;
+      }
+    }
     const double tm = 0.5 * item.ta + 0.5 * item.tb;
     if (item.tb - item.ta <= tol || result.intervals >= max_intervals || top + 2 > kStackSize ||
         !(tm > item.ta && tm < item.tb)) {
