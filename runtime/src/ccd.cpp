@@ -13,7 +13,9 @@
 // options.time_tolerance; a leaf that doubles cannot exclude is examined again in
 // double-double arithmetic (and, once that was needed, every interval doubles cannot
 // exclude); the first leaf still unexcluded is reported with toi = its start, so every time
-// before toi was proved contact-free.
+// before toi was proved contact-free. Below an interval where every inside condition is
+// proven positive only the coplanarity cubic can decide, so its sub-intervals test the cubic
+// alone, subdivided from that interval's coefficients (exact contact) or recomputed.
 
 #include <algorithm>
 #include <cmath>
