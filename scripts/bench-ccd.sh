@@ -23,12 +23,17 @@ done
 echo "== per-scene table (conservative)"
 "$tool" queries "$data/sample-queries"
 
-echo "== whole frames (BVH + dedup + tests, including PLY reading; user CPU and wall seconds)"
+echo "== whole frames: the runtime scene, then the sort-and-sweep baseline (same tests);"
+echo "   user CPU and wall seconds including PLY reading, then the tool's own CPU and counts"
 for scene in "cloth-funnel 227 228" "rod-twist 3036 3037" "cloth-ball cloth_ball92 cloth_ball93"; do
   set -- $scene
   dir="$data/sample-scalable-ccd-data/$1/frames"
   [ -f "$dir/$2.ply" ] || continue
-  TIMEFORMAT="%U s user, %R s wall"
-  { time "$tool" frames "$dir/$2.ply" "$dir/$3.ply" 2>/dev/null | wc -l > "$build/contacts.txt"; } 2> "$build/time.txt"
-  echo "$1: $(cat "$build/contacts.txt") contacts, $(cat "$build/time.txt")"
+  for broad in "" --sweep; do
+    TIMEFORMAT="%U s user, %R s wall"
+    { time "$tool" frames "$dir/$2.ply" "$dir/$3.ply" $broad 2>"$build/stderr.txt" |
+        wc -l > "$build/contacts.txt"; } 2> "$build/time.txt"
+    echo "$1 ${broad:-(scene)}: $(cat "$build/contacts.txt") contacts, $(cat "$build/time.txt")"
+    tail -1 "$build/stderr.txt" | sed 's/^/  /'
+  done
 done

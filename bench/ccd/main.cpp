@@ -29,11 +29,7 @@ namespace io = tetseg::test::ccd_io;
 
 constexpr const char* kTool = "tetseg-ccd";
 
-double thread_cpu_seconds() {
-  timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
-}
+using soup::thread_cpu_seconds;
 
 struct Tally {
   long queries = 0;
@@ -165,13 +161,17 @@ io::Mesh load_mesh(const std::string& path) {
 }
 
 int command_frames(const std::string& path0, const std::string& path1, bool json,
-                   const tetseg::CcdOptions& options, bool brute) {
+                   const tetseg::CcdOptions& options, soup::BroadPhase broad_phase) {
   const io::Mesh m0 = load_mesh(path0);
   const io::Mesh m1 = load_mesh(path1);
   if (m0.vertices.size() != m1.vertices.size())
     throw ToolError(kExitBadInput, path1, "vertex count differs from " + path0);
   if (m0.faces != m1.faces) throw ToolError(kExitBadInput, path1, "faces differ from " + path0);
-  const auto contacts = soup::find_contacts(m0.vertices, m1.vertices, m0.faces, options, brute);
+  soup::FrameStats stats;
+  const double cpu_start = thread_cpu_seconds();
+  const auto contacts =
+      soup::find_contacts(m0.vertices, m1.vertices, m0.faces, options, broad_phase, &stats);
+  const double cpu = thread_cpu_seconds() - cpu_start;
   std::ostringstream out;
   char buf[160];
   if (json) {
@@ -199,6 +199,22 @@ int command_frames(const std::string& path0, const std::string& path1, bool json
   }
   std::cout << out.str();
   std::cerr << kTool << ": " << contacts.size() << " contacts\n";
+  if (broad_phase == soup::BroadPhase::kSweep) {
+    std::fprintf(stderr,
+                 "%s: sort and sweep: %llu VF + %llu EE candidates, %llu elementary tests; CPU "
+                 "%.3f s (broad phase %.3f s, tests %.3f s; PLY reading excluded)\n",
+                 kTool, static_cast<unsigned long long>(stats.vf_candidates),
+                 static_cast<unsigned long long>(stats.ee_candidates),
+                 static_cast<unsigned long long>(stats.tests), cpu, stats.broad_seconds,
+                 stats.test_seconds);
+  } else if (broad_phase == soup::BroadPhase::kScene) {
+    std::fprintf(stderr,
+                 "%s: scene: %llu triangle pairs, %llu feature pairs, %llu elementary tests; CPU "
+                 "%.3f s (PLY reading excluded)\n",
+                 kTool, static_cast<unsigned long long>(stats.triangle_pairs),
+                 static_cast<unsigned long long>(stats.feature_pairs),
+                 static_cast<unsigned long long>(stats.tests), cpu);
+  }
   return kExitOk;
 }
 
@@ -279,7 +295,13 @@ int main(int argc, char** argv) {
   frames->add_option("t1", ply1, "Frame at the end of the step (PLY, same faces)")->required();
   frames->add_flag("--json", json, "Print JSON");
   bool brute = false;
-  frames->add_flag("--brute", brute, "All face pairs instead of the BVH (quadratic; for tests)");
+  bool sweep = false;
+  auto* brute_flag = frames->add_flag("--brute", brute,
+                                      "All face pairs instead of the BVH (quadratic; for tests)");
+  frames
+      ->add_flag("--sweep", sweep,
+                 "Sort and sweep over swept boxes, then the same elementary tests (baseline)")
+      ->excludes(brute_flag);
   frames
       ->add_option("--min-separation", options.min_separation, "Minimum separation (length units)")
       ->check(CLI::NonNegativeNumber);
@@ -299,7 +321,11 @@ int main(int argc, char** argv) {
   }
   try {
     if (queries->parsed()) return command_queries(dir, json, method, options);
-    if (frames->parsed()) return command_frames(ply0, ply1, json, options, brute);
+    if (frames->parsed())
+      return command_frames(ply0, ply1, json, options,
+                            brute   ? soup::BroadPhase::kBrute
+                            : sweep ? soup::BroadPhase::kSweep
+                                    : soup::BroadPhase::kScene);
     return command_truth(truth_ply, boxes_path, bools_path, kind);
   } catch (const ToolError& e) {
     print_error(kTool, e.file(), e.what());

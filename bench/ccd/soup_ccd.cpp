@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <ctime>
 #include <numeric>
 #include <stdexcept>
 #include <string>
@@ -31,13 +32,157 @@ bool shares(const std::array<std::uint32_t, 3>& f, std::uint32_t v) {
   return f[0] == v || f[1] == v || f[2] == v;
 }
 
+/// Swept box of every vertex over the step, enlarged by the minimum separation (rounded
+/// outwards).
+std::vector<Box> swept_vertex_boxes(const std::vector<std::array<double, 3>>& x0,
+                                    const std::vector<std::array<double, 3>>& x1,
+                                    const CcdOptions& options) {
+  const double delta = options.min_separation > 0 ? options.min_separation : 0.0;
+  std::vector<Box> boxes(x0.size());
+  for (std::size_t v = 0; v < x0.size(); ++v) {
+    for (int k = 0; k < 3; ++k) {
+      boxes[v].lo[k] = std::min(x0[v][k], x1[v][k]);
+      boxes[v].hi[k] = std::max(x0[v][k], x1[v][k]);
+      if (delta > 0) {
+        boxes[v].lo[k] = std::nextafter(boxes[v].lo[k] - delta, -INFINITY);
+        boxes[v].hi[k] = std::nextafter(boxes[v].hi[k] + delta, INFINITY);
+      }
+    }
+  }
+  return boxes;
+}
+
+/// Sort and sweep along x over boxes of two kinds (`second_kind` true for the second): calls
+/// visit(i, j) once for every pair of boxes of different kinds (or, when `same_kind`, every
+/// pair) whose closed boxes overlap, i < j in the sorted order. One thread.
+template <class Visit>
+void sort_and_sweep(const std::vector<Box>& boxes, const std::vector<bool>& second_kind,
+                    bool same_kind, Visit&& visit) {
+  std::vector<std::uint32_t> order(boxes.size());
+  std::iota(order.begin(), order.end(), 0u);
+  std::sort(order.begin(), order.end(),
+            [&](std::uint32_t a, std::uint32_t b) { return boxes[a].lo[0] < boxes[b].lo[0]; });
+  for (std::size_t i = 0; i < order.size(); ++i) {
+    const Box& bi = boxes[order[i]];
+    for (std::size_t j = i + 1; j < order.size() && boxes[order[j]].lo[0] <= bi.hi[0]; ++j) {
+      const std::uint32_t a = order[i], b = order[j];
+      if (!same_kind && second_kind[a] == second_kind[b]) continue;
+      const Box& bj = boxes[b];
+      if (bi.lo[1] > bj.hi[1] || bj.lo[1] > bi.hi[1] || bi.lo[2] > bj.hi[2] || bj.lo[2] > bi.hi[2])
+        continue;
+      visit(a, b);
+    }
+  }
+}
+
+// The sort-and-sweep pipeline of the scalable-CCD papers, as a baseline: swept boxes of every
+// vertex, unique edge and face; one sweep along x over vertices and faces (vertex-face
+// candidates), one over edges (edge-edge candidates); pairs sharing a vertex skipped; every
+// candidate (listed, as those pipelines do) through the same pre-filter and elementary test
+// as the runtime. Contacts in the order of `find_contacts`.
+std::vector<Contact> sweep_contacts(const std::vector<std::array<double, 3>>& x0,
+                                    const std::vector<std::array<double, 3>>& x1,
+                                    const std::vector<std::array<std::uint32_t, 3>>& faces,
+                                    const CcdOptions& options, FrameStats* stats) {
+  FrameStats local;
+  FrameStats& st = stats ? *stats : local;
+  const double start = thread_cpu_seconds();
+  const std::vector<Box> vertex_boxes = swept_vertex_boxes(x0, x1, options);
+  std::vector<std::uint32_t> used(x0.size(), 0);  // vertices referenced by a face
+  for (const auto& f : faces)
+    for (auto v : f) used[v] = 1;
+  std::vector<std::array<std::uint32_t, 2>> edges;  // a < b, unique
+  edges.reserve(faces.size() * 3);
+  for (const auto& f : faces)
+    for (int i = 0; i < 3; ++i)
+      edges.push_back({std::min(f[i], f[(i + 1) % 3]), std::max(f[i], f[(i + 1) % 3])});
+  std::sort(edges.begin(), edges.end());
+  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+
+  // Vertex-face: boxes of the used vertices, then of the faces.
+  std::vector<Box> boxes;
+  std::vector<std::uint32_t> ids;
+  std::vector<bool> is_face;
+  for (std::uint32_t v = 0; v < x0.size(); ++v) {
+    if (!used[v]) continue;
+    boxes.push_back(vertex_boxes[v]);
+    ids.push_back(v);
+    is_face.push_back(false);
+  }
+  for (std::uint32_t f = 0; f < faces.size(); ++f) {
+    Box box;
+    for (auto v : faces[f]) box.add(vertex_boxes[v]);
+    boxes.push_back(box);
+    ids.push_back(f);
+    is_face.push_back(true);
+  }
+  std::vector<std::array<std::uint32_t, 2>> vf;  // vertex, face
+  sort_and_sweep(boxes, is_face, false, [&](std::uint32_t a, std::uint32_t b) {
+    if (is_face[a]) std::swap(a, b);
+    if (!shares(faces[ids[b]], ids[a])) vf.push_back({ids[a], ids[b]});
+  });
+  boxes.clear();
+  for (const auto& e : edges) {
+    Box box = vertex_boxes[e[0]];
+    box.add(vertex_boxes[e[1]]);
+    boxes.push_back(box);
+  }
+  std::vector<std::array<std::uint32_t, 2>> ee;  // edge indices
+  sort_and_sweep(boxes, {}, true, [&](std::uint32_t i, std::uint32_t j) {
+    const auto &e = edges[i], &g = edges[j];
+    if (e[0] != g[0] && e[0] != g[1] && e[1] != g[0] && e[1] != g[1]) ee.push_back({i, j});
+  });
+  st.vf_candidates = vf.size();
+  st.ee_candidates = ee.size();
+  const double tests_start = thread_cpu_seconds();
+
+  struct Found {
+    Contact contact;
+    std::uint32_t face;  // vertex-face: face index (for the order)
+  };
+  std::vector<Found> found;
+  for (const auto& [v, f] : vf) {
+    const auto& face = faces[f];
+    const Vec3d &p0 = x0[v], &a0 = x0[face[0]], &b0 = x0[face[1]], &c0 = x0[face[2]];
+    const Vec3d &p1 = x1[v], &a1 = x1[face[0]], &b1 = x1[face[1]], &c1 = x1[face[2]];
+    if (!vertex_face_ccd_filter(p0, a0, b0, c0, p1, a1, b1, c1, options)) continue;
+    ++st.tests;
+    const CcdResult r = vertex_face_ccd(p0, a0, b0, c0, p1, a1, b1, c1, options);
+    if (r.hit()) found.push_back({{true, {v, face[0], face[1], face[2]}, r.toi}, f});
+  }
+  for (const auto& [i, j] : ee) {
+    auto e = edges[i], g = edges[j];
+    if (g < e) std::swap(e, g);
+    const Vec3d &a0 = x0[e[0]], &b0 = x0[e[1]], &c0 = x0[g[0]], &d0 = x0[g[1]];
+    const Vec3d &a1 = x1[e[0]], &b1 = x1[e[1]], &c1 = x1[g[0]], &d1 = x1[g[1]];
+    if (!edge_edge_ccd_filter(a0, b0, c0, d0, a1, b1, c1, d1, options)) continue;
+    ++st.tests;
+    const CcdResult r = edge_edge_ccd(a0, b0, c0, d0, a1, b1, c1, d1, options);
+    if (r.hit()) found.push_back({{false, {e[0], e[1], g[0], g[1]}, r.toi}, 0});
+  }
+  const double tests_end = thread_cpu_seconds();
+  std::sort(found.begin(), found.end(), [](const Found& a, const Found& b) {
+    if (a.contact.vertex_face != b.contact.vertex_face) return a.contact.vertex_face;
+    if (a.contact.vertex_face && a.contact.ids[0] != b.contact.ids[0])
+      return a.contact.ids[0] < b.contact.ids[0];
+    if (a.contact.vertex_face) return a.face < b.face;
+    return a.contact.ids < b.contact.ids;
+  });
+  std::vector<Contact> contacts;
+  contacts.reserve(found.size());
+  for (const Found& f : found) contacts.push_back(f.contact);
+  st.broad_seconds = tests_start - start;
+  st.test_seconds = tests_end - tests_start;
+  return contacts;
+}
+
 // The soup as one surface-only body of a runtime scene (one median-split BVH over the swept
 // triangle boxes, self traversal, exact deduplication, the runtime's feature filters and
 // elementary tests). Memory: the mesh, the scene's scratch and the contacts found.
 std::vector<Contact> scene_contacts(const std::vector<std::array<double, 3>>& x0,
                                     const std::vector<std::array<double, 3>>& x1,
                                     const std::vector<std::array<std::uint32_t, 3>>& faces,
-                                    const CcdOptions& options) {
+                                    const CcdOptions& options, FrameStats* stats) {
   const auto nodes = static_cast<std::uint32_t>(x0.size());
   std::vector<std::uint32_t> ids;
   ids.reserve(faces.size() * 3);
@@ -72,6 +217,12 @@ std::vector<Contact> scene_contacts(const std::vector<std::array<double, 3>>& x0
   if (st != ColliderStatus::kOk)
     throw std::runtime_error(std::string("query failed: ") + tetseg::to_string(st));
   found.resize(r.written);
+  if (stats != nullptr) {
+    const ColliderStats& body_stats = scene.body_stats(body);
+    stats->triangle_pairs = body_stats.triangle_pairs;
+    stats->feature_pairs = body_stats.feature_pairs;
+    stats->tests = body_stats.feature_tests;
+  }
   // Vertex-face by (vertex, face id), then edge-edge by nodes.
   std::sort(found.begin(), found.end(), [](const tetseg::Contact& a, const tetseg::Contact& b) {
     if (a.kind != b.kind) return a.kind == ContactKind::kVertexFace;
@@ -89,24 +240,20 @@ std::vector<Contact> scene_contacts(const std::vector<std::array<double, 3>>& x0
 
 }  // namespace
 
+double thread_cpu_seconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
+
 std::vector<Contact> find_contacts(const std::vector<std::array<double, 3>>& x0,
                                    const std::vector<std::array<double, 3>>& x1,
                                    const std::vector<std::array<std::uint32_t, 3>>& faces,
-                                   const CcdOptions& options, bool brute) {
-  if (!brute) return scene_contacts(x0, x1, faces, options);
-  const double delta = options.min_separation > 0 ? options.min_separation : 0.0;
-  // Swept vertex boxes, enlarged by the minimum separation (rounded outwards).
-  std::vector<Box> vertex_boxes(x0.size());
-  for (std::size_t v = 0; v < x0.size(); ++v) {
-    for (int k = 0; k < 3; ++k) {
-      vertex_boxes[v].lo[k] = std::min(x0[v][k], x1[v][k]);
-      vertex_boxes[v].hi[k] = std::max(x0[v][k], x1[v][k]);
-      if (delta > 0) {
-        vertex_boxes[v].lo[k] = std::nextafter(vertex_boxes[v].lo[k] - delta, -INFINITY);
-        vertex_boxes[v].hi[k] = std::nextafter(vertex_boxes[v].hi[k] + delta, INFINITY);
-      }
-    }
-  }
+                                   const CcdOptions& options, BroadPhase broad_phase,
+                                   FrameStats* stats) {
+  if (broad_phase == BroadPhase::kScene) return scene_contacts(x0, x1, faces, options, stats);
+  if (broad_phase == BroadPhase::kSweep) return sweep_contacts(x0, x1, faces, options, stats);
+  const std::vector<Box> vertex_boxes = swept_vertex_boxes(x0, x1, options);
   std::vector<Box> face_boxes(faces.size());
   for (std::size_t f = 0; f < faces.size(); ++f)
     for (auto v : faces[f]) face_boxes[f].add(vertex_boxes[v]);

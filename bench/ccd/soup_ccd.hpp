@@ -23,13 +23,35 @@ struct Contact {
   double toi = 1.0;
 };
 
+enum class BroadPhase {
+  kScene,  ///< the runtime: one surface-only scene body
+  kSweep,  ///< sort and sweep along x over swept boxes, the same elementary tests (baseline)
+  kBrute,  ///< all face pairs (quadratic; a reference for tests)
+};
+
+/// Work of one frame. Sort and sweep: candidates (box-overlapping pairs that share no vertex),
+/// thread CPU time of the broad phase and of the pre-filters and elementary tests. Scene: the
+/// body's `ColliderStats` counts. Both: elementary tests run (after the pre-filters).
+struct FrameStats {
+  std::uint64_t vf_candidates = 0, ee_candidates = 0;
+  double broad_seconds = 0, test_seconds = 0;
+  std::uint64_t triangle_pairs = 0, feature_pairs = 0;
+  std::uint64_t tests = 0;
+};
+
 /// Contacts sorted by kind (vf first), then vertex-face by (vertex, face index) and edge-edge
 /// by ids. Vertices not referenced by a face are ignored. Preconditions: face indices <
 /// x0.size() == x1.size(). Throws std::runtime_error for a face with a repeated vertex or when
-/// the runtime fails. `brute` is quadratic (a reference for tests).
+/// the runtime fails. `kBrute` is quadratic (a reference for tests); `stats`
+/// (optional) receives the work of `kSweep` and `kScene`.
 std::vector<Contact> find_contacts(const std::vector<std::array<double, 3>>& x0,
                                    const std::vector<std::array<double, 3>>& x1,
                                    const std::vector<std::array<std::uint32_t, 3>>& faces,
-                                   const CcdOptions& options, bool brute = false);
+                                   const CcdOptions& options,
+                                   BroadPhase broad_phase = BroadPhase::kScene,
+                                   FrameStats* stats = nullptr);
+
+/// CPU time of the calling thread, in seconds.
+double thread_cpu_seconds();
 
 }  // namespace tetseg::tools::soup

@@ -13,7 +13,9 @@
 // options.time_tolerance; a leaf that doubles cannot exclude is examined again in
 // double-double arithmetic (and, once that was needed, every interval doubles cannot
 // exclude); the first leaf still unexcluded is reported with toi = its start, so every time
-// before toi was proved contact-free.
+// before toi was proved contact-free. Below an interval where every inside condition is
+// proven positive only the coplanarity cubic can decide, so its sub-intervals test the cubic
+// alone, subdivided from that interval's coefficients (exact contact) or recomputed.
 
 #include <algorithm>
 #include <cmath>
@@ -93,38 +95,35 @@ Sums<I, 2> bilinear(const Slot<I>& w1, const Slot<I>& w2) noexcept {
            dot(w1.v[1], w2.v[1])}};
 }
 
-/// (w1 x w2) . w3 (degree 3).
+/// w1 x w2 (degree 2) as Bernstein sums of vectors: c[k] sums the cross products of the ends
+/// i + j = k. Forms that share a cross product compute it once.
 template <class I>
-Sums<I, 3> trilinear(const Slot<I>& w1, const Slot<I>& w2, const Slot<I>& w3) noexcept {
-  Sums<I, 3> sum{{make<I>(0), make<I>(0), make<I>(0), make<I>(0)}};
-  for (int i = 0; i < 2; ++i) {
-    for (int j = 0; j < 2; ++j) {
-      const Vec<I> c = cross(w1.v[i], w2.v[j]);
-      for (int k = 0; k < 2; ++k) sum.s[i + j + k] = sum.s[i + j + k] + dot(c, w3.v[k]);
-    }
-  }
-  return sum;
+struct CrossSums {
+  Vec<I> c[3];
+};
+
+template <class I>
+CrossSums<I> cross_sums(const Slot<I>& w1, const Slot<I>& w2) noexcept {
+  const Vec<I> mixed0 = cross(w1.v[0], w2.v[1]);
+  const Vec<I> mixed1 = cross(w1.v[1], w2.v[0]);
+  return {{cross(w1.v[0], w2.v[0]),
+           {mixed0.x + mixed1.x, mixed0.y + mixed1.y, mixed0.z + mixed1.z},
+           cross(w1.v[1], w2.v[1])}};
 }
 
-/// (w1 x w2) . (w3 x w4) (degree 4).
+/// (w1 x w2) . w3 (degree 3), with n = w1 x w2.
 template <class I>
-Sums<I, 4> quadrilinear(const Slot<I>& w1, const Slot<I>& w2, const Slot<I>& w3,
-                        const Slot<I>& w4) noexcept {
-  Vec<I> left[2][2];
-  Vec<I> right[2][2];
-  for (int i = 0; i < 2; ++i) {
-    for (int j = 0; j < 2; ++j) {
-      left[i][j] = cross(w1.v[i], w2.v[j]);
-      right[i][j] = cross(w3.v[i], w4.v[j]);
-    }
-  }
-  Sums<I, 4> sum{{make<I>(0), make<I>(0), make<I>(0), make<I>(0), make<I>(0)}};
-  for (int i = 0; i < 2; ++i)
-    for (int j = 0; j < 2; ++j)
-      for (int k = 0; k < 2; ++k)
-        for (int l = 0; l < 2; ++l)
-          sum.s[i + j + k + l] = sum.s[i + j + k + l] + dot(left[i][j], right[k][l]);
-  return sum;
+Sums<I, 3> trilinear(const CrossSums<I>& n, const Slot<I>& w3) noexcept {
+  return {{dot(n.c[0], w3.v[0]), dot(n.c[0], w3.v[1]) + dot(n.c[1], w3.v[0]),
+           dot(n.c[1], w3.v[1]) + dot(n.c[2], w3.v[0]), dot(n.c[2], w3.v[1])}};
+}
+
+/// (w1 x w2) . (w3 x w4) (degree 4), with l = w1 x w2 and r = w3 x w4.
+template <class I>
+Sums<I, 4> quadrilinear(const CrossSums<I>& l, const CrossSums<I>& r) noexcept {
+  return {{dot(l.c[0], r.c[0]), dot(l.c[0], r.c[1]) + dot(l.c[1], r.c[0]),
+           dot(l.c[0], r.c[2]) + dot(l.c[1], r.c[1]) + dot(l.c[2], r.c[0]),
+           dot(l.c[1], r.c[2]) + dot(l.c[2], r.c[1]), dot(l.c[2], r.c[2])}};
 }
 
 /// Mid value of an enclosure, as a double.
@@ -245,7 +244,27 @@ bool all_finite(const Vec3d* const* points, int count) noexcept {
   return true;
 }
 
-enum class Depth { kFilter, kFull };
+/// How much of a test to run on an interval. kFilter: boxes and the coplanarity cubic (the
+/// cheap pre-filter). kFull: every exclusion test. kCoplanarOnly: boxes and the coplanarity
+/// cubic, for an interval inside one where every inside condition was proven positive (the
+/// point strictly inside the edge planes, the closest-point parameters of both edges strictly
+/// inside (0,1)): there the other tests cannot exclude anything (their conditions are proven
+/// false), and contact happens exactly where the cubic vanishes. Any subset of the tests is
+/// sound (each is a necessary condition of contact); this one only drops useless work.
+enum class Depth { kFilter, kFull, kCoplanarOnly };
+
+/// Outcome of one interval: excluded, or open (with `inside` when every inside condition is
+/// proven strictly positive on it, so that its sub-intervals need only kCoplanarOnly).
+struct IntervalOutcome {
+  bool excluded = false;
+  bool inside = false;
+};
+
+/// True when every Bernstein sum is proven strictly positive (the polynomial > 0 on T).
+template <class I, int N>
+bool positive(const Sums<I, N>& raw) noexcept {
+  return range_of(raw).lo > 0.0;
+}
 
 /// The four points of a query at the ends of the time interval [ta, tb]: x[i][0] at ta,
 /// x[i][1] at tb.
@@ -265,34 +284,42 @@ struct VertexFaceTest {
   Separation sep;
 
   template <class I>
-  bool excluded(double ta, double tb, Depth depth) const noexcept {
+  IntervalOutcome check(double ta, double tb, Depth depth,
+                        Sums<I, 3>* coplanarity = nullptr) const noexcept {
     Vec<I> x[4][2];
     positions_at<I>(x0, x1, ta, tb, x);
-    if (boxes_disjoint<I>(x, 1, x + 1, 3, sep)) return true;
+    if (boxes_disjoint<I>(x, 1, x + 1, 3, sep)) return {true, false};
 
     const Slot<I> u = difference(x[2], x[1]);  // b - a
     const Slot<I> v = difference(x[3], x[1]);  // c - a
     const Slot<I> w = difference(x[0], x[1]);  // p - a
     const double n2 = sep.zero() ? 0.0 : cross_norm2_upper(u, v);
-    const Sums<I, 3> f = trilinear(u, v, w);
-    if (away_from_zero(f, sep, n2)) return true;
-    if (depth == Depth::kFilter) return false;
+    const CrossSums<I> n = cross_sums(u, v);
+    const Sums<I, 3> f = trilinear(n, w);
+    if (coplanarity != nullptr) *coplanarity = f;
+    if (away_from_zero(f, sep, n2)) return {true, false};
+    if (depth != Depth::kFull) return {false, depth == Depth::kCoplanarOnly};
 
     // Edge planes (through an edge, perpendicular to the triangle): inside needs
     // n . ((b-a) x (p-a)) >= 0 and the two others.
-    const Sums<I, 4> e_ab = quadrilinear(u, v, u, w);
-    if (below_minus_delta(e_ab, sep, sep.zero() ? 0.0 : mul_up(n2, norm2_upper(u)))) return true;
+    const Sums<I, 4> e_ab = quadrilinear(n, cross_sums(u, w));
+    if (below_minus_delta(e_ab, sep, sep.zero() ? 0.0 : mul_up(n2, norm2_upper(u))))
+      return {true, false};
     const Slot<I> cb = difference(x[3], x[2]);
     const Slot<I> pb = difference(x[0], x[2]);
-    const Sums<I, 4> e_bc = quadrilinear(u, v, cb, pb);
-    if (below_minus_delta(e_bc, sep, sep.zero() ? 0.0 : mul_up(n2, norm2_upper(cb)))) return true;
+    const Sums<I, 4> e_bc = quadrilinear(n, cross_sums(cb, pb));
+    if (below_minus_delta(e_bc, sep, sep.zero() ? 0.0 : mul_up(n2, norm2_upper(cb))))
+      return {true, false};
     const Slot<I> ac = difference(x[1], x[3]);
     const Slot<I> pc = difference(x[0], x[3]);
-    const Sums<I, 4> e_ca = quadrilinear(u, v, ac, pc);
-    if (below_minus_delta(e_ca, sep, sep.zero() ? 0.0 : mul_up(n2, norm2_upper(ac)))) return true;
-    if (!sep.zero()) return false;
-    return negative_where_coplanar(e_ab, f) || negative_where_coplanar(e_bc, f) ||
-           negative_where_coplanar(e_ca, f);
+    const Sums<I, 4> e_ca = quadrilinear(n, cross_sums(ac, pc));
+    if (below_minus_delta(e_ca, sep, sep.zero() ? 0.0 : mul_up(n2, norm2_upper(ac))))
+      return {true, false};
+    const bool inside = positive(e_ab) && positive(e_bc) && positive(e_ca);
+    if (!sep.zero()) return {false, inside};
+    return {negative_where_coplanar(e_ab, f) || negative_where_coplanar(e_bc, f) ||
+                negative_where_coplanar(e_ca, f),
+            inside};
   }
 };
 
@@ -303,35 +330,42 @@ struct EdgeEdgeTest {
   Separation sep;
 
   template <class I>
-  bool excluded(double ta, double tb, Depth depth) const noexcept {
+  IntervalOutcome check(double ta, double tb, Depth depth,
+                        Sums<I, 3>* coplanarity = nullptr) const noexcept {
     Vec<I> x[4][2];
     positions_at<I>(x0, x1, ta, tb, x);
-    if (boxes_disjoint<I>(x, 2, x + 2, 2, sep)) return true;
+    if (boxes_disjoint<I>(x, 2, x + 2, 2, sep)) return {true, false};
 
     const Slot<I> ba = difference(x[1], x[0]);
     const Slot<I> dc = difference(x[3], x[2]);
     const Slot<I> ca = difference(x[2], x[0]);
     const double n2 = sep.zero() ? 0.0 : cross_norm2_upper(ba, dc);
-    const Sums<I, 3> f = trilinear(ba, dc, ca);
-    if (away_from_zero(f, sep, n2)) return true;
-    if (depth == Depth::kFilter) return false;
+    const CrossSums<I> n = cross_sums(ba, dc);
+    const Sums<I, 3> f = trilinear(n, ca);
+    if (coplanarity != nullptr) *coplanarity = f;
+    if (away_from_zero(f, sep, n2)) return {true, false};
+    if (depth != Depth::kFull) return {false, depth == Depth::kCoplanarOnly};
 
     // Planes through one edge containing the common normal n = (b-a) x (d-c): the other edge
     // strictly beyond one of them (by delta) cannot touch. With N = |n|^2:
     // h1 = ((c-a) x (d-c)).n, h2 = ((b-c) x (d-c)).n, h1 + h2 = N (closest point on ab at
     // u = h1/N in [0,1]); h3 = ((c-a) x (b-a)).n, h4 = ((b-a) x (d-a)).n, h3 + h4 = N.
     const double dc2 = sep.zero() ? 0.0 : mul_up(n2, norm2_upper(dc));
-    const Sums<I, 4> h1 = quadrilinear(ca, dc, ba, dc);
-    if (below_minus_delta(h1, sep, dc2)) return true;
+    const CrossSums<I> left1 = cross_sums(ca, dc);
+    const Sums<I, 4> h1 = quadrilinear(left1, n);
+    if (below_minus_delta(h1, sep, dc2)) return {true, false};
     const Slot<I> bc = difference(x[1], x[2]);
-    const Sums<I, 4> h2 = quadrilinear(bc, dc, ba, dc);
-    if (below_minus_delta(h2, sep, dc2)) return true;
+    const CrossSums<I> left2 = cross_sums(bc, dc);
+    const Sums<I, 4> h2 = quadrilinear(left2, n);
+    if (below_minus_delta(h2, sep, dc2)) return {true, false};
     const double ba2 = sep.zero() ? 0.0 : mul_up(n2, norm2_upper(ba));
-    const Sums<I, 4> h3 = quadrilinear(ca, ba, ba, dc);
-    if (below_minus_delta(h3, sep, ba2)) return true;
+    const CrossSums<I> left3 = cross_sums(ca, ba);
+    const Sums<I, 4> h3 = quadrilinear(left3, n);
+    if (below_minus_delta(h3, sep, ba2)) return {true, false};
     const Slot<I> da = difference(x[3], x[0]);
-    const Sums<I, 4> h4 = quadrilinear(ba, da, ba, dc);
-    if (below_minus_delta(h4, sep, ba2)) return true;
+    const CrossSums<I> left4 = cross_sums(ba, da);
+    const Sums<I, 4> h4 = quadrilinear(left4, n);
+    if (below_minus_delta(h4, sep, ba2)) return {true, false};
 
     // Planes containing one edge and turned towards an endpoint of the other (decide parallel
     // and coplanar edges, where n vanishes): m = (b-a) x ((b-a) x (c-a)) puts c at
@@ -339,8 +373,12 @@ struct EdgeEdgeTest {
     // (d-a).m = ((d-a) x (b-a)).((b-a) x (c-a)) < 0, the plane separates the edges. With a
     // separation: c's distance to line ab, |(b-a) x (c-a)| / |b-a|, and d's, |(d-a).m| / |m|,
     // must both exceed delta. Same with the roles of the edges swapped.
+    // (d-a) x (b-a) = left4 negated and (b-a) x (c-a) = left3 negated; (b-c) x (d-c) = left2
+    // and (d-c) x (a-c) = left1.
     const Slot<I> ac = difference(x[0], x[2]);
-    if (separated_by_edge_plane(da, ba, ca) || separated_by_edge_plane(bc, dc, ac)) return true;
+    if (separated_by_edge_plane(left4, left3, ba, ca) ||
+        separated_by_edge_plane(left2, left1, dc, ac))
+      return {true, false};
 
     // End caps (decide parallel edges): both points of one edge beyond the plane through an
     // endpoint of the other, perpendicular to it.
@@ -351,33 +389,38 @@ struct EdgeEdgeTest {
     const Slot<I> bd = difference(x[1], x[3]);
     // cap at a: (c-a).(a-b) > delta |a-b| and (d-a).(a-b) > delta |a-b|.
     if (above_delta(bilinear(ca, ab), sep, ab2) && above_delta(bilinear(da, ab), sep, ab2))
-      return true;
+      return {true, false};
     // cap at b: (c-b).(b-a), (d-b).(b-a), i.e. (b-c).(a-b), (b-d).(a-b).
     if (above_delta(bilinear(bc, ab), sep, ab2) && above_delta(bilinear(bd, ab), sep, ab2))
-      return true;
+      return {true, false};
     // cap at c: (a-c).(c-d), (b-c).(c-d).
     if (above_delta(bilinear(ac, cd), sep, cd2) && above_delta(bilinear(bc, cd), sep, cd2))
-      return true;
+      return {true, false};
     // cap at d: (a-d).(d-c), (b-d).(d-c), i.e. (d-a).(c-d), (d-b).(c-d).
     if (above_delta(bilinear(da, cd), sep, cd2) &&
         above_delta(bilinear(difference(x[3], x[1]), cd), sep, cd2))
-      return true;
-    if (!sep.zero()) return false;
-    return negative_where_coplanar(h1, f) || negative_where_coplanar(h2, f) ||
-           negative_where_coplanar(h3, f) || negative_where_coplanar(h4, f);
+      return {true, false};
+    // Both closest-point parameters strictly inside (0,1) on all of T (then |n| > 0): the
+    // edges touch exactly where the coplanarity cubic vanishes.
+    const bool inside = positive(h1) && positive(h2) && positive(h3) && positive(h4);
+    if (!sep.zero()) return {false, inside};
+    return {negative_where_coplanar(h1, f) || negative_where_coplanar(h2, f) ||
+                negative_where_coplanar(h3, f) || negative_where_coplanar(h4, f),
+            inside};
   }
 
   /// Plane through the edge with direction e (from point o), normal e x (e x (near - o)):
   /// true when far - o and near - o are both strictly (by delta) on the near side.
+  /// far_e = (far - o) x e and e_near = e x (near - o), or both negated.
   template <class I>
-  bool separated_by_edge_plane(const Slot<I>& far_o, const Slot<I>& e,
-                               const Slot<I>& near_o) const noexcept {
-    const Sums<I, 4> far_side = quadrilinear(far_o, e, e, near_o);
+  bool separated_by_edge_plane(const CrossSums<I>& far_e, const CrossSums<I>& e_near,
+                               const Slot<I>& e, const Slot<I>& near_o) const noexcept {
+    const Sums<I, 4> far_side = quadrilinear(far_e, e_near);
     if (sep.zero()) return range_of(far_side).hi < 0.0;
     const Range far_range = value_range(far_side);
     if (!(far_range.hi < 0.0)) return false;
     const double e2 = norm2_upper(e);
-    const Range near2 = value_range(quadrilinear(e, near_o, e, near_o));  // |e x (near-o)|^2
+    const Range near2 = value_range(quadrilinear(e_near, e_near));  // |e x (near-o)|^2
     if (!(near2.lo > 0.0) || !(mul_down(near2.lo, 1.0) > mul_up(sep.delta2, e2))) return false;
     return mul_down(far_range.hi, far_range.hi) >
            mul_up(sep.delta2, mul_up(e2, cross_norm2_upper(e, near_o)));
@@ -389,8 +432,46 @@ double clamp_tolerance(double tol) noexcept {
   return min_nan(tol, 1.0);
 }
 
+/// Bernstein coefficients (not sums) of the coplanarity cubic on an interval.
+struct Cubic {
+  Iv b[4];
+};
+
+Cubic cubic_of(const Sums<Iv, 3>& f) noexcept {
+  return {{f.s[0], divide(f.s[1], 3.0), divide(f.s[2], 3.0), f.s[3]}};
+}
+
+Iv average(Iv a, Iv b) noexcept {
+  return (a + b) * exact(0.5);
+}
+
+/// De Casteljau at the midpoint: the cubic's coefficients on both halves (rigorous: each
+/// coefficient of a half is an average of averages of the enclosed coefficients).
+void split(const Cubic& c, Cubic& left, Cubic& right) noexcept {
+  const Iv b01 = average(c.b[0], c.b[1]);
+  const Iv b12 = average(c.b[1], c.b[2]);
+  const Iv b23 = average(c.b[2], c.b[3]);
+  const Iv b012 = average(b01, b12);
+  const Iv b123 = average(b12, b23);
+  const Iv mid = average(b012, b123);
+  left = {{c.b[0], b01, b012, mid}};
+  right = {{mid, b123, b23, c.b[3]}};
+}
+
+/// True when the cubic is proven of one sign on its interval.
+bool one_sign(const Cubic& c) noexcept {
+  const Sums<Iv, 3> sums{{c.b[0], c.b[1], c.b[2], c.b[3]}};
+  const Range r = range_of(sums);
+  return r.lo > 0.0 || r.hi < 0.0;
+}
+
 struct Item {
   double ta, tb;
+  /// kFull, or kCoplanarOnly inside an interval with the inside proven. Exact contact only:
+  /// then `cubic` holds the coplanarity cubic's coefficients on [ta, tb], subdivided from the
+  /// interval where the inside was proven, and the test is its sign (no recomputation).
+  Depth depth;
+  Cubic cubic;
 };
 
 template <class Test>
@@ -402,18 +483,14 @@ CcdResult run_bisection(const Test& test, const CcdOptions& options) noexcept {
     return result;
   }
   const bool exact_contact = test.sep.zero();
-  result.intervals = 1;
-  if (!test.template excluded<Iv>(0.0, 0.0, Depth::kFull) &&
-      !(exact_contact && test.template excluded<Dd>(0.0, 0.0, Depth::kFull))) {
-    result.outcome = CcdOutcome::kContactAtStart;
-    result.toi = 0.0;
-    return result;
-  }
+  // The start t = 0 is tested once the whole step could not be excluded: a step excluded as
+  // a whole has no contact at t = 0 either, and most queries end there.
+  bool start_tested = false;
   const double tol = clamp_tolerance(options.time_tolerance);
   const std::uint32_t max_intervals = std::max<std::uint32_t>(options.max_intervals, 1);
   Item stack[kStackSize];
   int top = 0;
-  stack[top++] = {0.0, 1.0};
+  stack[top++] = {0.0, 1.0, Depth::kFull, {}};
   // Once a leaf has needed double-double to be excluded, the query is near-degenerate (the
   // primitives graze within rounding of doubles): from then on double-double is tried on
   // every interval doubles cannot exclude, before splitting it.
@@ -421,13 +498,30 @@ CcdResult run_bisection(const Test& test, const CcdOptions& options) noexcept {
   while (top > 0) {
     const Item item = stack[--top];
     ++result.intervals;
-    if (test.template excluded<Iv>(item.ta, item.tb, Depth::kFull)) continue;
-    if (near_degenerate && test.template excluded<Dd>(item.ta, item.tb, Depth::kFull)) continue;
+    const bool subdivided = exact_contact && item.depth == Depth::kCoplanarOnly;
+    Sums<Iv, 3> f{};
+    IntervalOutcome outcome{};
+    if (subdivided)
+      outcome = {one_sign(item.cubic), true};
+    else
+      outcome = test.template check<Iv>(item.ta, item.tb, item.depth, &f);
+    if (outcome.excluded) continue;
+    if (near_degenerate && test.template check<Dd>(item.ta, item.tb, item.depth).excluded) continue;
+    if (!start_tested) {
+      start_tested = true;
+      ++result.intervals;
+      if (!test.template check<Iv>(0.0, 0.0, Depth::kFull).excluded &&
+          !(exact_contact && test.template check<Dd>(0.0, 0.0, Depth::kFull).excluded)) {
+        result.outcome = CcdOutcome::kContactAtStart;
+        result.toi = 0.0;
+        return result;
+      }
+    }
     const double tm = 0.5 * item.ta + 0.5 * item.tb;
     if (item.tb - item.ta <= tol || result.intervals >= max_intervals || top + 2 > kStackSize ||
         !(tm > item.ta && tm < item.tb)) {
       if (exact_contact && !near_degenerate && result.intervals < max_intervals &&
-          test.template excluded<Dd>(item.ta, item.tb, Depth::kFull)) {
+          test.template check<Dd>(item.ta, item.tb, item.depth).excluded) {
         near_degenerate = true;
         continue;
       }
@@ -435,8 +529,11 @@ CcdResult run_bisection(const Test& test, const CcdOptions& options) noexcept {
       result.toi = item.ta;
       return result;
     }
-    stack[top++] = {tm, item.tb};
-    stack[top++] = {item.ta, tm};
+    const Depth child = outcome.inside ? Depth::kCoplanarOnly : Depth::kFull;
+    Cubic left{}, right{};
+    if (exact_contact && outcome.inside) split(subdivided ? item.cubic : cubic_of(f), left, right);
+    stack[top++] = {tm, item.tb, child, right};
+    stack[top++] = {item.ta, tm, child, left};
   }
   return result;
 }
@@ -446,7 +543,7 @@ CcdResult run_bisection(const Test& test, const CcdOptions& options) noexcept {
 template <typename Test>
 bool filter_may_hit(const Test& test) noexcept {
   if (!all_finite(test.x0, 4) || !all_finite(test.x1, 4)) return true;
-  return !test.template excluded<Iv>(0.0, 1.0, Depth::kFilter);
+  return !test.template check<Iv>(0.0, 1.0, Depth::kFilter).excluded;
 }
 
 }  // namespace

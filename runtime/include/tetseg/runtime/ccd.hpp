@@ -13,7 +13,7 @@
 /// parallel edges, degenerate triangles) is handled by the same rule. Non-finite input is
 /// reported as a contact (kContact, toi 0): the test never proves separation it cannot see.
 ///
-/// Cost: about 5 us per query on the reference queries (docs/benchmarks.md); well-separated
+/// Cost: about 2-3 us per query on the reference queries (docs/benchmarks.md); well-separated
 /// pairs exit after one interval (< 1 us); near-degenerate ones are bounded by max_intervals.
 /// Thread safety: every function is reentrant (no global state). No allocation, no
 /// exceptions. The floating-point environment must be round-to-nearest (the default).
