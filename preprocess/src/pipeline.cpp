@@ -347,7 +347,7 @@ format::Asset build_asset(const TetMesh& mesh, const std::string& source,
     for (std::uint32_t c = 0; c < segmentation.cluster_count; ++c) {
       ClusterBvh bvh = build_cluster_bvh(mesh.nodes, surface.triangles, members[c]);
       format::Cluster cluster;
-      cluster.detector_node = detectors[c].node;
+      cluster.detector = format::DetectorPoint::at_node(detectors[c].node);
       cluster.rest_positive_fraction = detectors[c].rest_positive_fraction;
       cluster.triangle_offset = static_cast<std::uint32_t>(asset.cluster_triangles.size());
       cluster.triangle_count = static_cast<std::uint32_t>(bvh.triangles.size());

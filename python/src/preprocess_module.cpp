@@ -212,7 +212,10 @@ py::dict report_dict(const std::string& source, const BuildReport& report,
   for (const format::Cluster& c : asset.clusters) {
     py::dict d;
     d["triangles"] = c.triangle_count;
-    d["detector_node"] = c.detector_node;
+    d["detector_nodes"] = c.detector.nodes;
+    d["detector_weights"] = c.detector.weights;
+    d["detector_tet"] = c.detector.tet;
+    d["overlap_only"] = (c.flags & format::kClusterOverlapOnly) != 0;
     d["rest_positive_fraction"] = c.rest_positive_fraction;
     clusters.append(d);
   }

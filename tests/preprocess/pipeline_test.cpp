@@ -48,7 +48,7 @@ TEST_CASE("The pipeline turns a dumbbell into a valid, loadable asset", "[pipeli
   std::vector<int> seen(asset.triangles.size(), 0);
   for (std::size_t c = 0; c < asset.clusters.size(); ++c) {
     const auto& cluster = asset.clusters[c];
-    REQUIRE(interior.count(cluster.detector_node) == 1);
+    REQUIRE(interior.count(cluster.detector.nodes[0]) == 1);
     for (std::uint32_t i = 0; i < cluster.triangle_count; ++i) {
       const std::uint32_t t = asset.cluster_triangles[cluster.triangle_offset + i];
       ++seen[t];

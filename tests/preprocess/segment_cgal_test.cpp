@@ -91,7 +91,7 @@ TEST_CASE("Real meshes build into valid assets with interior detector nodes",
   const std::set<std::uint32_t> interior(surface.interior_nodes.begin(),
                                          surface.interior_nodes.end());
   for (const auto& cluster : asset.clusters) {
-    CHECK(interior.count(cluster.detector_node) == 1);
+    CHECK(interior.count(cluster.detector.nodes[0]) == 1);
     CHECK(cluster.rest_positive_fraction > 0.0f);
     CHECK(cluster.rest_positive_fraction <= 1.0f);
   }

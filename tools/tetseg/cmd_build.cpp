@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "commands.hpp"
+#include "mesh_output.hpp"
 #include "tetseg/format/asset_io.hpp"
 #include "tetseg/preprocess/io.hpp"
 #include "tetseg/preprocess/meshing.hpp"
@@ -89,7 +90,7 @@ std::string report_json(const BuildArgs& args, const BuildReport& report,
   out << "  \"clusters\": [";
   for (std::size_t c = 0; c < asset.clusters.size(); ++c) {
     out << (c ? ",\n    " : "\n    ") << "{\"triangles\": " << asset.clusters[c].triangle_count
-        << ", \"detector_node\": " << asset.clusters[c].detector_node
+        << ", " << detector_json(asset, asset.clusters[c])
         << ", \"rest_positive_fraction\": " << asset.clusters[c].rest_positive_fraction << "}";
   }
   out << "\n  ],\n  \"options\": {";
