@@ -182,7 +182,10 @@ inline void add_loop(Asset& a, const std::vector<std::uint32_t>& nodes) {
 /// The golden asset: the surface of an octahedral tet mesh (6 surface nodes, 2 interior
 /// nodes on the z axis, tets fanning from them), split at the equator into two clusters, each
 /// culled from the interior node on its side. One boundary loop: the equator.
-inline Asset make_octahedron_asset() {
+/// The octahedron with its two clusters: upper half (7 BVH nodes, one triangle per leaf) and
+/// lower half (3, two triangles per leaf), seen from `upper` and `lower`.
+inline Asset make_octahedron(const DetectorPoint& upper, const DetectorPoint& lower,
+                             std::uint32_t lower_flags = 0) {
   Asset a;
   a.rest_positions = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0},    {0, -1, 0},
                       {0, 0, 1}, {0, 0, -1}, {0, 0, 0.25}, {0, 0, -0.25}};
@@ -190,9 +193,8 @@ inline Asset make_octahedron_asset() {
   // +x=0 -x=1 +y=2 -y=3 +z=4 -z=5, wound outward.
   a.triangles = {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4},
                  {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}};
-  // upper half: 7 BVH nodes, one triangle per leaf; lower half: 3, two triangles per leaf
-  add_cluster(a, DetectorPoint::at_node(6), {0, 1, 2, 3}, 1);
-  add_cluster(a, DetectorPoint::at_node(7), {6, 7, 4, 5}, 2);
+  add_cluster(a, upper, {0, 1, 2, 3}, 1);
+  add_cluster(a, lower, {6, 7, 4, 5}, 2, lower_flags);
   add_loop(a, {0, 2, 1, 3});
   a.provenance.tool_version = "tetseg 0.1.0";
   a.provenance.source = "octahedron.off";
@@ -200,16 +202,14 @@ inline Asset make_octahedron_asset() {
   return a;
 }
 
+inline Asset make_octahedron_asset() {
+  return make_octahedron(DetectorPoint::at_node(6), DetectorPoint::at_node(7));
+}
+
 /// The golden asset of version 1.1: the octahedron's surface with the upper cluster seen from
 /// a point inside tet 0 = (6, 0, 2, 4) and the lower cluster flagged overlap-only, its
 /// detector the centroid of tet 9 = (6, 7, 1, 3) (a tet of the same octahedral mesh).
 inline Asset make_octahedron_asset_v11() {
-  Asset a;
-  a.rest_positions = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0},    {0, -1, 0},
-                      {0, 0, 1}, {0, 0, -1}, {0, 0, 0.25}, {0, 0, -0.25}};
-  a.node_count = 8;
-  a.triangles = {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4},
-                 {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}};
   DetectorPoint upper;
   upper.nodes = {6, 0, 2, 4};
   upper.weights = {0.625, 0.125, 0.125, 0.125};
@@ -218,13 +218,7 @@ inline Asset make_octahedron_asset_v11() {
   lower.nodes = {6, 7, 1, 3};
   lower.weights = {0.25, 0.25, 0.25, 0.25};
   lower.tet = 9;
-  add_cluster(a, upper, {0, 1, 2, 3}, 1);
-  add_cluster(a, lower, {6, 7, 4, 5}, 2, kClusterOverlapOnly);
-  add_loop(a, {0, 2, 1, 3});
-  a.provenance.tool_version = "tetseg 0.1.0";
-  a.provenance.source = "octahedron.off";
-  a.provenance.options = {{"clusters", "2"}, {"detector", "interior"}, {"leaf_size", "1,2"}};
-  return a;
+  return make_octahedron(upper, lower, kClusterOverlapOnly);
 }
 
 /// A larger asset: the surface of the cube [-1,1]^3 with an n x n grid per face (shared

@@ -12,6 +12,7 @@
 
 #include "runtime/support/compare.hpp"
 #include "runtime/support/motions.hpp"
+#include "runtime/support/scenes.hpp"
 #include "tetseg/format/asset.hpp"
 #include "tetseg/runtime/classify.hpp"
 #include "tetseg/runtime/collider.hpp"
@@ -222,17 +223,6 @@ TEST_CASE("A node-form detector is the node itself, bit for bit", "[detector]") 
 }
 
 namespace {
-
-Scene sphere_scene(int clusters) {
-  const Surface s = sphere(1.0, 20, 11);
-  if (clusters == 1)
-    return make_scene(s, std::vector<std::uint32_t>(s.tris.size(), 0), {{0.3, 0.1, 0.05}});
-  return make_axial_scene(s, {0.0}, {-0.45, 0.45});
-}
-
-Scene dumbbell_scene() {
-  return make_axial_scene(dumbbell(16, 26), {-0.6, 0.6}, {-1.6, 0.0, 1.6});
-}
 
 /// Moves the detector tets' nodes (the last 4 per cluster, with_detector_tets) on their own:
 /// node 3 of every tet passes through the opposite face between frame 0 and the last frame
