@@ -212,9 +212,16 @@ py::dict report_dict(const std::string& source, const BuildReport& report,
   for (const format::Cluster& c : asset.clusters) {
     py::dict d;
     d["triangles"] = c.triangle_count;
-    d["detector_nodes"] = c.detector.nodes;
-    d["detector_weights"] = c.detector.weights;
-    d["detector_tet"] = c.detector.tet;
+    // The same members as the CLI report's "detector" (tools/common/mesh_output.cpp).
+    py::dict detector;
+    detector["nodes"] = c.detector.nodes;
+    detector["weights"] = c.detector.weights;
+    detector["tet"] = c.detector.tet == format::kNoTet ? py::object(py::none())
+                                                       : py::object(py::int_(c.detector.tet));
+    if (!asset.rest_positions.empty() && asset.rest_positions.size() == asset.node_count)
+      detector["position"] =
+          format::detector_position(c.detector, asset.rest_positions.front().data());
+    d["detector"] = detector;
     d["overlap_only"] = (c.flags & format::kClusterOverlapOnly) != 0;
     d["rest_positive_fraction"] = c.rest_positive_fraction;
     clusters.append(d);
