@@ -73,6 +73,56 @@ else
   skip_without_data "CGAL demo mesh dino.off (visibility note)"
 fi
 
+# A mat one tet layer thick has no interior node: it builds, its detectors are tet centroids,
+# and tetseg-dump shows them; --min-visibility 1 flags every cluster not seen whole.
+python3 - mat.mesh <<'PY'
+import sys
+nx, ny = 8, 8
+idx = lambda i, j, k: (i * (ny + 1) + j) * 2 + k
+nodes = [(0.1 * i, 0.1 * j, 0.03 * k) for i in range(nx + 1) for j in range(ny + 1) for k in range(2)]
+tets = []
+for i in range(nx):
+    for j in range(ny):
+        c = [idx(i + a, j + b, k) for a in (0, 1) for b in (0, 1) for k in (0, 1)]  # a b k bits
+        for p in ((0, 1, 2), (0, 2, 1), (1, 0, 2), (1, 2, 0), (2, 0, 1), (2, 1, 0)):
+            path, cur = [0], [0, 0, 0]
+            for ax in p:
+                cur[ax] = 1
+                path.append(cur[0] * 4 + cur[1] * 2 + cur[2])
+            t = [c[v] for v in path]
+            a, b, cc, d = (nodes[v] for v in t)
+            u = [b[q] - a[q] for q in range(3)]; v = [cc[q] - a[q] for q in range(3)]; w = [d[q] - a[q] for q in range(3)]
+            det = u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0]) + u[2] * (v[0] * w[1] - v[1] * w[0])
+            if det < 0: t[2], t[3] = t[3], t[2]
+            tets.append(t)
+with open(sys.argv[1], "w") as f:
+    f.write("MeshVersionFormatted 1\nDimension 3\nVertices\n%d\n" % len(nodes))
+    for p in nodes: f.write("%r %r %r 0\n" % p)
+    f.write("Tetrahedra\n%d\n" % len(tets))
+    for t in tets: f.write("%d %d %d %d 0\n" % tuple(v + 1 for v in t))
+    f.write("End\n")
+PY
+"$bin/tetseg" build mat.mesh -o mat.tetseg -q
+"$bin/tetseg-dump" mat.tetseg --json >mat.json
+"$bin/tetseg-dump" mat.tetseg >mat.txt
+grep -q " tet [0-9]* (" mat.txt || fail "tetseg-dump shows no detector inside a tet: $(cat mat.txt)"
+grep -q '"format_version": "1.1"' mat.json || fail "a mat's asset is not format 1.1"
+"$bin/tetseg" build mat.mesh -o mat1.tetseg -q --min-visibility 1
+"$bin/tetseg-dump" mat1.tetseg --json >mat1.json
+python3 - mat.json mat1.json <<'PY'
+import json, sys
+for path, bound in ((sys.argv[1], 0.5), (sys.argv[2], 1.0)):
+    d = json.load(open(path))
+    assert d["provenance"]["options"]["segmentation.min_visibility"] == ("0.5" if bound == 0.5 else "1"), d
+    for c in d["clusters"]:
+        det = c["detector"]
+        assert det["tet"] is not None and len(set(det["nodes"])) == 4, c
+        assert abs(sum(det["weights"]) - 1) < 1e-12 and len(det["position"]) == 3, c
+        assert c["overlap_only"] == (c["rest_positive_fraction"] < bound), (path, c)
+PY
+expect_exit 2 "min-visibility" -- "$bin/tetseg" build mat.mesh -o x.tetseg --min-visibility 1.5
+[ ! -e x.tetseg ] || fail "a usage error left an asset"
+
 # Same input and options give byte-identical assets.
 "$bin/tetseg" build sphere.mesh -o again.tetseg --clusters single -q
 cmp single.tetseg again.tetseg || fail "assets differ between two identical runs"

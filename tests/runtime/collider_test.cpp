@@ -6,30 +6,12 @@
 
 #include "runtime/support/compare.hpp"
 #include "runtime/support/motions.hpp"
+#include "runtime/support/scenes.hpp"
 #include "tetseg/runtime/collider.hpp"
 #include "tetseg/testing/synthetic_scenes.hpp"
 
 using namespace tetseg;
 using namespace tetseg::test;
-
-namespace {
-
-Scene sphere_scene(int clusters) {
-  const Surface s = sphere(1.0, 20, 11);
-  if (clusters == 1)
-    return make_scene(s, std::vector<std::uint32_t>(s.tris.size(), 0), {{0.3, 0.1, 0.05}});
-  return make_axial_scene(s, {0.0}, {-0.45, 0.45});
-}
-
-Scene dumbbell_scene() {
-  return make_axial_scene(dumbbell(16, 26), {-0.6, 0.6}, {-1.6, 0.0, 1.6});
-}
-
-Scene pawn_scene() {
-  return make_axial_scene(pawn(16, 30), {1.0, 2.6}, {0.4, 1.6, 3.3});
-}
-
-}  // namespace
 
 TEST_CASE("Radial-view culling finds the first contact of a pressed sphere", "[collider][rvbc]") {
   for (int clusters : {1, 2}) {
