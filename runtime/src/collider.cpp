@@ -118,6 +118,7 @@ void Collider::Impl::construct(std::shared_ptr<const BodyShape> sh, const Collid
   nneg.assign(nn, 0);
   nunc.assign(nn, 0);
   nmov.assign(nn, 0);
+  cluster_err.resize(cluster_count());
 
   skip_adjacent = uses_global_bvh();
   if (skip_adjacent) build_orphan_sets();
@@ -244,15 +245,30 @@ void Collider::Impl::refit_and_classify() noexcept {
 
   if (!orientation_mode()) return;
   const auto t_class = Clock::now();
+  // Static error bound of each cluster's cubics: its triangles lie in its root box (refit), so
+  // the box widened by the detector bounds every coordinate difference.
+  for (std::uint32_t c = 0; c < cluster_count(); ++c) {
+    const format::Cluster& cl = asset->clusters[c];
+    if (cl.bvh_count == 0) continue;
+    Box b = nbox[cl.bvh_offset];
+    for (const double* p : {pos0(cl.detector_node), pos1(cl.detector_node)}) {
+      for (int k = 0; k < 3; ++k) {
+        b.lo[k] = std::min(b.lo[k], p[k]);
+        b.hi[k] = std::max(b.hi[k], p[k]);
+      }
+    }
+    const double extent[3] = {b.hi[0] - b.lo[0], b.hi[1] - b.lo[1], b.hi[2] - b.lo[2]};
+    cluster_err[c] = orientation_detail::StaticErr::of(extent);
+  }
 #if defined(TETSEG_HAVE_OPENMP)
 #pragma omp parallel for if (opt.use_openmp && nt > 2048)
 #endif
   for (std::int64_t t = 0; t < nt; ++t) {
     const auto& tri = tris[t];
     const std::uint32_t o = asset->clusters[asset->triangle_cluster[t]].detector_node;
-    tcls[t] = static_cast<std::uint8_t>(orientation_of(pos0(o), pos0(tri[0]), pos0(tri[1]),
-                                                       pos0(tri[2]), pos1(o), pos1(tri[0]),
-                                                       pos1(tri[1]), pos1(tri[2])));
+    tcls[t] = static_cast<std::uint8_t>(
+        orientation_of(pos0(o), pos0(tri[0]), pos0(tri[1]), pos0(tri[2]), pos1(o), pos1(tri[0]),
+                       pos1(tri[1]), pos1(tri[2]), cluster_err[asset->triangle_cluster[t]]));
   }
   std::uint64_t count[3] = {0, 0, 0};
   for (std::uint32_t t = 0; t < tri_count; ++t) ++count[tcls[t]];

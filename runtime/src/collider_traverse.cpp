@@ -272,11 +272,17 @@ bool plane_separated(Worker& w, const Collider::Impl& A, std::uint32_t t1, const
     }
     return &w.plane[t];
   };
+  // Both triangles lie in the union of their swept boxes: its extents bound every coordinate
+  // difference of the cubics (the static error bound).
+  Box u = A.tbox[t1];
+  box_union(u, B.tbox[t2]);
+  const double extent[3] = {u.hi[0] - u.lo[0], u.hi[1] - u.lo[1], u.hi[2] - u.lo[2]};
+  const orientation_detail::StaticErr err = orientation_detail::StaticErr::of(extent);
   MovingTriangle m1{A.tris[t1], A.x0, A.x1, cache ? cached(t1) : nullptr};
   MovingTriangle m2{B.tris[t2], B.x0, B.x1};
-  if (nodes_strictly_on_one_side(m1, m2, same)) return true;  // plane_separated, in two steps
+  if (nodes_strictly_on_one_side(m1, m2, same, &err)) return true;  // plane_separated
   if (cache) m2.minors = cached(t2);
-  return nodes_strictly_on_one_side(m2, m1, same);
+  return nodes_strictly_on_one_side(m2, m1, same, &err);
 }
 
 // Tests the feature pairs of triangle t1 of A and t2 of B (t1 != t2 within one body):
