@@ -30,10 +30,11 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-/// Thread CPU time in milliseconds (robust to other processes on the shared cores).
-double thread_cpu_ms() {
+/// Process CPU time in milliseconds, all threads (robust to other processes on the shared
+/// cores; with OpenMP it sums the threads' time).
+double process_cpu_ms() {
   timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
   return double(ts.tv_sec) * 1e3 + double(ts.tv_nsec) * 1e-6;
 }
 
@@ -92,15 +93,37 @@ void load_scene(Scene& s, const std::string& asset_path, const std::string& fram
     throw Failure{kExitBadInput, frames_path + ": node count differs from the asset's"};
 }
 
-/// Runs `mode` over the steps (f, f + stride); fills timing and counts; when `truth` is given
+/// Which steps are run and what is timed.
+struct Plan {
+  std::size_t stride = 1;  ///< step f -> f + stride
+  bool pairs = false;      ///< frame-pair file: step i is frame 2i -> 2i + 1
+  std::size_t max_steps = 1000000;
+  int repeat = 3;           ///< runs per step, the fastest kept
+  bool time_tests = false;  ///< ColliderOptions::time_tests
+  bool earliest = false;    ///< time step + earliest_toi (else step + contacts)
+};
+
+/// Steps of `frames` under `plan`, and the frames of step i.
+std::size_t step_count(const tetseg::FrameSequence& frames, const Plan& plan) {
+  const std::size_t n = frames.frame_count;
+  const std::size_t steps = plan.pairs ? n / 2 : n > plan.stride ? (n - 1) / plan.stride : 0;
+  return std::min(steps, plan.max_steps);
+}
+std::size_t step_start(std::size_t i, const Plan& plan) {
+  return plan.pairs ? 2 * i : i * plan.stride;
+}
+std::size_t step_end(std::size_t i, const Plan& plan) {
+  return plan.pairs ? 2 * i + 1 : i * plan.stride + plan.stride;
+}
+
+/// Runs `mode` over the steps of `plan`; fills timing and counts; when `truth` is given
 /// and `record` is false, compares; when `record` is true, stores the mode's results in it.
-Row run_mode(const Scene& s, tetseg::ColliderMode mode, bool openmp, bool time_tests,
-             std::size_t stride, std::size_t max_steps, int repeat, std::vector<StepTruth>& truth,
-             bool record, std::vector<tetseg::Contact>& buffer) {
+Row run_mode(const Scene& s, tetseg::ColliderMode mode, bool openmp, const Plan& plan,
+             std::vector<StepTruth>& truth, bool record, std::vector<tetseg::Contact>& buffer) {
   tetseg::ColliderOptions opt;
   opt.mode = mode;
   opt.use_openmp = openmp;
-  opt.time_tests = time_tests;
+  opt.time_tests = plan.time_tests;
   tetseg::Collider collider(s.asset, opt);
   if (collider.status() != tetseg::ColliderStatus::kOk)
     throw Failure{kExitFailed, "cannot create the collider"};
@@ -108,35 +131,37 @@ Row run_mode(const Scene& s, tetseg::ColliderMode mode, bool openmp, bool time_t
   row.scene = s.name;
   row.mode = tetseg::to_string(mode);
   row.openmp = openmp;
-  row.timed_tests = time_tests;
+  row.timed_tests = plan.time_tests;
   row.clusters = s.asset.cluster_count();
-  const std::size_t frames = s.frames.frame_count;
-  std::size_t steps = frames > stride ? (frames - 1) / stride : 0;
-  steps = std::min(steps, max_steps);
+  const std::size_t steps = step_count(s.frames, plan);
   if (record) truth.assign(steps, {});
   row.steps = steps;
   for (std::size_t i = 0; i < steps; ++i) {
-    const double* x0 = s.frames.frame(i * stride);
-    const double* x1 = s.frames.frame(i * stride + stride);
+    const double* x0 = s.frames.frame(step_start(i, plan));
+    const double* x1 = s.frames.frame(step_end(i, plan));
     double best_total = 1e300, best_cpu = 1e300;
     tetseg::ColliderStats best_stats;
     tetseg::ContactsResult result;
-    for (int r = 0; r < repeat; ++r) {
-      const double c0 = thread_cpu_ms();
+    tetseg::EarliestContact e;
+    for (int r = 0; r < plan.repeat; ++r) {
+      const double c0 = process_cpu_ms();
       const auto t0 = Clock::now();
       if (collider.step(x0, x1) != tetseg::ColliderStatus::kOk)
         throw Failure{kExitBadInput, s.name + ": step " + std::to_string(i) + " rejected"};
-      const tetseg::ColliderStatus st = collider.contacts(buffer.data(), buffer.size(), result);
+      const tetseg::ColliderStatus st =
+          plan.earliest ? collider.earliest_toi(e)
+                        : collider.contacts(buffer.data(), buffer.size(), result);
       const double ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-      best_cpu = std::min(best_cpu, thread_cpu_ms() - c0);
+      best_cpu = std::min(best_cpu, process_cpu_ms() - c0);
       if (st != tetseg::ColliderStatus::kOk) throw Failure{kExitFailed, s.name + ": query failed"};
       if (ms < best_total) {
         best_total = ms;
         best_stats = collider.stats();
       }
     }
-    tetseg::EarliestContact e;
-    if (collider.earliest_toi(e) != tetseg::ColliderStatus::kOk)
+    // Untimed: the other query, for the counts and the comparison.
+    if ((plan.earliest ? collider.contacts(buffer.data(), buffer.size(), result)
+                       : collider.earliest_toi(e)) != tetseg::ColliderStatus::kOk)
       throw Failure{kExitFailed, s.name + ": query failed"};
     row.total += best_total;
     row.cpu += best_cpu;
@@ -203,8 +228,7 @@ std::string fmt(const char* f, double v) {
 }
 
 int table(const std::vector<std::string>& scene_args, const std::string& mode_list,
-          std::size_t stride, std::size_t max_steps, int repeat, bool openmp, bool json,
-          bool with_truth, bool time_tests) {
+          const Plan& plan, bool openmp, bool json, bool with_truth) {
   if (scene_args.empty() || scene_args.size() % 3 != 0)
     throw Failure{kExitUsage, "scenes are given as NAME ASSET FRAMES triples"};
   std::vector<tetseg::ColliderMode> modes;
@@ -227,19 +251,21 @@ int table(const std::vector<std::string>& scene_args, const std::string& mode_li
     Scene s;
     s.name = scene_args[i];
     load_scene(s, scene_args[i + 1], scene_args[i + 2]);
+    if (plan.pairs && s.frames.frame_count % 2 != 0)
+      throw Failure{kExitBadInput, scene_args[i + 2] + ": --pairs needs an even frame count"};
     // A scene on the same frames as an earlier one (another asset of the same mesh, e.g.
     // another cluster method) reuses that scene's brute-force truth.
     std::vector<StepTruth>& truth = truths[scene_args[i + 2]];
     if (with_truth && truth.empty()) {
-      rows.push_back(run_mode(s, tetseg::ColliderMode::kBrute, false, time_tests, stride, max_steps,
-                              1, truth, true, buffer));
+      Plan once = plan;
+      once.repeat = 1;
+      rows.push_back(run_mode(s, tetseg::ColliderMode::kBrute, false, once, truth, true, buffer));
       std::fprintf(stderr, "tetseg-bench: %s: brute done (%.1f ms/step)\n", s.name.c_str(),
                    rows.back().total);
     }
     for (tetseg::ColliderMode m : modes) {
       for (int omp = 0; omp <= (openmp ? 1 : 0); ++omp) {
-        rows.push_back(
-            run_mode(s, m, omp == 1, time_tests, stride, max_steps, repeat, truth, false, buffer));
+        rows.push_back(run_mode(s, m, omp == 1, plan, truth, false, buffer));
         std::fprintf(stderr, "tetseg-bench: %s: %s%s done\n", s.name.c_str(), to_string(m),
                      omp ? " (OpenMP)" : "");
       }
@@ -364,25 +390,35 @@ int main(int argc, char** argv) {
       "table", "Table I: per-step stage times, work counts and missed contacts per mode");
   std::vector<std::string> scenes;
   std::string modes = "rvbc,bvh,cone,brute";
-  std::size_t stride = 1, max_steps = 1000000;
-  int repeat = 3;
-  bool openmp = false, json = false, no_truth = false, time_tests = false;
+  Plan plan;
+  std::string query = "all";
+  bool openmp = false, json = false, no_truth = false;
   t->add_option("scenes", scenes,
                 "NAME ASSET FRAMES, repeated per scene (scenes on the same FRAMES file share "
                 "one brute-force truth)")
       ->required();
   t->add_option("--modes", modes, "Comma-separated modes (brute always runs as the truth)");
-  t->add_option("--stride", stride, "Step from frame f to f + stride (default 1)")
+  t->add_option("--stride", plan.stride, "Step from frame f to f + stride (default 1)")
       ->check(CLI::Range(std::size_t(1), std::size_t(1000)));
-  t->add_option("--max-steps", max_steps, "Use at most this many steps per scene")
+  t->add_flag("--pairs", plan.pairs,
+              "FRAMES are frame pairs (tetseg-sim --record-queries): step i is frame 2i -> 2i + 1")
+      ->excludes("--stride");
+  t->add_option("--max-steps", plan.max_steps, "Use at most this many steps per scene")
       ->check(CLI::PositiveNumber);
-  t->add_option("--repeat", repeat, "Runs per step; the fastest is kept (default 3)")
+  t->add_option("--repeat", plan.repeat, "Runs per step; the fastest is kept (default 3)")
       ->check(CLI::Range(1, 100));
-  t->add_flag("--openmp", openmp, "Also run each mode with use_openmp (refit, classification)");
+  t->add_option("--query", query,
+                "Timed query after each step: all (contacts into a buffer, default) or earliest "
+                "(earliest_toi, which rvbc traverses in parallel with --openmp); the other runs "
+                "untimed for the comparison")
+      ->check(CLI::IsMember({"all", "earliest"}));
+  t->add_flag("--openmp", openmp,
+              "Also run each mode with use_openmp (refit, classification; rvbc's traversal "
+              "with --query earliest)");
   t->add_flag("--no-truth", no_truth,
               "Skip brute force and the comparison (timings only; missed reads 0)");
   t->add_flag("--json", json, "JSON on stdout instead of the Markdown table");
-  t->add_flag("--time-tests", time_tests,
+  t->add_flag("--time-tests", plan.time_tests,
               "Time the elementary tests apart (two clock reads per test, in every total); "
               "without it their time counts as traversal and the column reads '-'");
   CLI::App* c = app.add_subcommand(
@@ -413,7 +449,8 @@ int main(int argc, char** argv) {
     app.parse(argc, argv);
     if (c->parsed()) return check(check_asset, check_frames);
     if (sc->parsed()) return tetseg::bench::scene_table(scene_options);
-    return table(scenes, modes, stride, max_steps, repeat, openmp, json, !no_truth, time_tests);
+    plan.earliest = query == "earliest";
+    return table(scenes, modes, plan, openmp, json, !no_truth);
   } catch (const CLI::ParseError& e) {
     const int code = app.exit(e);
     return code == 0 ? 0 : kExitUsage;

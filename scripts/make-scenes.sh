@@ -5,7 +5,9 @@
 # with the other cluster methods (NAME-charge.tetseg, NAME-single.tetseg); then the scenes with
 # several bodies ("Scenes"): a pile of soft balls dropped into a bin, two characters dropped
 # on each other, a soft pancake draped over a still sphere, each a frame sequence plus a scene
-# description for `tetseg-bench scene` (NAME.tsscene). Outputs go to OUT_DIR (default
+# description for `tetseg-bench scene` (NAME.tsscene). The single-body scenes also record every
+# eighth collision query of the simulator as frame pairs (NAME.queries.tsf, docs/simulation.md,
+# "Recording the queries"). Outputs go to OUT_DIR (default
 # BUILD_DIR/scenes), never into the repository.
 #
 #   scripts/make-scenes.sh [BUILD_DIR] [OUT_DIR]      (BUILD_DIR default: ./build)
@@ -33,7 +35,8 @@ scene() {  # scene NAME SIM-OPTIONS...  (NAME.mesh exists)
       --report "$name-$clusters.build.json"
   done
   echo "make-scenes: $name: simulating" >&2
-  "$sim" "$name.mesh" "$name.tetseg" -o "$name.tsf" --json "$@" > "$name.sim.json"
+  "$sim" "$name.mesh" "$name.tetseg" -o "$name.tsf" --json "$@" \
+    --record-queries "$name.queries.tsf" --record-every 8 > "$name.sim.json"
   echo "make-scenes: $name: $(cat "$name.sim.json")" >&2
 }
 

@@ -27,7 +27,8 @@ using namespace tetseg::tools;
 constexpr const char* kTool = "tetseg-sim";
 
 struct Args {
-  std::string mesh, asset, output, scene_out, mode = "rvbc";
+  std::string mesh, asset, output, scene_out, queries_out, mode = "rvbc";
+  std::uint32_t record_every = 1;
   std::vector<std::string> bodies, boxes, bins, spheres;
   std::uint32_t frames = 100;
   std::uint32_t obstacle_resolution = 8;
@@ -192,11 +193,24 @@ int run(const Args& a, SimOptions opt) {
   seq.frame_count = a.frames;
   seq.positions.reserve(std::size_t(a.frames) * seq.node_count * 3);
   sim.append_positions(seq.positions);
+  tetseg::FrameSequence queries;
+  queries.node_count = seq.node_count;
+  if (!a.queries_out.empty()) sim.record_queries(&queries.positions, a.record_every);
   for (std::uint32_t f = 1; f < a.frames; ++f) {
     sim.advance_frame();
     sim.append_positions(seq.positions);
   }
+  if (!a.queries_out.empty()) {  // checked before anything is written
+    const SimCounters& c = sim.counters();
+    if (c.queries_recorded == 0)
+      throw ToolError(kExitProcessingFailed, a.queries_out,
+                      "no substep had a contact: no query step to record");
+    if (c.queries_recorded * 2 > 0xffffffffull)
+      throw ToolError(kExitProcessingFailed, a.queries_out, "too many query steps to record");
+    queries.frame_count = static_cast<std::uint32_t>(c.queries_recorded * 2);
+  }
   write_file_atomic(a.output, tetseg::write_frames(seq));
+  if (!a.queries_out.empty()) write_file_atomic(a.queries_out, tetseg::write_frames(queries));
   if (!a.scene_out.empty()) write_file_atomic(a.scene_out, scene.str());
   const SimCounters& c = sim.counters();
   if (a.json) {
@@ -208,7 +222,8 @@ int run(const Args& a, SimOptions opt) {
               << ", \"body_contacts\": " << c.body_contacts
               << ", \"query_rounds\": " << c.query_rounds << ", \"max_rounds\": " << c.max_rounds
               << ", \"nodes_frozen\": " << c.nodes_frozen
-              << ", \"ground_contacts\": " << c.ground_contacts << "}\n";
+              << ", \"ground_contacts\": " << c.ground_contacts
+              << ", \"queries_recorded\": " << c.queries_recorded << "}\n";
   } else {
     std::fprintf(stderr,
                  "tetseg-sim: %u frames, %llu substeps; contact: %llu contacts resolved (%llu "
@@ -250,6 +265,13 @@ int main(int argc, char** argv) {
   app.add_option("--scene", a.scene_out,
                  "Scene description to write for tetseg-bench scene (docs/format.md)");
   app.add_option("-o,--output", a.output, "Frame-sequence file to write")->required();
+  app.add_option(
+      "--record-queries", a.queries_out,
+      "Also write the collision queries of substeps with contact as a frame-pair file "
+      "(frames 2i, 2i+1: start and predicted end of query i; tetseg-bench table --pairs)");
+  app.add_option("--record-every", a.record_every,
+                 "Record every N-th substep with contact (default 1)")
+      ->check(CLI::Range(1u, 1000000u));
   app.add_option("--frames", a.frames, "Frames to write, including the start (default 100)")
       ->check(CLI::Range(1u, 100000u));
   app.add_option("--substeps", opt.substeps, "Substeps per frame (default 4)")

@@ -304,7 +304,14 @@ void Simulation::resolve_contacts() {
     if (qs != tetseg::ColliderStatus::kOk)
       throw std::runtime_error(std::string("scene query failed: ") + tetseg::to_string(qs));
     if (!hit) break;
-    if (first) ++m_counters.substeps_with_contact;
+    if (first) {
+      ++m_counters.substeps_with_contact;
+      if (m_record && (m_counters.substeps_with_contact - 1) % m_record_every == 0) {
+        append_starts(*m_record);  // the query as asked: nothing frozen yet
+        append_positions(*m_record);
+        ++m_counters.queries_recorded;
+      }
+    }
     first = false;
     m_counters.contacts_resolved += r.found;
     bool progress = false;
@@ -330,6 +337,18 @@ void Simulation::resolve_contacts() {
 void Simulation::append_positions(std::vector<double>& out) const {
   for (const Body& b : m_bodies) {
     const std::vector<double>& x = b.soft ? b.soft->positions() : b.obstacle.positions;
+    out.insert(out.end(), x.begin(), x.end());
+  }
+}
+
+void Simulation::record_queries(std::vector<double>* out, std::uint32_t every) {
+  m_record = out;
+  m_record_every = std::max<std::uint32_t>(1, every);
+}
+
+void Simulation::append_starts(std::vector<double>& out) const {
+  for (const Body& b : m_bodies) {
+    const std::vector<double>& x = b.soft ? b.soft->previous() : b.obstacle.positions;
     out.insert(out.end(), x.begin(), x.end());
   }
 }

@@ -56,6 +56,7 @@ struct SimCounters {
   std::uint64_t nodes_frozen = 0;           ///< node freezes by the contact response
   std::uint64_t ground_contacts = 0;        ///< node-substeps clamped to the ground
   std::uint32_t max_rounds = 0;             ///< most query rounds in one substep
+  std::uint64_t queries_recorded = 0;       ///< query steps appended by `record_queries`
 };
 
 /// One soft body's dynamics (no contact handling: `Simulation` does that for all bodies).
@@ -123,6 +124,12 @@ class Simulation {
   /// InputError naming the bodies' `what` otherwise. Call once, after adding every body.
   void check_start();
 
+  /// Records the collision queries: from now on, every `every`-th substep whose first query
+  /// finds a contact appends two frames to `out` (positions of all bodies, as
+  /// `append_positions`): the substep's start and its predicted end, before the contact
+  /// response. `out` (null: stop recording) must outlive the recording; `every` >= 1.
+  void record_queries(std::vector<double>* out, std::uint32_t every);
+
   /// Advances one frame (`options.substeps` substeps). Throws std::runtime_error if the scene
   /// fails (never expected).
   void advance_frame();
@@ -136,8 +143,11 @@ class Simulation {
   void substep(double h);
   void resolve_contacts();
   void set_positions();
+  void append_starts(std::vector<double>& out) const;
 
   SimOptions m_opt;
+  std::vector<double>* m_record = nullptr;
+  std::uint32_t m_record_every = 1;
   std::vector<Body> m_bodies;
   tetseg::Scene m_scene;
   std::vector<tetseg::Contact> m_contacts;

@@ -121,6 +121,7 @@ void Collider::Impl::construct(std::shared_ptr<const BodyShape> sh, const Collid
   nneg.assign(nn, 0);
   nunc.assign(nn, 0);
   nmov.assign(nn, 0);
+  cluster_err.resize(cluster_count());
 
   skip_adjacent = uses_global_bvh();
   if (skip_adjacent) build_orphan_sets();
@@ -253,6 +254,8 @@ void Collider::Impl::refit_and_classify() noexcept {
   const auto t_class = Clock::now();
   // Detector points at both ends of the step; the detector moves linearly between them, like
   // every node, so the orientation stays a cubic in t (docs/runtime.md, "Detector points").
+  // Static error bound of each cluster's cubics: its triangles lie in its root box (refit), so
+  // the box widened by the detector's two positions bounds every coordinate difference.
   for (std::uint32_t c = 0; c < cluster_count(); ++c) {
     const format::Cluster& cl = asset->clusters[c];
     det_ok[c] = 0;
@@ -266,6 +269,16 @@ void Collider::Impl::refit_and_classify() noexcept {
       ok = ok && std::isfinite(a[k]) && std::isfinite(b[k]);
     }
     det_ok[c] = ok ? 1 : 0;  // an overflowing combination: the cluster's triangles uncertain
+    if (!ok || cl.bvh_count == 0) continue;
+    Box box = nbox[cl.bvh_offset];
+    for (const std::array<double, 3>* p : {&a, &b}) {
+      for (int k = 0; k < 3; ++k) {
+        box.lo[k] = std::min(box.lo[k], (*p)[k]);
+        box.hi[k] = std::max(box.hi[k], (*p)[k]);
+      }
+    }
+    const double extent[3] = {box.hi[0] - box.lo[0], box.hi[1] - box.lo[1], box.hi[2] - box.lo[2]};
+    cluster_err[c] = orientation_detail::StaticErr::of(extent);
   }
 #if defined(TETSEG_HAVE_OPENMP)
 #pragma omp parallel for if (opt.use_openmp && nt > 2048)
@@ -279,9 +292,9 @@ void Collider::Impl::refit_and_classify() noexcept {
     }
     const double* o0 = det0.data() + 3 * std::size_t(c);
     const double* o1 = det1.data() + 3 * std::size_t(c);
-    tcls[t] =
-        static_cast<std::uint8_t>(orientation_of(o0, pos0(tri[0]), pos0(tri[1]), pos0(tri[2]), o1,
-                                                 pos1(tri[0]), pos1(tri[1]), pos1(tri[2])));
+    tcls[t] = static_cast<std::uint8_t>(orientation_of(o0, pos0(tri[0]), pos0(tri[1]), pos0(tri[2]),
+                                                       o1, pos1(tri[0]), pos1(tri[1]), pos1(tri[2]),
+                                                       cluster_err[c]));
   }
   std::uint64_t count[3] = {0, 0, 0};
   for (std::uint32_t t = 0; t < tri_count; ++t) ++count[tcls[t]];

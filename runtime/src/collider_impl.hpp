@@ -27,11 +27,12 @@ struct Box {
 };
 
 inline bool boxes_overlap(const Box& a, const Box& b, double margin) noexcept {
-  // Written so that NaN never yields "disjoint" (positions are checked finite anyway).
-  for (int k = 0; k < 3; ++k) {
-    if (a.lo[k] > b.hi[k] + margin || b.lo[k] > a.hi[k] + margin) return false;
-  }
-  return true;
+  // Written so that NaN never yields "disjoint" (positions are checked finite anyway). All six
+  // comparisons combined without branches: the traversal's outcomes are hard to predict.
+  const bool apart = (a.lo[0] > b.hi[0] + margin) | (b.lo[0] > a.hi[0] + margin) |
+                     (a.lo[1] > b.hi[1] + margin) | (b.lo[1] > a.hi[1] + margin) |
+                     (a.lo[2] > b.hi[2] + margin) | (b.lo[2] > a.hi[2] + margin);
+  return !apart;
 }
 
 inline void box_union(Box& a, const Box& b) noexcept {
@@ -294,6 +295,7 @@ struct Collider::Impl {
   std::vector<std::array<std::uint32_t, 2>> orphan_ee;  // (edge, edge), first < second
   std::vector<Box> nbox;                                // per asset BVH node
   std::vector<std::uint32_t> nneg, nunc, nmov;
+  std::vector<orientation_detail::StaticErr> cluster_err;  // per cluster, this step (classify)
   std::vector<Worker> workers;
   // Contact closure scratch (capacity tri_count, reserved at construction).
   std::vector<std::uint32_t> closure_ring;

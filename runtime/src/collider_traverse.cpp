@@ -272,11 +272,17 @@ bool plane_separated(Worker& w, const Collider::Impl& A, std::uint32_t t1, const
     }
     return &w.plane[t];
   };
+  // Both triangles lie in the union of their swept boxes: its extents bound every coordinate
+  // difference of the cubics (the static error bound).
+  Box u = A.tbox[t1];
+  box_union(u, B.tbox[t2]);
+  const double extent[3] = {u.hi[0] - u.lo[0], u.hi[1] - u.lo[1], u.hi[2] - u.lo[2]};
+  const orientation_detail::StaticErr err = orientation_detail::StaticErr::of(extent);
   MovingTriangle m1{A.tris[t1], A.x0, A.x1, cache ? cached(t1) : nullptr};
   MovingTriangle m2{B.tris[t2], B.x0, B.x1};
-  if (nodes_strictly_on_one_side(m1, m2, same)) return true;  // plane_separated, in two steps
+  if (nodes_strictly_on_one_side(m1, m2, same, &err)) return true;  // plane_separated
   if (cache) m2.minors = cached(t2);
-  return nodes_strictly_on_one_side(m2, m1, same);
+  return nodes_strictly_on_one_side(m2, m1, same, &err);
 }
 
 // Tests the feature pairs of triangle t1 of A and t2 of B (t1 != t2 within one body):
@@ -287,19 +293,14 @@ template <typename Claimed>
 void test_features(Worker& w, const Collider::Impl& A, std::uint32_t t1, const Collider::Impl& B,
                    std::uint32_t t2, Claimed&& claimed) noexcept {
   const double ms = A.opt.ccd.min_separation;
-  // The plane filter runs once per pair: first thing without orientation culling (bvh and
-  // cone modes, surface-only bodies, pairs of bodies), else lazily when the first feature pair
-  // passes its box checks (measured both ways per mode: docs/benchmarks.md, "Per-pair work").
-  int plane = ms <= 0 ? -1 : 0;  // -1 unknown, 0 not separated, 1 separated
-  auto separated = [&]() {
-    if (plane < 0) {
-      plane = plane_separated(w, A, t1, B, t2) ? 1 : 0;
-      w.stats.triangle_pairs_plane_filtered += plane;
-    }
-    return plane == 1;
-  };
+  // The plane filter first, in every mode: with its static error bound it costs less than the
+  // feature boxes it saves (rvbc evaluated it lazily before; docs/benchmarks.md, "Static error
+  // bounds").
+  if (ms <= 0 && plane_separated(w, A, t1, B, t2)) {
+    ++w.stats.triangle_pairs_plane_filtered;
+    return;
+  }
   const bool same = &A == &B;
-  if ((!same || !A.orientation_mode()) && separated()) return;
   const auto& TA = A.tris[t1];
   const auto& TB = B.tris[t2];
   // Vertex-face, both directions.
@@ -315,7 +316,6 @@ void test_features(Worker& w, const Collider::Impl& A, std::uint32_t t1, const C
       // Cheap rejections before the ownership scan (repeated inside, harmless).
       if (!PB.vmoved[ip] && !FB.tmov[face]) continue;
       if (!boxes_overlap(PB.vbox[ip], FB.tbox[face], ms)) continue;
-      if (separated()) return;
       bool owner = true;
       const auto& vt_offset = PB.topo->vt_offset;
       const auto& vt_list = PB.topo->vt_list;
@@ -338,7 +338,6 @@ void test_features(Worker& w, const Collider::Impl& A, std::uint32_t t1, const C
       const auto& E2 = EB[e2];
       if (same && (E1[0] == E2[0] || E1[0] == E2[1] || E1[1] == E2[0] || E1[1] == E2[1])) continue;
       if (!edge_boxes_overlap(A, e1, B, e2)) continue;
-      if (separated()) return;
       bool owner = true;
       const auto& ea_offset = A.topo->et_offset;
       const auto& ea_list = A.topo->et_list;

@@ -75,6 +75,50 @@ inline BernsteinCubic bernstein(const V3& u0, const V3& u1, const Minors& m00, c
   return r;
 }
 
+/// Semi-static error bounds (Shewchuk's filters, per box): when every coordinate difference of
+/// the points of a cubic is at most `d[k]` in absolute value on axis k (all points of the step
+/// lie in a box of extents d), `err0` bounds the error terms `bernstein` computes for k0 and
+/// k3, `err1` those of k1 and k2. The bound evaluates the same rounded operations on the
+/// extents instead of the differences' absolute values; rounding is monotone, so each is at
+/// least the computed bound it replaces (not a new error analysis).
+struct StaticErr {
+  double err0, err1;
+  static StaticErr of(const double d[3]) noexcept {
+    const V3 dv{d[0], d[1], d[2]};
+    const Minors m = minors(dv, dv);
+    double unused, p;
+    det_perm(dv, m, unused, p);
+    return {kRelErr * p + kAbsErr, kRelErr * (p + p + p) + kAbsErr};
+  }
+};
+
+/// Bernstein coefficients only (no error terms), the same operations as `bernstein`.
+inline void bernstein_k(const V3& u0, const V3& u1, const Minors& m00, const Minors& m10,
+                        const Minors& m01, const Minors& m11, double k[4]) noexcept {
+  auto det = [](const V3& u, const Minors& m) { return u.x * m.m0 - u.y * m.m1 + u.z * m.m2; };
+  k[0] = det(u0, m00);
+  k[1] = det(u1, m00) + det(u0, m10) + det(u0, m01);
+  k[2] = det(u0, m11) + det(u1, m01) + det(u1, m10);
+  k[3] = det(u1, m11);
+}
+
+/// The sign `sign(bernstein(...))` would give, decided from the coefficients and a static bound
+/// when it can be: a definite sign when all four clear `e`, uncertain when two clear it with
+/// opposite signs (then they clear the smaller computed bounds too). kUncertain with
+/// `decided = false` otherwise: the caller computes the full cubic.
+inline Orientation static_sign(const double k[4], const StaticErr& e, bool& decided) noexcept {
+  const double err[4] = {e.err0, e.err1, e.err1, e.err0};
+  int pos = 0, neg = 0;
+  for (int i = 0; i < 4; ++i) {
+    pos += k[i] > err[i];
+    neg += k[i] < -err[i];
+  }
+  decided = pos == 4 || neg == 4 || (pos > 0 && neg > 0);
+  return pos == 4   ? Orientation::kPositive
+         : neg == 4 ? Orientation::kNegative
+                    : Orientation::kUncertain;
+}
+
 /// The sign of a cubic proven by its four Bernstein coefficients (sign_of in classify.cpp).
 inline Orientation sign(const BernsteinCubic& c) noexcept {
   // Written so that NaN coefficients or bounds fail every comparison: uncertain.
@@ -107,6 +151,25 @@ inline Orientation orientation_of(const double* o0, const double* a0, const doub
   return sign(cubic(o0, a0, b0, c0, o1, a1, b1, c1));
 }
 
+/// `orientation_of` for points whose coordinate differences are bounded by the extents that
+/// gave `e` (StaticErr::of): bitwise the same answer, without the error terms when the static
+/// bound decides.
+inline Orientation orientation_of(const double* o0, const double* a0, const double* b0,
+                                  const double* c0, const double* o1, const double* a1,
+                                  const double* b1, const double* c1,
+                                  const orientation_detail::StaticErr& e) noexcept {
+  using namespace orientation_detail;
+  const V3 v0 = sub(b0, o0), w0 = sub(c0, o0), v1 = sub(b1, o1), w1 = sub(c1, o1);
+  auto m = [](const V3& v, const V3& w) {  // the minors' m terms only, as `minors`
+    return Minors{v.y * w.z - v.z * w.y, v.x * w.z - v.z * w.x, v.x * w.y - v.y * w.x, 0, 0, 0};
+  };
+  double k[4];
+  bernstein_k(sub(a0, o0), sub(a1, o1), m(v0, w0), m(v1, w0), m(v0, w1), m(v1, w1), k);
+  bool decided;
+  const Orientation o = static_sign(k, e, decided);
+  return decided ? o : sign(cubic(o0, a0, b0, c0, o1, a1, b1, c1));
+}
+
 /// The four minor sets of a moving triangle's edge vectors b - a, c - a (start, end and
 /// crossed): everything of its plane that does not depend on the point tested. A collider
 /// computes them once per triangle and step (refit) and shares them read-only.
@@ -124,6 +187,18 @@ struct FacePlaneMinors {
                    const double* p1) const noexcept {
     using namespace orientation_detail;
     return sign(bernstein(sub(p0, a0), sub(p1, a1), m00, m10, m01, m11));
+  }
+  /// Bitwise `side(a0, a1, p0, p1)` when the triangle's and the point's positions at both ends
+  /// lie in a box whose extents give `e` (StaticErr::of); cheaper when the static bound decides.
+  Orientation side(const double* a0, const double* a1, const double* p0, const double* p1,
+                   const orientation_detail::StaticErr& e) const noexcept {
+    using namespace orientation_detail;
+    const V3 u0 = sub(p0, a0), u1 = sub(p1, a1);
+    double k[4];
+    bernstein_k(u0, u1, m00, m10, m01, m11, k);
+    bool decided;
+    const Orientation o = static_sign(k, e, decided);
+    return decided ? o : sign(bernstein(u0, u1, m00, m10, m01, m11));
   }
 };
 

@@ -41,6 +41,36 @@ set +e; "$bin/tetseg-bench" check d.tetseg n.tsf > checkn.txt; rc=$?; set -e
 "$sim" d.mesh d.tetseg -o c.tsf --frames 60 "${args[@]}" --mode bvh 2>/dev/null
 "$bin/tetseg-bench" check d.tetseg c.tsf > /dev/null || fail "bvh-mode frames not clean"
 
+# Recorded queries: the substeps with contact as frame pairs, the main frames unchanged; each
+# pair's end penetrates (brute force finds contacts) and every mode finds the earliest ones.
+"$sim" d.mesh d.tetseg -o q.tsf --frames 150 "${args[@]}" --json --record-queries q.queries.tsf \
+  --record-every 3 > q.json
+cmp a.tsf q.tsf || fail "recording the queries changed the frames"
+python3 - <<'PY'
+import json, os
+d = json.load(open("q.json"))
+n = d["queries_recorded"]
+assert n == (d["substeps_with_contact"] + 2) // 3 and n > 0, d
+assert os.path.getsize("q.queries.tsf") == 24 + 24 * d["nodes"] * 2 * n, d
+PY
+"$bin/tetseg-bench" table d d.tetseg q.queries.tsf --pairs --modes rvbc,bvh,cone --repeat 1 \
+  --json > qt.json || fail "a mode missed a contact on the recorded queries"
+python3 - <<'PY'
+import json
+rows = json.load(open("qt.json"))["rows"]
+brute = [r for r in rows if r["mode"] == "brute"][0]
+assert brute["contacts"] > 0 and brute["compared"] == brute["steps"], brute
+for r in rows:
+    assert r["missed"] == 0 and r["any_mismatch"] == 0 and r["toi_later"] == 0, r
+PY
+"$sim" d.mesh d.tetseg -o x.tsf --frames 2 --substeps 1 --dt 0.005 --drop 1 \
+  --record-queries xq.tsf 2>err.txt && fail "no query to record: must fail"
+grep -q "xq.tsf" err.txt || fail "the error must name the queries file"
+[ ! -e x.tsf ] && [ ! -e xq.tsf ] || fail "output written although no query was recorded"
+expect_exit 2 "" -- "$bin/tetseg-bench" table d d.tetseg q.queries.tsf --pairs --stride 2
+"$sim" d.mesh d.tetseg -o odd.tsf --frames 3 "${args[@]}" 2>/dev/null
+expect_exit 3 "even frame count" -- "$bin/tetseg-bench" table d d.tetseg odd.tsf --pairs --no-truth
+
 expect_exit 0 "Usage" -- "$sim" --help
 expect_exit 2 "" -- "$sim" d.mesh d.tetseg
 expect_exit 3 "tetseg-sim: error: missing.mesh" -- "$sim" missing.mesh d.tetseg -o x.tsf

@@ -2,8 +2,10 @@
 // bitwise the orientation cubic of classify.hpp, and a plane-separated triangle pair has no
 // feature pair with four distinct nodes that the elementary tests (brute force's) find in contact.
 
+#include <algorithm>
 #include <array>
 #include <catch2/catch.hpp>
+#include <cmath>
 #include <random>
 #include <vector>
 
@@ -75,6 +77,59 @@ TEST_CASE("A face plane computed once gives bitwise the orientation cubic of cla
               classify_orientation(p[0], p[3], p[1], p[2], p[4], p[7], p[5], p[6]));
     }
   }
+}
+
+TEST_CASE("The static error bound gives bitwise the orientation cubic's sign", "[plane-filter]") {
+  // Points in boxes of random shape (one axis often much thinner), some exactly or nearly
+  // coplanar; the runtime's bound: StaticErr::of the extents of the box of all eight points.
+  std::mt19937_64 rng(13);
+  std::uniform_real_distribution<double> u(-1.0, 1.0), e(-12.0, 4.0);
+  std::size_t decided = 0, trials = 0;
+  for (int trial = 0; trial < 20000; ++trial) {
+    double axis[3];
+    for (double& a : axis) a = std::pow(10.0, trial % 3 == 0 ? e(rng) : e(rng) / 4);
+    double p[8][3];
+    for (auto& q : p)
+      for (int k = 0; k < 3; ++k) q[k] = axis[k] * u(rng) + (trial % 7 == 0 ? 1e3 : 0.0);
+    if (trial % 4 == 0)  // nearly coplanar point
+      for (int k = 0; k < 3; ++k) p[3][k] = (p[0][k] + p[1][k] + p[2][k]) / 3;
+    if (trial % 5 == 0)  // coplanar at the start, integer coordinates: k0 is exactly 0
+      for (int k = 0; k < 3; ++k) {
+        for (int i = 0; i < 3; ++i) p[i][k] = std::round(p[i][k] * 8);
+        p[3][k] = p[0][k] + p[1][k] - p[2][k];
+      }
+    double lo[3], hi[3];
+    for (int k = 0; k < 3; ++k) {
+      lo[k] = hi[k] = p[0][k];
+      for (const auto& q : p) {
+        lo[k] = std::min(lo[k], q[k]);
+        hi[k] = std::max(hi[k], q[k]);
+      }
+    }
+    const double extent[3] = {hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]};
+    const auto err = orientation_detail::StaticErr::of(extent);
+    const BernsteinCubic ref =
+        orientation_bernstein(p[0], p[3], p[1], p[2], p[4], p[7], p[5], p[6]);
+    // The property the shortcut rests on: the static bounds dominate the computed ones.
+    REQUIRE(err.err0 >= ref.err[0]);
+    REQUIRE(err.err1 >= ref.err[1]);
+    REQUIRE(err.err1 >= ref.err[2]);
+    REQUIRE(err.err0 >= ref.err[3]);
+    bool d = false;
+    orientation_detail::static_sign(ref.k, err, d);
+    decided += d ? 1 : 0;
+    ++trials;
+    const Orientation want = classify_orientation(p[0], p[3], p[1], p[2], p[4], p[7], p[5], p[6]);
+    const FacePlane plane(p[0], p[1], p[2], p[4], p[5], p[6]);
+    const FacePlaneMinors minors = FacePlaneMinors::of(p[0], p[1], p[2], p[4], p[5], p[6]);
+    REQUIRE(minors.side(p[0], p[4], p[3], p[7], err) == want);
+    REQUIRE(plane.side(p[3], p[7]) == want);
+    // Classification's form: detector o = p[3], triangle (p[0], p[1], p[2]).
+    REQUIRE(orientation_of(p[3], p[0], p[1], p[2], p[7], p[4], p[5], p[6], err) ==
+            classify_orientation(p[3], p[0], p[1], p[2], p[7], p[4], p[5], p[6]));
+  }
+  // The shortcut is taken, not bypassed (most random cubics are decided by it).
+  CHECK(decided > trials / 2);
 }
 
 TEST_CASE("Plane-separated triangle pairs have no feature pair in contact (brute force)",
