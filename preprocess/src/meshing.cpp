@@ -140,7 +140,7 @@ TetMesh run_mesh_3_guarded(const TriangleMesh& input, const detail::Mesh3Criteri
 /// validate_tet_mesh.
 std::string boundary_defect(const TetMesh& mesh, const std::string& file) {
   try {
-    validate_tet_mesh(mesh, extract_surface(mesh), file);
+    extract_valid_surface(mesh, file);
   } catch (const InputError& e) {
     return e.what();
   }

@@ -265,8 +265,7 @@ format::Asset build_asset(const TetMesh& mesh, const std::string& source,
   report.tets = static_cast<std::uint32_t>(mesh.tets.size());
 
   const Surface surface = timer.run("surface", [&](std::string& summary) {
-    Surface s = extract_surface(mesh);
-    validate_tet_mesh(mesh, s, source);
+    Surface s = extract_valid_surface(mesh, source);
     summary = std::to_string(s.triangles.size()) + " triangles, " +
               std::to_string(s.interior_nodes.size()) + " interior nodes";
     return s;

@@ -379,8 +379,7 @@ py::dict charge(const py::object& mesh, const py::object& source, const std::str
     // As `tetseg charge`: a tet mesh's boundary, or a closed surface as given.
     read_input(in);
     if (in.is_tet_mesh) {
-      const Surface surface = extract_surface(in.tet_mesh);
-      validate_tet_mesh(in.tet_mesh, surface, in.source);
+      const Surface surface = extract_valid_surface(in.tet_mesh, in.source);
       points = std::move(in.tet_mesh.nodes);
       triangles = surface.triangles;
     } else {

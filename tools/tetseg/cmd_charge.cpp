@@ -184,8 +184,7 @@ void run_charge(const ChargeArgs& args) {
   std::vector<preprocess::Tri> triangles;
   if (preprocess::is_tet_mesh_path(args.input)) {
     preprocess::TetMesh mesh = preprocess::read_tet_mesh(args.input);
-    const preprocess::Surface surface = preprocess::extract_surface(mesh);
-    preprocess::validate_tet_mesh(mesh, surface, args.input);
+    const preprocess::Surface surface = preprocess::extract_valid_surface(mesh, args.input);
     points = std::move(mesh.nodes);
     triangles = surface.triangles;
   } else {

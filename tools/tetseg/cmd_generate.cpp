@@ -142,9 +142,9 @@ void finish_tet_mesh(const preprocess::TetMesh& mesh, const std::string& output,
                      const MshOutput& msh, const std::string& what) {
   {
     Stage stage("validating " + what);
-    const preprocess::Surface surface = preprocess::extract_surface(mesh);
+    preprocess::Surface surface;
     try {
-      preprocess::validate_tet_mesh(mesh, surface, output);
+      surface = preprocess::extract_valid_surface(mesh, output);
     } catch (const preprocess::InputError& e) {
       throw ToolError(kExitProcessingFailed, output,
                       std::string("meshing produced an invalid mesh: ") + e.what() +

@@ -29,6 +29,10 @@ Surface extract_surface(const TetMesh& mesh);
 /// Thread-safe.
 void validate_tet_mesh(const TetMesh& mesh, const Surface& surface, const std::string& file);
 
+/// extract_surface then validate_tet_mesh (same result, same InputError), matching the faces
+/// once instead of twice: what every tool stage that reads a tet mesh runs. Thread-safe.
+Surface extract_valid_surface(const TetMesh& mesh, const std::string& file);
+
 /// The same surface checks for a triangle mesh that is about to be tetrahedralised or used as
 /// a conductor: finite coordinates, indices in range, no zero-area triangle (|2 area| <=
 /// 1e-12 x longest edge^2, or a repeated vertex), then closed, edge-manifold, consistently
