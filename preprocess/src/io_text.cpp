@@ -249,10 +249,18 @@ std::string lower_extension(const std::string& path) {
 void orient_consistently_negative_meshes(TetMesh& mesh) {
   std::size_t negative = 0;
   std::size_t positive = 0;
-  for (const Tet& t : mesh.tets) {
+  std::size_t out_of_range = 0;
+  const std::int64_t tet_count = static_cast<std::int64_t>(mesh.tets.size());
+#if defined(TETSEG_HAVE_OPENMP)
+#pragma omp parallel for schedule(static) reduction(+ : negative, positive, out_of_range)
+#endif
+  for (std::int64_t i = 0; i < tet_count; ++i) {
+    const Tet& t = mesh.tets[static_cast<std::size_t>(i)];
     if (t[0] >= mesh.nodes.size() || t[1] >= mesh.nodes.size() || t[2] >= mesh.nodes.size() ||
-        t[3] >= mesh.nodes.size())
-      return;
+        t[3] >= mesh.nodes.size()) {
+      ++out_of_range;
+      continue;
+    }
     const Vec3& a = mesh.nodes[t[0]];
     const Vec3& b = mesh.nodes[t[1]];
     const Vec3& c = mesh.nodes[t[2]];
@@ -261,7 +269,7 @@ void orient_consistently_negative_meshes(TetMesh& mesh) {
     if (det > 0) ++positive;
     if (det < 0) ++negative;
   }
-  if (positive == 0 && negative > 0)
+  if (out_of_range == 0 && positive == 0 && negative > 0)
     for (Tet& t : mesh.tets) std::swap(t[2], t[3]);
 }
 

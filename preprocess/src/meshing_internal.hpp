@@ -16,6 +16,7 @@ struct Mesh3Criteria {
   bool optimize = true;  ///< false: neither optimiser runs
   bool perturb = true;   ///< with optimize: sliver perturbation
   bool exude = true;     ///< with optimize: sliver exudation
+  int threads = 1;       ///< 1: sequential (Sequential_tag); > 1: Parallel_tag on that many
 };
 
 /// Mesh_3 on the implicit function of `shape`. Returns compacted, positively oriented tets.

@@ -11,6 +11,8 @@
 #include <sstream>
 #include <type_traits>
 
+#include <sys/resource.h>
+
 #include "tetseg/format/asset_io.hpp"
 #include "tetseg/preprocess/names.hpp"
 #include "tetseg/preprocess/surface.hpp"
@@ -255,6 +257,23 @@ bool options_from_provenance(const std::vector<std::pair<std::string, std::strin
     }
   }
   return true;
+}
+
+std::uint64_t process_peak_rss_bytes() {
+  // "VmHWM:   123456 kB" (Linux); the whole file is a few hundred bytes.
+  if (std::FILE* status = std::fopen("/proc/self/status", "r")) {
+    char line[256];
+    unsigned long long kib = 0;
+    bool found = false;
+    while (!found && std::fgets(line, sizeof line, status) != nullptr)
+      found = std::sscanf(line, "VmHWM: %llu kB", &kib) == 1;
+    std::fclose(status);
+    if (found) return static_cast<std::uint64_t>(kib) * 1024;
+  }
+  struct rusage usage {};
+  if (::getrusage(RUSAGE_SELF, &usage) == 0 && usage.ru_maxrss > 0)
+    return static_cast<std::uint64_t>(usage.ru_maxrss) * 1024;  // KiB on Linux
+  return 0;
 }
 
 format::Asset build_asset(const TetMesh& mesh, const std::string& source,

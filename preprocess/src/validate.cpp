@@ -218,13 +218,28 @@ void detail::validate_tet_mesh(const TetMesh& mesh, const Surface& surface, cons
   if (mesh.tets.empty()) throw InputError(file, "mesh has no tetrahedra");
   check_finite(mesh.nodes, file, "node");
   std::vector<char> used(n, 0);
-  for (std::size_t t = 0; t < mesh.tets.size(); ++t)
-    for (std::uint32_t v : mesh.tets[t]) {
-      if (v >= n)
-        throw InputError(file, "tet " + std::to_string(t) + " refers to node " + std::to_string(v) +
-                                   " out of range (" + std::to_string(n) + " nodes)");
-      used[v] = 1;
+  std::size_t first_out_of_range = SIZE_MAX;  // tet
+  const std::int64_t tet_count = static_cast<std::int64_t>(mesh.tets.size());
+#if defined(TETSEG_HAVE_OPENMP)
+#pragma omp parallel for schedule(static) reduction(min : first_out_of_range)
+#endif
+  for (std::int64_t i = 0; i < tet_count; ++i)
+    for (std::uint32_t v : mesh.tets[static_cast<std::size_t>(i)]) {
+      if (v >= n) {
+        first_out_of_range = std::min(first_out_of_range, static_cast<std::size_t>(i));
+      } else {
+#if defined(TETSEG_HAVE_OPENMP)
+#pragma omp atomic write
+#endif
+        used[v] = 1;
+      }
     }
+  if (first_out_of_range != SIZE_MAX)
+    for (std::uint32_t v : mesh.tets[first_out_of_range])
+      if (v >= n)
+        throw InputError(file, "tet " + std::to_string(first_out_of_range) + " refers to node " +
+                                   std::to_string(v) + " out of range (" + std::to_string(n) +
+                                   " nodes)");
   const std::size_t unused = static_cast<std::size_t>(std::count(used.begin(), used.end(), 0));
   if (unused > 0)
     throw InputError(file,
@@ -234,7 +249,6 @@ void detail::validate_tet_mesh(const TetMesh& mesh, const Surface& surface, cons
   std::size_t inverted = 0;
   std::size_t first_degenerate = SIZE_MAX;
   std::size_t first_inverted = SIZE_MAX;
-  const std::int64_t tet_count = static_cast<std::int64_t>(mesh.tets.size());
 #if defined(TETSEG_HAVE_OPENMP)
 #pragma omp parallel for schedule(static) reduction(+ : degenerate, inverted) \
     reduction(min : first_degenerate, first_inverted)

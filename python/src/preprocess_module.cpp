@@ -183,9 +183,13 @@ py::array_t<double> doubles_array(const std::vector<double>& v) {
 py::dict report_dict(const std::string& source, const BuildReport& report,
                      const format::Asset& asset, std::size_t asset_bytes, double total) {
   py::dict seconds;
+  py::dict peak_rss_bytes;
+  py::dict peak_rss_growth_bytes;
   py::list stages;
   for (const StageReport& s : report.stages) {
     seconds[py::str(s.name)] = s.seconds;
+    peak_rss_bytes[py::str(s.name)] = s.peak_rss_bytes;
+    peak_rss_growth_bytes[py::str(s.name)] = s.peak_rss_growth_bytes;
     stages.append(py::make_tuple(s.name, s.seconds, s.summary));
   }
   seconds["total"] = total;
@@ -223,6 +227,8 @@ py::dict report_dict(const std::string& source, const BuildReport& report,
   d["input"] = source;
   d["asset_bytes"] = asset_bytes;
   d["seconds"] = seconds;
+  d["peak_rss_bytes"] = peak_rss_bytes;
+  d["peak_rss_growth_bytes"] = peak_rss_growth_bytes;
   d["stages"] = stages;
   d["counts"] = counts;
   d["segmentation"] = segmentation;
