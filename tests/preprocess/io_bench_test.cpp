@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <ctime>
 #include <filesystem>
 #include <numeric>
@@ -123,7 +124,9 @@ TEST_CASE("Benchmark: read, extract and validate 4.8 M tets", "[.bench][scale-be
   const auto dir =
       std::filesystem::temp_directory_path() / ("tetseg_scale_bench_" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);
-  const std::string path = (dir / "grid.mesh").string();
+  // TETSEG_SCALE_MESH=<path>: also leave the mesh there, for timing `tetseg build` on it.
+  const char* keep = std::getenv("TETSEG_SCALE_MESH");
+  const std::string path = keep != nullptr ? std::string(keep) : (dir / "grid.mesh").string();
   write_tet_mesh(path, mesh);
   std::printf("%zu nodes, %zu tets, %.1f MB MEDIT\n", mesh.nodes.size(), mesh.tets.size(),
               static_cast<double>(std::filesystem::file_size(path)) / 1e6);

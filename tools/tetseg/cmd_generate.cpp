@@ -40,7 +40,8 @@ void add_threads_option(CLI::App& cmd, preprocess::MeshingOptions& m, const std:
   cmd.add_option("--threads", m.threads,
                  prefix +
                      "Mesh_3 threads: 1 = sequential and reproducible; N > 1 = parallel "
-                     "(oneTBB), faster but the mesh differs from run to run; 0 = all cores")
+                     "(oneTBB), can be faster on idle cores, but the mesh differs from run to "
+                     "run; 0 = all cores")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
 }
