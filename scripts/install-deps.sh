@@ -7,6 +7,7 @@ packages=(
   build-essential cmake ninja-build ccache pkg-config
   libcgal-dev libcgal-demo libgmp-dev libmpfr-dev libboost-dev   # preprocess (CGAL, GPL)
   libeigen3-dev libassimp-dev libomp-dev                           # preprocess
+  libtbb-dev                                                       # parallel Mesh_3 (--threads)
   libcereal-dev                                                    # asset payload (header-only)
   libcli11-dev libpng-dev                                          # command-line tools
   catch2                                                           # tests

@@ -64,7 +64,9 @@ TetMesh read_medit(const std::string& path) {
   const std::string text = read_file_text(path);
   Tokenizer tok(path, text, '#');
   TetMesh mesh;
-  std::vector<std::size_t> tet_lines;
+  // Tets that referred to a node not read yet, with their lines: checked once all sections
+  // are read (every other tet is in range then too, since nodes are only added).
+  std::vector<std::pair<std::size_t, std::size_t>> pending_tets;
   const std::size_t max_count = text.size() / 2 + 1;
   bool saw_dimension = false;
   while (true) {
@@ -94,19 +96,20 @@ TetMesh read_medit(const std::string& path) {
     } else if (keyword == "tetrahedra") {
       const std::size_t n = read_count(tok, "Tetrahedra", max_count / 5);
       mesh.tets.reserve(mesh.tets.size() + n);
-      tet_lines.reserve(tet_lines.size() + n);
       for (std::size_t i = 0; i < n; ++i) {
         Tet t;
+        bool pending = false;
         for (int k = 0; k < 4; ++k) {
           const std::int64_t index = tok.next_int("a vertex index");
           if (index < 1 || index > static_cast<std::int64_t>(UINT32_MAX))
             tok.fail("vertex index " + std::to_string(index) +
                      " out of range (indices are 1-based)");
           t[static_cast<std::size_t>(k)] = static_cast<std::uint32_t>(index - 1);
+          pending |= static_cast<std::size_t>(index) > mesh.nodes.size();
         }
+        if (pending) pending_tets.emplace_back(mesh.tets.size(), tok.line());
         tok.next_int("a tetrahedron reference");
         mesh.tets.push_back(t);
-        tet_lines.push_back(tok.line());
       }
     } else {
       const int arity = skipped_arity(keyword);
@@ -124,12 +127,11 @@ TetMesh read_medit(const std::string& path) {
   }
   if (!saw_dimension && mesh.nodes.empty())
     throw InputError(path, "not a MEDIT mesh (no Dimension, no Vertices)");
-  for (std::size_t i = 0; i < mesh.tets.size(); ++i)
-    for (std::uint32_t v : mesh.tets[i])
+  for (const auto& [tet, line] : pending_tets)
+    for (std::uint32_t v : mesh.tets[tet])
       if (v >= mesh.nodes.size())
-        tok.fail_at(tet_lines[i], "vertex index " + std::to_string(std::uint64_t{v} + 1) +
-                                      " out of range (" + std::to_string(mesh.nodes.size()) +
-                                      " vertices)");
+        tok.fail_at(line, "vertex index " + std::to_string(std::uint64_t{v} + 1) +
+                              " out of range (" + std::to_string(mesh.nodes.size()) + " vertices)");
   return mesh;
 }
 

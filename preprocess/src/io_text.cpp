@@ -1,5 +1,7 @@
 // Shared text I/O helpers and the format dispatch of read_tet_mesh / write_tet_mesh.
 
+#include <sys/stat.h>
+
 #include <algorithm>
 #include <cctype>
 #include <charconv>
@@ -8,7 +10,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
-#include <sstream>
+#include <memory>
 
 #include "io_text.hpp"
 #include "tetseg/preprocess/io.hpp"
@@ -18,13 +20,41 @@ namespace tetseg::preprocess {
 namespace detail {
 
 std::string read_file_text(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path, "cannot open file");
-  std::ostringstream buffer;
-  buffer << in.rdbuf();
-  if (in.bad()) throw InputError(path, "cannot read file");
-  return buffer.str();
+  // One read into a buffer of the file's size (no stream copies); read until end of file in
+  // case the size changes meanwhile or is unknown (pipes).
+  const std::unique_ptr<std::FILE, int (*)(std::FILE*)> owner(std::fopen(path.c_str(), "rb"),
+                                                              &std::fclose);
+  std::FILE* file = owner.get();
+  if (file == nullptr) throw InputError(path, "cannot open file");
+  std::string text;
+  struct stat status {};
+  if (::fstat(::fileno(file), &status) == 0 && S_ISREG(status.st_mode) && status.st_size > 0)
+    text.reserve(static_cast<std::size_t>(status.st_size) + 1);
+  char chunk[1 << 16];
+  std::size_t got = 0;
+  while (true) {
+    const std::size_t used = text.size();
+    if (text.capacity() > used + sizeof chunk) {
+      // Read straight into the reserved space.
+      text.resize(text.capacity());
+      got = std::fread(text.data() + used, 1, text.size() - used, file);
+      text.resize(used + got);
+    } else {
+      got = std::fread(chunk, 1, sizeof chunk, file);
+      text.append(chunk, got);
+    }
+    if (got == 0) break;
+  }
+  if (std::ferror(file) != 0) throw InputError(path, "cannot read file");
+  return text;
 }
+
+namespace {
+/// std::isspace in the "C" locale, inline.
+bool is_space(char c) {
+  return c == ' ' || c == '\n' || c == '\t' || c == '\r' || c == '\f' || c == '\v';
+}
+}  // namespace
 
 Tokenizer::Tokenizer(std::string file, std::string_view text, char comment)
     : m_file(std::move(file)), m_text(text), m_comment(comment) {}
@@ -55,7 +85,7 @@ std::string_view Tokenizer::next_or_end() {
   const std::size_t begin = m_pos;
   while (m_pos < m_text.size()) {
     const char c = m_text[m_pos];
-    if (std::isspace(static_cast<unsigned char>(c)) || (m_comment != '\0' && c == m_comment)) break;
+    if (is_space(c) || (m_comment != '\0' && c == m_comment)) break;
     ++m_pos;
   }
   m_token_line = m_line;
@@ -81,8 +111,7 @@ std::vector<std::string_view> Tokenizer::rest_of_line() {
     const std::size_t begin = m_pos;
     while (m_pos < m_text.size()) {
       const char c = m_text[m_pos];
-      if (std::isspace(static_cast<unsigned char>(c)) || (m_comment != '\0' && c == m_comment))
-        break;
+      if (is_space(c) || (m_comment != '\0' && c == m_comment)) break;
       ++m_pos;
     }
     tokens.push_back(m_text.substr(begin, m_pos - begin));
@@ -220,10 +249,18 @@ std::string lower_extension(const std::string& path) {
 void orient_consistently_negative_meshes(TetMesh& mesh) {
   std::size_t negative = 0;
   std::size_t positive = 0;
-  for (const Tet& t : mesh.tets) {
+  std::size_t out_of_range = 0;
+  const std::int64_t tet_count = static_cast<std::int64_t>(mesh.tets.size());
+#if defined(TETSEG_HAVE_OPENMP)
+#pragma omp parallel for schedule(static) reduction(+ : negative, positive, out_of_range)
+#endif
+  for (std::int64_t i = 0; i < tet_count; ++i) {
+    const Tet& t = mesh.tets[static_cast<std::size_t>(i)];
     if (t[0] >= mesh.nodes.size() || t[1] >= mesh.nodes.size() || t[2] >= mesh.nodes.size() ||
-        t[3] >= mesh.nodes.size())
-      return;
+        t[3] >= mesh.nodes.size()) {
+      ++out_of_range;
+      continue;
+    }
     const Vec3& a = mesh.nodes[t[0]];
     const Vec3& b = mesh.nodes[t[1]];
     const Vec3& c = mesh.nodes[t[2]];
@@ -232,7 +269,7 @@ void orient_consistently_negative_meshes(TetMesh& mesh) {
     if (det > 0) ++positive;
     if (det < 0) ++negative;
   }
-  if (positive == 0 && negative > 0)
+  if (out_of_range == 0 && positive == 0 && negative > 0)
     for (Tet& t : mesh.tets) std::swap(t[2], t[3]);
 }
 

@@ -6,7 +6,9 @@
 #include <CGAL/Cartesian_converter.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Exact_rational.h>
+#include <CGAL/Mesh_complex_3_in_triangulation_3.h>
 #include <CGAL/Mesh_criteria_3.h>
+#include <CGAL/Mesh_triangulation_3.h>
 #include <CGAL/Simple_cartesian.h>
 #include <CGAL/make_mesh_3.h>
 
@@ -17,6 +19,10 @@
 
 #include "meshing_internal.hpp"
 #include "vec3_math.hpp"
+
+#if defined(CGAL_LINKED_WITH_TBB)
+#include <tbb/global_control.h>
+#endif
 
 namespace tetseg::preprocess::detail {
 
@@ -131,6 +137,28 @@ C3t3 run_mesh_3(const Domain& domain, const Criteria& criteria, const Mesh3Crite
     throw MeshingBudgetExceeded("refinement reached " + std::to_string(options.max_vertices) +
                                 " vertices without meeting the criteria");
   return c3t3;
+}
+
+/// Meshes `domain` (run_mesh_3, then c3t3_to_tet_mesh) on Mesh_3's triangulation for the
+/// concurrency `options.threads` asks for: Sequential_tag for 1; with oneTBB
+/// (CGAL_LINKED_WITH_TBB), Parallel_tag under a limit of that many threads otherwise.
+template <class Domain>
+TetMesh mesh_domain(const Domain& domain, const Mesh3Criteria& options) {
+  auto run = [&](auto concurrency) {
+    using Tr = typename CGAL::Mesh_triangulation_3<Domain, ExactFallbackKernel,
+                                                   decltype(concurrency)>::type;
+    using C3t3 = CGAL::Mesh_complex_3_in_triangulation_3<Tr>;
+    using Criteria = CGAL::Mesh_criteria_3<Tr>;
+    return c3t3_to_tet_mesh(run_mesh_3<C3t3>(domain, make_criteria<Criteria>(options), options));
+  };
+#if defined(CGAL_LINKED_WITH_TBB)
+  if (options.threads > 1) {
+    const tbb::global_control limit(tbb::global_control::max_allowed_parallelism,
+                                    static_cast<std::size_t>(options.threads));
+    return run(CGAL::Parallel_tag{});
+  }
+#endif
+  return run(CGAL::Sequential_tag{});
 }
 
 }  // namespace tetseg::preprocess::detail

@@ -19,9 +19,6 @@ using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
 using FT = Kernel::FT;
 using Point = Kernel::Point_3;
 using Domain = CGAL::Labeled_mesh_domain_3<Kernel>;
-using Tr = CGAL::Mesh_triangulation_3<Domain, ExactFallbackKernel, CGAL::Sequential_tag>::type;
-using C3t3 = CGAL::Mesh_complex_3_in_triangulation_3<Tr>;
-using Criteria = CGAL::Mesh_criteria_3<Tr>;
 
 /// Polynomial smooth minimum (blend width k): C1, equal to min where |a - b| >= k.
 double smooth_min(double a, double b, double k) {
@@ -84,6 +81,23 @@ double dumbbell(const Point& p) {
 
 }  // namespace
 
+}  // namespace tetseg::preprocess::detail
+
+namespace tetseg::preprocess {
+
+// Here because only the Mesh_3 units are compiled with CGAL_LINKED_WITH_TBB.
+bool meshing_threads_available() {
+#if defined(CGAL_LINKED_WITH_TBB)
+  return true;
+#else
+  return false;
+#endif
+}
+
+}  // namespace tetseg::preprocess
+
+namespace tetseg::preprocess::detail {
+
 TetMesh mesh_implicit_shape(Shape shape, const ShapeOptions& o, const Mesh3Criteria& criteria) {
   std::function<FT(const Point&)> f;
   Point center(0, 0, 0);
@@ -126,8 +140,7 @@ TetMesh mesh_implicit_shape(Shape shape, const ShapeOptions& o, const Mesh3Crite
   const Domain domain = Domain::create_implicit_mesh_domain(
       f, Kernel::Sphere_3(center, bound * bound), params::relative_error_bound = 1e-6,
       params::p_rng = &rng);
-  const C3t3 c3t3 = run_mesh_3<C3t3>(domain, make_criteria<Criteria>(criteria), criteria);
-  return c3t3_to_tet_mesh(c3t3);
+  return mesh_domain(domain, criteria);
 }
 
 }  // namespace tetseg::preprocess::detail

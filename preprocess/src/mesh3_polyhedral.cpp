@@ -21,9 +21,6 @@ using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
 using Point = Kernel::Point_3;
 using SurfaceMesh = CGAL::Surface_mesh<Point>;
 using Domain = CGAL::Polyhedral_mesh_domain_3<SurfaceMesh, Kernel>;
-using Tr = CGAL::Mesh_triangulation_3<Domain, ExactFallbackKernel, CGAL::Sequential_tag>::type;
-using C3t3 = CGAL::Mesh_complex_3_in_triangulation_3<Tr>;
-using Criteria = CGAL::Mesh_criteria_3<Tr>;
 
 }  // namespace
 
@@ -40,8 +37,7 @@ TetMesh mesh_polyhedral_surface(const TriangleMesh& surface, const Mesh3Criteria
     throw std::runtime_error("surface could not be converted to a polygon mesh");
   CGAL::Random rng(0);
   const Domain domain(mesh, &rng);
-  const C3t3 c3t3 = run_mesh_3<C3t3>(domain, make_criteria<Criteria>(criteria), criteria);
-  return c3t3_to_tet_mesh(c3t3);
+  return mesh_domain(domain, criteria);
 }
 
 }  // namespace tetseg::preprocess::detail

@@ -7,6 +7,7 @@
 #include <new>
 #include <stdexcept>
 #include <string>
+#include <thread>
 #include <utility>
 #include <vector>
 
@@ -64,7 +65,14 @@ detail::Mesh3Criteria resolve(const MeshingOptions& o, double default_facet) {
     throw std::invalid_argument("facet angle must be in (0, 30] degrees");
   if (!(o.cell_radius_edge_ratio >= 2.0 && std::isfinite(o.cell_radius_edge_ratio)))
     throw std::invalid_argument("cell radius-edge ratio must be at least 2");
+  if (o.threads < 0) throw std::invalid_argument("threads must be zero or a positive number");
+  if (o.threads != 1 && !meshing_threads_available())
+    throw std::invalid_argument(
+        "threads other than 1 need a build with oneTBB (Debian libtbb-dev); this one meshes "
+        "sequentially only");
   detail::Mesh3Criteria c;
+  c.threads = o.threads == 0 ? static_cast<int>(std::max(1u, std::thread::hardware_concurrency()))
+                             : o.threads;
   c.facet_angle = o.facet_angle;
   c.cell_radius_edge_ratio = o.cell_radius_edge_ratio;
   c.optimize = o.optimize;
@@ -160,7 +168,7 @@ TetMesh run_mesh_3_guarded(const TriangleMesh& input, const detail::Mesh3Criteri
 /// validate_tet_mesh.
 std::string boundary_defect(const TetMesh& mesh, const std::string& file) {
   try {
-    validate_tet_mesh(mesh, extract_surface(mesh), file);
+    extract_valid_surface(mesh, file);
   } catch (const InputError& e) {
     return e.what();
   }

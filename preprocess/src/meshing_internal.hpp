@@ -19,6 +19,7 @@ struct Mesh3Criteria {
   bool optimize = true;  ///< false: neither optimiser runs
   bool perturb = true;   ///< with optimize: sliver perturbation
   bool exude = true;     ///< with optimize: sliver exudation
+  int threads = 1;       ///< 1: sequential (Sequential_tag); > 1: Parallel_tag on that many
   /// Refinement stops and MeshingBudgetExceeded is thrown once the triangulation has this
   /// many vertices (0: no limit). Mesh_3's manifold refinement does not always terminate
   /// (sharp corners without feature protection); the budget turns that into an error.

@@ -11,6 +11,8 @@
 #include <sstream>
 #include <type_traits>
 
+#include <sys/resource.h>
+
 #include "tetseg/format/asset_io.hpp"
 #include "tetseg/preprocess/names.hpp"
 #include "tetseg/preprocess/surface.hpp"
@@ -264,6 +266,23 @@ bool options_from_provenance(const std::vector<std::pair<std::string, std::strin
   return true;
 }
 
+std::uint64_t process_peak_rss_bytes() {
+  // "VmHWM:   123456 kB" (Linux); the whole file is a few hundred bytes.
+  if (std::FILE* status = std::fopen("/proc/self/status", "r")) {
+    char line[256];
+    unsigned long long kib = 0;
+    bool found = false;
+    while (!found && std::fgets(line, sizeof line, status) != nullptr)
+      found = std::sscanf(line, "VmHWM: %llu kB", &kib) == 1;
+    std::fclose(status);
+    if (found) return static_cast<std::uint64_t>(kib) * 1024;
+  }
+  struct rusage usage {};
+  if (::getrusage(RUSAGE_SELF, &usage) == 0 && usage.ru_maxrss > 0)
+    return static_cast<std::uint64_t>(usage.ru_maxrss) * 1024;  // KiB on Linux
+  return 0;
+}
+
 format::Asset build_asset(const TetMesh& mesh, const std::string& source,
                           const BuildOptions& options, BuildReport& report,
                           const std::function<void(const StageReport&)>& on_stage) {
@@ -272,8 +291,7 @@ format::Asset build_asset(const TetMesh& mesh, const std::string& source,
   report.tets = static_cast<std::uint32_t>(mesh.tets.size());
 
   const Surface surface = timer.run("surface", [&](std::string& summary) {
-    Surface s = extract_surface(mesh);
-    validate_tet_mesh(mesh, s, source);
+    Surface s = extract_valid_surface(mesh, source);
     summary = std::to_string(s.triangles.size()) + " triangles, " +
               std::to_string(s.interior_nodes.size()) + " interior nodes";
     return s;

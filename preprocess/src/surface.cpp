@@ -1,11 +1,18 @@
 // Boundary extraction and volumes. No CGAL here.
 
 #include <algorithm>
-#include <tuple>
+#include <cstdint>
+#include <stdexcept>
+#include <utility>
 #include <vector>
 
 #include "tetseg/preprocess/surface.hpp"
+#include "validate_internal.hpp"
 #include "vec3_math.hpp"
+
+#if defined(TETSEG_HAVE_OPENMP)
+#include <omp.h>
+#endif
 
 namespace tetseg::preprocess {
 namespace {
@@ -14,45 +21,165 @@ namespace {
 // vertex (index = the opposite vertex).
 constexpr int kFace[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
 
-struct FaceRecord {
-  std::array<std::uint32_t, 3> key;  // sorted vertex ids
-  std::uint32_t tet;
-  std::uint8_t local;
+using FaceKey = std::array<std::uint32_t, 3>;
+
+FaceKey sorted_face(const Tet& tet, int f) {
+  std::uint32_t a = tet[kFace[f][0]], b = tet[kFace[f][1]], c = tet[kFace[f][2]];
+  if (a > b) std::swap(a, b);
+  if (b > c) std::swap(b, c);
+  if (a > b) std::swap(a, b);
+  return {a, b, c};
+}
+
+/// A face: its sorted node ids and its id (4 x tet + local face).
+struct FaceEntry {
+  std::uint32_t low, mid, high, face;
 };
+
+/// Slot of a face in a block's hash table of 2^bits slots.
+std::size_t face_hash(const FaceEntry& e, unsigned bits) {
+  std::uint64_t h = e.low * 0x9E3779B97F4A7C15ull ^ e.mid * 0xC2B2AE3D27D4EB4Full ^
+                    e.high * 0x165667B19E3779F9ull;
+  h ^= h >> 29;
+  return static_cast<std::size_t>((h * 0xBF58476D1CE4E5B9ull) >> (64 - bits));
+}
+
+bool same_face(const FaceEntry& x, const FaceEntry& y) {
+  return x.low == y.low && x.mid == y.mid && x.high == y.high;
+}
+
+int thread_count() {
+#if defined(TETSEG_HAVE_OPENMP)
+  return omp_get_max_threads();
+#else
+  return 1;
+#endif
+}
 
 }  // namespace
 
-Surface extract_surface(const TetMesh& mesh) {
-  std::vector<FaceRecord> faces;
-  faces.reserve(mesh.tets.size() * 4);
-  for (std::size_t t = 0; t < mesh.tets.size(); ++t) {
-    const Tet& tet = mesh.tets[t];
-    for (std::uint8_t f = 0; f < 4; ++f) {
-      std::array<std::uint32_t, 3> key = {tet[kFace[f][0]], tet[kFace[f][1]], tet[kFace[f][2]]};
-      std::sort(key.begin(), key.end());
-      faces.push_back({key, static_cast<std::uint32_t>(t), f});
+detail::FaceMatch detail::match_faces(const TetMesh& mesh) {
+  // No comparison sort of the 4 T faces: a counting sort into blocks of 1024 smallest-node ids
+  // (one streaming scatter, a write stream per block), then a hash table per block, in cache.
+  // Faces whose nodes are all out of range share a last block. Threads split the tets for the
+  // scatter and the blocks for the rest; the result does not depend on their number.
+  const std::vector<Tet>& tets = mesh.tets;
+  if (tets.size() >= (std::size_t{1} << 30))
+    throw std::length_error("match_faces: 2^30 tets or more");
+  constexpr unsigned kFineBits = 10;
+  const std::size_t node_count = mesh.nodes.size();
+  const std::size_t out_of_range_block = (node_count >> kFineBits) + 1;
+  const std::size_t block_count = out_of_range_block + 1;
+  auto entry_of = [&](std::size_t t, int f) {
+    const FaceKey key = sorted_face(tets[t], f);
+    return FaceEntry{key[0], key[1], key[2], static_cast<std::uint32_t>(4 * t + f)};
+  };
+  auto block_of = [&](const FaceEntry& e) -> std::size_t {
+    return e.low < node_count ? e.low >> kFineBits : out_of_range_block;
+  };
+
+  // Scatter into blocks: part p (a contiguous range of tets) writes its faces of block b from
+  // start[b * parts + p] on, so every part can run on its own thread.
+  const std::size_t parts = static_cast<std::size_t>(std::max(1, thread_count()));
+  auto part_begin = [&](std::size_t p) { return tets.size() * p / parts; };
+  std::vector<std::size_t> start(block_count * parts + 1, 0);
+  const std::int64_t part_count = static_cast<std::int64_t>(parts);
+#if defined(TETSEG_HAVE_OPENMP)
+#pragma omp parallel for schedule(static, 1)
+#endif
+  for (std::int64_t pi = 0; pi < part_count; ++pi) {
+    const std::size_t p = static_cast<std::size_t>(pi);
+    for (std::size_t t = part_begin(p); t < part_begin(p + 1); ++t)
+      for (int f = 0; f < 4; ++f) ++start[block_of(entry_of(t, f)) * parts + p + 1];
+  }
+  for (std::size_t i = 1; i < start.size(); ++i) start[i] += start[i - 1];
+  std::vector<FaceEntry> entries(tets.size() * 4);
+#if defined(TETSEG_HAVE_OPENMP)
+#pragma omp parallel for schedule(static, 1)
+#endif
+  for (std::int64_t pi = 0; pi < part_count; ++pi) {
+    const std::size_t p = static_cast<std::size_t>(pi);
+    std::vector<std::size_t> next(block_count);
+    for (std::size_t b = 0; b < block_count; ++b) next[b] = start[b * parts + p];
+    for (std::size_t t = part_begin(p); t < part_begin(p + 1); ++t)
+      for (int f = 0; f < 4; ++f) {
+        const FaceEntry e = entry_of(t, f);
+        entries[next[block_of(e)]++] = e;
+      }
+  }
+
+  // Count each block's faces in a hash table (open addressing, at most half full, in cache
+  // for the usual 1024 nodes' 25,000 faces): a face seen once is on the boundary.
+  std::vector<std::vector<std::uint32_t>> block_boundary(block_count);
+  std::vector<std::size_t> block_crowded(block_count, 0);
+  std::vector<FaceKey> block_first_crowded(block_count);
+  const std::int64_t blocks = static_cast<std::int64_t>(block_count);
+#if defined(TETSEG_HAVE_OPENMP)
+#pragma omp parallel
+#endif
+  {
+    struct Slot {
+      std::uint32_t entry;  // index in the block; kEmpty when free
+      std::uint32_t count;
+    };
+    constexpr std::uint32_t kEmpty = UINT32_MAX;
+    std::vector<Slot> table;
+#if defined(TETSEG_HAVE_OPENMP)
+#pragma omp for schedule(dynamic, 8)
+#endif
+    for (std::int64_t bi = 0; bi < blocks; ++bi) {
+      const std::size_t b = static_cast<std::size_t>(bi);
+      const FaceEntry* const first = entries.data() + start[b * parts];
+      const std::size_t size = start[(b + 1) * parts] - start[b * parts];
+      if (size == 0) continue;
+      unsigned bits = 4;
+      while ((std::size_t{1} << bits) < 2 * size) ++bits;
+      const std::size_t slot_mask = (std::size_t{1} << bits) - 1;
+      table.assign(std::size_t{1} << bits, Slot{kEmpty, 0});
+      for (std::size_t i = 0; i < size; ++i) {
+        std::size_t h = face_hash(first[i], bits);
+        while (table[h].entry != kEmpty && !same_face(first[table[h].entry], first[i]))
+          h = (h + 1) & slot_mask;
+        if (table[h].entry == kEmpty) table[h].entry = static_cast<std::uint32_t>(i);
+        ++table[h].count;
+      }
+      for (const Slot& slot : table) {
+        if (slot.count == 1) {
+          block_boundary[b].push_back(first[slot.entry].face);
+        } else if (slot.count > 2) {
+          const FaceEntry& e = first[slot.entry];
+          const FaceKey key = {e.low, e.mid, e.high};
+          if (block_crowded[b]++ == 0 || key < block_first_crowded[b]) block_first_crowded[b] = key;
+        }
+      }
     }
   }
-  std::sort(faces.begin(), faces.end(), [](const FaceRecord& a, const FaceRecord& b) {
-    return std::tie(a.key, a.tet, a.local) < std::tie(b.key, b.tet, b.local);
-  });
-  std::vector<std::pair<std::uint32_t, std::uint8_t>> boundary;
-  for (std::size_t i = 0; i < faces.size();) {
-    std::size_t j = i + 1;
-    while (j < faces.size() && faces[j].key == faces[i].key) ++j;
-    if (j - i == 1) boundary.emplace_back(faces[i].tet, faces[i].local);
-    i = j;
+
+  FaceMatch match;
+  match.boundary.assign(tets.size(), 0);
+  for (std::size_t b = 0; b < block_count; ++b) {
+    for (std::uint32_t face : block_boundary[b])
+      match.boundary[face / 4] |= static_cast<std::uint8_t>(1u << (face % 4));
+    // Blocks ascend by smallest node: the first block with a crowded face has the smallest.
+    if (block_crowded[b] > 0 && match.crowded == 0) match.first_crowded = block_first_crowded[b];
+    match.crowded += block_crowded[b];
   }
-  std::sort(boundary.begin(), boundary.end());
+  return match;
+}
+
+Surface detail::surface_from_faces(const TetMesh& mesh, const FaceMatch& match) {
   Surface surface;
-  surface.triangles.reserve(boundary.size());
   std::vector<char> on_surface(mesh.nodes.size(), 0);
-  for (const auto& [t, f] : boundary) {
+  for (std::size_t t = 0; t < mesh.tets.size(); ++t) {
+    if (match.boundary[t] == 0) continue;
     const Tet& tet = mesh.tets[t];
-    const Tri tri = {tet[kFace[f][0]], tet[kFace[f][1]], tet[kFace[f][2]]};
-    surface.triangles.push_back(tri);
-    for (std::uint32_t v : tri)
-      if (v < on_surface.size()) on_surface[v] = 1;
+    for (int f = 0; f < 4; ++f) {
+      if (!(match.boundary[t] & (1u << f))) continue;
+      const Tri tri = {tet[kFace[f][0]], tet[kFace[f][1]], tet[kFace[f][2]]};
+      surface.triangles.push_back(tri);
+      for (std::uint32_t v : tri)
+        if (v < on_surface.size()) on_surface[v] = 1;
+    }
   }
   for (std::uint32_t v = 0; v < on_surface.size(); ++v) {
     if (on_surface[v]) {
@@ -61,6 +188,17 @@ Surface extract_surface(const TetMesh& mesh) {
       surface.interior_nodes.push_back(v);
     }
   }
+  return surface;
+}
+
+Surface extract_surface(const TetMesh& mesh) {
+  return detail::surface_from_faces(mesh, detail::match_faces(mesh));
+}
+
+Surface extract_valid_surface(const TetMesh& mesh, const std::string& file) {
+  const detail::FaceMatch match = detail::match_faces(mesh);
+  Surface surface = detail::surface_from_faces(mesh, match);
+  detail::validate_tet_mesh(mesh, surface, match, file);
   return surface;
 }
 

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <numeric>
 #include <string>
 #include <tuple>
@@ -208,17 +209,37 @@ void check_surface(const std::vector<Vec3>& points, const std::vector<Tri>& tria
 }  // namespace
 
 void validate_tet_mesh(const TetMesh& mesh, const Surface& surface, const std::string& file) {
+  detail::validate_tet_mesh(mesh, surface, detail::match_faces(mesh), file);
+}
+
+void detail::validate_tet_mesh(const TetMesh& mesh, const Surface& surface, const FaceMatch& match,
+                               const std::string& file) {
   const std::size_t n = mesh.nodes.size();
   if (mesh.tets.empty()) throw InputError(file, "mesh has no tetrahedra");
   check_finite(mesh.nodes, file, "node");
   std::vector<char> used(n, 0);
-  for (std::size_t t = 0; t < mesh.tets.size(); ++t)
-    for (std::uint32_t v : mesh.tets[t]) {
-      if (v >= n)
-        throw InputError(file, "tet " + std::to_string(t) + " refers to node " + std::to_string(v) +
-                                   " out of range (" + std::to_string(n) + " nodes)");
-      used[v] = 1;
+  std::size_t first_out_of_range = SIZE_MAX;  // tet
+  const std::int64_t tet_count = static_cast<std::int64_t>(mesh.tets.size());
+#if defined(TETSEG_HAVE_OPENMP)
+#pragma omp parallel for schedule(static) reduction(min : first_out_of_range)
+#endif
+  for (std::int64_t i = 0; i < tet_count; ++i)
+    for (std::uint32_t v : mesh.tets[static_cast<std::size_t>(i)]) {
+      if (v >= n) {
+        first_out_of_range = std::min(first_out_of_range, static_cast<std::size_t>(i));
+      } else {
+#if defined(TETSEG_HAVE_OPENMP)
+#pragma omp atomic write
+#endif
+        used[v] = 1;
+      }
     }
+  if (first_out_of_range != SIZE_MAX)
+    for (std::uint32_t v : mesh.tets[first_out_of_range])
+      if (v >= n)
+        throw InputError(file, "tet " + std::to_string(first_out_of_range) + " refers to node " +
+                                   std::to_string(v) + " out of range (" + std::to_string(n) +
+                                   " nodes)");
   const std::size_t unused = static_cast<std::size_t>(std::count(used.begin(), used.end(), 0));
   if (unused > 0)
     throw InputError(file,
@@ -226,22 +247,30 @@ void validate_tet_mesh(const TetMesh& mesh, const Surface& surface, const std::s
                          std::to_string(std::find(used.begin(), used.end(), 0) - used.begin()));
   std::size_t degenerate = 0;
   std::size_t inverted = 0;
-  std::size_t first_degenerate = 0;
-  std::size_t first_inverted = 0;
-  for (std::size_t t = 0; t < mesh.tets.size(); ++t) {
+  std::size_t first_degenerate = SIZE_MAX;
+  std::size_t first_inverted = SIZE_MAX;
+#if defined(TETSEG_HAVE_OPENMP)
+#pragma omp parallel for schedule(static) reduction(+ : degenerate, inverted) \
+    reduction(min : first_degenerate, first_inverted)
+#endif
+  for (std::int64_t i = 0; i < tet_count; ++i) {
+    const std::size_t t = static_cast<std::size_t>(i);
     const Tet& tet = mesh.tets[t];
     const Vec3& a = mesh.nodes[tet[0]];
     const Vec3& b = mesh.nodes[tet[1]];
     const Vec3& c = mesh.nodes[tet[2]];
     const Vec3& d = mesh.nodes[tet[3]];
     const double det = detail::tet_det(a, b, c, d);
-    const double edge = std::max({detail::distance_between(a, b), detail::distance_between(a, c),
-                                  detail::distance_between(a, d), detail::distance_between(b, c),
-                                  detail::distance_between(b, d), detail::distance_between(c, d)});
+    // sqrt of the largest squared edge: the same double as the largest of the six lengths.
+    const double edge = std::sqrt(
+        std::max({detail::distance2(a, b), detail::distance2(a, c), detail::distance2(a, d),
+                  detail::distance2(b, c), detail::distance2(b, d), detail::distance2(c, d)}));
     if (!(std::abs(det) > kDegenerateVolume * edge * edge * edge)) {
-      if (degenerate++ == 0) first_degenerate = t;
+      ++degenerate;
+      first_degenerate = std::min(first_degenerate, t);
     } else if (det < 0) {
-      if (inverted++ == 0) first_inverted = t;
+      ++inverted;
+      first_inverted = std::min(first_inverted, t);
     }
   }
   if (degenerate > 0)
@@ -252,24 +281,8 @@ void validate_tet_mesh(const TetMesh& mesh, const Surface& surface, const std::s
                                " (negative volume), first is tet " +
                                std::to_string(first_inverted));
   // Faces shared by more than two tets.
-  std::vector<std::array<std::uint32_t, 3>> faces;
-  faces.reserve(mesh.tets.size() * 4);
-  for (const Tet& tet : mesh.tets)
-    for (int skip = 0; skip < 4; ++skip) {
-      std::array<std::uint32_t, 3> f;
-      int k = 0;
-      for (int i = 0; i < 4; ++i)
-        if (i != skip) f[static_cast<std::size_t>(k++)] = tet[static_cast<std::size_t>(i)];
-      std::sort(f.begin(), f.end());
-      faces.push_back(f);
-    }
-  std::sort(faces.begin(), faces.end());
-  std::size_t crowded = 0;
-  std::array<std::uint32_t, 3> first_crowded{};
-  for (std::size_t i = 0; i + 2 < faces.size(); ++i)
-    if (faces[i] == faces[i + 2] && (i == 0 || faces[i - 1] != faces[i])) {
-      if (crowded++ == 0) first_crowded = faces[i];
-    }
+  const std::size_t crowded = match.crowded;
+  const std::array<std::uint32_t, 3>& first_crowded = match.first_crowded;
   if (crowded > 0)
     throw InputError(file, plural(crowded, "face is", "faces are") +
                                " shared by more than two tets (non-manifold), first has nodes " +

@@ -1,6 +1,9 @@
 #pragma once
-// Private: the CGAL self-intersection test, kept in its own translation unit.
+// Private: the face matching shared by extract_surface and validate_tet_mesh, and the CGAL
+// self-intersection test (kept in its own translation unit).
 
+#include <array>
+#include <cstdint>
 #include <string>
 #include <utility>
 #include <vector>
@@ -8,6 +11,29 @@
 #include "tetseg/preprocess/mesh.hpp"
 
 namespace tetseg::preprocess::detail {
+
+/// The faces of a tet mesh matched by their node sets (surface.cpp).
+struct FaceMatch {
+  /// Per tet: bit f set when face f (opposite vertex f) belongs to no other tet.
+  std::vector<std::uint8_t> boundary;
+  /// Distinct faces shared by three or more tets, and the smallest of them (sorted node ids,
+  /// compared lexicographically).
+  std::size_t crowded = 0;
+  std::array<std::uint32_t, 3> first_crowded{};
+};
+
+/// Matches the faces of every tet in O(T): a counting sort into blocks of smallest-node ids,
+/// then a hash table per block. Any indices (out-of-range ones included); throws
+/// std::length_error at 2^30 tets or more. Uses OpenMP threads when built with them; the
+/// result does not depend on their number.
+FaceMatch match_faces(const TetMesh& mesh);
+
+/// The Surface (order, winding, node lists) described by extract_surface, from `match`.
+Surface surface_from_faces(const TetMesh& mesh, const FaceMatch& match);
+
+/// validate_tet_mesh given the face matching of `mesh`.
+void validate_tet_mesh(const TetMesh& mesh, const Surface& surface, const FaceMatch& match,
+                       const std::string& file);
 
 /// Pairs of intersecting triangles (indices into `triangles`; empty when none) of a closed,
 /// edge- and vertex-manifold, consistently oriented triangle surface whose indices are in

@@ -183,9 +183,13 @@ py::array_t<double> doubles_array(const std::vector<double>& v) {
 py::dict report_dict(const std::string& source, const BuildReport& report,
                      const format::Asset& asset, std::size_t asset_bytes, double total) {
   py::dict seconds;
+  py::dict peak_rss_bytes;
+  py::dict peak_rss_growth_bytes;
   py::list stages;
   for (const StageReport& s : report.stages) {
     seconds[py::str(s.name)] = s.seconds;
+    peak_rss_bytes[py::str(s.name)] = s.peak_rss_bytes;
+    peak_rss_growth_bytes[py::str(s.name)] = s.peak_rss_growth_bytes;
     stages.append(py::make_tuple(s.name, s.seconds, s.summary));
   }
   seconds["total"] = total;
@@ -233,6 +237,8 @@ py::dict report_dict(const std::string& source, const BuildReport& report,
   d["input"] = source;
   d["asset_bytes"] = asset_bytes;
   d["seconds"] = seconds;
+  d["peak_rss_bytes"] = peak_rss_bytes;
+  d["peak_rss_growth_bytes"] = peak_rss_growth_bytes;
   d["stages"] = stages;
   d["counts"] = counts;
   d["segmentation"] = segmentation;
@@ -262,7 +268,7 @@ py::tuple build(const py::object& mesh, const py::object& source, const std::str
                 std::uint32_t min_cluster_triangles, const std::string& detector,
                 double min_visibility, const std::string& solver, double tolerance,
                 double cell_size, double facet_size, double facet_distance, bool optimize,
-                const std::string& repair, double wrap_alpha, double wrap_offset,
+                int threads, const std::string& repair, double wrap_alpha, double wrap_offset,
                 bool keep_largest_component, bool rest_positions, const py::object& on_stage) {
   BuildOptions options;
   options.clusters = enum_from_name<ClusterMethod>("clusters", clusters);
@@ -297,6 +303,8 @@ py::tuple build(const py::object& mesh, const py::object& source, const std::str
   meshing.facet_size = facet_size;
   meshing.facet_distance = facet_distance;
   meshing.optimize = optimize;
+  check_range("threads", threads, 0, 4096);
+  meshing.threads = threads;
   meshing.repair = enum_from_name<MeshingOptions::Repair>("repair", repair);
   check_range("wrap_alpha", wrap_alpha, 1e-4, 1.0);
   check_range("wrap_offset", wrap_offset, 1e-4, 1.0);
@@ -393,8 +401,7 @@ py::dict charge(const py::object& mesh, const py::object& source, const std::str
     // As `tetseg charge`: a tet mesh's boundary, or a closed surface as given.
     read_input(in);
     if (in.is_tet_mesh) {
-      const Surface surface = extract_surface(in.tet_mesh);
-      validate_tet_mesh(in.tet_mesh, surface, in.source);
+      const Surface surface = extract_valid_surface(in.tet_mesh, in.source);
       points = std::move(in.tet_mesh.nodes);
       triangles = surface.triangles;
     } else {
@@ -429,7 +436,7 @@ py::dict charge(const py::object& mesh, const py::object& source, const std::str
 py::tuple generate(const std::string& shape_name, double size, double radius,
                    const std::array<double, 3>& axes, double cell_size, double facet_size,
                    double facet_distance, double facet_angle, double radius_edge_ratio,
-                   bool optimize) {
+                   bool optimize, int threads) {
   const Shape shape = shape_from_name(shape_name);
   ShapeOptions shape_options;
   shape_options.size = size;
@@ -442,6 +449,8 @@ py::tuple generate(const std::string& shape_name, double size, double radius,
   meshing.facet_angle = facet_angle;
   meshing.cell_radius_edge_ratio = radius_edge_ratio;
   meshing.optimize = optimize;
+  check_range("threads", threads, 0, 4096);
+  meshing.threads = threads;
   TetMesh mesh;
   {
     py::gil_scoped_release release;
@@ -505,6 +514,7 @@ PYBIND11_MODULE(preprocess, m) {
         py::arg("tolerance") = b.charge.tolerance, py::arg("cell_size") = meshing.cell_size,
         py::arg("facet_size") = meshing.facet_size,
         py::arg("facet_distance") = meshing.facet_distance, py::arg("optimize") = meshing.optimize,
+        py::arg("threads") = meshing.threads,
         py::arg("repair") = std::string(name_of(meshing.repair)),
         py::arg("wrap_alpha") = meshing.wrap_alpha, py::arg("wrap_offset") = meshing.wrap_offset,
         py::arg("keep_largest_component") = meshing.keep_largest_component,
@@ -512,8 +522,8 @@ PYBIND11_MODULE(preprocess, m) {
         "Returns (asset bytes, report dict). "
         "Runs the whole pipeline as `tetseg build` does. mesh: a tet mesh file (.mesh, "
         ".node/.ele, .msh), a closed surface file (.obj, .ply, .stl, .off, ...; tetrahedralised "
-        "first with cell_size, facet_size, facet_distance, optimize, repair, wrap_alpha, "
-        "wrap_offset, keep_largest_component), or a pair of arrays "
+        "first with cell_size, facet_size, facet_distance, optimize, threads, repair, "
+        "wrap_alpha, wrap_offset, keep_largest_component), or a pair of arrays "
         "(nodes (N, 3), tets (M, 4)) or (points (N, 3), triangles (M, 3)). source: the name "
         "recorded in the asset's provenance and used in messages (default: the path, or "
         "'arrays'). Every other option is the `tetseg build` option of the same name "
@@ -543,8 +553,9 @@ PYBIND11_MODULE(preprocess, m) {
         py::arg("facet_distance") = meshing.facet_distance,
         py::arg("facet_angle") = meshing.facet_angle,
         py::arg("radius_edge_ratio") = meshing.cell_radius_edge_ratio,
-        py::arg("optimize") = meshing.optimize,
+        py::arg("optimize") = meshing.optimize, py::arg("threads") = meshing.threads,
         "Returns (nodes (N, 3) float64, tets (M, 4) uint32). "
         "Meshes a procedural shape as `tetseg generate` does: 'sphere', 'ellipsoid', "
-        "'dumbbell' or 'pawn'. Deterministic.");
+        "'dumbbell' or 'pawn'. Deterministic with threads=1 (the default); threads > 1 meshes "
+        "in parallel (oneTBB) and the mesh differs from run to run.");
 }

@@ -55,6 +55,13 @@ def test_build_equals_cli(pp, bin_dir, sphere_mesh, tmp_path, options, flags):
         assert report[key] == pytest.approx(expected_report[key]), key
     assert ("charge" in report) == ("charge" in expected_report)
     assert set(report["seconds"]) == set(expected_report["seconds"])
+    # Memory per stage, as in the CLI report: the process peak never decreases.
+    stage_names = [s[0] for s in report["stages"]]
+    for key in ("peak_rss_bytes", "peak_rss_growth_bytes"):
+        assert list(report[key]) == stage_names, key
+        assert set(expected_report[key]) == set(expected_report["seconds"]) - {"total"}, key
+    peaks = [report["peak_rss_bytes"][name] for name in stage_names]
+    assert peaks[0] > 0 and peaks == sorted(peaks)
     import tetseg
     asset = tetseg.load_asset(data)
     assert asset.triangle_count == report["counts"]["surface_triangles"]

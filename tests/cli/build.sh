@@ -34,6 +34,11 @@ assert all(0.0 <= c["rest_positive_fraction"] <= 1.0 for c in dump["clusters"])
 assert dump["provenance"]["source"] == "sphere.mesh"
 assert dump["provenance"]["options"]["clusters"] == mode
 assert all(k in report["seconds"] for k in ("surface", "detectors", "bvh", "write", "total"))
+# Memory per stage: same stages as the times; the process peak is positive and never decreases.
+stages = [k for k in report["seconds"] if k != "total"]
+assert list(report["peak_rss_bytes"]) == stages == list(report["peak_rss_growth_bytes"]), report
+peaks = [report["peak_rss_bytes"][s] for s in stages]
+assert peaks[0] > 0 and peaks == sorted(peaks), peaks
 assert report["refinement"]["clusters_before"] == (len(dump["clusters"]) - report["refinement"]["splits"]
                                                   + report["refinement"]["merges"] if mode == "refined" else 0)
 assert ("refine.min_visibility" in dump["provenance"]["options"]) == (mode == "refined")

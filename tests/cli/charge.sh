@@ -49,6 +49,13 @@ assert len(rows) == 512 == rep["triangles"], (len(rows), rep["triangles"])
 assert rep["solver"] == sys.argv[3], rep
 for key in ("iterations", "residual", "capacitance", "assembly_seconds", "solve_seconds"):
     assert key in rep, key
+# Memory per step: the process peak is positive and never decreases; growth is its increase.
+steps = ["read", "charge", "write"]
+assert list(rep["peak_rss_bytes"]) == steps == list(rep["peak_rss_growth_bytes"]), rep
+peaks = [rep["peak_rss_bytes"][s] for s in steps]
+assert peaks[0] > 0 and peaks == sorted(peaks), peaks
+for before, step in zip([0] + peaks, steps):
+    assert 0 <= rep["peak_rss_growth_bytes"][step] <= rep["peak_rss_bytes"][step] - before, rep
 assert rep["residual"] <= 1e-8, rep
 # A 512-face polyhedral sphere: capacitance a little below the radius, density near 1.
 assert 0.97 < rep["capacitance"] < 1.0, rep["capacitance"]

@@ -138,6 +138,30 @@ TEST_CASE("Bad meshing options are rejected", "[meshing]") {
   m = MeshingOptions{};
   m.cell_size = std::nan("");
   CHECK_THROWS_AS(generate_shape(Shape::kSphere, ShapeOptions{}, m), std::invalid_argument);
+  m = MeshingOptions{};
+  m.threads = -1;
+  CHECK_THROWS_AS(generate_shape(Shape::kSphere, ShapeOptions{}, m), std::invalid_argument);
+}
+
+TEST_CASE("Meshing with two threads gives a valid mesh of the shape (with oneTBB)", "[meshing]") {
+  MeshingOptions m;
+  m.threads = 2;
+  ShapeOptions o;
+  o.size = 0.7;
+  if (!meshing_threads_available()) {
+    // A build without oneTBB refuses threads instead of meshing sequentially unasked.
+    CHECK_THROWS_AS(generate_shape(Shape::kSphere, o, m), std::invalid_argument);
+    return;
+  }
+  // Independent truth: the unit ball's volume; the mesh is not reproducible, so no equality.
+  for (const Shape shape : {Shape::kSphere, Shape::kDumbbell}) {
+    const Checked c = check_valid(generate_shape(shape, o, m));
+    if (shape == Shape::kSphere) CHECK(c.volume == Approx(4.0 / 3.0 * kPi).epsilon(0.05));
+  }
+  const TriangleMesh s = tetseg::test::icosphere(5);
+  m.facet_size = 0.2;
+  const Checked c = check_valid(tetrahedralize(s, m, "sphere"));
+  CHECK(c.volume == Approx(enclosed_volume(s.vertices, s.triangles)).epsilon(0.03));
 }
 
 TEST_CASE("A closed surface is filled with valid tets of the same volume", "[meshing]") {

@@ -1,5 +1,9 @@
+#include <unistd.h>
+
 #include <algorithm>
 #include <catch2/catch.hpp>
+#include <cstdint>
+#include <cstdio>
 #include <set>
 
 #include "preprocess/grid_mesh.hpp"
@@ -65,6 +69,15 @@ TEST_CASE("The pipeline turns a dumbbell into a valid, loadable asset", "[pipeli
   REQUIRE(report.surface_triangles == surface.triangles.size());
   REQUIRE(report.clusters == asset.clusters.size());
   REQUIRE(report.rest_positive_fraction.size() == asset.clusters.size());
+  // Memory per stage: the process peak never decreases, and a stage raises it by at most
+  // the difference to the previous stage's peak.
+  std::uint64_t previous_peak = 0;
+  for (const StageReport& stage : report.stages) {
+    CHECK(stage.peak_rss_bytes > 0);
+    CHECK(stage.peak_rss_bytes >= previous_peak);
+    CHECK(stage.peak_rss_growth_bytes <= stage.peak_rss_bytes - previous_peak);
+    previous_peak = stage.peak_rss_bytes;
+  }
 
   // Detectors are interior nodes or tet centroids, and every triangle is in exactly one
   // cluster.
@@ -277,6 +290,42 @@ TEST_CASE("StageTimer keeps its own copy of a temporary callback", "[pipeline]")
   CHECK(seen == std::vector<std::string>{"first", "second"});
   REQUIRE(report.stages.size() == 2);
   CHECK(report.stages[0].summary == "done");
+}
+
+TEST_CASE("StageTimer reports the peak RSS a stage reached and how much it raised it",
+          "[pipeline]") {
+  // Independent truth: the resident size now (/proc/self/statm) and a buffer of known size
+  // touched in a stage, large enough to lift the process above its earlier peak.
+  auto resident_bytes = [] {
+    std::FILE* statm = std::fopen("/proc/self/statm", "r");
+    REQUIRE(statm != nullptr);
+    unsigned long long size = 0, resident = 0;
+    REQUIRE(std::fscanf(statm, "%llu %llu", &size, &resident) == 2);
+    std::fclose(statm);
+    return static_cast<std::uint64_t>(resident) *
+           static_cast<std::uint64_t>(::sysconf(_SC_PAGESIZE));
+  };
+  BuildReport report;
+  StageTimer timer(report, nullptr);
+  timer.run("idle", [](std::string&) { return 0; });
+  const std::uint64_t peak_before = report.stages[0].peak_rss_bytes;
+  const std::uint64_t resident = resident_bytes();
+  REQUIRE(peak_before >= resident / 2);  // same quantity, up to pages freed since
+  constexpr std::uint64_t kRaise = 48u << 20;
+  const std::uint64_t size = (peak_before > resident ? peak_before - resident : 0) + kRaise;
+  timer.run("allocate", [&](std::string&) {
+    std::vector<char> buffer(size, 1);  // every page touched
+    return static_cast<int>(buffer[size / 2]);
+  });
+  timer.run("after", [](std::string&) { return 0; });
+  REQUIRE(report.stages.size() == 3);
+  const StageReport& allocate = report.stages[1];
+  CHECK(allocate.peak_rss_bytes >= resident + size - (4u << 20));
+  CHECK(allocate.peak_rss_growth_bytes >= kRaise - (4u << 20));
+  CHECK(allocate.peak_rss_growth_bytes == allocate.peak_rss_bytes - peak_before);
+  // The buffer is gone: the next stage keeps the peak and does not raise it.
+  CHECK(report.stages[2].peak_rss_bytes == allocate.peak_rss_bytes);
+  CHECK(report.stages[2].peak_rss_growth_bytes == 0);
 }
 
 TEST_CASE(

@@ -51,6 +51,16 @@ std::string report_json(const BuildArgs& args, const BuildReport& report,
     out << (i ? ", " : "") << '"' << report.stages[i].name << "\": " << report.stages[i].seconds;
   }
   out << ", \"total\": " << total << "},\n";
+  // Process peak RSS at the end of each stage, and how much each stage raised it (docs/cli.md).
+  out << "  \"peak_rss_bytes\": {";
+  for (std::size_t i = 0; i < report.stages.size(); ++i)
+    out << (i ? ", " : "") << '"' << report.stages[i].name
+        << "\": " << report.stages[i].peak_rss_bytes;
+  out << "},\n  \"peak_rss_growth_bytes\": {";
+  for (std::size_t i = 0; i < report.stages.size(); ++i)
+    out << (i ? ", " : "") << '"' << report.stages[i].name
+        << "\": " << report.stages[i].peak_rss_growth_bytes;
+  out << "},\n";
   out << "  \"counts\": {\"nodes\": " << report.nodes << ", \"tets\": " << report.tets
       << ", \"surface_triangles\": " << report.surface_triangles
       << ", \"interior_nodes\": " << report.interior_nodes << ", \"clusters\": " << report.clusters
@@ -278,6 +288,7 @@ void add_build_command(CLI::App& root) {
   cmd->add_flag(
       "--no-optimize", [args](std::int64_t) { args->meshing.optimize = false; },
       "Surface input only: skip sliver perturbation and exudation (faster meshing)");
+  mesh_cli::add_threads_option(*cmd, args->meshing, "Surface input only: ");
   mesh_cli::add_repair_option(*cmd, args->meshing);
   cmd->add_flag("--no-rest-positions", args->no_rest_positions,
                 "Do not store rest positions in the asset (smaller; tools cannot draw it)");

@@ -11,6 +11,7 @@
 #include <memory>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "commands.hpp"
@@ -18,6 +19,7 @@
 #include "tetseg/preprocess/charge.hpp"
 #include "tetseg/preprocess/io.hpp"
 #include "tetseg/preprocess/names.hpp"
+#include "tetseg/preprocess/pipeline.hpp"
 #include "tetseg/preprocess/surface.hpp"
 #include "tool_support.hpp"
 
@@ -179,13 +181,22 @@ void run_charge(const ChargeArgs& args) {
   options.fast_theta = args.theta;
   options.fast_order = args.order;
 
+  // Process peak RSS at the end of each step, and how much the step raised it (docs/cli.md).
+  std::vector<std::pair<const char*, std::uint64_t>> peaks;
+  std::uint64_t last_peak = preprocess::process_peak_rss_bytes();
+  std::vector<std::uint64_t> growths;
+  auto take_peak = [&](const char* step) {
+    const std::uint64_t peak = preprocess::process_peak_rss_bytes();
+    peaks.emplace_back(step, peak);
+    growths.push_back(peak > last_peak ? peak - last_peak : 0);
+    last_peak = peak;
+  };
   auto t0 = std::chrono::steady_clock::now();
   std::vector<preprocess::Vec3> points;
   std::vector<preprocess::Tri> triangles;
   if (preprocess::is_tet_mesh_path(args.input)) {
     preprocess::TetMesh mesh = preprocess::read_tet_mesh(args.input);
-    const preprocess::Surface surface = preprocess::extract_surface(mesh);
-    preprocess::validate_tet_mesh(mesh, surface, args.input);
+    const preprocess::Surface surface = preprocess::extract_valid_surface(mesh, args.input);
     points = std::move(mesh.nodes);
     triangles = surface.triangles;
   } else {
@@ -194,6 +205,7 @@ void run_charge(const ChargeArgs& args) {
     points = std::move(mesh.vertices);
     triangles = std::move(mesh.triangles);
   }
+  take_peak("read");
   std::fprintf(stderr, "tetseg: reading %s ... %.2f s, %zu surface triangles\n",
                base_name(args.input).c_str(),
                std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(),
@@ -204,6 +216,7 @@ void run_charge(const ChargeArgs& args) {
   const preprocess::ChargeResult r =
       preprocess::compute_charge(points, triangles, options, args.input);
   progress.finish();
+  take_peak("charge");
   std::fprintf(stderr,
                "tetseg: charge ... %.2f s (assembly %.2f s, solve %.2f s), solver %s, %d "
                "iterations, residual %.2e, capacitance %.6g\n",
@@ -221,6 +234,7 @@ void run_charge(const ChargeArgs& args) {
       ext == ".csv" ? format_csv(out) : (ext == ".vtu" ? format_vtu(out) : format_ply(out));
   write_file_atomic(args.output, text);
   std::fprintf(stderr, "tetseg: wrote %s\n", base_name(args.output).c_str());
+  take_peak("write");
 
   if (!args.report.empty()) {
     std::ostringstream j;
@@ -232,7 +246,14 @@ void run_charge(const ChargeArgs& args) {
       << ",\n  \"tolerance\": " << r.tolerance << ",\n  \"capacitance\": " << r.capacitance
       << ",\n  \"total_area\": " << r.total_area << ",\n  \"equalization\": \""
       << preprocess::name_of(method) << "\",\n  \"assembly_seconds\": " << r.assembly_seconds
-      << ",\n  \"solve_seconds\": " << r.solve_seconds << "\n}\n";
+      << ",\n  \"solve_seconds\": " << r.solve_seconds;
+    j << ",\n  \"peak_rss_bytes\": {";
+    for (std::size_t i = 0; i < peaks.size(); ++i)
+      j << (i ? ", " : "") << '"' << peaks[i].first << "\": " << peaks[i].second;
+    j << "},\n  \"peak_rss_growth_bytes\": {";
+    for (std::size_t i = 0; i < peaks.size(); ++i)
+      j << (i ? ", " : "") << '"' << peaks[i].first << "\": " << growths[i];
+    j << "}\n}\n";
     write_file_atomic(args.report, j.str());
   }
 }

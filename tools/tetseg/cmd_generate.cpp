@@ -36,6 +36,16 @@ class Stage {
   std::chrono::steady_clock::time_point m_start;
 };
 
+void add_threads_option(CLI::App& cmd, preprocess::MeshingOptions& m, const std::string& prefix) {
+  cmd.add_option("--threads", m.threads,
+                 prefix +
+                     "Mesh_3 threads: 1 = sequential and reproducible; N > 1 = parallel "
+                     "(oneTBB), can be faster on idle cores, but the mesh differs from run to "
+                     "run; 0 = all cores")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+}
+
 void add_meshing_options(CLI::App& cmd, preprocess::MeshingOptions& m, MshOutput& msh) {
   cmd.add_option("--cell-size", m.cell_size,
                  "Max tet circumradius (0 = facet size; see docs/cli.md, Meshing options)")
@@ -53,6 +63,7 @@ void add_meshing_options(CLI::App& cmd, preprocess::MeshingOptions& m, MshOutput
       ->check(CLI::Range(2.0, 1000.0));
   cmd.add_flag_callback(
       "--no-optimize", [&m] { m.optimize = false; }, "Skip sliver perturbation and exudation");
+  add_threads_option(cmd, m, "");
   CLI::Option* gmsh22 =
       cmd.add_flag("--gmsh22", msh.gmsh22, "Write Gmsh 2.2 instead of 4.1 when the output is .msh");
   cmd.add_flag("--binary", msh.binary, "Write binary Gmsh 4.1 when the output is .msh")
@@ -145,9 +156,9 @@ void finish_tet_mesh(const preprocess::TetMesh& mesh, const std::string& output,
                      const MshOutput& msh, const std::string& what) {
   {
     Stage stage("validating " + what);
-    const preprocess::Surface surface = preprocess::extract_surface(mesh);
+    preprocess::Surface surface;
     try {
-      preprocess::validate_tet_mesh(mesh, surface, output);
+      surface = preprocess::extract_valid_surface(mesh, output);
     } catch (const preprocess::InputError& e) {
       throw ToolError(kExitProcessingFailed, output,
                       std::string("meshing produced an invalid mesh: ") + e.what() +

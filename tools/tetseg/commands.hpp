@@ -63,6 +63,8 @@ void finish_tet_mesh(const preprocess::TetMesh& mesh, const std::string& output,
 /// optimised mesh's boundary was invalid (`notes`).
 void print_retry_note(const std::string& file, const preprocess::TetrahedralizeNotes& notes);
 
+/// Adds `--threads N` (MeshingOptions::threads); `prefix` starts its help text.
+void add_threads_option(CLI::App& cmd, preprocess::MeshingOptions& m, const std::string& prefix);
 /// Adds `--repair none|fix` (MeshingOptions::repair).
 void add_repair_option(CLI::App& cmd, preprocess::MeshingOptions& m);
 /// Prints the repairs tetrahedralize made to `file` ("tetseg: repaired x.off: 2 duplicate

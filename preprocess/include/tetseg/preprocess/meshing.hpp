@@ -1,7 +1,8 @@
 #pragma once
 /// \file
 /// Tetrahedral meshing with CGAL Mesh_3: procedural shapes and closed surfaces. Deterministic
-/// (fixed seeds, no parallel refinement): the same input and options give the same mesh.
+/// by default (fixed seeds, sequential refinement): the same input and options give the same
+/// mesh. MeshingOptions::threads > 1 trades that for speed.
 
 #include <cstddef>
 #include <string>
@@ -33,7 +34,17 @@ struct MeshingOptions {
   /// (drops floating debris and stray parts); off by default, since several closed
   /// components are a valid input.
   bool keep_largest_component = false;
+  /// Mesh_3 threads. 1 (default): sequential and deterministic. N > 1: Mesh_3's parallel
+  /// refinement and optimisers (CGAL Parallel_tag) on N oneTBB threads; the mesh then differs
+  /// from run to run (node order and tets; docs/cli.md, "Meshing options"). 0: one thread per
+  /// hardware thread. Needs a build with oneTBB (meshing_threads_available()); without it,
+  /// any value but 1 throws std::invalid_argument. Not recorded in an asset's provenance: an
+  /// asset meshed with several threads does not rebuild byte for byte.
+  int threads = 1;
 };
+
+/// Whether this build meshes in parallel (linked with oneTBB): MeshingOptions::threads != 1.
+bool meshing_threads_available();
 
 /// One kind of repair tetrahedralize made to its input, and how many.
 struct RepairCount {

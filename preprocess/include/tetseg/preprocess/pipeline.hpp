@@ -41,12 +41,22 @@ struct BuildOptions {
   std::vector<RepairCount> repairs;
 };
 
-/// One finished stage: its name, wall time and a short human summary.
+/// One finished stage: its name, wall time, memory and a short human summary.
 struct StageReport {
   std::string name;
   double seconds = 0.0;
   std::string summary;
+  /// The process's peak resident set size (Linux VmHWM) at the end of the stage, bytes:
+  /// never decreases from stage to stage; 0 where the platform does not say.
+  std::uint64_t peak_rss_bytes = 0;
+  /// How much the stage raised that peak (end minus start), bytes: 0 when the stage stayed
+  /// below an earlier stage's peak.
+  std::uint64_t peak_rss_growth_bytes = 0;
 };
+
+/// The process's peak resident set size so far, bytes: VmHWM of /proc/self/status, else
+/// getrusage's ru_maxrss; 0 when neither is available.
+std::uint64_t process_peak_rss_bytes();
 
 /// Counts and times of one build, for `--report`.
 struct BuildReport {
@@ -63,7 +73,8 @@ struct BuildReport {
   std::vector<float> rest_positive_fraction;  ///< per cluster
 };
 
-/// Runs stages, timing each, appending it to `report.stages` and passing it to `on_stage`.
+/// Runs stages, timing each and taking the process peak RSS before and after it (StageReport),
+/// appending it to `report.stages` and passing it to `on_stage`.
 /// `work(summary)` does the stage, may fill the human summary, and returns its result.
 /// Keeps a copy of `on_stage` (a temporary lambda may be passed) and a reference to `report`.
 class StageTimer {
@@ -73,11 +84,15 @@ class StageTimer {
 
   template <typename Work>
   auto run(const char* name, Work&& work) {
+    const std::uint64_t peak_before = process_peak_rss_bytes();
     const auto start = std::chrono::steady_clock::now();
     StageReport stage;
     stage.name = name;
     auto result = work(stage.summary);
     stage.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    stage.peak_rss_bytes = process_peak_rss_bytes();
+    stage.peak_rss_growth_bytes =
+        stage.peak_rss_bytes > peak_before ? stage.peak_rss_bytes - peak_before : 0;
     m_report.stages.push_back(stage);
     if (m_on_stage) m_on_stage(stage);
     return result;

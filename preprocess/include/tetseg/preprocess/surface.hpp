@@ -13,7 +13,9 @@ namespace tetseg::preprocess {
 /// assumes positively oriented tets (the face opposite vertex i has its normal pointing away
 /// from vertex i); faces shared by three or more tets are not boundary faces (validation
 /// rejects them). Never throws on bad indices (they may appear in triangles; validate first).
-/// Nodes used by no tet are listed as interior. Thread-safe.
+/// Nodes used by no tet are listed as interior. Cost: O(T), faces matched by blocks of node
+/// ids with a hash table per block, on OpenMP threads (about 0.6 s of CPU for 4.8 M tets);
+/// throws std::length_error at 2^30 tets or more. Thread-safe.
 Surface extract_surface(const TetMesh& mesh);
 
 /// Validates a tet mesh and its boundary (`surface`, normally extract_surface(mesh)), in this
@@ -24,10 +26,15 @@ Surface extract_surface(const TetMesh& mesh);
 /// fan of triangles per vertex), one connected component (the count is reported), free of
 /// self-intersection at rest (CGAL box-intersection broad phase with exact predicates).
 /// Throws InputError(`file`, message) naming the first defect found, e.g. "surface is not
-/// closed (3 border edges, first between vertices 4 and 7)". Cost: O(n log n) plus the
-/// self-intersection test (about 0.4 s for 365k tets / 24k boundary triangles).
+/// closed (3 border edges, first between vertices 4 and 7)". Cost: the face matching of
+/// extract_surface, O(T) checks of the tets, O(B log B) checks of the B boundary triangles
+/// and the self-intersection test (about 1.1 s of CPU for 4.8 M tets / 104k triangles).
 /// Thread-safe.
 void validate_tet_mesh(const TetMesh& mesh, const Surface& surface, const std::string& file);
+
+/// extract_surface then validate_tet_mesh (same result, same InputError), matching the faces
+/// once instead of twice: what every tool stage that reads a tet mesh runs. Thread-safe.
+Surface extract_valid_surface(const TetMesh& mesh, const std::string& file);
 
 /// The same surface checks for a triangle mesh that is about to be tetrahedralised or used as
 /// a conductor: finite coordinates, indices in range, no zero-area triangle (|2 area| <=
