@@ -214,7 +214,8 @@ int main(int argc, char** argv) {
   int leaf_size = ChargeOptions{}.leaf_size;
   app.add_option("--mesh-dir", mesh_dir, "Directory with the CGAL demo meshes");
   app.add_option("--real", real, "Real mesh (OFF) subdivided to the sizes");
-  app.add_option("--sizes", sizes, "Any of 1k 5k 20k 100k");
+  app.add_option("--sizes", sizes,
+                 "Any of 1k 5k 20k 100k 82k 327k 1.3M (ellipsoids of 20 k^2 triangles)");
   app.add_option("--solvers", solvers,
                  "Any of direct gmres fast auto, optionally name/preconditioner (jacobi, block, "
                  "near, two), @tolerance (name@auto: automatic) and :order[:theta] of the FMM");
@@ -235,8 +236,9 @@ int main(int argc, char** argv) {
     bool analytic;
   };
   std::vector<Mesh> meshes;
-  const int ks[] = {7, 16, 32, 71};
-  const char* names[] = {"1k", "5k", "20k", "100k"};
+  // 20 k^2 triangles: 980, 5120, 20,480, 100,820, 81,920, 327,680, 1,310,720.
+  const int ks[] = {7, 16, 32, 71, 64, 128, 256};
+  const char* names[] = {"1k", "5k", "20k", "100k", "82k", "327k", "1.3M"};
   TriangleMesh base;
   bool have_real = false;
   try {
@@ -245,14 +247,15 @@ int main(int argc, char** argv) {
   } catch (const std::exception& e) {
     std::fprintf(stderr, "bench: no real mesh (%s); ellipsoids only\n", e.what());
   }
-  for (int s = 0; s < 4; ++s) {
+  for (int s = 0; s < 7; ++s) {
     if (std::find(sizes.begin(), sizes.end(), names[s]) == sizes.end()) continue;
     meshes.push_back(
         {"ellipsoid 1:0.6:0.3", names[s], test::ellipsoid(ks[s], 1.0, 0.6, 0.3), true});
     if (have_real) {
       TriangleMesh m = base;
       // elephant: 5558 -> 22232 -> 88928; the 1k class uses the mesh as given.
-      const std::size_t target = s == 0 ? 0 : (s == 1 ? 5000 : (s == 2 ? 20000 : 80000));
+      const std::size_t targets[] = {0, 5000, 20000, 80000, 80000, 320000, 1280000};
+      const std::size_t target = targets[s];
       while (m.triangles.size() < target) m = test::subdivide(m);
       if (s == 0 && m.triangles.size() > 2000) continue;  // no ~1k version of this mesh
       meshes.push_back({real, names[s], m, false});

@@ -38,9 +38,10 @@ constexpr double kAutoLargeTheta = 0.45;
 /// nearest near-field neighbours). Measured 64 / 96 / 128 / 160 on the ellipsoid and the
 /// elephant at 5k and 100k (docs/charge.md, "Preconditioner").
 constexpr std::size_t kSchwarzSet = 128;
-/// Two-level: at most this many coarse clusters and N x K coarse-operator entries.
-constexpr std::size_t kCoarseMax = 256;
-constexpr std::size_t kCoarseEntries = 25'000'000;
+/// Two-level: at most this many coarse clusters (dense LU of K x K), each of at least about
+/// kCoarseClusterMin triangles.
+constexpr std::size_t kCoarseMax = 2048;
+constexpr std::size_t kCoarseClusterMin = 64;
 
 double seconds_since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
@@ -121,9 +122,7 @@ ChargeResult compute_charge(const std::vector<Vec3>& points, const std::vector<T
   }
   if (options.preconditioner == ChargePreconditioner::kTwoLevel &&
       solver != ChargeSolver::kDirect) {
-    // K: at most 256, clusters of at least ~64 triangles, and N x K floats <= 100 MB.
-    const std::size_t k =
-        std::min({kCoarseMax, n / 64, kCoarseEntries / std::max<std::size_t>(n, 1)});
+    const std::size_t k = std::min(kCoarseMax, n / kCoarseClusterMin);
     two_level = std::make_unique<TwoLevelSchwarz>(panels, tree, near, kSchwarzSet, k);
   }
   const ApplyFn precondition = [&](const double* in, double* out) {

@@ -424,7 +424,8 @@ void TreecodeOperator::apply(const double* x, double* y) const {
 #endif
   {
     constexpr std::size_t kBatch = 4;
-    std::vector<double> mono(kc), deriv((kc + 1) * kBatch), pot, zeros(kc, 0.0);
+    std::vector<double> mono(kc), deriv((kc + 1) * kBatch), moments(kc * kBatch), pot,
+        zeros(kc, 0.0);
     // Upward pass: leaf moments from the members.
 #if defined(TETSEG_HAVE_OPENMP)
 #pragma omp for schedule(dynamic, 16)
@@ -512,19 +513,53 @@ void TreecodeOperator::apply(const double* x, double* y) const {
         for (std::size_t k = 0; k < kc; ++k) {
           for (std::size_t p = 0; p < kBatch; ++p) deriv[k * kBatch + p] *= m_fact[k];
         }
+        // The batch's moments interleaved like deriv (lane p of slot b), so that every term is
+        // one product of two contiguous kBatch-vectors.
+        for (std::size_t b = 0; b < kc; ++b) {
+          for (std::size_t p = 0; p < kBatch; ++p) moments[b * kBatch + p] = mom[p][b];
+        }
         // Terms are sorted by the target index a: accumulate each L_a in registers.
         const std::uint16_t* tb = m_m2l_b.data();
         const std::uint16_t* tc = m_m2l_c.data();
+        const double* dv = deriv.data();
+        const double* mv = moments.data();
         std::size_t e = 0;
         for (std::size_t a = 0; a < kc; ++a) {
           const std::size_t end = m_m2l_start[a + 1];
+#if defined(__SSE2__)
+          // Two independent accumulator pairs (even and odd terms) for lanes 0-1 and 2-3.
+          __m128d lo0 = _mm_setzero_pd(), hi0 = _mm_setzero_pd();
+          __m128d lo1 = _mm_setzero_pd(), hi1 = _mm_setzero_pd();
+          for (; e + 2 <= end; e += 2) {
+            const double* d0 = dv + static_cast<std::size_t>(tc[e]) * kBatch;
+            const double* m0 = mv + static_cast<std::size_t>(tb[e]) * kBatch;
+            const double* d1 = dv + static_cast<std::size_t>(tc[e + 1]) * kBatch;
+            const double* m1 = mv + static_cast<std::size_t>(tb[e + 1]) * kBatch;
+            lo0 = _mm_add_pd(lo0, _mm_mul_pd(_mm_loadu_pd(d0), _mm_loadu_pd(m0)));
+            hi0 = _mm_add_pd(hi0, _mm_mul_pd(_mm_loadu_pd(d0 + 2), _mm_loadu_pd(m0 + 2)));
+            lo1 = _mm_add_pd(lo1, _mm_mul_pd(_mm_loadu_pd(d1), _mm_loadu_pd(m1)));
+            hi1 = _mm_add_pd(hi1, _mm_mul_pd(_mm_loadu_pd(d1 + 2), _mm_loadu_pd(m1 + 2)));
+          }
+          if (e < end) {
+            const double* d0 = dv + static_cast<std::size_t>(tc[e]) * kBatch;
+            const double* m0 = mv + static_cast<std::size_t>(tb[e]) * kBatch;
+            lo0 = _mm_add_pd(lo0, _mm_mul_pd(_mm_loadu_pd(d0), _mm_loadu_pd(m0)));
+            hi0 = _mm_add_pd(hi0, _mm_mul_pd(_mm_loadu_pd(d0 + 2), _mm_loadu_pd(m0 + 2)));
+            ++e;
+          }
+          const __m128d both = _mm_add_pd(_mm_add_pd(lo0, lo1), _mm_add_pd(hi0, hi1));
+          double lanes[2];
+          _mm_storeu_pd(lanes, both);
+          local[a] += (lanes[0] + lanes[1]) * m_inv_fact[a];
+#else
           double acc[kBatch] = {};
           for (; e < end; ++e) {
-            const double* d = deriv.data() + static_cast<std::size_t>(tc[e]) * kBatch;
-            const std::size_t b = tb[e];
-            for (std::size_t p = 0; p < kBatch; ++p) acc[p] += d[p] * mom[p][b];
+            const double* d = dv + static_cast<std::size_t>(tc[e]) * kBatch;
+            const double* m = mv + static_cast<std::size_t>(tb[e]) * kBatch;
+            for (std::size_t p = 0; p < kBatch; ++p) acc[p] += d[p] * m[p];
           }
           local[a] += ((acc[0] + acc[1]) + (acc[2] + acc[3])) * m_inv_fact[a];
+#endif
         }
       }
     }
