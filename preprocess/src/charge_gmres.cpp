@@ -29,8 +29,9 @@ GmresOutcome solve_gmres(std::size_t n, const ApplyFn& apply, const ApplyFn& pre
     return out;
   }
   std::vector<double> r(n), w(n), z(n);
-  std::vector<std::vector<double>> basis(static_cast<std::size_t>(restart) + 1,
-                                         std::vector<double>(n));
+  // Krylov vectors are allocated when first used: a solve that converges in a few iterations
+  // needs a few of the restart + 1 vectors (81 x 8 bytes per unknown).
+  std::vector<std::vector<double>> basis(static_cast<std::size_t>(restart) + 1);
   const std::size_t m = static_cast<std::size_t>(restart);
   std::vector<double> h((m + 1) * m), cs(m), sn(m), g(m + 1), y(m);
   auto hh = [&](std::size_t i, std::size_t j) -> double& { return h[i * m + j]; };
@@ -52,6 +53,7 @@ GmresOutcome solve_gmres(std::size_t n, const ApplyFn& apply, const ApplyFn& pre
       return out;
     }
     if (out.iterations >= max_iterations) return out;
+    basis[0].resize(n);
     for (std::size_t i = 0; i < n; ++i) basis[0][i] = r[i] / beta;
     std::fill(g.begin(), g.end(), 0.0);
     g[0] = beta;
@@ -70,6 +72,7 @@ GmresOutcome solve_gmres(std::size_t n, const ApplyFn& apply, const ApplyFn& pre
       const double wn = norm2(w);
       hh(k + 1, k) = wn;
       if (wn > 0.0) {
+        basis[k + 1].resize(n);
         for (std::size_t i = 0; i < n; ++i) basis[k + 1][i] = w[i] / wn;
       }
       for (std::size_t j = 0; j < k; ++j) {

@@ -208,10 +208,12 @@ NearField build_near_field(const PanelSet& panels, const ClusterTree& tree) {
         value = triangle_self_potential(t[0], t[1], t[2]);
         near.diagonal[i] = value;
       } else {
-        value = kernels[j].potential(p);
         const Vec3& q = panels.centroid[j];
         const double dx = p[0] - q[0], dy = p[1] - q[1], dz = p[2] - q[2];
         const double r2 = dx * dx + dy * dy + dz * dz;
+        const double band = kQuadratureFactor * panels.diameter[j];
+        value = r2 > band * band ? triangle_potential_quadrature(t, panels.area[j], p)
+                                 : kernels[j].potential(p);
         if (r2 > 0.0) point = panels.area[j] / std::sqrt(r2);
       }
       near.column[e] = j;
