@@ -471,12 +471,38 @@ TreecodeOperator::TreecodeOperator(const PanelSet& panels, const ClusterTree& tr
     m_area[k] = panels.area[j];
   }
   const std::size_t node_count = tree.nodes.size();
+  // Shift terms grouped by their target index a (M2M already is), with start offsets.
+  std::stable_sort(m_l2l.begin(), m_l2l.end(),
+                   [](const Term& u, const Term& v) { return u.a < v.a; });
+  for (auto [terms, start] : {std::pair{&m_m2m, &m_m2m_start}, std::pair{&m_l2l, &m_l2l_start}}) {
+    start->assign(static_cast<std::size_t>(kc) + 1, 0);
+    for (const Term& t : *terms) ++(*start)[static_cast<std::size_t>(t.a) + 1];
+    for (std::size_t a = 0; a < static_cast<std::size_t>(kc); ++a) (*start)[a + 1] += (*start)[a];
+  }
   m_parent.assign(node_count, -1);
   for (std::size_t id = 0; id < node_count; ++id) {
     const Cluster& c = tree.nodes[id];
     if (c.left >= 0) {
       m_parent[static_cast<std::size_t>(c.left)] = static_cast<std::int32_t>(id);
       m_parent[static_cast<std::size_t>(c.right)] = static_cast<std::int32_t>(id);
+    }
+  }
+  // Nodes by depth (children have larger ids than their parent), for the level-parallel
+  // upward and downward passes.
+  {
+    std::vector<std::size_t> depth(node_count, 0);
+    std::size_t deepest = 0;
+    for (std::size_t id = 1; id < node_count; ++id) {
+      depth[id] = depth[static_cast<std::size_t>(m_parent[id])] + 1;
+      deepest = std::max(deepest, depth[id]);
+    }
+    m_level_start.assign(deepest + 2, 0);
+    for (std::size_t id = 0; id < node_count; ++id) ++m_level_start[depth[id] + 1];
+    for (std::size_t d = 0; d <= deepest; ++d) m_level_start[d + 1] += m_level_start[d];
+    m_level_nodes.resize(node_count);
+    std::vector<std::size_t> fill(m_level_start.begin(), m_level_start.end() - 1);
+    for (std::size_t id = 0; id < node_count; ++id) {
+      m_level_nodes[fill[depth[id]]++] = static_cast<std::int32_t>(id);
     }
   }
   m_leaf_of_node.assign(node_count, -1);
@@ -559,9 +585,17 @@ void TreecodeOperator::apply(const double* x, double* y) const {
       out[k] = out[m1[static_cast<std::size_t>(i)]] * w[i];
     }
   };
-  auto shift = [&](const std::vector<Term>& terms, const double* d_mono, const double* from,
-                   double* to) {
-    for (const Term& t : terms) to[t.a] += t.coef * d_mono[t.c] * from[t.b];
+  // to[a] += sum over a's terms of coef * d^c * from[b], one register sum per a.
+  auto shift = [&](const std::vector<Term>& terms, const std::vector<std::size_t>& start,
+                   const double* d_mono, const double* from, double* to) {
+    for (std::size_t a = 0; a < kc; ++a) {
+      double acc = 0.0;
+      for (std::size_t e = start[a]; e < start[a + 1]; ++e) {
+        const Term& t = terms[e];
+        acc += t.coef * d_mono[t.c] * from[t.b];
+      }
+      to[a] += acc;
+    }
   };
 #if defined(TETSEG_HAVE_OPENMP)
 #pragma omp parallel
@@ -586,26 +620,57 @@ void TreecodeOperator::apply(const double* x, double* y) const {
         for (std::size_t e = 0; e < kc; ++e) mom[e] += q * mono[e];
       }
     }
+    // Parents after children, one level at a time (deepest first); levels of fewer than
+    // kParallelLevel nodes together in one thread (fewer barriers).
+    constexpr std::size_t kParallelLevel = 256;
+    const std::size_t levels = m_level_start.size() - 1;
+    std::size_t first_wide = 0;  // levels >= first_wide have at least kParallelLevel nodes
+    while (first_wide < levels &&
+           m_level_start[first_wide + 1] - m_level_start[first_wide] < kParallelLevel) {
+      ++first_wide;
+    }
+    auto upward = [&](std::size_t id) {
+      const Cluster& c = nodes[id];
+      if (c.left < 0) return;
+      double* mom = m_moments.data() + id * kc;
+      std::fill(mom, mom + kc, 0.0);
+      for (const std::int32_t child : {c.left, c.right}) {
+        const Cluster& ch = nodes[static_cast<std::size_t>(child)];
+        monomials(ch.center[0] - c.center[0], ch.center[1] - c.center[1],
+                  ch.center[2] - c.center[2], mono.data());
+        shift(m_m2m, m_m2m_start, mono.data(),
+              m_moments.data() + static_cast<std::size_t>(child) * kc, mom);
+      }
+    };
+    auto downward = [&](std::size_t id) {
+      const Cluster& c = nodes[id];
+      const Cluster& pc = nodes[static_cast<std::size_t>(m_parent[id])];
+      monomials(c.center[0] - pc.center[0], c.center[1] - pc.center[1], c.center[2] - pc.center[2],
+                mono.data());
+      shift(m_l2l, m_l2l_start, mono.data(),
+            m_local.data() + static_cast<std::size_t>(m_parent[id]) * kc, m_local.data() + id * kc);
+    };
+    for (std::size_t level = levels; level-- > first_wide;) {
+#if defined(TETSEG_HAVE_OPENMP)
+#pragma omp for schedule(dynamic, 16)
+#endif
+      for (std::ptrdiff_t at = static_cast<std::ptrdiff_t>(m_level_start[level]);
+           at < static_cast<std::ptrdiff_t>(m_level_start[level + 1]); ++at) {
+        upward(static_cast<std::size_t>(m_level_nodes[static_cast<std::size_t>(at)]));
+      }
+    }
 #if defined(TETSEG_HAVE_OPENMP)
 #pragma omp single
 #endif
-    {
-      // Parents after children: children have larger ids than their parent.
-      for (std::ptrdiff_t id = node_count - 1; id >= 0; --id) {
-        const Cluster& c = nodes[static_cast<std::size_t>(id)];
-        if (c.left < 0) continue;
-        double* mom = m_moments.data() + static_cast<std::size_t>(id) * kc;
-        std::fill(mom, mom + kc, 0.0);
-        for (const std::int32_t child : {c.left, c.right}) {
-          const Cluster& ch = nodes[static_cast<std::size_t>(child)];
-          monomials(ch.center[0] - c.center[0], ch.center[1] - c.center[1],
-                    ch.center[2] - c.center[2], mono.data());
-          shift(m_m2m, mono.data(), m_moments.data() + static_cast<std::size_t>(child) * kc, mom);
-        }
-      }
-      for (std::size_t e = 0; e < m_scaled.size(); ++e) {
-        m_scaled[e] = m_moments[e] * m_moment_scale[e % kc];
-      }
+    for (std::size_t at = m_level_start[first_wide]; at-- > 0;) {
+      upward(static_cast<std::size_t>(m_level_nodes[at]));
+    }
+#if defined(TETSEG_HAVE_OPENMP)
+#pragma omp for schedule(static)
+#endif
+    for (std::ptrdiff_t e = 0; e < static_cast<std::ptrdiff_t>(m_scaled.size()); ++e) {
+      const std::size_t u = static_cast<std::size_t>(e);
+      m_scaled[u] = m_moments[u] * m_moment_scale[u % kc];
     }
     // Multipole-to-local for every target cluster.
 #if defined(TETSEG_HAVE_OPENMP)
@@ -671,19 +736,20 @@ void TreecodeOperator::apply(const double* x, double* y) const {
         }
       }
     }
+    // Downward pass: parents before children, the narrow levels in one thread first.
 #if defined(TETSEG_HAVE_OPENMP)
 #pragma omp single
 #endif
-    {
-      // Downward pass: parents before children.
-      for (std::ptrdiff_t id = 1; id < node_count; ++id) {
-        const Cluster& c = nodes[static_cast<std::size_t>(id)];
-        const std::int32_t parent = m_parent[static_cast<std::size_t>(id)];
-        const Cluster& pc = nodes[static_cast<std::size_t>(parent)];
-        monomials(c.center[0] - pc.center[0], c.center[1] - pc.center[1],
-                  c.center[2] - pc.center[2], mono.data());
-        shift(m_l2l, mono.data(), m_local.data() + static_cast<std::size_t>(parent) * kc,
-              m_local.data() + static_cast<std::size_t>(id) * kc);
+    for (std::size_t at = 1; at < m_level_start[first_wide]; ++at) {
+      downward(static_cast<std::size_t>(m_level_nodes[at]));
+    }
+    for (std::size_t level = std::max<std::size_t>(first_wide, 1); level < levels; ++level) {
+#if defined(TETSEG_HAVE_OPENMP)
+#pragma omp for schedule(dynamic, 16)
+#endif
+      for (std::ptrdiff_t at = static_cast<std::ptrdiff_t>(m_level_start[level]);
+           at < static_cast<std::ptrdiff_t>(m_level_start[level + 1]); ++at) {
+        downward(static_cast<std::size_t>(m_level_nodes[static_cast<std::size_t>(at)]));
       }
     }
     // Leaves: evaluate the local expansion and the direct sums.
