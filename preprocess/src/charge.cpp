@@ -105,7 +105,7 @@ ChargeResult compute_charge(const std::vector<Vec3>& points, const std::vector<T
   result.tolerance = tolerance;
   progress("assembly", 0.0);
   const ClusterTree tree = build_cluster_tree(panels, options.leaf_size);
-  const NearField near = build_near_field(panels, tree);
+  NearField near = build_near_field(panels, tree);
   result.near_entries = near.column.size();
   progress("assembly", 0.3);
 
@@ -147,6 +147,9 @@ ChargeResult compute_charge(const std::vector<Vec3>& points, const std::vector<T
     const double theta = options.fast_theta > 0.0
                              ? options.fast_theta
                              : (n < kAutoHighOrderMin ? kAutoTheta : kAutoLargeTheta);
+    // The analytic values served the preconditioner; the FMM needs only the corrections
+    // (8 bytes per near entry freed: 0.6 GB at 1.3 M triangles).
+    std::vector<double>().swap(near.value);
     const TreecodeOperator op(panels, tree, near, theta, order);
     result.assembly_seconds = seconds_since(t0);
     progress("assembly", 1.0);
