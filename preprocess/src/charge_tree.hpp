@@ -30,8 +30,10 @@ struct ClusterTree {
 ClusterTree build_cluster_tree(const PanelSet& panels, int leaf_size);
 
 /// The near field of the collocation matrix in CSR form: for row i, the columns j with
-/// |c_i - c_j| <= kNearFactor * diameter_j (always including j = i) and the analytic entry
-/// M_ij, plus `correction` = M_ij minus the point-charge entry A_j / r_ij (M_ii for j = i).
+/// |c_i - c_j| <= kNearFactor * diameter_j (always including j = i) and the entry M_ij
+/// (closed form, or the six-point quadrature beyond kQuadratureFactor diameters: the rule of
+/// matrix_entry), plus `correction` = M_ij minus the point-charge entry A_j / r_ij (M_ii for
+/// j = i). compute_charge's fast path frees `value` once the preconditioner is built.
 struct NearField {
   std::vector<std::size_t> row_start;  ///< size n + 1
   std::vector<std::uint32_t> column;
