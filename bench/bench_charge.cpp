@@ -4,10 +4,12 @@
 
 #include <sys/resource.h>
 #include <sys/wait.h>
+#include <time.h>
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -197,6 +199,53 @@ double exact_residual(const TriangleMesh& m, const std::vector<double>& density,
   return cd::exact_residual(panels, near, b, y);
 }
 
+/// Wall and process CPU seconds since construction.
+struct StageClock {
+  std::chrono::steady_clock::time_point wall = std::chrono::steady_clock::now();
+  double cpu = process_cpu();
+  static double process_cpu() {
+    timespec t{};
+    ::clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+    return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+  }
+  std::string lap() {
+    const auto now = std::chrono::steady_clock::now();
+    const double c = process_cpu();
+    char b[64];
+    std::snprintf(b, sizeof b, "%.3f / %.3f", std::chrono::duration<double>(now - wall).count(),
+                  c - cpu);
+    wall = now;
+    cpu = c;
+    return b;
+  }
+};
+
+/// `--stages`: wall / CPU seconds of compute_charge's internal stages for the fast solver
+/// with the two-level preconditioner (set cap 128, K = min(2048, N / 64): compute_charge's
+/// defaults), in this process (no fork afterwards).
+void print_stages(const std::string& name, const TriangleMesh& mesh, int order, double theta) {
+  namespace cd = preprocess::charge_detail;
+  StageClock clock;
+  const cd::PanelSet panels = cd::make_panels(mesh.vertices, mesh.triangles, "");
+  const cd::ClusterTree tree = cd::build_cluster_tree(panels, ChargeOptions{}.leaf_size);
+  const std::string t_tree = clock.lap();
+  const cd::NearField near = cd::build_near_field(panels, tree);
+  const std::string t_near = clock.lap();
+  const std::size_t n = panels.size();
+  const cd::TwoLevelSchwarz pre(panels, tree, near, 128, std::min<std::size_t>(2048, n / 64));
+  const std::string t_pre = clock.lap();
+  const cd::TreecodeOperator op(panels, tree, near, theta, order);
+  const std::string t_fmm = clock.lap();
+  std::vector<double> x(n, 1.0), y(n);
+  op.apply(x.data(), y.data());
+  const std::string t_apply = clock.lap();
+  pre.apply(x.data(), y.data());
+  const std::string t_pre_apply = clock.lap();
+  std::printf("| %s | %zu | %s | %s | %s | %s | %s | %s |\n", name.c_str(), n, t_tree.c_str(),
+              t_near.c_str(), t_pre.c_str(), t_fmm.c_str(), t_apply.c_str(), t_pre_apply.c_str());
+  std::fflush(stdout);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -226,6 +275,10 @@ int main(int argc, char** argv) {
                  "Largest N for the residual against the exact matrix (O(N^2) product)");
   app.add_option("--tolerance", tolerance, "Relative residual for the timed runs");
   app.add_flag("--no-reference{false}", reference, "Skip the reference solves");
+  bool stages = false;
+  app.add_flag("--stages", stages,
+               "Instead of the solver table: wall / CPU s of the fast solver's stages (two-level "
+               "preconditioner; --order, default 8, and --theta, default 0.45)");
   app.add_option("--repeat", repeat, "Runs per timed case; the row shows the fastest (wall)")
       ->check(CLI::PositiveNumber);
   CLI11_PARSE(app, argc, argv);
@@ -262,11 +315,20 @@ int main(int argc, char** argv) {
     }
   }
 
-  std::printf(
-      "| mesh | N | solver | assembly s | solve s | total s | CPU s | iterations | residual | "
-      "exact residual | peak RSS MB | error vs analytic, max / mean | vs reference, max / mean | "
-      "vs reference, max abs | reference "
-      "|\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+  if (stages) {
+    std::printf(
+        "| mesh | N | panels + tree | near field | two-level setup | FMM lists | one FMM product "
+        "| one preconditioner application |\n|---|---|---|---|---|---|---|---|\n");
+    std::printf(
+        "| mesh | N | solver | assembly s | solve s | total s | CPU s | iterations | residual | "
+        "exact residual | peak RSS MB | error vs analytic, max / mean | vs reference, max / mean | "
+        "vs reference, max abs | reference "
+        "|\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+    for (const Mesh& m : meshes) {
+      print_stages(m.name, m.mesh, order >= 0 ? order : 8, theta > 0.0 ? theta : 0.45);
+    }
+    return 0;
+  }
   for (const Mesh& m : meshes) {
     const std::size_t n = m.mesh.triangles.size();
     std::vector<double> exact;
