@@ -4,10 +4,12 @@
 
 #include <sys/resource.h>
 #include <sys/wait.h>
+#include <time.h>
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -197,6 +199,53 @@ double exact_residual(const TriangleMesh& m, const std::vector<double>& density,
   return cd::exact_residual(panels, near, b, y);
 }
 
+/// Wall and process CPU seconds since construction.
+struct StageClock {
+  std::chrono::steady_clock::time_point wall = std::chrono::steady_clock::now();
+  double cpu = process_cpu();
+  static double process_cpu() {
+    timespec t{};
+    ::clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+    return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+  }
+  std::string lap() {
+    const auto now = std::chrono::steady_clock::now();
+    const double c = process_cpu();
+    char b[64];
+    std::snprintf(b, sizeof b, "%.3f / %.3f", std::chrono::duration<double>(now - wall).count(),
+                  c - cpu);
+    wall = now;
+    cpu = c;
+    return b;
+  }
+};
+
+/// `--stages`: wall / CPU seconds of compute_charge's internal stages for the fast solver
+/// with the two-level preconditioner (set cap 128, K = min(2048, N / 64): compute_charge's
+/// defaults), in this process (no fork afterwards).
+void print_stages(const std::string& name, const TriangleMesh& mesh, int order, double theta) {
+  namespace cd = preprocess::charge_detail;
+  StageClock clock;
+  const cd::PanelSet panels = cd::make_panels(mesh.vertices, mesh.triangles, "");
+  const cd::ClusterTree tree = cd::build_cluster_tree(panels, ChargeOptions{}.leaf_size);
+  const std::string t_tree = clock.lap();
+  const cd::NearField near = cd::build_near_field(panels, tree);
+  const std::string t_near = clock.lap();
+  const std::size_t n = panels.size();
+  const cd::TwoLevelSchwarz pre(panels, tree, near, 128, std::min<std::size_t>(2048, n / 64));
+  const std::string t_pre = clock.lap();
+  const cd::TreecodeOperator op(panels, tree, near, theta, order);
+  const std::string t_fmm = clock.lap();
+  std::vector<double> x(n, 1.0), y(n);
+  op.apply(x.data(), y.data());
+  const std::string t_apply = clock.lap();
+  pre.apply(x.data(), y.data());
+  const std::string t_pre_apply = clock.lap();
+  std::printf("| %s | %zu | %s | %s | %s | %s | %s | %s |\n", name.c_str(), n, t_tree.c_str(),
+              t_near.c_str(), t_pre.c_str(), t_fmm.c_str(), t_apply.c_str(), t_pre_apply.c_str());
+  std::fflush(stdout);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -214,7 +263,8 @@ int main(int argc, char** argv) {
   int leaf_size = ChargeOptions{}.leaf_size;
   app.add_option("--mesh-dir", mesh_dir, "Directory with the CGAL demo meshes");
   app.add_option("--real", real, "Real mesh (OFF) subdivided to the sizes");
-  app.add_option("--sizes", sizes, "Any of 1k 5k 20k 100k");
+  app.add_option("--sizes", sizes,
+                 "Any of 1k 5k 20k 100k 82k 327k 1.3M (ellipsoids of 20 k^2 triangles)");
   app.add_option("--solvers", solvers,
                  "Any of direct gmres fast auto, optionally name/preconditioner (jacobi, block, "
                  "near, two), @tolerance (name@auto: automatic) and :order[:theta] of the FMM");
@@ -225,6 +275,10 @@ int main(int argc, char** argv) {
                  "Largest N for the residual against the exact matrix (O(N^2) product)");
   app.add_option("--tolerance", tolerance, "Relative residual for the timed runs");
   app.add_flag("--no-reference{false}", reference, "Skip the reference solves");
+  bool stages = false;
+  app.add_flag("--stages", stages,
+               "Instead of the solver table: wall / CPU s of the fast solver's stages (two-level "
+               "preconditioner; --order, default 8, and --theta, default 0.45)");
   app.add_option("--repeat", repeat, "Runs per timed case; the row shows the fastest (wall)")
       ->check(CLI::PositiveNumber);
   CLI11_PARSE(app, argc, argv);
@@ -235,8 +289,9 @@ int main(int argc, char** argv) {
     bool analytic;
   };
   std::vector<Mesh> meshes;
-  const int ks[] = {7, 16, 32, 71};
-  const char* names[] = {"1k", "5k", "20k", "100k"};
+  // 20 k^2 triangles: 980, 5120, 20,480, 100,820, 81,920, 327,680, 1,310,720.
+  const int ks[] = {7, 16, 32, 71, 64, 128, 256};
+  const char* names[] = {"1k", "5k", "20k", "100k", "82k", "327k", "1.3M"};
   TriangleMesh base;
   bool have_real = false;
   try {
@@ -245,20 +300,30 @@ int main(int argc, char** argv) {
   } catch (const std::exception& e) {
     std::fprintf(stderr, "bench: no real mesh (%s); ellipsoids only\n", e.what());
   }
-  for (int s = 0; s < 4; ++s) {
+  for (int s = 0; s < 7; ++s) {
     if (std::find(sizes.begin(), sizes.end(), names[s]) == sizes.end()) continue;
     meshes.push_back(
         {"ellipsoid 1:0.6:0.3", names[s], test::ellipsoid(ks[s], 1.0, 0.6, 0.3), true});
     if (have_real) {
       TriangleMesh m = base;
       // elephant: 5558 -> 22232 -> 88928; the 1k class uses the mesh as given.
-      const std::size_t target = s == 0 ? 0 : (s == 1 ? 5000 : (s == 2 ? 20000 : 80000));
+      const std::size_t targets[] = {0, 5000, 20000, 80000, 80000, 320000, 1280000};
+      const std::size_t target = targets[s];
       while (m.triangles.size() < target) m = test::subdivide(m);
       if (s == 0 && m.triangles.size() > 2000) continue;  // no ~1k version of this mesh
       meshes.push_back({real, names[s], m, false});
     }
   }
 
+  if (stages) {
+    std::printf(
+        "| mesh | N | panels + tree | near field | two-level setup | FMM lists | one FMM product "
+        "| one preconditioner application |\n|---|---|---|---|---|---|---|---|\n");
+    for (const Mesh& m : meshes) {
+      print_stages(m.name, m.mesh, order >= 0 ? order : 8, theta > 0.0 ? theta : 0.45);
+    }
+    return 0;
+  }
   std::printf(
       "| mesh | N | solver | assembly s | solve s | total s | CPU s | iterations | residual | "
       "exact residual | peak RSS MB | error vs analytic, max / mean | vs reference, max / mean | "

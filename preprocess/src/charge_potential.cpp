@@ -150,8 +150,35 @@ double matrix_entry(const PanelSet& panels, std::size_t i, std::size_t j) {
   const double r2 = dot(d, d);
   const double near = kNearFactor * panels.diameter[j];
   if (r2 > near * near) return panels.area[j] / std::sqrt(r2);
+  const double band = kQuadratureFactor * panels.diameter[j];
+  if (r2 > band * band) {
+    return triangle_potential_quadrature(panels.corners[j], panels.area[j], panels.centroid[i]);
+  }
   const auto& t = panels.corners[j];
   return triangle_potential(t[0], t[1], t[2], panels.centroid[i]);
+}
+
+double triangle_potential_quadrature(const std::array<Vec3, 3>& corners, double area,
+                                     const Vec3& r) {
+  // Dunavant's degree-4 rule: two orbits of three points (barycentric (1 - 2 b, b, b)).
+  constexpr double kB[2] = {0.091576213509771, 0.445948490915965};
+  constexpr double kW[2] = {0.109951743655322, 0.223381589678011};
+  double sum = 0.0;
+  for (int orbit = 0; orbit < 2; ++orbit) {
+    const double b = kB[orbit], a = 1.0 - 2.0 * b;
+    double partial = 0.0;
+    for (int k = 0; k < 3; ++k) {
+      const Vec3& p = corners[static_cast<std::size_t>(k)];
+      const Vec3& q = corners[static_cast<std::size_t>((k + 1) % 3)];
+      const Vec3& s = corners[static_cast<std::size_t>((k + 2) % 3)];
+      const double x = a * p[0] + b * (q[0] + s[0]) - r[0];
+      const double y = a * p[1] + b * (q[1] + s[1]) - r[1];
+      const double z = a * p[2] + b * (q[2] + s[2]) - r[2];
+      partial += 1.0 / std::sqrt(x * x + y * y + z * z);
+    }
+    sum += kW[orbit] * partial;
+  }
+  return area * sum;
 }
 
 }  // namespace tetseg::preprocess::charge_detail

@@ -3,6 +3,7 @@
 // preconditioning: Jacobi, block Jacobi, near-field Schwarz) and the dense collocation matrix.
 
 #include <functional>
+#include <memory>
 #include <vector>
 
 #include "charge_potential.hpp"
@@ -65,24 +66,40 @@ class NearFieldSchwarz {
 /// Two-level preconditioner: a coarse correction on K tree clusters (the nodes at one depth,
 /// K <= max_coarse), applied first, then the near-field Schwarz on the remaining residual:
 ///   u = C^-1 Z^T r,  out = Z u + Schwarz(r - (M Z) u),
-/// with Z the cluster indicators (piecewise-constant densities) and C = Z^T M Z. M Z (N x K,
-/// single precision) comes from a Barnes-Hut sum per target (cluster subtrees, monopoles at
-/// area centroids when radius < 0.5 distance, point charges in leaves otherwise, plus the
-/// analytic near-field corrections): an approximation of the coarse operator, which only
-/// makes the preconditioner less exact, never the solution.
+/// with Z the cluster indicators (piecewise-constant densities) and C = Z^T (M Z) (dense LU,
+/// K x K). M Z is never stored whole: for the clusters J near a target's cluster I (not
+/// separated by (rho_I + rho_J) < kCoarseOpening |g_I - g_J|, or holding one of the target's
+/// near-field columns) the entries (M Z)_iJ come from a Barnes-Hut sum over J's subtree plus
+/// the analytic near-field corrections (|I| x |near(I)| floats per cluster); the far clusters
+/// act as point charges A_J u_J at their area centroids g_J, summed per target cluster into a
+/// second-order Taylor expansion about g_I (K^2 work per application) that is evaluated at
+/// the targets. C is the Galerkin product of Z with exactly this approximation, so the coarse
+/// correction is exact for it; the approximation only makes the preconditioner less exact,
+/// never the solution.
 class TwoLevelSchwarz {
  public:
   TwoLevelSchwarz(const PanelSet& panels, const ClusterTree& tree, const NearField& near,
                   std::size_t max_set, std::size_t max_coarse);
+  ~TwoLevelSchwarz();
   void apply(const double* in, double* out) const;
   std::size_t coarse_size() const { return m_k; }
 
  private:
+  struct CoarseLu;
   NearFieldSchwarz m_local;
+  const ClusterTree& m_tree;
   std::size_t m_n = 0, m_k = 0;
-  std::vector<std::uint32_t> m_cluster;  ///< per triangle: its coarse cluster
-  std::vector<float> m_mz;               ///< n x k, row-major: (M Z)_iJ
-  std::vector<double> m_coarse_inverse;  ///< k x k, row-major: C^-1
+  std::vector<std::uint32_t> m_cluster;       ///< per triangle: its coarse cluster
+  std::vector<std::uint32_t> m_begin, m_end;  ///< per cluster: its range of tree.order
+  std::vector<double> m_area;                 ///< per cluster: A_J
+  std::vector<double> m_gx, m_gy, m_gz;       ///< per cluster: area centroid g_J
+  std::vector<std::size_t> m_near_start;      ///< per cluster (CSR) into m_near
+  std::vector<std::uint32_t> m_near;          ///< near clusters of each cluster
+  std::vector<std::size_t> m_block_start;     ///< per cluster into m_block
+  std::vector<float> m_block;  ///< per cluster I, member a (tree order): (M Z)_aJ, J in near(I)
+  std::vector<std::uint8_t> m_far;       ///< k x k: 1 where I and J interact by point charges
+  std::vector<double> m_wx, m_wy, m_wz;  ///< per tree position: c_i - g_I of its cluster I
+  std::unique_ptr<CoarseLu> m_lu;
   mutable std::vector<double> m_residual;
 };
 

@@ -8,6 +8,9 @@
 #if defined(__SSE2__)
 #include <immintrin.h>
 #endif
+#if defined(__x86_64__) && defined(__GNUC__)
+#define TETSEG_CHARGE_AVX2 1  // AVX2 + FMA kernels, chosen at run time (cpu_has_avx2)
+#endif
 
 namespace tetseg::preprocess::charge_detail {
 namespace {
@@ -65,6 +68,144 @@ inline double direct_sum(double tx, double ty, double tz, const double* px, cons
   }
   return sum;
 }
+
+/// The multipole-to-local sums of one batch of kBatch = 4 source clusters: for each target
+/// index a, L_a += (1 / a!) sum over a's terms e of sum_p deriv[c_e][p] * moments[b_e][p]
+/// (deriv and moments interleaved: lane p of slot k at k * 4 + p). Terms are sorted by a.
+void m2l_sums(std::size_t kc, const std::size_t* start, const std::uint16_t* tb,
+              const std::uint16_t* tc, const double* dv, const double* mv, const double* inv_fact,
+              double* local) {
+  constexpr std::size_t kBatch = 4;
+  std::size_t e = 0;
+  for (std::size_t a = 0; a < kc; ++a) {
+    const std::size_t end = start[a + 1];
+#if defined(__SSE2__)
+    // Two independent accumulator pairs (even and odd terms) for lanes 0-1 and 2-3.
+    __m128d lo0 = _mm_setzero_pd(), hi0 = _mm_setzero_pd();
+    __m128d lo1 = _mm_setzero_pd(), hi1 = _mm_setzero_pd();
+    for (; e + 2 <= end; e += 2) {
+      const double* d0 = dv + static_cast<std::size_t>(tc[e]) * kBatch;
+      const double* m0 = mv + static_cast<std::size_t>(tb[e]) * kBatch;
+      const double* d1 = dv + static_cast<std::size_t>(tc[e + 1]) * kBatch;
+      const double* m1 = mv + static_cast<std::size_t>(tb[e + 1]) * kBatch;
+      lo0 = _mm_add_pd(lo0, _mm_mul_pd(_mm_loadu_pd(d0), _mm_loadu_pd(m0)));
+      hi0 = _mm_add_pd(hi0, _mm_mul_pd(_mm_loadu_pd(d0 + 2), _mm_loadu_pd(m0 + 2)));
+      lo1 = _mm_add_pd(lo1, _mm_mul_pd(_mm_loadu_pd(d1), _mm_loadu_pd(m1)));
+      hi1 = _mm_add_pd(hi1, _mm_mul_pd(_mm_loadu_pd(d1 + 2), _mm_loadu_pd(m1 + 2)));
+    }
+    if (e < end) {
+      const double* d0 = dv + static_cast<std::size_t>(tc[e]) * kBatch;
+      const double* m0 = mv + static_cast<std::size_t>(tb[e]) * kBatch;
+      lo0 = _mm_add_pd(lo0, _mm_mul_pd(_mm_loadu_pd(d0), _mm_loadu_pd(m0)));
+      hi0 = _mm_add_pd(hi0, _mm_mul_pd(_mm_loadu_pd(d0 + 2), _mm_loadu_pd(m0 + 2)));
+      ++e;
+    }
+    const __m128d both = _mm_add_pd(_mm_add_pd(lo0, lo1), _mm_add_pd(hi0, hi1));
+    double lanes[2];
+    _mm_storeu_pd(lanes, both);
+    local[a] += (lanes[0] + lanes[1]) * inv_fact[a];
+#else
+    double acc[kBatch] = {};
+    for (; e < end; ++e) {
+      const double* d = dv + static_cast<std::size_t>(tc[e]) * kBatch;
+      const double* m = mv + static_cast<std::size_t>(tb[e]) * kBatch;
+      for (std::size_t p = 0; p < kBatch; ++p) acc[p] += d[p] * m[p];
+    }
+    local[a] += ((acc[0] + acc[1]) + (acc[2] + acc[3])) * inv_fact[a];
+#endif
+  }
+}
+
+#if defined(TETSEG_CHARGE_AVX2)
+/// m2l_sums with 256-bit fused multiply-adds (one per term), for CPUs that have them.
+__attribute__((target("avx2,fma"))) void m2l_sums_avx2(std::size_t kc, const std::size_t* start,
+                                                       const std::uint16_t* tb,
+                                                       const std::uint16_t* tc, const double* dv,
+                                                       const double* mv, const double* inv_fact,
+                                                       double* local) {
+  std::size_t e = 0;
+  for (std::size_t a = 0; a < kc; ++a) {
+    const std::size_t end = start[a + 1];
+    __m256d acc0 = _mm256_setzero_pd(), acc1 = _mm256_setzero_pd();
+    __m256d acc2 = _mm256_setzero_pd(), acc3 = _mm256_setzero_pd();
+    for (; e + 4 <= end; e += 4) {
+      acc0 = _mm256_fmadd_pd(_mm256_loadu_pd(dv + 4 * static_cast<std::size_t>(tc[e])),
+                             _mm256_loadu_pd(mv + 4 * static_cast<std::size_t>(tb[e])), acc0);
+      acc1 = _mm256_fmadd_pd(_mm256_loadu_pd(dv + 4 * static_cast<std::size_t>(tc[e + 1])),
+                             _mm256_loadu_pd(mv + 4 * static_cast<std::size_t>(tb[e + 1])), acc1);
+      acc2 = _mm256_fmadd_pd(_mm256_loadu_pd(dv + 4 * static_cast<std::size_t>(tc[e + 2])),
+                             _mm256_loadu_pd(mv + 4 * static_cast<std::size_t>(tb[e + 2])), acc2);
+      acc3 = _mm256_fmadd_pd(_mm256_loadu_pd(dv + 4 * static_cast<std::size_t>(tc[e + 3])),
+                             _mm256_loadu_pd(mv + 4 * static_cast<std::size_t>(tb[e + 3])), acc3);
+    }
+    for (; e < end; ++e) {
+      acc0 = _mm256_fmadd_pd(_mm256_loadu_pd(dv + 4 * static_cast<std::size_t>(tc[e])),
+                             _mm256_loadu_pd(mv + 4 * static_cast<std::size_t>(tb[e])), acc0);
+    }
+    const __m256d sum = _mm256_add_pd(_mm256_add_pd(acc0, acc1), _mm256_add_pd(acc2, acc3));
+    const __m128d half = _mm_add_pd(_mm256_castpd256_pd128(sum), _mm256_extractf128_pd(sum, 1));
+    double lanes[2];
+    _mm_storeu_pd(lanes, half);
+    local[a] += (lanes[0] + lanes[1]) * inv_fact[a];
+  }
+}
+
+/// direct_sum with 256-bit vectors: four sources per step, the same rsqrt estimate and two
+/// Newton steps (fused), the same relative error bound.
+__attribute__((target("avx2,fma"))) double direct_sum_avx2(double tx, double ty, double tz,
+                                                           const double* px, const double* py,
+                                                           const double* pz, const double* q,
+                                                           std::uint32_t begin, std::uint32_t end,
+                                                           double inv_scale2) {
+  const __m256d vx = _mm256_set1_pd(tx), vy = _mm256_set1_pd(ty), vz = _mm256_set1_pd(tz);
+  const __m256d vs = _mm256_set1_pd(inv_scale2), half = _mm256_set1_pd(0.5),
+                three_halves = _mm256_set1_pd(1.5), zero = _mm256_setzero_pd();
+  __m256d acc = _mm256_setzero_pd();
+  std::uint32_t j = begin;
+  for (; j + 4 <= end; j += 4) {
+    const __m256d dx = _mm256_sub_pd(vx, _mm256_loadu_pd(px + j));
+    const __m256d dy = _mm256_sub_pd(vy, _mm256_loadu_pd(py + j));
+    const __m256d dz = _mm256_sub_pd(vz, _mm256_loadu_pd(pz + j));
+    const __m256d r2 =
+        _mm256_mul_pd(_mm256_fmadd_pd(dz, dz, _mm256_fmadd_pd(dy, dy, _mm256_mul_pd(dx, dx))), vs);
+    const __m256d live = _mm256_cmp_pd(r2, zero, _CMP_GT_OQ);
+    __m256d y = _mm256_cvtps_pd(_mm_rsqrt_ps(_mm256_cvtpd_ps(r2)));
+    const __m256d hr2 = _mm256_mul_pd(half, r2);
+    y = _mm256_mul_pd(y, _mm256_fnmadd_pd(hr2, _mm256_mul_pd(y, y), three_halves));
+    y = _mm256_mul_pd(y, _mm256_fnmadd_pd(hr2, _mm256_mul_pd(y, y), three_halves));
+    y = _mm256_and_pd(y, live);  // r2 == 0 (the target itself): drop it
+    acc = _mm256_fmadd_pd(y, _mm256_loadu_pd(q + j), acc);
+  }
+  const __m128d pair = _mm_add_pd(_mm256_castpd256_pd128(acc), _mm256_extractf128_pd(acc, 1));
+  double lanes[2];
+  _mm_storeu_pd(lanes, pair);
+  double sum = (lanes[0] + lanes[1]) * std::sqrt(inv_scale2);
+  for (; j < end; ++j) {
+    const double dx = tx - px[j], dy = ty - py[j], dz = tz - pz[j];
+    const double r2 = dx * dx + dy * dy + dz * dz;
+    if (r2 > 0.0) sum += q[j] / std::sqrt(r2);
+  }
+  return sum;
+}
+
+bool cpu_has_avx2() {
+  return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+}
+#else
+void m2l_sums_avx2(std::size_t kc, const std::size_t* start, const std::uint16_t* tb,
+                   const std::uint16_t* tc, const double* dv, const double* mv,
+                   const double* inv_fact, double* local) {
+  m2l_sums(kc, start, tb, tc, dv, mv, inv_fact, local);
+}
+double direct_sum_avx2(double tx, double ty, double tz, const double* px, const double* py,
+                       const double* pz, const double* q, std::uint32_t begin, std::uint32_t end,
+                       double inv_scale2) {
+  return direct_sum(tx, ty, tz, px, py, pz, q, begin, end, inv_scale2);
+}
+bool cpu_has_avx2() {
+  return false;
+}
+#endif
 
 }  // namespace
 
@@ -208,10 +349,12 @@ NearField build_near_field(const PanelSet& panels, const ClusterTree& tree) {
         value = triangle_self_potential(t[0], t[1], t[2]);
         near.diagonal[i] = value;
       } else {
-        value = kernels[j].potential(p);
         const Vec3& q = panels.centroid[j];
         const double dx = p[0] - q[0], dy = p[1] - q[1], dz = p[2] - q[2];
         const double r2 = dx * dx + dy * dy + dz * dz;
+        const double band = kQuadratureFactor * panels.diameter[j];
+        value = r2 > band * band ? triangle_potential_quadrature(t, panels.area[j], p)
+                                 : kernels[j].potential(p);
         if (r2 > 0.0) point = panels.area[j] / std::sqrt(r2);
       }
       near.column[e] = j;
@@ -328,12 +471,38 @@ TreecodeOperator::TreecodeOperator(const PanelSet& panels, const ClusterTree& tr
     m_area[k] = panels.area[j];
   }
   const std::size_t node_count = tree.nodes.size();
+  // Shift terms grouped by their target index a (M2M already is), with start offsets.
+  std::stable_sort(m_l2l.begin(), m_l2l.end(),
+                   [](const Term& u, const Term& v) { return u.a < v.a; });
+  for (auto [terms, start] : {std::pair{&m_m2m, &m_m2m_start}, std::pair{&m_l2l, &m_l2l_start}}) {
+    start->assign(static_cast<std::size_t>(kc) + 1, 0);
+    for (const Term& t : *terms) ++(*start)[static_cast<std::size_t>(t.a) + 1];
+    for (std::size_t a = 0; a < static_cast<std::size_t>(kc); ++a) (*start)[a + 1] += (*start)[a];
+  }
   m_parent.assign(node_count, -1);
   for (std::size_t id = 0; id < node_count; ++id) {
     const Cluster& c = tree.nodes[id];
     if (c.left >= 0) {
       m_parent[static_cast<std::size_t>(c.left)] = static_cast<std::int32_t>(id);
       m_parent[static_cast<std::size_t>(c.right)] = static_cast<std::int32_t>(id);
+    }
+  }
+  // Nodes by depth (children have larger ids than their parent), for the level-parallel
+  // upward and downward passes.
+  {
+    std::vector<std::size_t> depth(node_count, 0);
+    std::size_t deepest = 0;
+    for (std::size_t id = 1; id < node_count; ++id) {
+      depth[id] = depth[static_cast<std::size_t>(m_parent[id])] + 1;
+      deepest = std::max(deepest, depth[id]);
+    }
+    m_level_start.assign(deepest + 2, 0);
+    for (std::size_t id = 0; id < node_count; ++id) ++m_level_start[depth[id] + 1];
+    for (std::size_t d = 0; d <= deepest; ++d) m_level_start[d + 1] += m_level_start[d];
+    m_level_nodes.resize(node_count);
+    std::vector<std::size_t> fill(m_level_start.begin(), m_level_start.end() - 1);
+    for (std::size_t id = 0; id < node_count; ++id) {
+      m_level_nodes[fill[depth[id]]++] = static_cast<std::int32_t>(id);
     }
   }
   m_leaf_of_node.assign(node_count, -1);
@@ -405,6 +574,7 @@ void TreecodeOperator::apply(const double* x, double* y) const {
   const double* pz = m_z.data();
   const double root_radius = nodes[0].radius > 0.0 ? nodes[0].radius : 1.0;
   const double inv_scale2 = 1.0 / (root_radius * root_radius);
+  static const bool avx2 = cpu_has_avx2();
   // Monomials w^k for |k| <= order, graded order, from k - e_i.
   auto monomials = [&](double wx, double wy, double wz, double* out) {
     out[0] = 1.0;
@@ -415,16 +585,25 @@ void TreecodeOperator::apply(const double* x, double* y) const {
       out[k] = out[m1[static_cast<std::size_t>(i)]] * w[i];
     }
   };
-  auto shift = [&](const std::vector<Term>& terms, const double* d_mono, const double* from,
-                   double* to) {
-    for (const Term& t : terms) to[t.a] += t.coef * d_mono[t.c] * from[t.b];
+  // to[a] += sum over a's terms of coef * d^c * from[b], one register sum per a.
+  auto shift = [&](const std::vector<Term>& terms, const std::vector<std::size_t>& start,
+                   const double* d_mono, const double* from, double* to) {
+    for (std::size_t a = 0; a < kc; ++a) {
+      double acc = 0.0;
+      for (std::size_t e = start[a]; e < start[a + 1]; ++e) {
+        const Term& t = terms[e];
+        acc += t.coef * d_mono[t.c] * from[t.b];
+      }
+      to[a] += acc;
+    }
   };
 #if defined(TETSEG_HAVE_OPENMP)
 #pragma omp parallel
 #endif
   {
     constexpr std::size_t kBatch = 4;
-    std::vector<double> mono(kc), deriv((kc + 1) * kBatch), pot, zeros(kc, 0.0);
+    std::vector<double> mono(kc), deriv((kc + 1) * kBatch), moments(kc * kBatch), pot,
+        zeros(kc, 0.0);
     // Upward pass: leaf moments from the members.
 #if defined(TETSEG_HAVE_OPENMP)
 #pragma omp for schedule(dynamic, 16)
@@ -441,26 +620,57 @@ void TreecodeOperator::apply(const double* x, double* y) const {
         for (std::size_t e = 0; e < kc; ++e) mom[e] += q * mono[e];
       }
     }
+    // Parents after children, one level at a time (deepest first); levels of fewer than
+    // kParallelLevel nodes together in one thread (fewer barriers).
+    constexpr std::size_t kParallelLevel = 256;
+    const std::size_t levels = m_level_start.size() - 1;
+    std::size_t first_wide = 0;  // levels >= first_wide have at least kParallelLevel nodes
+    while (first_wide < levels &&
+           m_level_start[first_wide + 1] - m_level_start[first_wide] < kParallelLevel) {
+      ++first_wide;
+    }
+    auto upward = [&](std::size_t id) {
+      const Cluster& c = nodes[id];
+      if (c.left < 0) return;
+      double* mom = m_moments.data() + id * kc;
+      std::fill(mom, mom + kc, 0.0);
+      for (const std::int32_t child : {c.left, c.right}) {
+        const Cluster& ch = nodes[static_cast<std::size_t>(child)];
+        monomials(ch.center[0] - c.center[0], ch.center[1] - c.center[1],
+                  ch.center[2] - c.center[2], mono.data());
+        shift(m_m2m, m_m2m_start, mono.data(),
+              m_moments.data() + static_cast<std::size_t>(child) * kc, mom);
+      }
+    };
+    auto downward = [&](std::size_t id) {
+      const Cluster& c = nodes[id];
+      const Cluster& pc = nodes[static_cast<std::size_t>(m_parent[id])];
+      monomials(c.center[0] - pc.center[0], c.center[1] - pc.center[1], c.center[2] - pc.center[2],
+                mono.data());
+      shift(m_l2l, m_l2l_start, mono.data(),
+            m_local.data() + static_cast<std::size_t>(m_parent[id]) * kc, m_local.data() + id * kc);
+    };
+    for (std::size_t level = levels; level-- > first_wide;) {
+#if defined(TETSEG_HAVE_OPENMP)
+#pragma omp for schedule(dynamic, 16)
+#endif
+      for (std::ptrdiff_t at = static_cast<std::ptrdiff_t>(m_level_start[level]);
+           at < static_cast<std::ptrdiff_t>(m_level_start[level + 1]); ++at) {
+        upward(static_cast<std::size_t>(m_level_nodes[static_cast<std::size_t>(at)]));
+      }
+    }
 #if defined(TETSEG_HAVE_OPENMP)
 #pragma omp single
 #endif
-    {
-      // Parents after children: children have larger ids than their parent.
-      for (std::ptrdiff_t id = node_count - 1; id >= 0; --id) {
-        const Cluster& c = nodes[static_cast<std::size_t>(id)];
-        if (c.left < 0) continue;
-        double* mom = m_moments.data() + static_cast<std::size_t>(id) * kc;
-        std::fill(mom, mom + kc, 0.0);
-        for (const std::int32_t child : {c.left, c.right}) {
-          const Cluster& ch = nodes[static_cast<std::size_t>(child)];
-          monomials(ch.center[0] - c.center[0], ch.center[1] - c.center[1],
-                    ch.center[2] - c.center[2], mono.data());
-          shift(m_m2m, mono.data(), m_moments.data() + static_cast<std::size_t>(child) * kc, mom);
-        }
-      }
-      for (std::size_t e = 0; e < m_scaled.size(); ++e) {
-        m_scaled[e] = m_moments[e] * m_moment_scale[e % kc];
-      }
+    for (std::size_t at = m_level_start[first_wide]; at-- > 0;) {
+      upward(static_cast<std::size_t>(m_level_nodes[at]));
+    }
+#if defined(TETSEG_HAVE_OPENMP)
+#pragma omp for schedule(static)
+#endif
+    for (std::ptrdiff_t e = 0; e < static_cast<std::ptrdiff_t>(m_scaled.size()); ++e) {
+      const std::size_t u = static_cast<std::size_t>(e);
+      m_scaled[u] = m_moments[u] * m_moment_scale[u % kc];
     }
     // Multipole-to-local for every target cluster.
 #if defined(TETSEG_HAVE_OPENMP)
@@ -512,35 +722,34 @@ void TreecodeOperator::apply(const double* x, double* y) const {
         for (std::size_t k = 0; k < kc; ++k) {
           for (std::size_t p = 0; p < kBatch; ++p) deriv[k * kBatch + p] *= m_fact[k];
         }
-        // Terms are sorted by the target index a: accumulate each L_a in registers.
-        const std::uint16_t* tb = m_m2l_b.data();
-        const std::uint16_t* tc = m_m2l_c.data();
-        std::size_t e = 0;
-        for (std::size_t a = 0; a < kc; ++a) {
-          const std::size_t end = m_m2l_start[a + 1];
-          double acc[kBatch] = {};
-          for (; e < end; ++e) {
-            const double* d = deriv.data() + static_cast<std::size_t>(tc[e]) * kBatch;
-            const std::size_t b = tb[e];
-            for (std::size_t p = 0; p < kBatch; ++p) acc[p] += d[p] * mom[p][b];
-          }
-          local[a] += ((acc[0] + acc[1]) + (acc[2] + acc[3])) * m_inv_fact[a];
+        // The batch's moments interleaved like deriv (lane p of slot b), so that every term is
+        // one product of two contiguous kBatch-vectors.
+        for (std::size_t b = 0; b < kc; ++b) {
+          for (std::size_t p = 0; p < kBatch; ++p) moments[b * kBatch + p] = mom[p][b];
+        }
+        if (avx2) {
+          m2l_sums_avx2(kc, m_m2l_start.data(), m_m2l_b.data(), m_m2l_c.data(), deriv.data(),
+                        moments.data(), m_inv_fact.data(), local);
+        } else {
+          m2l_sums(kc, m_m2l_start.data(), m_m2l_b.data(), m_m2l_c.data(), deriv.data(),
+                   moments.data(), m_inv_fact.data(), local);
         }
       }
     }
+    // Downward pass: parents before children, the narrow levels in one thread first.
 #if defined(TETSEG_HAVE_OPENMP)
 #pragma omp single
 #endif
-    {
-      // Downward pass: parents before children.
-      for (std::ptrdiff_t id = 1; id < node_count; ++id) {
-        const Cluster& c = nodes[static_cast<std::size_t>(id)];
-        const std::int32_t parent = m_parent[static_cast<std::size_t>(id)];
-        const Cluster& pc = nodes[static_cast<std::size_t>(parent)];
-        monomials(c.center[0] - pc.center[0], c.center[1] - pc.center[1],
-                  c.center[2] - pc.center[2], mono.data());
-        shift(m_l2l, mono.data(), m_local.data() + static_cast<std::size_t>(parent) * kc,
-              m_local.data() + static_cast<std::size_t>(id) * kc);
+    for (std::size_t at = 1; at < m_level_start[first_wide]; ++at) {
+      downward(static_cast<std::size_t>(m_level_nodes[at]));
+    }
+    for (std::size_t level = std::max<std::size_t>(first_wide, 1); level < levels; ++level) {
+#if defined(TETSEG_HAVE_OPENMP)
+#pragma omp for schedule(dynamic, 16)
+#endif
+      for (std::ptrdiff_t at = static_cast<std::ptrdiff_t>(m_level_start[level]);
+           at < static_cast<std::ptrdiff_t>(m_level_start[level + 1]); ++at) {
+        downward(static_cast<std::size_t>(m_level_nodes[static_cast<std::size_t>(at)]));
       }
     }
     // Leaves: evaluate the local expansion and the direct sums.
@@ -563,8 +772,10 @@ void TreecodeOperator::apply(const double* x, double* y) const {
       for (std::size_t d = m_direct_start[l]; d < m_direct_start[l + 1]; ++d) {
         const Cluster& s = nodes[static_cast<std::size_t>(m_direct[d])];
         for (std::uint32_t k = target.begin; k < target.end; ++k) {
-          pot[k - target.begin] +=
-              direct_sum(px[k], py[k], pz[k], px, py, pz, charge, s.begin, s.end, inv_scale2);
+          pot[k - target.begin] += avx2 ? direct_sum_avx2(px[k], py[k], pz[k], px, py, pz, charge,
+                                                          s.begin, s.end, inv_scale2)
+                                        : direct_sum(px[k], py[k], pz[k], px, py, pz, charge,
+                                                     s.begin, s.end, inv_scale2);
         }
       }
       // Exact near field of each target: analytic minus the point charge counted above.

@@ -30,8 +30,10 @@ struct ClusterTree {
 ClusterTree build_cluster_tree(const PanelSet& panels, int leaf_size);
 
 /// The near field of the collocation matrix in CSR form: for row i, the columns j with
-/// |c_i - c_j| <= kNearFactor * diameter_j (always including j = i) and the analytic entry
-/// M_ij, plus `correction` = M_ij minus the point-charge entry A_j / r_ij (M_ii for j = i).
+/// |c_i - c_j| <= kNearFactor * diameter_j (always including j = i) and the entry M_ij
+/// (closed form, or the six-point quadrature beyond kQuadratureFactor diameters: the rule of
+/// matrix_entry), plus `correction` = M_ij minus the point-charge entry A_j / r_ij (M_ii for
+/// j = i). compute_charge's fast path frees `value` once the preconditioner is built.
 struct NearField {
   std::vector<std::size_t> row_start;  ///< size n + 1
   std::vector<std::uint32_t> column;
@@ -96,6 +98,9 @@ class TreecodeOperator {
   std::vector<double> m_moment_scale;           ///< (-1)^|k| / k!
   std::vector<Term> m_m2m;  ///< M_a(parent) += coef * d^c * M_b(child), c = a - b
   std::vector<Term> m_l2l;  ///< L_a(child) += coef * d^c * L_b(parent), c = b - a
+  std::vector<std::size_t> m_m2m_start, m_l2l_start;  ///< first term of each a
+  std::vector<std::size_t> m_level_start;             ///< per depth (CSR) into m_level_nodes
+  std::vector<std::int32_t> m_level_nodes;            ///< node ids by depth
   mutable std::vector<double> m_charge;
   mutable std::vector<double> m_moments;  ///< nodes x index count
   mutable std::vector<double> m_local;    ///< nodes x index count

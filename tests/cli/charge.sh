@@ -63,7 +63,10 @@ d = [float(r["density"]) for r in rows]
 assert max(abs(x - 1) for x in d) < 0.05, (min(d), max(d))
 area = sum(float(r["area"]) for r in rows)
 mean = sum(float(r["area"]) * float(r["density"]) for r in rows) / area
-assert abs(mean - 1) < 1e-9, mean
+# Exactly 1 before printing; the CSV has 9 significant digits and the sphere's triangles fall
+# into a few symmetry classes that share their rounding error, so about 1e-8 after it
+# (measured 1.3e-9 with --solver direct since issue 17's near-field quadrature).
+assert abs(mean - 1) < 1e-8, mean
 e = [float(r["equalized"]) for r in rows]
 assert 0 < min(e) and max(e) == 1.0
 PY

@@ -221,6 +221,25 @@ TEST_CASE("The near-field and two-level preconditioners need far fewer iteration
   CHECK(ChargeOptions{}.preconditioner == ChargePreconditioner::kTwoLevel);  // the default
 }
 
+TEST_CASE("The two-level preconditioner's iteration count does not grow with N", "[charge]") {
+  // The coarse space grows with N (one cluster per ~64 triangles, up to 2048), so the counts
+  // stay flat: measured 6 / 5 / 5 at 980 / 5120 / 20,480 triangles and 5 at 81,920, 327,680
+  // and 6 at 1,310,720 (docs/charge.md). With a coarse space of fixed size they doubled
+  // from 82k to 327k (5 -> 12). Deterministic counts, not a timing test.
+  std::vector<int> counts;
+  for (const int k : {7, 16, 32}) {
+    const TriangleMesh m = tetseg::test::ellipsoid(k, 1.0, 0.6, 0.3);
+    const ChargeResult r = solve(m, ChargeSolver::kFast, 1e-8);
+    CAPTURE(m.triangles.size(), r.iterations);
+    CHECK(r.converged);
+    counts.push_back(r.iterations);
+  }
+  CAPTURE(counts[0], counts[1], counts[2]);
+  CHECK(counts[2] <= counts[1] + 1);
+  CHECK(counts[1] <= counts[0] + 1);
+  CHECK(counts[2] <= 8);
+}
+
 TEST_CASE("The fast solver's error against GMRES is bounded at 20k triangles", "[charge][slow]") {
   const TriangleMesh m = tetseg::test::ellipsoid(32, 1.0, 0.6, 0.3);
   REQUIRE(m.triangles.size() == 20480);

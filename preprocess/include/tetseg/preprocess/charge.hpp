@@ -30,8 +30,9 @@ enum class ChargePreconditioner {
   /// Restricted additive Schwarz on the exact near field: per leaf, a dense LU of the matrix
   /// on the leaf plus its nearest near-field neighbours (docs/charge.md, "Preconditioner").
   kNearField,
-  /// kNearField plus a coarse correction on up to 256 tree clusters (piecewise-constant
-  /// densities, Galerkin coarse matrix): removes the smooth error the local solves leave.
+  /// kNearField plus a coarse correction on up to 2048 tree clusters of at least ~64
+  /// triangles (piecewise-constant densities, Galerkin coarse matrix): removes the smooth
+  /// error the local solves leave, so the iteration count stays flat with N.
   kTwoLevel,
 };
 
