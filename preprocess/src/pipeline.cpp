@@ -11,6 +11,7 @@
 #include <sstream>
 #include <type_traits>
 
+#include "components.hpp"
 #include "tetseg/format/asset_io.hpp"
 #include "tetseg/preprocess/names.hpp"
 #include "tetseg/preprocess/surface.hpp"
@@ -264,29 +265,36 @@ format::Asset build_asset(const TetMesh& mesh, const std::string& source,
   report.nodes = static_cast<std::uint32_t>(mesh.nodes.size());
   report.tets = static_cast<std::uint32_t>(mesh.tets.size());
 
+  std::vector<detail::SurfacePart> parts;  // one per component (docs/segmentation.md)
   const Surface surface = timer.run("surface", [&](std::string& summary) {
     Surface s = extract_surface(mesh);
     validate_tet_mesh(mesh, s, source);
+    parts = detail::split_surface(mesh, s);
     summary = std::to_string(s.triangles.size()) + " triangles, " +
-              std::to_string(s.interior_nodes.size()) + " interior nodes";
+              std::to_string(s.interior_nodes.size()) + " interior nodes, " +
+              std::to_string(parts.size()) + (parts.size() == 1 ? " component" : " components");
     return s;
   });
   report.surface_triangles = static_cast<std::uint32_t>(surface.triangles.size());
   report.interior_nodes = static_cast<std::uint32_t>(surface.interior_nodes.size());
-  if (surface.interior_nodes.empty()) {
-    throw InputError(source,
-                     "tet mesh has no interior node to serve as a detector point "
-                     "(refine the mesh or tetrahedralise with a smaller cell size)");
+  report.components = static_cast<std::uint32_t>(parts.size());
+  for (std::size_t p = 0; p < parts.size(); ++p) {
+    if (parts[p].surface.interior_nodes.empty()) {
+      throw InputError(source, (parts.size() == 1 ? std::string("tet mesh")
+                                                  : "component " + std::to_string(p + 1) + " of " +
+                                                        std::to_string(parts.size())) +
+                                   " has no interior node to serve as a detector point "
+                                   "(refine the mesh or tetrahedralise with a smaller cell size)");
+    }
   }
 
   Segmentation segmentation;
   if (options.clusters == ClusterMethod::kSingle) {
-    segmentation.triangle_cluster.assign(surface.triangles.size(), 0);
-    segmentation.cluster_count = 1;
-    segmentation.counts.clusters = 1;
+    segmentation = detail::one_cluster_per_part(parts, surface.triangles.size());
   } else {
     ChargeResult charge = timer.run("charge", [&](std::string& summary) {
-      ChargeResult r = compute_charge(mesh.nodes, surface.triangles, options.charge, source);
+      ChargeResult r = detail::charge_by_part(mesh.nodes, parts, surface.triangles.size(),
+                                              options.charge, source);
       std::ostringstream text;
       text << r.solver << ", " << r.iterations << " iterations, residual " << r.residual
            << " (tolerance " << r.tolerance << ")"
@@ -294,14 +302,22 @@ format::Asset build_asset(const TetMesh& mesh, const std::string& source,
       summary = text.str();
       return r;
     });
-    const std::vector<double> equalized = timer.run("equalize", [&](std::string& summary) {
+    std::vector<std::vector<double>> equalized;  // per part
+    timer.run("equalize", [&](std::string& summary) {
       summary = name_of(options.segmentation.equalization);
-      return equalize(charge.density, options.segmentation.equalization);
+      for (const detail::SurfacePart& part : parts)
+        equalized.push_back(
+            equalize(detail::part_values(charge.density, part), options.segmentation.equalization));
+      return 0;
     });
     charge.density.clear();
     report.charge = std::move(charge);
+    std::vector<Segmentation> pieces;  // per part
     segmentation = timer.run("segmentation", [&](std::string& summary) {
-      Segmentation s = segment_surface(mesh.nodes, surface, equalized, options.segmentation);
+      for (std::size_t p = 0; p < parts.size(); ++p)
+        pieces.push_back(
+            segment_surface(mesh.nodes, parts[p].surface, equalized[p], options.segmentation));
+      Segmentation s = detail::join_segmentations(parts, pieces, surface.triangles.size());
       summary = std::to_string(s.counts.segments_found) + " segments, " +
                 std::to_string(s.boundary_loops.size()) + " boundaries, " +
                 std::to_string(s.cluster_count) + " clusters";
@@ -309,8 +325,15 @@ format::Asset build_asset(const TetMesh& mesh, const std::string& source,
     });
     if (options.clusters == ClusterMethod::kRefined) {
       segmentation = timer.run("refinement", [&](std::string& summary) {
-        Segmentation s = refine_clusters(mesh.nodes, surface, equalized, segmentation,
-                                         options.refinement, &report.refinement);
+        for (std::size_t p = 0; p < parts.size(); ++p) {
+          RefinementCounts counts;
+          pieces[p] = refine_clusters(mesh.nodes, parts[p].surface, equalized[p], pieces[p],
+                                      options.refinement, &counts);
+          report.refinement.clusters_before += counts.clusters_before;
+          report.refinement.splits += counts.splits;
+          report.refinement.merges += counts.merges;
+        }
+        Segmentation s = detail::join_segmentations(parts, pieces, surface.triangles.size());
         summary = std::to_string(report.refinement.splits) + " splits, " +
                   std::to_string(report.refinement.merges) + " merges, " +
                   std::to_string(s.cluster_count) + " clusters";
@@ -324,8 +347,7 @@ format::Asset build_asset(const TetMesh& mesh, const std::string& source,
 
   const std::vector<Detector> detectors = timer.run("detectors", [&](std::string& summary) {
     std::vector<Detector> d =
-        choose_detectors(mesh.nodes, surface, segmentation.triangle_cluster,
-                         segmentation.cluster_count, options.segmentation.detector);
+        detail::detectors_by_part(mesh.nodes, parts, segmentation, options.segmentation.detector);
     double worst = 1.0;
     for (const Detector& detector : d)
       worst = std::min<double>(worst, detector.rest_positive_fraction);
