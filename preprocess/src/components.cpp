@@ -83,7 +83,6 @@ std::vector<SurfacePart> split_surface(const TetMesh& mesh, const Surface& surfa
 void check_components(const TetMesh& mesh, const Surface& surface, const std::string& file) {
   std::uint32_t count = 0;
   const std::vector<std::uint32_t> part = node_parts(mesh, surface, count);
-  if (count <= 1) return;
   // Closed surfaces per component: triangles joined through shared nodes (the surface is
   // vertex-manifold here, so this is edge-connectivity).
   std::vector<std::uint32_t> parent(mesh.nodes.size());
@@ -110,6 +109,7 @@ void check_components(const TetMesh& mesh, const Surface& surface, const std::st
                                  " (node " + std::to_string(first_node[c]) + ") is bounded by " +
                                  std::to_string(shells[c]) +
                                  " closed surfaces: bodies with a cavity are not supported");
+  if (count <= 1) return;
   // Nesting: a surface node of component c inside the closed surface of component d.
   std::vector<std::array<Vec3, 2>> box(count);
   for (auto& b : box) {
