@@ -111,7 +111,7 @@ Status read_impl(const std::uint8_t* data, std::size_t size, Asset& out, std::st
     why = "payload checksum " + hex32(stored_payload_crc) + ", computed " + hex32(payload_crc);
     return Status::kPayloadChecksum;
   }
-  const Status decoded = detail::decode_payload(payload, available, out, why);
+  const Status decoded = detail::decode_payload(payload, available, minor, out, why);
   if (decoded != Status::kOk) return decoded;
   return validate(out, &why);
 }
@@ -155,14 +155,22 @@ const char* to_string(Status status) noexcept {
   return "unknown status";
 }
 
+std::uint16_t minor_version_needed(const Asset& asset) noexcept {
+  for (const Cluster& c : asset.clusters) {
+    if (!c.detector.is_node() || c.detector.tet != kNoTet || c.flags != 0) return 1;
+  }
+  return 0;
+}
+
 std::vector<std::uint8_t> write_asset(const Asset& asset) {
+  const std::uint16_t minor = minor_version_needed(asset);
   std::vector<std::uint8_t> bytes(kEnvelopeBytes, 0);
-  detail::encode_payload(asset, bytes);
+  detail::encode_payload(asset, minor, bytes);
   const std::size_t payload_size = bytes.size() - kEnvelopeBytes;
   std::uint8_t* h = bytes.data();
   for (std::size_t i = 0; i < kMagic.size(); ++i) h[i] = kMagic[i];
   put_le(h + kOffsetMajor, kVersionMajor, 2);
-  put_le(h + kOffsetMinor, kVersionMinor, 2);
+  put_le(h + kOffsetMinor, minor, 2);
   put_le(h + kOffsetHeaderSize, kEnvelopeBytes, 4);
   put_le(h + kOffsetFlags, 0, 4);
   put_le(h + kOffsetPayloadSize, payload_size, 8);

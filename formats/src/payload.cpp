@@ -163,20 +163,27 @@ void decode_u32_vector(Decoder& d, const char* what, std::uint64_t limit, std::v
   if (n > 0) d.array(reinterpret_cast<std::uint32_t*>(v.data()), n * (sizeof(T) / 4));
 }
 
+/// Bytes of one cluster record: 1.0 stores the detector node, 1.1 the detector point (four
+/// node ids, four weights, the tet id) and the flags.
+constexpr std::size_t cluster_record_bytes(std::uint16_t minor) {
+  return minor == 0 ? 24 : 76;
+}
+
 }  // namespace
 
-std::size_t payload_bytes(const Asset& a) {
+std::size_t payload_bytes(const Asset& a, std::uint16_t minor) {
   std::size_t n = 1 + 4 + 8 * 11;
   n += 24 * a.rest_positions.size() + 12 * a.triangles.size() + 4 * a.triangle_cluster.size();
-  n += 24 * a.clusters.size() + 4 * a.cluster_triangles.size() + 12 * a.bvh_nodes.size();
+  n += cluster_record_bytes(minor) * a.clusters.size() + 4 * a.cluster_triangles.size() +
+       12 * a.bvh_nodes.size();
   n += 8 * a.boundaries.size() + 4 * a.boundary_nodes.size();
   n += a.provenance.tool_version.size() + a.provenance.source.size();
   for (const auto& [key, value] : a.provenance.options) n += 16 + key.size() + value.size();
   return n;
 }
 
-void encode_payload(const Asset& a, std::vector<std::uint8_t>& out) {
-  out.reserve(out.size() + payload_bytes(a));
+void encode_payload(const Asset& a, std::uint16_t minor, std::vector<std::uint8_t>& out) {
+  out.reserve(out.size() + payload_bytes(a, minor));
   Encoder e(out);  // writes the little-endian tag byte
   e.scalar(a.node_count);
   e.count(a.rest_positions.size());
@@ -188,7 +195,14 @@ void encode_payload(const Asset& a, std::vector<std::uint8_t>& out) {
   e.array(a.triangle_cluster.data(), a.triangle_cluster.size());
   e.count(a.clusters.size());
   for (const Cluster& c : a.clusters) {
-    e.scalar(c.detector_node);
+    if (minor == 0) {
+      e.scalar(c.detector.nodes[0]);
+    } else {
+      for (std::uint32_t id : c.detector.nodes) e.scalar(id);
+      for (double w : c.detector.weights) e.scalar(w);
+      e.scalar(c.detector.tet);
+      e.scalar(c.flags);
+    }
     e.scalar(c.rest_positive_fraction);
     e.scalar(c.triangle_offset);
     e.scalar(c.triangle_count);
@@ -212,7 +226,7 @@ void encode_payload(const Asset& a, std::vector<std::uint8_t>& out) {
   }
 }
 
-Status decode_payload(const std::uint8_t* data, std::size_t size, Asset& a,
+Status decode_payload(const std::uint8_t* data, std::size_t size, std::uint16_t minor, Asset& a,
                       std::string& detail) noexcept {
   try {
     if (size == 0) {
@@ -237,10 +251,17 @@ Status decode_payload(const std::uint8_t* data, std::size_t size, Asset& a,
     }
     decode_u32_vector(d, "triangle_cluster", kMaxTriangles, a.triangle_cluster);
     {
-      const std::size_t n = d.count("clusters", kMaxClusters, 24);
+      const std::size_t n = d.count("clusters", kMaxClusters, cluster_record_bytes(minor));
       a.clusters.resize(n);
       for (Cluster& c : a.clusters) {
-        c.detector_node = d.scalar<std::uint32_t>();
+        if (minor == 0) {
+          c.detector = DetectorPoint::at_node(d.scalar<std::uint32_t>());
+        } else {
+          for (std::uint32_t& id : c.detector.nodes) id = d.scalar<std::uint32_t>();
+          for (double& w : c.detector.weights) w = d.scalar<double>();
+          c.detector.tet = d.scalar<std::uint32_t>();
+          c.flags = d.scalar<std::uint32_t>();
+        }
         c.rest_positive_fraction = d.scalar<float>();
         c.triangle_offset = d.scalar<std::uint32_t>();
         c.triangle_count = d.scalar<std::uint32_t>();

@@ -83,6 +83,45 @@ void check_nodes_and_triangles(const Asset& a) {
   }
 }
 
+/// A cluster's detector is in node form or point form (asset.hpp, DetectorPoint), its ids
+/// below node_count, and its flags known. Whether a point-form detector lies inside the body
+/// is not checked (the asset stores no tets); the runtime is correct for any detector point.
+void check_detector_point(const Asset& a, std::size_t c) {
+  const Cluster& cl = a.clusters[c];
+  const DetectorPoint& d = cl.detector;
+  if ((cl.flags & ~kKnownClusterFlags) != 0) {
+    fail(at("clusters", c) + ".flags has unknown bits " + std::to_string(cl.flags));
+  }
+  for (std::uint32_t id : d.nodes) {
+    if (id >= a.node_count) {
+      fail(at("clusters", c) + ".detector node " + std::to_string(id) + " >= node_count " +
+           std::to_string(a.node_count));
+    }
+  }
+  if (d.is_node()) return;
+  for (int i = 0; i < 4; ++i) {
+    for (int j = i + 1; j < 4; ++j) {
+      if (d.nodes[i] == d.nodes[j]) {
+        fail(at("clusters", c) + ".detector repeats node " + std::to_string(d.nodes[i]) +
+             " (point form needs four distinct nodes; node form four equal ids and weights 1, 0, "
+             "0, 0)");
+      }
+    }
+  }
+  double sum = 0.0;
+  for (double w : d.weights) {
+    if (!std::isfinite(w) || w < 0.0) {
+      fail(at("clusters", c) + ".detector weight " + std::to_string(w) +
+           " is not a finite non-negative value");
+    }
+    sum += w;
+  }
+  if (!(std::fabs(sum - 1.0) <= kDetectorWeightSumTolerance)) {
+    fail(at("clusters", c) + ".detector weights sum to " + std::to_string(sum) + ", not 1 within " +
+         std::to_string(kDetectorWeightSumTolerance));
+  }
+}
+
 /// Clusters are contiguous, in order, and partition the triangles; triangle_cluster agrees.
 void check_partition(const Asset& a) {
   const std::size_t tri_count = a.triangles.size();
@@ -118,10 +157,7 @@ void check_partition(const Asset& a) {
         cl.rest_positive_fraction > 1.0f) {
       fail(at("clusters", c) + ".rest_positive_fraction is not a finite value in [0,1]");
     }
-    if (cl.detector_node >= a.node_count) {
-      fail(at("clusters", c) + ".detector_node " + std::to_string(cl.detector_node) +
-           " >= node_count " + std::to_string(a.node_count));
-    }
+    check_detector_point(a, c);
   }
   if (next_triangle != tri_count)
     fail("clusters cover " + std::to_string(next_triangle) + " of " + std::to_string(tri_count) +
@@ -149,19 +185,20 @@ void check_partition(const Asset& a) {
   // cluster_triangles.size() == tri_count every triangle appears exactly once.
 }
 
-/// Detector nodes are interior: not a vertex of any surface triangle. Searches the (few)
+/// Node-form detectors are interior: not a vertex of any surface triangle. Searches the (few)
 /// detector ids for every triangle corner rather than sorting all surface nodes.
 void check_detectors(const Asset& a) {
   std::vector<std::uint32_t> detectors;
   detectors.reserve(a.clusters.size());
-  for (const Cluster& c : a.clusters) detectors.push_back(c.detector_node);
+  for (const Cluster& c : a.clusters)
+    if (c.detector.is_node()) detectors.push_back(c.detector.nodes[0]);
   std::sort(detectors.begin(), detectors.end());
   detectors.erase(std::unique(detectors.begin(), detectors.end()), detectors.end());
   for (std::size_t t = 0; t < a.triangles.size(); ++t) {
     for (std::uint32_t v : a.triangles[t]) {
       if (std::binary_search(detectors.begin(), detectors.end(), v)) {
         for (std::size_t c = 0; c < a.clusters.size(); ++c) {
-          if (a.clusters[c].detector_node == v) {
+          if (a.clusters[c].detector.is_node() && a.clusters[c].detector.nodes[0] == v) {
             fail(at("clusters", c) + ".detector_node " + std::to_string(v) +
                  " is a surface node (of triangle " + std::to_string(t) + ")");
           }

@@ -64,6 +64,8 @@ std::vector<SurfacePart> split_surface(const TetMesh& mesh, const Surface& surfa
     SurfacePart whole;
     whole.triangles.resize(surface.triangles.size());
     std::iota(whole.triangles.begin(), whole.triangles.end(), 0u);
+    whole.tets.resize(mesh.tets.size());
+    std::iota(whole.tets.begin(), whole.tets.end(), 0u);
     whole.surface = surface;
     return {whole};
   }
@@ -73,6 +75,8 @@ std::vector<SurfacePart> split_surface(const TetMesh& mesh, const Surface& surfa
     p.triangles.push_back(t);
     p.surface.triangles.push_back(surface.triangles[t]);
   }
+  for (std::uint32_t t = 0; t < mesh.tets.size(); ++t)
+    if (part[mesh.tets[t][0]] != kUnset) parts[part[mesh.tets[t][0]]].tets.push_back(t);
   for (std::uint32_t v : surface.surface_nodes)
     if (part[v] != kUnset) parts[part[v]].surface.surface_nodes.push_back(v);
   for (std::uint32_t v : surface.interior_nodes)
@@ -226,15 +230,17 @@ Segmentation one_cluster_per_part(const std::vector<SurfacePart>& parts,
   return out;
 }
 
-std::vector<Detector> detectors_by_part(const std::vector<Vec3>& nodes,
-                                        const std::vector<SurfacePart>& parts,
-                                        const Segmentation& segmentation,
-                                        DetectorStrategy strategy) {
+std::vector<DetectorChoice> detectors_by_part(const TetMesh& mesh,
+                                              const std::vector<SurfacePart>& parts,
+                                              const Segmentation& segmentation,
+                                              DetectorStrategy strategy, double min_visibility) {
   if (parts.size() == 1)
-    return choose_detectors(nodes, parts[0].surface, segmentation.triangle_cluster,
-                            segmentation.cluster_count, strategy);
-  std::vector<Detector> out(segmentation.cluster_count);
+    return choose_detector_points(mesh, parts[0].surface, segmentation.triangle_cluster,
+                                  segmentation.cluster_count, strategy, min_visibility);
+  std::vector<DetectorChoice> out(segmentation.cluster_count);
   std::vector<std::uint32_t> local_of(segmentation.cluster_count, kUnset);
+  TetMesh component;  // all nodes (ids kept), the part's tets
+  component.nodes = mesh.nodes;
   for (const SurfacePart& part : parts) {
     std::vector<std::uint32_t> global_of;  // local cluster -> global cluster
     std::vector<std::uint32_t> local(part.triangles.size());
@@ -246,9 +252,16 @@ std::vector<Detector> detectors_by_part(const std::vector<Vec3>& nodes,
       }
       local[i] = local_of[c];
     }
-    const std::vector<Detector> chosen = choose_detectors(
-        nodes, part.surface, local, static_cast<std::uint32_t>(global_of.size()), strategy);
-    for (std::size_t k = 0; k < chosen.size(); ++k) out[global_of[k]] = chosen[k];
+    component.tets.clear();
+    for (std::uint32_t t : part.tets) component.tets.push_back(mesh.tets[t]);
+    std::vector<DetectorChoice> chosen = choose_detector_points(
+        component, part.surface, local, static_cast<std::uint32_t>(global_of.size()), strategy,
+        min_visibility);
+    for (std::size_t k = 0; k < chosen.size(); ++k) {
+      if (chosen[k].point.tet != format::kNoTet)
+        chosen[k].point.tet = part.tets[chosen[k].point.tet];
+      out[global_of[k]] = chosen[k];
+    }
   }
   return out;
 }

@@ -17,6 +17,7 @@ namespace tetseg::preprocess::detail {
 /// surface, ascending, and its surface and interior nodes.
 struct SurfacePart {
   std::vector<std::uint32_t> triangles;  ///< ids into the whole surface, ascending
+  std::vector<std::uint32_t> tets;       ///< the component's tet ids, ascending
   Surface surface;                       ///< those triangles; sorted surface / interior nodes
 };
 
@@ -51,11 +52,12 @@ Segmentation join_segmentations(const std::vector<SurfacePart>& parts,
 Segmentation one_cluster_per_part(const std::vector<SurfacePart>& parts,
                                   std::size_t triangle_count);
 
-/// choose_detectors for each part on its own (only its interior nodes are candidates), for a
-/// segmentation whose clusters never span two parts; one detector per cluster.
-std::vector<Detector> detectors_by_part(const std::vector<Vec3>& nodes,
-                                        const std::vector<SurfacePart>& parts,
-                                        const Segmentation& segmentation,
-                                        DetectorStrategy strategy);
+/// choose_detector_points for each part on its own (only its interior nodes and tets are
+/// candidates), for a segmentation whose clusters never span two parts; one detector per
+/// cluster, tet ids those of `mesh`. Copies the node array once when there are several parts.
+std::vector<DetectorChoice> detectors_by_part(const TetMesh& mesh,
+                                              const std::vector<SurfacePart>& parts,
+                                              const Segmentation& segmentation,
+                                              DetectorStrategy strategy, double min_visibility);
 
 }  // namespace tetseg::preprocess::detail

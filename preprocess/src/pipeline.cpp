@@ -172,6 +172,8 @@ const std::vector<ProvenanceField>& provenance_fields() {
           [](O& o) -> std::uint32_t& { return o.segmentation.min_cluster_triangles; }),
       named<DetectorStrategy>("segmentation.detector", always,
                               [](O& o) -> DetectorStrategy& { return o.segmentation.detector; }),
+      number<double>("segmentation.min_visibility", always,
+                     [](O& o) -> double& { return o.segmentation.min_visibility; }),
       flag("rest_positions", always, [](O& o) -> bool& { return o.keep_rest_positions; }),
       number<double>("refine.min_visibility", refined,
                      [](O& o) -> double& { return o.refinement.min_visibility; }),
@@ -278,15 +280,6 @@ format::Asset build_asset(const TetMesh& mesh, const std::string& source,
   report.surface_triangles = static_cast<std::uint32_t>(surface.triangles.size());
   report.interior_nodes = static_cast<std::uint32_t>(surface.interior_nodes.size());
   report.components = static_cast<std::uint32_t>(parts.size());
-  for (std::size_t p = 0; p < parts.size(); ++p) {
-    if (parts[p].surface.interior_nodes.empty()) {
-      throw InputError(source, (parts.size() == 1 ? std::string("tet mesh")
-                                                  : "component " + std::to_string(p + 1) + " of " +
-                                                        std::to_string(parts.size())) +
-                                   " has no interior node to serve as a detector point "
-                                   "(refine the mesh or tetrahedralise with a smaller cell size)");
-    }
-  }
 
   Segmentation segmentation;
   if (options.clusters == ClusterMethod::kSingle) {
@@ -323,9 +316,12 @@ format::Asset build_asset(const TetMesh& mesh, const std::string& source,
                 std::to_string(s.cluster_count) + " clusters";
       return s;
     });
-    if (options.clusters == ClusterMethod::kRefined) {
+    // Refinement searches interior nodes; a mesh without one (a mat one tet thick) keeps the
+    // charge segmentation, and its detectors are points inside tets.
+    if (options.clusters == ClusterMethod::kRefined && !surface.interior_nodes.empty()) {
       segmentation = timer.run("refinement", [&](std::string& summary) {
         for (std::size_t p = 0; p < parts.size(); ++p) {
+          if (parts[p].surface.interior_nodes.empty()) continue;
           RefinementCounts counts;
           pieces[p] = refine_clusters(mesh.nodes, parts[p].surface, equalized[p], pieces[p],
                                       options.refinement, &counts);
@@ -345,14 +341,24 @@ format::Asset build_asset(const TetMesh& mesh, const std::string& source,
   report.clusters = segmentation.cluster_count;
   report.boundaries = static_cast<std::uint32_t>(segmentation.boundary_loops.size());
 
-  const std::vector<Detector> detectors = timer.run("detectors", [&](std::string& summary) {
-    std::vector<Detector> d =
-        detail::detectors_by_part(mesh.nodes, parts, segmentation, options.segmentation.detector);
+  const std::vector<DetectorChoice> detectors = timer.run("detectors", [&](std::string& summary) {
+    std::vector<DetectorChoice> d;
+    try {
+      d = detail::detectors_by_part(mesh, parts, segmentation, options.segmentation.detector,
+                                    options.segmentation.min_visibility);
+    } catch (const InputError& e) {
+      throw InputError(source, e.what());
+    }
     double worst = 1.0;
-    for (const Detector& detector : d)
+    std::size_t in_tets = 0, flagged = 0;
+    for (const DetectorChoice& detector : d) {
       worst = std::min<double>(worst, detector.rest_positive_fraction);
+      in_tets += detector.point.is_node() ? 0 : 1;
+      flagged += detector.overlap_only ? 1 : 0;
+    }
     std::ostringstream text;
-    text << d.size() << " detector nodes, lowest rest visibility " << worst;
+    text << d.size() << " detectors (" << in_tets << " inside tets), " << flagged
+         << " overlap-only, lowest rest visibility " << worst;
     summary = text.str();
     return d;
   });
@@ -369,7 +375,8 @@ format::Asset build_asset(const TetMesh& mesh, const std::string& source,
     for (std::uint32_t c = 0; c < segmentation.cluster_count; ++c) {
       ClusterBvh bvh = build_cluster_bvh(mesh.nodes, surface.triangles, members[c]);
       format::Cluster cluster;
-      cluster.detector_node = detectors[c].node;
+      cluster.detector = detectors[c].point;
+      cluster.flags = detectors[c].overlap_only ? format::kClusterOverlapOnly : 0;
       cluster.rest_positive_fraction = detectors[c].rest_positive_fraction;
       cluster.triangle_offset = static_cast<std::uint32_t>(asset.cluster_triangles.size());
       cluster.triangle_count = static_cast<std::uint32_t>(bvh.triangles.size());
@@ -396,7 +403,7 @@ format::Asset build_asset(const TetMesh& mesh, const std::string& source,
   BuildOptions used = options;  // with the charge solver actually used in place of "auto"
   if (!report.charge.solver.empty()) parse_name(report.charge.solver, used.charge.solver);
   asset.provenance.options = provenance_options(used);
-  for (const Detector& detector : detectors) {
+  for (const DetectorChoice& detector : detectors) {
     report.rest_positive_fraction.push_back(detector.rest_positive_fraction);
   }
 

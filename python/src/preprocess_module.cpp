@@ -212,7 +212,10 @@ py::dict report_dict(const std::string& source, const BuildReport& report,
   for (const format::Cluster& c : asset.clusters) {
     py::dict d;
     d["triangles"] = c.triangle_count;
-    d["detector_node"] = c.detector_node;
+    d["detector_nodes"] = c.detector.nodes;
+    d["detector_weights"] = c.detector.weights;
+    d["detector_tet"] = c.detector.tet;
+    d["overlap_only"] = (c.flags & format::kClusterOverlapOnly) != 0;
     d["rest_positive_fraction"] = c.rest_positive_fraction;
     clusters.append(d);
   }
@@ -250,9 +253,10 @@ py::tuple build(const py::object& mesh, const py::object& source, const std::str
                 bool refine_merge, double alpha, double beta_divisor,
                 const std::string& equalization, double growth_bound, bool grow_through_marked,
                 std::uint32_t min_cluster_triangles, const std::string& detector,
-                const std::string& solver, double tolerance, double cell_size, double facet_size,
-                double facet_distance, bool optimize, const std::string& repair, double wrap_alpha,
-                double wrap_offset, bool rest_positions, const py::object& on_stage) {
+                double min_visibility, const std::string& solver, double tolerance,
+                double cell_size, double facet_size, double facet_distance, bool optimize,
+                const std::string& repair, double wrap_alpha, double wrap_offset,
+                bool rest_positions, const py::object& on_stage) {
   BuildOptions options;
   options.clusters = enum_from_name<ClusterMethod>("clusters", clusters);
   check_range("refine_visibility", refine_visibility, 0.0, 1.0);
@@ -272,6 +276,8 @@ py::tuple build(const py::object& mesh, const py::object& source, const std::str
   options.segmentation.grow_through_marked = grow_through_marked;
   options.segmentation.min_cluster_triangles = min_cluster_triangles;
   options.segmentation.detector = enum_from_name<DetectorStrategy>("detector", detector);
+  check_range("min_visibility", min_visibility, 0.0, 1.0);
+  options.segmentation.min_visibility = min_visibility;
   options.charge.solver = enum_from_name<ChargeSolver>("solver", solver);
   check_range("tolerance", tolerance, 0.0, 0.5);
   options.charge.tolerance = tolerance;
@@ -486,6 +492,7 @@ PYBIND11_MODULE(preprocess, m) {
         py::arg("grow_through_marked") = b.segmentation.grow_through_marked,
         py::arg("min_cluster_triangles") = b.segmentation.min_cluster_triangles,
         py::arg("detector") = std::string(name_of(b.segmentation.detector)),
+        py::arg("min_visibility") = b.segmentation.min_visibility,
         py::arg("solver") = std::string(name_of(b.charge.solver)),
         py::arg("tolerance") = b.charge.tolerance, py::arg("cell_size") = meshing.cell_size,
         py::arg("facet_size") = meshing.facet_size,

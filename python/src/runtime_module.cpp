@@ -75,14 +75,21 @@ py::dtype contact_record_dtype() {
 
 py::dtype cluster_dtype() {
   using format::Cluster;
-  static_assert(std::is_standard_layout_v<Cluster>);
-  return record_dtype({{"detector_node", "u4"},
+  using format::DetectorPoint;
+  static_assert(std::is_standard_layout_v<Cluster> && std::is_standard_layout_v<DetectorPoint>);
+  const std::size_t det = offsetof(Cluster, detector);
+  return record_dtype({{"detector_nodes", "(4,)u4"},
+                       {"detector_weights", "(4,)f8"},
+                       {"detector_tet", "u4"},
+                       {"flags", "u4"},
                        {"rest_positive_fraction", "f4"},
                        {"triangle_offset", "u4"},
                        {"triangle_count", "u4"},
                        {"bvh_offset", "u4"},
                        {"bvh_count", "u4"}},
-                      {offsetof(Cluster, detector_node), offsetof(Cluster, rest_positive_fraction),
+                      {det + offsetof(DetectorPoint, nodes), det + offsetof(DetectorPoint, weights),
+                       det + offsetof(DetectorPoint, tet), offsetof(Cluster, flags),
+                       offsetof(Cluster, rest_positive_fraction),
                        offsetof(Cluster, triangle_offset), offsetof(Cluster, triangle_count),
                        offsetof(Cluster, bvh_offset), offsetof(Cluster, bvh_count)},
                       sizeof(Cluster));
@@ -434,16 +441,18 @@ PYBIND11_MODULE(_runtime, m) {
           [](const PyAsset& a) {
             return vector_view(a.asset->data().clusters, cluster_dtype(), 0, a.asset);
           },
-          "(C,) structured: detector_node, rest_positive_fraction, triangle_offset, "
-          "triangle_count, bvh_offset, bvh_count.")
+          "(C,) structured: detector_nodes (4 u4), detector_weights (4 f8), detector_tet, "
+          "flags (1 = overlap-only), rest_positive_fraction, triangle_offset, triangle_count, "
+          "bvh_offset, bvh_count.")
       .def_property_readonly(
           "detectors",
           [](const PyAsset& a) -> py::object {
             const py::object clusters =
                 vector_view(a.asset->data().clusters, cluster_dtype(), 0, a.asset);
-            return clusters[py::str("detector_node")];
+            return clusters[py::str("detector_nodes")];
           },
-          "(C,) uint32: the detector node (interior tet-mesh node) of each cluster.")
+          "(C, 4) uint32: the four tet-mesh nodes of each cluster's detector point (a detector "
+          "at a node: that node four times; weights in clusters['detector_weights']).")
       .def_property_readonly(
           "cluster_triangles",
           [](const PyAsset& a) {

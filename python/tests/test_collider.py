@@ -121,7 +121,9 @@ def test_asset_arrays_agree_with_tetseg_dump(bin_dir, dumbbell):
     assert asset.triangle_count == dump["surface_triangles"] == asset.triangles.shape[0]
     assert asset.triangles.shape == (asset.triangle_count, 3) and asset.triangles.dtype == np.uint32
     assert [c["triangles"] for c in dump["clusters"]] == asset.clusters["triangle_count"].tolist()
-    assert np.array_equal(asset.detectors, asset.clusters["detector_node"])
+    assert np.array_equal(asset.detectors, asset.clusters["detector_nodes"])
+    assert asset.detectors.shape == (len(asset.clusters), 4)
+    assert np.allclose(asset.clusters["detector_weights"].sum(axis=1), 1.0)
     assert np.array_equal(np.sort(asset.cluster_triangles), np.arange(asset.triangle_count))
     for c, cl in enumerate(asset.clusters):
         ids = asset.cluster_triangles[cl["triangle_offset"]:cl["triangle_offset"] + cl["triangle_count"]]

@@ -111,6 +111,9 @@ void Collider::Impl::construct(std::shared_ptr<const BodyShape> sh, const Collid
   ebox.resize(topo->edges.size());
   emov.assign(topo->edges.size(), 0);
   tcls.assign(tri_count, static_cast<std::uint8_t>(Orientation::kUncertain));
+  det0.assign(3 * std::size_t(cluster_count()), 0.0);
+  det1.assign(3 * std::size_t(cluster_count()), 0.0);
+  det_ok.assign(cluster_count(), 0);
   tmov.assign(tri_count, 0);
   closure_ring.reserve(tri_count);
   closure_mark.assign(tri_count, 0);
@@ -143,19 +146,23 @@ ColliderStatus Collider::Impl::begin_step(const double* p0, const double* p1,
   if (ctor_status != ColliderStatus::kOk) return ColliderStatus::kNotReady;
   if (count != std::size_t(node_count) * 3) return ColliderStatus::kSizeMismatch;
   if (node_count > 0 && (!p0 || !p1)) return ColliderStatus::kNullInput;
-  // Only surface vertices and detector nodes are read; check exactly those.
-  for (std::uint32_t n : topo->surf_nodes) {
+  // Only surface vertices and the nodes of detectors that are classified against are read;
+  // check exactly those.
+  auto finite = [&](std::uint32_t n) {
     for (int k = 0; k < 3; ++k) {
       if (!std::isfinite(p0[std::size_t(n) * 3 + k]) || !std::isfinite(p1[std::size_t(n) * 3 + k]))
-        return ColliderStatus::kNonFinite;
+        return false;
     }
+    return true;
+  };
+  for (std::uint32_t n : topo->surf_nodes) {
+    if (!finite(n)) return ColliderStatus::kNonFinite;
   }
   for (std::uint32_t c = 0; c < cluster_count(); ++c) {
-    const std::uint32_t det = asset->clusters[c].detector_node;
-    for (int k = 0; k < 3; ++k) {
-      if (!std::isfinite(p0[std::size_t(det) * 3 + k]) ||
-          !std::isfinite(p1[std::size_t(det) * 3 + k]))
-        return ColliderStatus::kNonFinite;
+    const format::Cluster& cl = asset->clusters[c];
+    if (cl.flags & format::kClusterOverlapOnly) continue;
+    for (std::uint32_t n : cl.detector.nodes) {
+      if (!finite(n)) return ColliderStatus::kNonFinite;
     }
   }
   x0 = p0;
@@ -244,15 +251,37 @@ void Collider::Impl::refit_and_classify() noexcept {
 
   if (!orientation_mode()) return;
   const auto t_class = Clock::now();
+  // Detector points at both ends of the step; the detector moves linearly between them, like
+  // every node, so the orientation stays a cubic in t (docs/runtime.md, "Detector points").
+  for (std::uint32_t c = 0; c < cluster_count(); ++c) {
+    const format::Cluster& cl = asset->clusters[c];
+    det_ok[c] = 0;
+    if (cl.flags & format::kClusterOverlapOnly) continue;
+    const std::array<double, 3> a = format::detector_position(cl.detector, x0);
+    const std::array<double, 3> b = format::detector_position(cl.detector, x1);
+    bool ok = true;
+    for (int k = 0; k < 3; ++k) {
+      det0[3 * std::size_t(c) + k] = a[k];
+      det1[3 * std::size_t(c) + k] = b[k];
+      ok = ok && std::isfinite(a[k]) && std::isfinite(b[k]);
+    }
+    det_ok[c] = ok ? 1 : 0;  // an overflowing combination: the cluster's triangles uncertain
+  }
 #if defined(TETSEG_HAVE_OPENMP)
 #pragma omp parallel for if (opt.use_openmp && nt > 2048)
 #endif
   for (std::int64_t t = 0; t < nt; ++t) {
     const auto& tri = tris[t];
-    const std::uint32_t o = asset->clusters[asset->triangle_cluster[t]].detector_node;
-    tcls[t] = static_cast<std::uint8_t>(orientation_of(pos0(o), pos0(tri[0]), pos0(tri[1]),
-                                                       pos0(tri[2]), pos1(o), pos1(tri[0]),
-                                                       pos1(tri[1]), pos1(tri[2])));
+    const std::uint32_t c = asset->triangle_cluster[t];
+    if (!det_ok[c]) {
+      tcls[t] = static_cast<std::uint8_t>(Orientation::kUncertain);
+      continue;
+    }
+    const double* o0 = det0.data() + 3 * std::size_t(c);
+    const double* o1 = det1.data() + 3 * std::size_t(c);
+    tcls[t] =
+        static_cast<std::uint8_t>(orientation_of(o0, pos0(tri[0]), pos0(tri[1]), pos0(tri[2]), o1,
+                                                 pos1(tri[0]), pos1(tri[1]), pos1(tri[2])));
   }
   std::uint64_t count[3] = {0, 0, 0};
   for (std::uint32_t t = 0; t < tri_count; ++t) ++count[tcls[t]];

@@ -281,6 +281,10 @@ struct Collider::Impl {
   std::vector<Box> ebox;           // per edge, swept (refit)
   std::vector<std::uint8_t> emov;  // per edge: an end node moved
   std::vector<std::uint8_t> tcls;  // Orientation
+  // Per cluster, this step: the detector point at the start and end (3 doubles each), and
+  // whether the cluster is classified at all (0: overlap-only, or a non-finite detector).
+  std::vector<double> det0, det1;
+  std::vector<std::uint8_t> det_ok;
   std::vector<std::uint8_t> tmov;
   // Whole-surface modes (bvh, cone, surface-only bodies): triangle pairs that share a node are
   // not candidates; the feature pairs only such pairs hold (orphan sets, built at construction)

@@ -34,7 +34,8 @@ TEST_CASE("The envelope follows the documented byte table", "[format]") {
   const std::uint8_t magic[8] = {0x89, 'T', 'S', 'G', 0x0D, 0x0A, 0x1A, 0x0A};
   CHECK(std::equal(magic, magic + 8, bytes.begin()));
   CHECK(get_le(bytes, kMajorAt, 2) == kVersionMajor);
-  CHECK(get_le(bytes, kMinorAt, 2) == kVersionMinor);
+  CHECK(get_le(bytes, kMinorAt, 2) == 0);  // needs nothing of 1.1
+  CHECK(get_le(write_asset(make_octahedron_asset_v11()), kMinorAt, 2) == kVersionMinor);
   CHECK(get_le(bytes, kHeaderSizeAt, 4) == kHeaderBytes);
   CHECK(get_le(bytes, kFlagsAt, 4) == 0);
   CHECK(get_le(bytes, kPayloadSizeAt, 8) == bytes.size() - kHeaderBytes);
@@ -145,10 +146,61 @@ TEST_CASE("The golden asset of version 1.0 still loads with its original content
     }
     for (const Cluster& c : loaded.clusters) {
       CHECK(c.rest_positive_fraction == 1.0f);  // convex halves seen from inside
-      const Vec3& d = loaded.rest_positions[c.detector_node];
+      CHECK(c.detector.is_node());
+      CHECK(c.detector.tet == kNoTet);
+      CHECK(c.flags == 0);
+      const Vec3& d = loaded.rest_positions[c.detector.nodes[0]];
       CHECK(std::abs(d[0]) + std::abs(d[1]) + std::abs(d[2]) < 1.0);  // strictly inside
     }
   }
+}
+
+TEST_CASE("The golden asset of version 1.1 loads with detector points and a flagged cluster",
+          "[format][golden]") {
+  const std::string path = golden_path(1);
+  Asset loaded;
+  std::string why;
+  REQUIRE(read_asset_file(path, loaded, &why) == Status::kOk);
+  INFO(why);
+  std::uint16_t major = 0, minor = 0;
+  const auto bytes = read_file(path);
+  REQUIRE(peek_version(bytes.data(), bytes.size(), major, minor));
+  CHECK(major == 1);
+  CHECK(minor == 1);
+  CHECK(assets_equal(loaded, make_octahedron_asset_v11()));
+  CHECK(write_asset(loaded) == bytes);
+  REQUIRE(loaded.clusters.size() == 2);
+  CHECK_FALSE(loaded.clusters[0].detector.is_node());
+  CHECK(loaded.clusters[0].detector.tet == 0);
+  CHECK(loaded.clusters[0].flags == 0);
+  CHECK(loaded.clusters[1].flags == kClusterOverlapOnly);
+  for (const Cluster& c : loaded.clusters) {
+    const Vec3 d = detector_position(loaded, c);
+    CHECK(std::abs(d[0]) + std::abs(d[1]) + std::abs(d[2]) < 1.0);  // strictly inside
+    CHECK(c.rest_positive_fraction == 1.0f);
+  }
+}
+
+TEST_CASE("Writing uses the oldest minor version that holds the asset", "[format]") {
+  Asset a = make_octahedron_asset();
+  CHECK(minor_version_needed(a) == 0);
+  SECTION("A tet id alone needs 1.1.") {
+    a.clusters[0].detector.tet = 3;
+  }
+  SECTION("A flag alone needs 1.1.") {
+    a.clusters[1].flags = kClusterOverlapOnly;
+  }
+  SECTION("A point-form detector needs 1.1, even at a node (weights 1, 0, 0, 0).") {
+    a.clusters[0].detector.nodes = {6, 0, 2, 4};
+  }
+  CHECK(minor_version_needed(a) == 1);
+  const auto bytes = write_asset(a);
+  CHECK(get_le(bytes, kMinorAt, 2) == 1);
+  Asset back;
+  std::string why;
+  CHECK(read_asset(bytes.data(), bytes.size(), back, &why) == Status::kOk);
+  INFO(why);
+  CHECK(assets_equal(back, a));
 }
 
 TEST_CASE("Concurrent reads of shared bytes agree", "[format]") {
@@ -187,13 +239,13 @@ TEST_CASE("A missing or unreadable file is an i/o error", "[format]") {
   CHECK(is_empty(a));
 }
 
-// Rebuilds tests/golden/asset-v1.0.tetseg. Hidden; run only when the format version changes:
+// Rebuilds tests/golden/asset-v1.<minor>.tetseg of the current version. Hidden; run only when
+// the format version changes (never rewrite an older version's golden file):
 //   tetseg_tests_format "[.generate]"
 TEST_CASE("Generate the golden asset of this version", "[.generate]") {
-  const auto bytes = write_asset(make_octahedron_asset());
-  const std::string path = std::string(TETSEG_SOURCE_DIR) + "/tests/golden/asset-v" +
-                           std::to_string(kVersionMajor) + "." + std::to_string(kVersionMinor) +
-                           ".tetseg";
+  static_assert(kVersionMajor == 1 && kVersionMinor == 1, "add the new version's golden asset");
+  const auto bytes = write_asset(make_octahedron_asset_v11());
+  const std::string path = golden_path(kVersionMinor);
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
   out.write(reinterpret_cast<const char*>(bytes.data()),
             static_cast<std::streamsize>(bytes.size()));

@@ -21,6 +21,16 @@ struct Rule {
 constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
+/// A point-form detector (format 1.1) of the octahedron's upper tet (6, 0, 2, 4) by default.
+DetectorPoint point(std::array<std::uint32_t, 4> nodes = {6, 0, 2, 4},
+                    std::array<double, 4> weights = {0.625, 0.125, 0.125, 0.125}) {
+  DetectorPoint d;
+  d.nodes = nodes;
+  d.weights = weights;
+  d.tet = 0;
+  return d;
+}
+
 // Octahedron ids (test_assets.hpp): surface nodes 0..5, detectors 6 and 7; triangles 0..3 in
 // cluster 0, 4..7 in cluster 1; one loop {0, 2, 1, 3}. BVH nodes {first, second, count}:
 // cluster 0: 0 {1,4,0}, 1 {2,3,0}, 2 {0,0,1}, 3 {1,0,1}, 4 {5,6,0}, 5 {2,0,1}, 6 {3,0,1};
@@ -82,9 +92,56 @@ const std::vector<Rule>& rules() {
       {"a huge triangle_count wraps", "triangle range exceeds",
        [](Asset& a) { a.clusters[0].triangle_count = 0xFFFFFFFFu; }},
       {"a detector node equals node_count", ">= node_count",
-       [](Asset& a) { a.clusters[0].detector_node = 8; }},
+       [](Asset& a) { a.clusters[0].detector = DetectorPoint::at_node(8); }},
       {"a detector node is on the surface", "is a surface node",
-       [](Asset& a) { a.clusters[1].detector_node = 5; }},
+       [](Asset& a) { a.clusters[1].detector = DetectorPoint::at_node(5); }},
+      {"a point-form detector node equals node_count", ">= node_count",
+       [](Asset& a) {
+         a.clusters[0].detector = point({6, 0, 8, 4});
+       }},
+      {"a point-form detector node id is huge", ">= node_count",
+       [](Asset& a) {
+         a.clusters[1].detector = point({7, 0xFFFFFFFFu, 2, 4});
+       }},
+      {"a point-form detector repeats a node", "repeats node",
+       [](Asset& a) {
+         a.clusters[0].detector = point({6, 0, 0, 4});
+       }},
+      {"node-form weights with unequal ids repeat a node", "repeats node",
+       [](Asset& a) {
+         a.clusters[0].detector = point({6, 6, 6, 7}, {1, 0, 0, 0});
+       }},
+      {"equal ids without node-form weights repeat a node", "repeats node",
+       [](Asset& a) {
+         a.clusters[0].detector = point({6, 6, 6, 6}, {0.5, 0.5, 0, 0});
+       }},
+      {"a detector weight is negative", "not a finite non-negative",
+       [](Asset& a) {
+         a.clusters[0].detector = point({6, 0, 2, 4}, {1.25, -0.25, 0, 0});
+       }},
+      {"a detector weight is NaN", "not a finite non-negative",
+       [](Asset& a) {
+         a.clusters[1].detector = point({6, 0, 2, 4}, {std::nan(""), 1, 0, 0});
+       }},
+      {"a detector weight is infinite", "not a finite non-negative",
+       [](Asset& a) {
+         a.clusters[1].detector = point({6, 0, 2, 4}, {kInf, 0, 0, 0});
+       }},
+      {"detector weights sum above 1 + 1e-9", "sum to",
+       [](Asset& a) {
+         a.clusters[0].detector = point({6, 0, 2, 4}, {0.5, 0.5, 4e-9, 0});
+       }},
+      {"detector weights sum below 1 - 1e-9", "sum to",
+       [](Asset& a) {
+         a.clusters[0].detector = point({6, 0, 2, 4}, {0.25, 0.25, 0.25, 0.2499});
+       }},
+      {"detector weights are all zero", "sum to",
+       [](Asset& a) {
+         a.clusters[0].detector = point({6, 0, 2, 4}, {0, 0, 0, 0});
+       }},
+      {"a cluster flag is unknown", "unknown bits", [](Asset& a) { a.clusters[1].flags = 2; }},
+      {"a cluster flag is unknown beside overlap-only", "unknown bits",
+       [](Asset& a) { a.clusters[0].flags = kClusterOverlapOnly | 0x80000000u; }},
       {"rest_positive_fraction is NaN", "in [0,1]",
        [](Asset& a) { a.clusters[0].rest_positive_fraction = kNaN; }},
       {"rest_positive_fraction is negative", "in [0,1]",
@@ -236,7 +293,23 @@ TEST_CASE("Validation accepts the legitimate variations", "[format][validate]") 
     a.boundary_nodes.clear();
   }
   SECTION("Clusters may share a detector node.") {
-    a.clusters[1].detector_node = 6;
+    a.clusters[1].detector = DetectorPoint::at_node(6);
+  }
+  SECTION("Point-form detectors: a tet's point, its nodes on the surface or not.") {
+    a.clusters[0].detector = point();
+    a.clusters[1].detector = point({7, 6, 1, 3}, {0.25, 0.25, 0.25, 0.25});
+  }
+  SECTION("A point-form detector may sit at one of its nodes, even a surface node.") {
+    a.clusters[0].detector = point({4, 0, 2, 6}, {1, 0, 0, 0});
+  }
+  SECTION("Weights may miss 1 by up to the documented bound, and the tet id is free.") {
+    a.clusters[0].detector = point({6, 0, 2, 4}, {0.5, 0.5, 5e-10, 0});
+    a.clusters[1].detector = point({7, 6, 1, 3}, {0.25, 0.25, 0.25, 0.25 - 5e-10});
+    a.clusters[1].detector.tet = kNoTet;
+  }
+  SECTION("A cluster may be flagged overlap-only, and so may all.") {
+    a.clusters[0].flags = kClusterOverlapOnly;
+    a.clusters[1].flags = kClusterOverlapOnly;
   }
   SECTION("Interior nodes need not be detectors, and fractions 0 and 1 are in range.") {
     a.rest_positions.push_back({0.1, 0.1, 0.1});

@@ -22,6 +22,10 @@ namespace tetseg::test {
 using format::Asset;
 using format::BvhNode;
 using format::Cluster;
+using format::DetectorPoint;
+using format::kClusterOverlapOnly;
+using format::kNoTet;
+using format::minor_version_needed;
 using format::Triangle;
 using Vec3 = std::array<double, 3>;
 
@@ -80,7 +84,7 @@ inline std::vector<std::pair<std::string, std::size_t>> payload_size_tags(const 
   tag("rest_positions", a.rest_positions.size(), 24);
   tag("triangles", a.triangles.size(), 12);
   tag("triangle_cluster", a.triangle_cluster.size(), 4);
-  tag("clusters", a.clusters.size(), 24);
+  tag("clusters", a.clusters.size(), minor_version_needed(a) == 0 ? 24 : 76);
   tag("cluster_triangles", a.cluster_triangles.size(), 4);
   tag("bvh_nodes", a.bvh_nodes.size(), 12);
   tag("boundaries", a.boundaries.size(), 8);
@@ -127,9 +131,14 @@ inline double dot(const Vec3& a, const Vec3& b) {
   return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
 }
 
+/// Rest position of a cluster's detector.
+inline Vec3 detector_position(const Asset& a, const Cluster& c) {
+  return format::detector_position(c.detector, a.rest_positions.front().data());
+}
+
 /// Share of the cluster's triangles whose outward normal faces away from the detector.
 inline float positive_fraction(const Asset& a, const Cluster& c) {
-  const Vec3& d = a.rest_positions[c.detector_node];
+  const Vec3 d = detector_position(a, c);
   std::uint32_t positive = 0;
   for (std::uint32_t i = 0; i < c.triangle_count; ++i) {
     const Triangle& t = a.triangles[a.cluster_triangles[c.triangle_offset + i]];
@@ -141,10 +150,12 @@ inline float positive_fraction(const Asset& a, const Cluster& c) {
 }
 
 /// Appends a cluster over the given surface triangles (in BVH leaf order).
-inline void add_cluster(Asset& a, std::uint32_t detector, const std::vector<std::uint32_t>& tris,
-                        std::uint32_t leaf_size) {
+inline void add_cluster(Asset& a, const DetectorPoint& detector,
+                        const std::vector<std::uint32_t>& tris, std::uint32_t leaf_size,
+                        std::uint32_t flags = 0) {
   Cluster c;
-  c.detector_node = detector;
+  c.detector = detector;
+  c.flags = flags;
   c.triangle_offset = static_cast<std::uint32_t>(a.cluster_triangles.size());
   c.triangle_count = static_cast<std::uint32_t>(tris.size());
   c.bvh_offset = static_cast<std::uint32_t>(a.bvh_nodes.size());
@@ -179,8 +190,36 @@ inline Asset make_octahedron_asset() {
   // +x=0 -x=1 +y=2 -y=3 +z=4 -z=5, wound outward.
   a.triangles = {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4},
                  {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}};
-  add_cluster(a, 6, {0, 1, 2, 3}, 1);  // upper half: 7 BVH nodes, one triangle per leaf
-  add_cluster(a, 7, {6, 7, 4, 5}, 2);  // lower half: 3 BVH nodes, two triangles per leaf
+  // upper half: 7 BVH nodes, one triangle per leaf; lower half: 3, two triangles per leaf
+  add_cluster(a, DetectorPoint::at_node(6), {0, 1, 2, 3}, 1);
+  add_cluster(a, DetectorPoint::at_node(7), {6, 7, 4, 5}, 2);
+  add_loop(a, {0, 2, 1, 3});
+  a.provenance.tool_version = "tetseg 0.1.0";
+  a.provenance.source = "octahedron.off";
+  a.provenance.options = {{"clusters", "2"}, {"detector", "interior"}, {"leaf_size", "1,2"}};
+  return a;
+}
+
+/// The golden asset of version 1.1: the octahedron's surface with the upper cluster seen from
+/// a point inside tet 0 = (6, 0, 2, 4) and the lower cluster flagged overlap-only, its
+/// detector the centroid of tet 9 = (6, 7, 1, 3) (a tet of the same octahedral mesh).
+inline Asset make_octahedron_asset_v11() {
+  Asset a;
+  a.rest_positions = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0},    {0, -1, 0},
+                      {0, 0, 1}, {0, 0, -1}, {0, 0, 0.25}, {0, 0, -0.25}};
+  a.node_count = 8;
+  a.triangles = {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4},
+                 {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}};
+  DetectorPoint upper;
+  upper.nodes = {6, 0, 2, 4};
+  upper.weights = {0.625, 0.125, 0.125, 0.125};
+  upper.tet = 0;
+  DetectorPoint lower;
+  lower.nodes = {6, 7, 1, 3};
+  lower.weights = {0.25, 0.25, 0.25, 0.25};
+  lower.tet = 9;
+  add_cluster(a, upper, {0, 1, 2, 3}, 1);
+  add_cluster(a, lower, {6, 7, 4, 5}, 2, kClusterOverlapOnly);
   add_loop(a, {0, 2, 1, 3});
   a.provenance.tool_version = "tetseg 0.1.0";
   a.provenance.source = "octahedron.off";
@@ -243,7 +282,7 @@ inline Asset make_cube_asset(std::uint32_t n) {
   a.node_count = static_cast<std::uint32_t>(a.rest_positions.size());
   for (std::uint32_t f = 0; f < 6; ++f) {
     std::vector<std::uint32_t> leaf_order(face_tris[f].rbegin(), face_tris[f].rend());
-    add_cluster(a, surface_nodes + f, leaf_order, f % 3 + 1);
+    add_cluster(a, DetectorPoint::at_node(surface_nodes + f), leaf_order, f % 3 + 1);
     add_loop(a, face_loops[f]);
   }
   a.provenance.tool_version = "tetseg 0.1.0";
@@ -271,8 +310,12 @@ inline bool assets_equal(const Asset& a, const Asset& b) {
   for (std::size_t i = 0; i < a.clusters.size(); ++i) {
     const Cluster& x = a.clusters[i];
     const Cluster& y = b.clusters[i];
-    if (x.detector_node != y.detector_node ||
-        !same_bits(x.rest_positive_fraction, y.rest_positive_fraction) ||
+    if (x.detector.nodes != y.detector.nodes || x.detector.tet != y.detector.tet ||
+        x.flags != y.flags)
+      return false;
+    for (int k = 0; k < 4; ++k)
+      if (!same_bits(x.detector.weights[k], y.detector.weights[k])) return false;
+    if (!same_bits(x.rest_positive_fraction, y.rest_positive_fraction) ||
         x.triangle_offset != y.triangle_offset || x.triangle_count != y.triangle_count ||
         x.bvh_offset != y.bvh_offset || x.bvh_count != y.bvh_count)
       return false;
@@ -299,8 +342,10 @@ inline bool is_empty(const Asset& a) {
   return assets_equal(a, Asset{});
 }
 
-inline std::string golden_path() {
-  return std::string(TETSEG_SOURCE_DIR) + "/tests/golden/asset-v1.0.tetseg";
+/// The committed golden asset of version 1.`minor`.
+inline std::string golden_path(int minor = 0) {
+  return std::string(TETSEG_SOURCE_DIR) + "/tests/golden/asset-v1." + std::to_string(minor) +
+         ".tetseg";
 }
 
 inline std::vector<std::uint8_t> read_file(const std::string& path) {

@@ -2,15 +2,39 @@
 #include <catch2/catch.hpp>
 #include <set>
 
+#include "preprocess/grid_mesh.hpp"
 #include "tetseg/format/asset_io.hpp"
 #include "tetseg/preprocess/meshing.hpp"
 #include "tetseg/preprocess/pipeline.hpp"
+#include "tetseg/preprocess/segmentation.hpp"
 #include "tetseg/preprocess/surface.hpp"
 #include "tetseg/testing/charge_shapes.hpp"
 
 using namespace tetseg::preprocess;
 
 namespace {
+
+/// A cluster's detector lies inside the body: an interior node, or the centroid of a tet of
+/// the mesh with non-zero volume (strictly inside that tet), weights summing to 1.
+void require_detector_inside(const TetMesh& mesh, const Surface& surface,
+                             const tetseg::format::Cluster& cluster) {
+  const auto& d = cluster.detector;
+  if (d.is_node()) {
+    REQUIRE(std::binary_search(surface.interior_nodes.begin(), surface.interior_nodes.end(),
+                               d.nodes[0]));
+    return;
+  }
+  REQUIRE(d.tet < mesh.tets.size());
+  REQUIRE(mesh.tets[d.tet] == d.nodes);
+  double sum = 0;
+  for (double w : d.weights) {
+    REQUIRE(w > 0.0);
+    sum += w;
+  }
+  REQUIRE(sum == Approx(1.0).margin(1e-12));
+  const auto& n = mesh.nodes;
+  REQUIRE(tetseg::test::orient(n[d.nodes[0]], n[d.nodes[1]], n[d.nodes[2]], n[d.nodes[3]]) != 0.0);
+}
 
 const TetMesh& coarse_dumbbell() {
   static const TetMesh mesh = [] {
@@ -42,13 +66,12 @@ TEST_CASE("The pipeline turns a dumbbell into a valid, loadable asset", "[pipeli
   REQUIRE(report.clusters == asset.clusters.size());
   REQUIRE(report.rest_positive_fraction.size() == asset.clusters.size());
 
-  // Detector nodes are interior nodes, and every triangle is in exactly one cluster.
-  const std::set<std::uint32_t> interior(surface.interior_nodes.begin(),
-                                         surface.interior_nodes.end());
+  // Detectors are interior nodes or tet centroids, and every triangle is in exactly one
+  // cluster.
   std::vector<int> seen(asset.triangles.size(), 0);
   for (std::size_t c = 0; c < asset.clusters.size(); ++c) {
     const auto& cluster = asset.clusters[c];
-    REQUIRE(interior.count(cluster.detector_node) == 1);
+    require_detector_inside(mesh, surface, cluster);
     for (std::uint32_t i = 0; i < cluster.triangle_count; ++i) {
       const std::uint32_t t = asset.cluster_triangles[cluster.triangle_offset + i];
       ++seen[t];
@@ -87,6 +110,7 @@ TEST_CASE("The pipeline turns a dumbbell into a valid, loadable asset", "[pipeli
       {"segmentation.grow_through_marked", "yes"},
       {"segmentation.growth_bound", "0.25"},
       {"segmentation.min_cluster_triangles", "0"},
+      {"segmentation.min_visibility", "0.5"},
   };
   REQUIRE(asset.provenance.options == expected);
 
@@ -291,15 +315,56 @@ TEST_CASE("A single-cluster build skips charge and segmentation", "[pipeline]") 
   for (const auto& stage : report.stages) REQUIRE(stage.name != "charge");
 }
 
-TEST_CASE("A tet mesh without interior nodes is rejected with a clear message", "[pipeline]") {
+TEST_CASE("A tet mesh without interior nodes gets detector points inside tets", "[pipeline]") {
+  SECTION("One tet: its centroid sees all four faces.") {
+    TetMesh mesh;
+    mesh.nodes = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+    mesh.tets = {{0, 1, 2, 3}};
+    BuildReport report;
+    const auto asset = build_asset(mesh, "tet.mesh", BuildOptions{}, report);
+    REQUIRE(asset.clusters.size() == 1);
+    const auto& d = asset.clusters[0].detector;
+    CHECK(d.tet == 0);
+    CHECK(d.nodes == std::array<std::uint32_t, 4>{0, 1, 2, 3});
+    CHECK(d.weights == std::array<double, 4>{0.25, 0.25, 0.25, 0.25});
+    CHECK(asset.clusters[0].rest_positive_fraction == 1.0f);
+    CHECK(asset.clusters[0].flags == 0);
+  }
+  SECTION("A mat one tet layer thick (no interior node) builds; every detector is inside.") {
+    const TetMesh mesh = tetseg::test::kuhn_grid(12, 12, 1, [](int i, int j, int k) {
+      return Vec3{0.1 * i, 0.1 * j, 0.02 * k};
+    });
+    const Surface surface = extract_surface(mesh);
+    REQUIRE(surface.interior_nodes.empty());
+    BuildReport report;
+    const auto asset = build_asset(mesh, "mat.mesh", BuildOptions{}, report);
+    REQUIRE(asset.clusters.size() >= 1);
+    for (const auto& cluster : asset.clusters) require_detector_inside(mesh, surface, cluster);
+    std::string why;
+    REQUIRE(tetseg::format::validate(asset, &why) == tetseg::format::Status::kOk);
+  }
+  SECTION("With --min-visibility 1 every cluster not seen whole is flagged overlap-only.") {
+    const TetMesh mesh = tetseg::test::kuhn_grid(12, 12, 1, [](int i, int j, int k) {
+      return Vec3{0.1 * i, 0.1 * j, 0.02 * k};
+    });
+    BuildOptions options;
+    options.segmentation.min_visibility = 1.0;
+    BuildReport report;
+    const auto asset = build_asset(mesh, "mat.mesh", options, report);
+    for (const auto& cluster : asset.clusters) {
+      CHECK(((cluster.flags & tetseg::format::kClusterOverlapOnly) != 0) ==
+            (cluster.rest_positive_fraction < 1.0f));
+    }
+  }
+}
+
+TEST_CASE("A mesh with no interior node and no tet of non-zero volume is refused", "[pipeline]") {
   TetMesh mesh;
   mesh.nodes = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
   mesh.tets = {{0, 1, 2, 3}};
-  BuildReport report;
-  REQUIRE_THROWS_MATCHES(build_asset(mesh, "tet.mesh", BuildOptions{}, report), InputError,
-                         Catch::Matchers::Predicate<InputError>([](const InputError& e) {
-                           return e.file() == "tet.mesh" &&
-                                  std::string(e.what()).find("no interior node") !=
-                                      std::string::npos;
-                         }));
+  Surface surface = extract_surface(mesh);
+  mesh.nodes[3] = {1, 1, 0};  // flat
+  REQUIRE_THROWS_AS(
+      choose_detector_points(mesh, surface, {0, 0, 0, 0}, 1, DetectorStrategy::kVisibility, 0.5),
+      InputError);
 }

@@ -138,8 +138,10 @@ TEST_CASE("Two interlocked tori build into one asset with clusters per component
   const std::set<std::uint32_t> lower = clusters_of(a, half, false);
   const std::set<std::uint32_t> upper = clusters_of(a, half, true);
   CHECK(lower.size() + upper.size() == a.clusters.size());
-  for (std::uint32_t c : lower) CHECK(a.clusters[c].detector_node < half);
-  for (std::uint32_t c : upper) CHECK(a.clusters[c].detector_node >= half);
+  for (std::uint32_t c : lower)
+    for (std::uint32_t v : a.clusters[c].detector.nodes) CHECK(v < half);
+  for (std::uint32_t c : upper)
+    for (std::uint32_t v : a.clusters[c].detector.nodes) CHECK(v >= half);
   for (std::size_t t = 0; t < a.triangles.size(); ++t)
     for (std::uint32_t v : a.triangles[t]) CHECK((v >= half) == (a.triangles[t][0] >= half));
 
@@ -154,7 +156,7 @@ TEST_CASE("Two interlocked tori build into one asset with clusters per component
     CHECK(alone.triangle_cluster[t] == a.triangle_cluster[t]);
   }
   for (std::size_t c = 0; c < alone.clusters.size(); ++c)
-    CHECK(alone.clusters[c].detector_node == a.clusters[c].detector_node);
+    CHECK(alone.clusters[c].detector.nodes == a.clusters[c].detector.nodes);
 
   // --clusters single: one cluster per component.
   const format::Asset single = build(tori, preprocess::ClusterMethod::kSingle);

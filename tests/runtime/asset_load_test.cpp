@@ -51,8 +51,7 @@ TEST_CASE("A failed runtime load leaves the asset empty and says why", "[format]
     CHECK(tetseg::load_asset_file("/nonexistent/asset.tetseg", asset) == tetseg::Status::kIoError);
   }
   SECTION("A newer minor version is refused.") {
-    tetseg::test::put_le(bytes, tetseg::test::kMinorAt,
-                         get_le(bytes, tetseg::test::kMinorAt, 2) + 1, 2);
+    tetseg::test::put_le(bytes, tetseg::test::kMinorAt, tetseg::format::kVersionMinor + 1, 2);
     tetseg::test::reseal_header(bytes);
     CHECK(tetseg::load_asset(bytes.data(), bytes.size(), asset) ==
           tetseg::Status::kUnsupportedVersion);

@@ -43,7 +43,8 @@ UsedNodes used_nodes(const format::Asset& asset, bool with_detectors) {
     for (std::uint32_t v : t) mark(v);
   for (std::uint32_t v : asset.boundary_nodes) mark(v);
   if (with_detectors)
-    for (const auto& c : asset.clusters) mark(c.detector_node);
+    for (const auto& c : asset.clusters)
+      if (c.detector.is_node()) mark(c.detector.nodes[0]);
   used.index.assign(n, UINT32_MAX);
   for (std::uint32_t v = 0; v < n; ++v)
     if (flag[v]) {
@@ -89,9 +90,22 @@ std::string asset_to_vtu(const format::Asset& asset, const std::string& source) 
     grid.points.push_back(asset.rest_positions[v]);
     node_id.values.push_back(v);
   }
+  // Point-form detectors: extra points after the used nodes.
+  std::vector<std::uint32_t> detector_point(asset.clusters.size(), UINT32_MAX);
+  for (std::size_t c = 0; c < asset.clusters.size(); ++c) {
+    const format::DetectorPoint& d = asset.clusters[c].detector;
+    if (d.is_node()) {
+      detector_point[c] = used.index[d.nodes[0]];
+    } else {
+      detector_point[c] = static_cast<std::uint32_t>(grid.points.size());
+      grid.points.push_back(format::detector_position(d, asset.rest_positions.front().data()));
+      node_id.values.push_back(UINT32_MAX);
+    }
+  }
   grid.point_data.push_back(std::move(node_id));
   io::DataArray cluster{"cluster", "Int32", {}}, kind{"kind", "UInt8", {}},
-      boundary{"boundary", "Int32", {}}, visibility{"rest_positive_fraction", "Float32", {}};
+      boundary{"boundary", "Int32", {}}, visibility{"rest_positive_fraction", "Float32", {}},
+      overlap_only{"overlap_only", "UInt8", {}}, detector_tet{"detector_tet", "Int32", {}};
   auto add_cell = [&](std::uint8_t type, std::vector<std::uint32_t> points, double cluster_id,
                       double kind_id, double boundary_id, double fraction) {
     grid.cell_types.push_back(type);
@@ -100,6 +114,16 @@ std::string asset_to_vtu(const format::Asset& asset, const std::string& source) 
     kind.values.push_back(kind_id);
     boundary.values.push_back(boundary_id);
     visibility.values.push_back(fraction);
+    const bool in_cluster = cluster_id >= 0 && cluster_id < asset.clusters.size();
+    overlap_only.values.push_back(
+        in_cluster && (asset.clusters[static_cast<std::size_t>(cluster_id)].flags &
+                       format::kClusterOverlapOnly)
+            ? 1.0
+            : 0.0);
+    const std::uint32_t tet =
+        kind_id == 2 ? asset.clusters[static_cast<std::size_t>(cluster_id)].detector.tet
+                     : format::kNoTet;
+    detector_tet.values.push_back(tet == format::kNoTet ? -1.0 : static_cast<double>(tet));
   };
   const std::size_t det_count = asset.clusters.size();
   for (std::size_t t = 0; t < asset.triangles.size(); ++t) {
@@ -117,11 +141,11 @@ std::string asset_to_vtu(const format::Asset& asset, const std::string& source) 
     add_cell(4, std::move(points), -1, 1, static_cast<double>(l), 0.0);
   }
   for (std::size_t c = 0; c < det_count; ++c) {
-    add_cell(1, {used.index[asset.clusters[c].detector_node]}, static_cast<double>(c), 2, -1,
+    add_cell(1, {detector_point[c]}, static_cast<double>(c), 2, -1,
              asset.clusters[c].rest_positive_fraction);
   }
-  grid.cell_data = {std::move(cluster), std::move(kind), std::move(boundary),
-                    std::move(visibility)};
+  grid.cell_data = {std::move(cluster),    std::move(kind),         std::move(boundary),
+                    std::move(visibility), std::move(overlap_only), std::move(detector_tet)};
   return io::vtu_text(grid);
 }
 
@@ -150,6 +174,41 @@ std::string asset_to_ply(const format::Asset& asset, const std::string& source) 
     }
   }
   return io::ply_text(ply);
+}
+
+std::string detector_json(const format::Asset& asset, const format::Cluster& cluster) {
+  const format::DetectorPoint& d = cluster.detector;
+  std::ostringstream out;
+  out.precision(17);
+  out << "\"detector\": {\"nodes\": [" << d.nodes[0] << ", " << d.nodes[1] << ", " << d.nodes[2]
+      << ", " << d.nodes[3] << "], \"weights\": [" << d.weights[0] << ", " << d.weights[1] << ", "
+      << d.weights[2] << ", " << d.weights[3] << "], \"tet\": ";
+  if (d.tet == format::kNoTet)
+    out << "null";
+  else
+    out << d.tet;
+  if (!asset.rest_positions.empty() && asset.rest_positions.size() == asset.node_count) {
+    const auto p = format::detector_position(d, asset.rest_positions.front().data());
+    out << ", \"position\": [" << p[0] << ", " << p[1] << ", " << p[2] << "]";
+  }
+  out << "}, \"overlap_only\": "
+      << ((cluster.flags & format::kClusterOverlapOnly) ? "true" : "false");
+  return out.str();
+}
+
+std::string detector_text(const format::Cluster& cluster) {
+  const format::DetectorPoint& d = cluster.detector;
+  char buf[160];
+  if (d.is_node()) {
+    std::snprintf(buf, sizeof buf, "node %u", static_cast<unsigned>(d.nodes[0]));
+  } else {
+    const std::string tet = d.tet == format::kNoTet ? "?" : std::to_string(d.tet);
+    std::snprintf(buf, sizeof buf, "tet %s (%u %u %u %u) w %.4g %.4g %.4g %.4g", tet.c_str(),
+                  static_cast<unsigned>(d.nodes[0]), static_cast<unsigned>(d.nodes[1]),
+                  static_cast<unsigned>(d.nodes[2]), static_cast<unsigned>(d.nodes[3]),
+                  d.weights[0], d.weights[1], d.weights[2], d.weights[3]);
+  }
+  return buf;
 }
 
 }  // namespace tetseg::tools

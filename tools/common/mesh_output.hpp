@@ -27,16 +27,29 @@ Rgb scalar_color(double value) noexcept;
 void require_rest_positions(const format::Asset& asset, const std::string& source);
 
 /// VTK XML UnstructuredGrid (ASCII). Points: the rest positions of the nodes used by surface
-/// triangles, boundaries and detectors (renumbered, original id in point data `node_id`).
+/// triangles, boundaries and node-form detectors (renumbered, original id in point data
+/// `node_id`), then the rest position of every point-form detector (`node_id` 4294967295).
 /// Cells: surface triangles, then one closed poly-line per segment boundary, then one vertex
-/// per detector node. Cell data: `cluster` (Int32; -1 for boundaries), `kind` (0 triangle,
+/// per detector. Cell data: `cluster` (Int32; -1 for boundaries), `kind` (0 triangle,
 /// 1 boundary, 2 detector), `boundary` (loop index or -1), `rest_positive_fraction` (of the
-/// cell's cluster; 0 for boundaries). Deterministic. Calls require_rest_positions first.
+/// cell's cluster; 0 for boundaries), `overlap_only` (1 when the cell's cluster is flagged
+/// overlap-only, else 0), `detector_tet` (detector cells: the input tet holding the point, -1
+/// for a node or an unknown tet; -1 for other cells). Deterministic. Calls
+/// require_rest_positions first.
 std::string asset_to_vtu(const format::Asset& asset, const std::string& source);
 
 /// ASCII PLY: the surface with per-face colour palette_color(cluster) and a `cluster` face
 /// property, plus an `edge` element (black) for every segment-boundary edge. Deterministic.
 /// Calls require_rest_positions first.
 std::string asset_to_ply(const format::Asset& asset, const std::string& source);
+
+/// A cluster's detector and flag as JSON members (no braces), shared by `tetseg-dump --json`
+/// and the build report: `"detector": {"nodes": [4 ids], "weights": [4], "tet": id or null,
+/// "position": [x, y, z] (when rest positions are given, else omitted)}, "overlap_only": bool`.
+std::string detector_json(const format::Asset& asset, const format::Cluster& cluster);
+
+/// One-line human form of a detector: "node 17" for the node form, else
+/// "tet 512 (3 9 10 44) w 0.25 0.25 0.25 0.25".
+std::string detector_text(const format::Cluster& cluster);
 
 }  // namespace tetseg::tools

@@ -105,12 +105,24 @@ void print_summary(const std::string& path, const std::string& version, const As
   for (const auto& [key, value] : asset.provenance.options) {
     std::printf("    %-36s %s\n", key.c_str(), value.c_str());
   }
-  std::printf("  %-8s %10s %14s %18s %15s\n", "cluster", "triangles", "detector_node",
-              "rest_positive", "boundary_edges");
+  std::size_t flagged = 0;
+  for (const auto& cluster : asset.clusters)
+    flagged += (cluster.flags & tetseg::format::kClusterOverlapOnly) ? 1 : 0;
+  std::printf("  overlap-only        %zu clusters (culled by BVH overlap only)\n", flagged);
+  std::printf("  %-8s %10s %14s %15s %-12s  %s\n", "cluster", "triangles", "rest_positive",
+              "boundary_edges", "culling", "detector");
   for (std::size_t c = 0; c < asset.clusters.size(); ++c) {
     const auto& cluster = asset.clusters[c];
-    std::printf("  %-8zu %10u %14u %18.4f %15u\n", c, cluster.triangle_count, cluster.detector_node,
-                cluster.rest_positive_fraction, edges[c]);
+    const bool overlap_only = (cluster.flags & tetseg::format::kClusterOverlapOnly) != 0;
+    std::printf("  %-8zu %10u %14.4f %15u %-12s  %s", c, cluster.triangle_count,
+                cluster.rest_positive_fraction, edges[c], overlap_only ? "overlap-only" : "rvbc",
+                tetseg::tools::detector_text(cluster).c_str());
+    if (!asset.rest_positions.empty()) {
+      const auto p =
+          tetseg::format::detector_position(cluster.detector, asset.rest_positions.front().data());
+      std::printf(" at (%.6g, %.6g, %.6g)", p[0], p[1], p[2]);
+    }
+    std::printf("\n");
   }
 }
 
@@ -128,8 +140,8 @@ void print_json(const std::string& version, const Asset& asset) {
   out << "  \"clusters\": [";
   for (std::size_t c = 0; c < asset.clusters.size(); ++c) {
     const auto& cluster = asset.clusters[c];
-    out << (c ? ",\n    " : "\n    ") << "{\"triangles\": " << cluster.triangle_count
-        << ", \"detector_node\": " << cluster.detector_node
+    out << (c ? ",\n    " : "\n    ") << "{\"triangles\": " << cluster.triangle_count << ", "
+        << tetseg::tools::detector_json(asset, cluster)
         << ", \"rest_positive_fraction\": " << cluster.rest_positive_fraction
         << ", \"boundary_edges\": " << edges[c] << ", \"bvh_nodes\": " << cluster.bvh_count << "}";
   }
@@ -165,7 +177,7 @@ int main(int argc, char** argv) {
   std::string vtu_path, ply_path;
   app.add_option("--vtu", vtu_path,
                  "Also write the surface with cluster ids, boundaries and "
-                 "detector nodes as ParaView .vtu (needs rest positions)");
+                 "detector points as ParaView .vtu (needs rest positions)");
   app.add_option("--ply", ply_path,
                  "Also write the surface with cluster colours and boundary "
                  "edges as .ply (needs rest positions)");

@@ -31,13 +31,24 @@ RenderMesh mesh_from_asset(const std::string& path, bool boundaries, bool detect
   RenderMesh mesh;
   mesh.positions = asset.rest_positions;
   mesh.triangles = asset.triangles;
-  for (std::uint32_t c : asset.triangle_cluster) mesh.face_colors.push_back(palette_color(c));
+  // Overlap-only clusters (no detector sees them well) are drawn half grey.
+  for (std::uint32_t c : asset.triangle_cluster) {
+    Rgb color = palette_color(c);
+    if (asset.clusters[c].flags & tetseg::format::kClusterOverlapOnly)
+      for (auto& channel : color) channel = static_cast<std::uint8_t>((channel + 160) / 2);
+    mesh.face_colors.push_back(color);
+  }
   if (boundaries)
     for (const auto& loop : asset.boundaries)
       mesh.loops.emplace_back(asset.boundary_nodes.begin() + loop.node_offset,
                               asset.boundary_nodes.begin() + loop.node_offset + loop.node_count);
   if (detectors) {
-    for (const auto& c : asset.clusters) mesh.points.push_back(c.detector_node);
+    // Detector points (inside tets or at nodes) are appended as extra positions.
+    for (const auto& c : asset.clusters) {
+      mesh.points.push_back(static_cast<std::uint32_t>(mesh.positions.size()));
+      mesh.positions.push_back(
+          tetseg::format::detector_position(c.detector, asset.rest_positions.front().data()));
+    }
     mesh.points_on_top = true;
   }
   return mesh;
@@ -69,7 +80,10 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(16, 8192))
       ->capture_default_str();
   app.add_flag("--no-boundaries", no_boundaries, "Asset: do not draw segment boundaries");
-  app.add_flag("--detectors", detectors, "Asset: draw detector nodes (black squares, on top)");
+  app.add_flag(
+      "--detectors", detectors,
+      "Asset: draw detector points (black squares, on top; overlap-only clusters are drawn "
+      "half grey)");
   app.add_flag("--png-stored", stored, "Write the PNG uncompressed (zlib stored blocks)");
   app.add_option("--scalar", scalar,
                  "PLY: colour faces by this face property (rescaled to [min,max]) instead of "

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "commands.hpp"
+#include "mesh_output.hpp"
 #include "tetseg/format/asset_io.hpp"
 #include "tetseg/preprocess/io.hpp"
 #include "tetseg/preprocess/meshing.hpp"
@@ -90,7 +91,7 @@ std::string report_json(const BuildArgs& args, const BuildReport& report,
   out << "  \"clusters\": [";
   for (std::size_t c = 0; c < asset.clusters.size(); ++c) {
     out << (c ? ",\n    " : "\n    ") << "{\"triangles\": " << asset.clusters[c].triangle_count
-        << ", \"detector_node\": " << asset.clusters[c].detector_node
+        << ", " << detector_json(asset, asset.clusters[c])
         << ", \"rest_positive_fraction\": " << asset.clusters[c].rest_positive_fraction << "}";
   }
   out << "\n  ],\n  \"options\": {";
@@ -160,9 +161,10 @@ void run_build(const BuildArgs& args) {
                       report_json(args, report, notes, asset, bytes.size(), total));
   }
   if (!args.quiet) {
-    // Clusters no interior node sees well cost run time in every frame: say which, and why.
-    std::size_t poor = 0, worst = 0;
+    // Clusters no detector point sees well cost run time in every frame: say which, and why.
+    std::size_t poor = 0, worst = 0, flagged = 0;
     for (std::size_t c = 0; c < asset.clusters.size(); ++c) {
+      flagged += (asset.clusters[c].flags & format::kClusterOverlapOnly) ? 1 : 0;
       if (asset.clusters[c].rest_positive_fraction < kPoorVisibility) ++poor;
       if (asset.clusters[c].rest_positive_fraction < asset.clusters[worst].rest_positive_fraction)
         worst = c;
@@ -170,11 +172,12 @@ void run_build(const BuildArgs& args) {
     if (poor > 0) {
       std::fprintf(stderr,
                    "tetseg: note: %zu of %zu clusters are seen less than %.0f%% positive at rest "
-                   "from their detector node (lowest: cluster %zu, %.1f%%); thin parts without "
-                   "interior nodes cause this: a finer interior (--cell-size) gives more "
-                   "candidates (docs/segmentation.md, step 7)\n",
+                   "from their detector point (lowest: cluster %zu, %.1f%%); %zu flagged "
+                   "overlap-only (below --min-visibility %g); thin parts cause this: a finer "
+                   "interior (--cell-size) gives more candidates (docs/segmentation.md, step 7)\n",
                    poor, asset.clusters.size(), 100.0 * kPoorVisibility, worst,
-                   100.0 * asset.clusters[worst].rest_positive_fraction);
+                   100.0 * asset.clusters[worst].rest_positive_fraction, flagged,
+                   args.options.segmentation.min_visibility);
     }
     std::fprintf(stderr, "tetseg: done in %.3f s\n", total);
   }
@@ -244,6 +247,12 @@ void add_build_command(CLI::App& root) {
                   "nearest-centroid (the paper) or visibility (most triangles positive at rest)")
       ->transform(CLI::CheckedTransformer(name_map<DetectorStrategy>(), CLI::ignore_case))
       ->option_text(name_list<DetectorStrategy>() + " (visibility)");
+  cmd->add_option("--min-visibility", seg.min_visibility,
+                  "Clusters whose best detector point sees less than this share of them "
+                  "positive at rest are flagged overlap-only: culled by BVH overlap only at run "
+                  "time (0: none)")
+      ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str();
 
   cmd->add_option("--solver", args->options.charge.solver,
                   "Charge solver: auto, direct, gmres, fast")

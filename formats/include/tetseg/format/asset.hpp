@@ -9,6 +9,7 @@
 /// to tet-mesh node ids.
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <string>
 #include <utility>
@@ -17,9 +18,10 @@
 namespace tetseg::format {
 
 /// Asset format version. Major must match to load; an asset with an older or equal minor
-/// version loads, a newer minor does not.
+/// version loads, a newer minor does not. 1.1 added detector points inside tets and the
+/// overlap-only cluster flag; `write_asset` writes 1.0 when the asset needs neither.
 inline constexpr std::uint16_t kVersionMajor = 1;
-inline constexpr std::uint16_t kVersionMinor = 0;
+inline constexpr std::uint16_t kVersionMinor = 1;
 
 /// Documented limits, checked on load (docs/format.md). They bound memory for hostile input.
 inline constexpr std::uint32_t kMaxNodes = 1u << 26;              ///< 67,108,864 tet-mesh nodes
@@ -44,10 +46,63 @@ struct BvhNode {
   std::uint32_t count = 0;   ///< leaf: triangle count (> 0); inner: 0
 };
 
+/// Input tet id of a detector that is not traced to a tet (node form, or unknown).
+inline constexpr std::uint32_t kNoTet = 0xFFFFFFFFu;
+
+/// Largest |sum of a detector's weights - 1| that validation accepts (docs/format.md).
+inline constexpr double kDetectorWeightSumTolerance = 1e-9;
+
+/// The point radial views are taken from: a barycentric combination of four tet-mesh nodes,
+/// `sum weights[i] * x[nodes[i]]`, evaluated by the runtime from each step's positions (so it
+/// moves with its tet). Two forms (docs/format.md, "Detectors"):
+/// - node form: all four ids equal, weights exactly (1, 0, 0, 0): the node itself, an
+///   interior node (not on the surface), read bit for bit as in format 1.0;
+/// - point form: four distinct ids (the nodes of one tet), weights finite, >= 0, summing to 1
+///   within kDetectorWeightSumTolerance.
+struct DetectorPoint {
+  std::array<std::uint32_t, 4> nodes{};
+  std::array<double, 4> weights{1.0, 0.0, 0.0, 0.0};
+  std::uint32_t tet = kNoTet;  ///< input tet id, for tracing only (the asset stores no tets)
+
+  /// The node form at `node`.
+  static DetectorPoint at_node(std::uint32_t node) {
+    DetectorPoint d;
+    d.nodes = {node, node, node, node};
+    return d;
+  }
+  /// True for the node form (four equal ids, weights exactly 1, 0, 0, 0).
+  bool is_node() const {
+    return nodes[1] == nodes[0] && nodes[2] == nodes[0] && nodes[3] == nodes[0] &&
+           weights[0] == 1.0 && weights[1] == 0.0 && weights[2] == 0.0 && weights[3] == 0.0;
+  }
+};
+
+/// The detector's position given all node positions `xyz` (node_count x 3 doubles): for the
+/// node form the node's position bit for bit, else `w0 x0 + w1 x1 + w2 x2 + w3 x3` evaluated in
+/// this order. The one evaluation every reader uses (runtime per step, tools at rest).
+inline std::array<double, 3> detector_position(const DetectorPoint& d, const double* xyz) {
+  const double* p0 = xyz + 3 * std::size_t(d.nodes[0]);
+  if (d.is_node()) return {p0[0], p0[1], p0[2]};
+  std::array<double, 3> out{};
+  for (int k = 0; k < 3; ++k) {
+    double sum = d.weights[0] * p0[k];
+    for (int i = 1; i < 4; ++i) sum += d.weights[i] * xyz[3 * std::size_t(d.nodes[i]) + k];
+    out[k] = sum;
+  }
+  return out;
+}
+
+/// Cluster flag: no detector point sees the cluster well at rest, so it is culled by BVH
+/// overlap only (its triangles are never classified by orientation).
+inline constexpr std::uint32_t kClusterOverlapOnly = 1u;
+/// Every cluster flag this version defines; other bits are invalid content.
+inline constexpr std::uint32_t kKnownClusterFlags = kClusterOverlapOnly;
+
 /// A cluster: a connected patch of the surface bounded by segment boundaries, culled with
-/// radial views from its detector node.
+/// radial views from its detector point (or by overlap only when flagged).
 struct Cluster {
-  std::uint32_t detector_node = 0;      ///< interior tet-mesh node (not on the surface)
+  DetectorPoint detector;               ///< node form: an interior node
+  std::uint32_t flags = 0;              ///< kClusterOverlapOnly or 0
   float rest_positive_fraction = 0.0f;  ///< in [0,1]: share of triangles positive at rest
   std::uint32_t triangle_offset = 0;    ///< into Asset::cluster_triangles
   std::uint32_t triangle_count = 0;     ///< > 0

@@ -34,10 +34,16 @@ enum class Status : std::uint8_t {
 /// Short stable name of a status, e.g. "payload checksum". Never null.
 const char* to_string(Status status) noexcept;
 
-/// Serialises `asset` (envelope + payload) into bytes. Deterministic: equal assets give equal
-/// bytes, and `write_asset` of an asset read from bytes `b` gives `b` again. Does not
-/// validate; call `validate` first when the asset is built by hand (an invalid asset is
-/// written, and then refused by `read_asset`). Throws std::bad_alloc only. Thread-safe.
+/// The oldest minor version of format 1 that holds `asset`: 0 when every detector is in node
+/// form without a tet id and no cluster has a flag, else 1 (docs/format.md, "Versions").
+std::uint16_t minor_version_needed(const Asset& asset) noexcept;
+
+/// Serialises `asset` (envelope + payload) into bytes, as version
+/// 1.`minor_version_needed(asset)`, so an asset that needs nothing new stays readable by 1.0
+/// readers. Deterministic: equal assets give equal bytes, and `write_asset` of an asset read from
+/// bytes `b` gives `b` again. Does not validate; call `validate` first when the asset is built by
+/// hand (an invalid asset is written, and then refused by `read_asset`). Throws std::bad_alloc
+/// only. Thread-safe.
 std::vector<std::uint8_t> write_asset(const Asset& asset);
 
 /// Parses and validates `size` bytes at `data` into `out`. Safe on untrusted input: reads
@@ -61,8 +67,9 @@ Status read_asset_file(const std::string& path, Asset& out, std::string* detail 
 /// Semantic validation alone (what `read_asset` checks after decoding; the full rule list
 /// is in docs/format.md, "Validation rules"): counts within the documented limits, indices
 /// in range, clusters and loops contiguous, clusters partition the triangles, BVHs are
-/// trees whose leaves cover each cluster once, detector nodes interior, loop edges on the
-/// surface, floats finite, provenance keys sorted. Returns kOk or kInvalidContent (with the
+/// trees whose leaves cover each cluster once, detectors well formed (node form: an interior
+/// node; point form: four distinct ids, barycentric weights), known cluster flags only, loop edges
+/// on the surface, floats finite, provenance keys sorted. Returns kOk or kInvalidContent (with the
 /// first broken rule in `detail`). Memory is proportional to the asset's vectors, never to
 /// `node_count`. Thread-safe; never throws.
 Status validate(const Asset& asset, std::string* detail = nullptr) noexcept;

@@ -36,6 +36,9 @@ struct SegmentationOptions {
   /// derived_min_cluster_triangles(N).
   std::uint32_t min_cluster_triangles = 0;
   DetectorStrategy detector = DetectorStrategy::kVisibility;  ///< used by choose_detectors
+  /// A cluster whose best detector point sees a smaller share of its triangles positive at
+  /// rest is flagged overlap-only (culled by BVH overlap only at run time). 0 flags none.
+  double min_visibility = 0.5;
 };
 
 /// The default minimum cluster size for N surface triangles: max(8, ceil(N / 200)), capped at N.
@@ -117,6 +120,32 @@ std::uint32_t count_positive_triangles(const std::vector<Vec3>& nodes,
 std::vector<Detector> choose_detectors(const std::vector<Vec3>& nodes, const Surface& surface,
                                        const std::vector<std::uint32_t>& triangle_cluster,
                                        std::uint32_t cluster_count, DetectorStrategy strategy);
+
+/// A cluster's detector as stored in the asset: an interior node or a point inside a tet.
+struct DetectorChoice {
+  format::DetectorPoint point;  ///< node form, or point form: a tet's centroid, tet id set
+  Vec3 position{};              ///< rest position of the point
+  float rest_positive_fraction = 0.0f;
+  std::uint32_t triangle_count = 0;
+  std::uint32_t positive_triangles = 0;
+  bool overlap_only = false;  ///< rest_positive_fraction < min_visibility
+};
+
+/// One detector point per cluster (docs/segmentation.md, "Detector points"). The interior node
+/// choose_detectors would pick (when the mesh has interior nodes) is kept unless a tet
+/// centroid sees strictly more of the cluster positive at rest. Tet candidates (kVisibility,
+/// only for clusters that node does not see whole, or every cluster when there is no interior
+/// node): the centroids of non-degenerate tets, chosen like the nodes (kDetectorNearCentroid
+/// nearest the cluster's centroid, kDetectorNearKernel nearest its kernel estimate, up to
+/// kDetectorInBox in its box), scored exactly, ties to the one nearer the centroid, then the
+/// lower tet id. kNearestCentroid without interior nodes: the tet centroid nearest the
+/// cluster's centroid. A cluster seen less than `min_visibility` is flagged overlap_only.
+/// Deterministic; O(clusters x (interior nodes + tets) + candidates x N). Throws InputError
+/// when the mesh has neither an interior node nor a non-degenerate tet, and
+/// std::invalid_argument as choose_detectors.
+std::vector<DetectorChoice> choose_detector_points(
+    const TetMesh& mesh, const Surface& surface, const std::vector<std::uint32_t>& triangle_cluster,
+    std::uint32_t cluster_count, DetectorStrategy strategy, double min_visibility);
 
 /// The detector choose_detectors picks for one set of surface triangles (`triangle_ids`, any
 /// order). Preconditions (unchecked): at least one interior node, every id in range.

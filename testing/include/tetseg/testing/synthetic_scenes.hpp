@@ -169,6 +169,21 @@ struct Scene {
   std::uint32_t surface_nodes = 0;
 };
 
+/// Validates, writes and loads `a` as a scene whose first `surface_nodes` nodes are the
+/// surface's vertices. Throws std::runtime_error when the asset is invalid.
+inline Scene load_scene(const format::Asset& a, std::uint32_t surface_nodes) {
+  std::string why;
+  if (format::validate(a, &why) != format::Status::kOk)
+    throw std::runtime_error("invalid test asset: " + why);
+  const std::vector<std::uint8_t> bytes = format::write_asset(a);
+  Scene scene;
+  if (load_asset(bytes.data(), bytes.size(), scene.asset, &why) != format::Status::kOk)
+    throw std::runtime_error("test asset does not load: " + why);
+  for (const P3& p : a.rest_positions) scene.rest.insert(scene.rest.end(), p.begin(), p.end());
+  scene.surface_nodes = surface_nodes;
+  return scene;
+}
+
 /// Assembles, validates and loads an asset. `cluster_of[t]` in [0, detectors.size()).
 /// `leaf_size` 0 builds chain BVHs (build_chain_bvh) instead of median splits.
 inline Scene make_scene(const Surface& s, const std::vector<std::uint32_t>& cluster_of,
@@ -193,7 +208,7 @@ inline Scene make_scene(const Surface& s, const std::vector<std::uint32_t>& clus
       build_bvh(s, tris, leaf_size, order, nodes);
     }
     format::Cluster cl;
-    cl.detector_node = nv + c;
+    cl.detector = format::DetectorPoint::at_node(nv + c);
     cl.rest_positive_fraction = 1.0f;
     cl.triangle_offset = static_cast<std::uint32_t>(a.cluster_triangles.size());
     cl.triangle_count = static_cast<std::uint32_t>(order.size());
@@ -204,16 +219,39 @@ inline Scene make_scene(const Surface& s, const std::vector<std::uint32_t>& clus
     a.clusters.push_back(cl);
   }
   a.provenance.tool_version = "tetseg tests";
-  std::string why;
-  if (format::validate(a, &why) != format::Status::kOk)
-    throw std::runtime_error("invalid test asset: " + why);
-  const std::vector<std::uint8_t> bytes = format::write_asset(a);
-  Scene scene;
-  if (load_asset(bytes.data(), bytes.size(), scene.asset, &why) != format::Status::kOk)
-    throw std::runtime_error("test asset does not load: " + why);
-  for (const P3& p : a.rest_positions) scene.rest.insert(scene.rest.end(), p.begin(), p.end());
-  scene.surface_nodes = nv;
-  return scene;
+  return load_scene(a, nv);
+}
+
+/// The scene's asset with every cluster's detector moved into a small tet of its own: four new
+/// nodes (appended after all others, 4 per cluster, in cluster order) around the old detector
+/// position at distance `radius`, the detector the point with `weights` in it (point form,
+/// tet id = cluster id). The old detector nodes stay (unread). Positions of the new nodes
+/// follow the deformation like every node; tests may move them on their own.
+inline Scene with_detector_tets(const Scene& scene, double radius,
+                                const std::array<double, 4>& weights = {0.4, 0.3, 0.2, 0.1}) {
+  format::Asset a = scene.asset.data();
+  const P3 corner[4] = {{1, 1, 1}, {1, -1, -1}, {-1, 1, -1}, {-1, -1, 1}};
+  for (std::uint32_t c = 0; c < a.clusters.size(); ++c) {
+    const P3 center = a.rest_positions[a.clusters[c].detector.nodes[0]];
+    format::DetectorPoint d;
+    for (int i = 0; i < 4; ++i) {
+      d.nodes[i] = a.node_count++;
+      a.rest_positions.push_back({center[0] + radius * corner[i][0],
+                                  center[1] + radius * corner[i][1],
+                                  center[2] + radius * corner[i][2]});
+    }
+    d.weights = weights;
+    d.tet = c;
+    a.clusters[c].detector = d;
+  }
+  return load_scene(a, scene.surface_nodes);
+}
+
+/// The scene's asset with `flags` (e.g. format::kClusterOverlapOnly) set on every cluster.
+inline Scene with_cluster_flags(const Scene& scene, std::uint32_t flags) {
+  format::Asset a = scene.asset.data();
+  for (format::Cluster& c : a.clusters) c.flags = flags;
+  return load_scene(a, scene.surface_nodes);
 }
 
 /// Clusters by triangle-centroid z: cut at `cuts` (ascending); detectors on the axis at
