@@ -114,19 +114,33 @@ void check_components(const TetMesh& mesh, const Surface& surface, const std::st
                                  std::to_string(shells[c]) +
                                  " closed surfaces: bodies with a cavity are not supported");
   if (count <= 1) return;
-  // Nesting: a surface node of component c inside the closed surface of component d.
+  std::vector<std::uint32_t> triangle_component;
+  triangle_component.reserve(surface.triangles.size());
+  for (const Tri& t : surface.triangles) triangle_component.push_back(part[t[0]]);
+  check_not_nested(mesh.nodes, surface.triangles, triangle_component, count, file);
+}
+
+void check_not_nested(const std::vector<Vec3>& points, const std::vector<Tri>& triangles,
+                      const std::vector<std::uint32_t>& triangle_component, std::uint32_t count,
+                      const std::string& file) {
+  if (count <= 1) return;
   std::vector<std::array<Vec3, 2>> box(count);
   for (auto& b : box) {
     b[0] = {INFINITY, INFINITY, INFINITY};
     b[1] = {-INFINITY, -INFINITY, -INFINITY};
   }
-  for (std::uint32_t v : surface.surface_nodes)
-    for (int k = 0; k < 3; ++k) {
-      box[part[v]][0][k] = std::min(box[part[v]][0][k], mesh.nodes[v][k]);
-      box[part[v]][1][k] = std::max(box[part[v]][1][k], mesh.nodes[v][k]);
-    }
+  std::vector<std::uint32_t> first_node(count, kUnset);
+  for (std::size_t t = 0; t < triangles.size(); ++t) {
+    const std::uint32_t c = triangle_component[t];
+    if (first_node[c] == kUnset) first_node[c] = triangles[t][0];
+    for (std::uint32_t v : triangles[t])
+      for (int k = 0; k < 3; ++k) {
+        box[c][0][k] = std::min(box[c][0][k], points[v][k]);
+        box[c][1][k] = std::max(box[c][1][k], points[v][k]);
+      }
+  }
   for (std::uint32_t c = 0; c < count; ++c) {
-    const Vec3& p = mesh.nodes[first_node[c]];
+    const Vec3& p = points[first_node[c]];
     for (std::uint32_t d = 0; d < count; ++d) {
       if (d == c) continue;
       bool inside_box = true;
@@ -134,17 +148,43 @@ void check_components(const TetMesh& mesh, const Surface& surface, const std::st
         inside_box = inside_box && p[k] >= box[d][0][k] && p[k] <= box[d][1][k];
       if (!inside_box) continue;
       double angle = 0.0;
-      for (const Tri& t : surface.triangles)
-        if (part[t[0]] == d)
-          angle += solid_angle(p, mesh.nodes[t[0]], mesh.nodes[t[1]], mesh.nodes[t[2]]);
+      for (std::size_t t = 0; t < triangles.size(); ++t)
+        if (triangle_component[t] == d)
+          angle += solid_angle(p, points[triangles[t][0]], points[triangles[t][1]],
+                               points[triangles[t][2]]);
       const double four_pi = 16.0 * std::atan(1.0);
       if (std::fabs(angle) > 0.5 * four_pi)
         throw InputError(file, "component " + std::to_string(c + 1) + " (node " +
                                    std::to_string(first_node[c]) + ") lies inside component " +
                                    std::to_string(d + 1) + " of " + std::to_string(count) +
-                                   ": their volumes overlap at rest");
+                                   ": their volumes overlap at rest (a body inside another, or a "
+                                   "cavity, is not supported)");
     }
   }
+}
+
+void check_surface_not_nested(const TriangleMesh& mesh, const std::string& file) {
+  std::vector<std::uint32_t> parent(mesh.vertices.size());
+  std::iota(parent.begin(), parent.end(), 0u);
+  auto find = [&](std::uint32_t x) {
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];
+    return x;
+  };
+  for (const Tri& t : mesh.triangles)
+    for (int k = 1; k < 3; ++k) {
+      const std::uint32_t a = find(t[0]);
+      const std::uint32_t b = find(t[static_cast<std::size_t>(k)]);
+      if (a != b) parent[std::max(a, b)] = std::min(a, b);
+    }
+  std::vector<std::uint32_t> component_of_root(mesh.vertices.size(), kUnset);
+  std::vector<std::uint32_t> triangle_component;
+  std::uint32_t count = 0;
+  for (const Tri& t : mesh.triangles) {
+    std::uint32_t& c = component_of_root[find(t[0])];
+    if (c == kUnset) c = count++;
+    triangle_component.push_back(c);
+  }
+  check_not_nested(mesh.vertices, mesh.triangles, triangle_component, count, file);
 }
 
 std::vector<double> part_values(const std::vector<double>& whole, const SurfacePart& part) {

@@ -31,6 +31,18 @@ std::vector<SurfacePart> split_surface(const TetMesh& mesh, const Surface& surfa
 /// one surface node of each component). Throws InputError(file, ...) naming the component.
 void check_components(const TetMesh& mesh, const Surface& surface, const std::string& file);
 
+/// Throws InputError(file, ...) when a surface node of one component (triangles labelled
+/// 0..count-1 by `triangle_component`) lies inside the closed, oriented surface of another
+/// (generalised winding number above 1/2; only components whose box holds the node are
+/// summed). O(count x triangles) at worst.
+void check_not_nested(const std::vector<Vec3>& points, const std::vector<Tri>& triangles,
+                      const std::vector<std::uint32_t>& triangle_component, std::uint32_t count,
+                      const std::string& file);
+
+/// check_not_nested for a validated closed surface whose components are its triangles joined
+/// through shared vertices (the input of tetrahedralize).
+void check_surface_not_nested(const TriangleMesh& mesh, const std::string& file);
+
 /// The values of `whole` (one per surface triangle) at the part's triangles, in order.
 std::vector<double> part_values(const std::vector<double>& whole, const SurfacePart& part);
 

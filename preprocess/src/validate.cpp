@@ -149,9 +149,8 @@ void check_surface(const std::vector<Vec3>& points, const std::vector<Tri>& tria
   for (std::uint32_t t = 0; t < triangles.size(); ++t)
     if (components.find(t) == t) ++count;
   if (count > 1 && !options.allow_components)
-    throw InputError(file, "surface has " + std::to_string(count) +
-                               " connected components (expected 1; a tet mesh may have several, "
-                               "docs/cli.md)");
+    throw InputError(file,
+                     "surface has " + std::to_string(count) + " connected components (expected 1)");
   // Pinched vertices: one copy per extra fan, so the surface becomes a manifold mesh.
   std::vector<Vec3> split_points;
   std::vector<Tri> split_triangles;

@@ -8,11 +8,13 @@
 #include <set>
 
 #include "tetseg/format/asset_io.hpp"
+#include "tetseg/preprocess/meshing.hpp"
 #include "tetseg/preprocess/pipeline.hpp"
 #include "tetseg/preprocess/structured.hpp"
 #include "tetseg/preprocess/surface.hpp"
 #include "tetseg/runtime/asset.hpp"
 #include "tetseg/runtime/collider.hpp"
+#include "tetseg/testing/charge_shapes.hpp"
 #include "tetseg/testing/scene_oracle.hpp"
 
 using namespace tetseg;
@@ -240,4 +242,31 @@ TEST_CASE("A torus one tet thick builds and its contacts equal brute force when 
   const FrameCheck check = compare_with_oracle(asset, frames);
   CHECK(check.brute_contacts > 0);
   CHECK(check.frames > 6);  // the halves meet late in the fold, not at once
+}
+
+TEST_CASE("A surface with two closed components is tetrahedralised into one two-component mesh",
+          "[components][meshing]") {
+  auto two_spheres = [](double offset, double radius) {
+    preprocess::TriangleMesh s = test::icosphere(3);
+    const preprocess::TriangleMesh other = test::icosphere(3, radius);
+    const auto base = static_cast<std::uint32_t>(s.vertices.size());
+    for (const Vec3& p : other.vertices) s.vertices.push_back({p[0] + offset, p[1], p[2]});
+    for (const preprocess::Tri& t : other.triangles)
+      s.triangles.push_back({t[0] + base, t[1] + base, t[2] + base});
+    return s;
+  };
+  preprocess::MeshingOptions meshing;
+  meshing.facet_size = 0.3;
+  const TetMesh mesh = preprocess::tetrahedralize(two_spheres(2.5, 1.0), meshing, "two.off");
+  preprocess::BuildReport report;
+  preprocess::build_asset(mesh, "two.off", preprocess::BuildOptions{}, report);
+  CHECK(report.components == 2);
+  // A sphere inside the other encloses a cavity: refused before meshing, naming both.
+  try {
+    preprocess::tetrahedralize(two_spheres(0.2, 0.4), meshing, "nested.off");
+    FAIL("a sphere inside another was meshed");
+  } catch (const preprocess::InputError& e) {
+    CHECK(e.file() == "nested.off");
+    CHECK_THAT(e.what(), Catch::Contains("lies inside component 1 of 2"));
+  }
 }

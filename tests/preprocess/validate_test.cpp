@@ -122,7 +122,7 @@ TEST_CASE("Each tet mesh defect is reported with a clear message", "[validate]")
       return Vec3{2.5 + i, 2.5 + j, 2.5 + k};
     });
     CHECK_THAT(tet_error(join(big, small)),
-               Catch::Contains("component 2 (node 64) lies inside component 1 of 2: their "
+               Catch::Contains("component 2 (node 68) lies inside component 1 of 2: their "
                                "volumes overlap at rest"));
   }
   SECTION("A hollow block (a cavity) is refused.") {
