@@ -59,8 +59,9 @@ struct FrameCheck {
   std::vector<Contact> first;      ///< those contacts
 };
 
-/// Steps `frames` through the asset's colliders in rvbc and bvh modes until the first step with
-/// contacts. Each step: `any` agrees with brute force; bvh reports exactly the brute-force set;
+/// Steps `frames` through the asset's colliders in rvbc, bvh and cone modes until the first step
+/// with contacts. Each step: `any` agrees with brute force; bvh and cone report exactly the
+/// brute-force set;
 /// rvbc reports every brute-force contact up to the earliest one (the runtime's guarantee,
 /// docs/runtime.md) and the same earliest time.
 FrameCheck compare_with_oracle(const Asset& asset, const std::vector<std::vector<double>>& frames) {
@@ -68,10 +69,14 @@ FrameCheck compare_with_oracle(const Asset& asset, const std::vector<std::vector
   rvbc_options.mode = ColliderMode::kRvbc;
   ColliderOptions bvh_options;
   bvh_options.mode = ColliderMode::kBvh;
+  ColliderOptions cone_options;
+  cone_options.mode = ColliderMode::kCone;
   Collider rvbc(asset, rvbc_options);
   Collider bvh(asset, bvh_options);
+  Collider cone(asset, cone_options);
   REQUIRE(rvbc.status() == ColliderStatus::kOk);
   REQUIRE(bvh.status() == ColliderStatus::kOk);
+  REQUIRE(cone.status() == ColliderStatus::kOk);
   const auto& tris = asset.data().triangles;
   FrameCheck out;
   for (std::size_t f = 0; f + 1 < frames.size(); ++f) {
@@ -83,9 +88,9 @@ FrameCheck compare_with_oracle(const Asset& asset, const std::vector<std::vector
     body.x0 = frames[f].data();
     body.x1 = frames[f + 1].data();
     const std::vector<Contact> brute = test::scene_brute_contacts({body});
-    std::vector<Contact> found[2];
-    Collider* colliders[2] = {&rvbc, &bvh};
-    for (int m = 0; m < 2; ++m) {
+    std::vector<Contact> found[3];
+    Collider* colliders[3] = {&rvbc, &bvh, &cone};
+    for (int m = 0; m < 3; ++m) {
       REQUIRE(colliders[m]->step(frames[f].data(), frames[f + 1].data()) == ColliderStatus::kOk);
       bool any = false;
       REQUIRE(colliders[m]->any_collision(any) == ColliderStatus::kOk);
@@ -96,8 +101,11 @@ FrameCheck compare_with_oracle(const Asset& asset, const std::vector<std::vector
       REQUIRE(r.found <= found[m].size());
       found[m].resize(r.found);
     }
-    REQUIRE(found[1].size() == brute.size());
-    for (std::size_t i = 0; i < brute.size(); ++i) REQUIRE(same_contact(found[1][i], brute[i]));
+    for (int m = 1; m < 3; ++m) {
+      CAPTURE(m);
+      REQUIRE(found[m].size() == brute.size());
+      for (std::size_t i = 0; i < brute.size(); ++i) REQUIRE(same_contact(found[m][i], brute[i]));
+    }
     if (brute.empty()) continue;
     REQUIRE(!found[0].empty());
     CHECK(found[0].front().toi == Approx(brute.front().toi).margin(1e-9));
