@@ -7,6 +7,7 @@
 #include <cmath>
 #include <numeric>
 
+#include "segment_topology.hpp"
 #include "vec3_math.hpp"
 
 namespace tetseg::preprocess::detail {
@@ -14,22 +15,21 @@ namespace {
 
 constexpr std::uint32_t kUnset = 0xffffffffu;
 
+/// Node sets joined through every triangle (or tet) of `elements`.
+template <typename Elements>
+UnionFind joined_nodes(std::size_t node_count, const Elements& elements) {
+  UnionFind sets(static_cast<std::uint32_t>(node_count));
+  for (const auto& element : elements)
+    for (std::size_t k = 1; k < element.size(); ++k) sets.unite(element[0], element[k]);
+  return sets;
+}
+
 /// Per node, the root of its component (nodes joined through every tet).
 std::vector<std::uint32_t> node_roots(const TetMesh& mesh) {
-  std::vector<std::uint32_t> parent(mesh.nodes.size());
-  std::iota(parent.begin(), parent.end(), 0u);
-  auto find = [&](std::uint32_t x) {
-    while (parent[x] != x) x = parent[x] = parent[parent[x]];
-    return x;
-  };
-  for (const Tet& tet : mesh.tets)
-    for (int k = 1; k < 4; ++k) {
-      const std::uint32_t a = find(tet[0]);
-      const std::uint32_t b = find(tet[static_cast<std::size_t>(k)]);
-      if (a != b) parent[std::max(a, b)] = std::min(a, b);
-    }
-  for (std::uint32_t v = 0; v < parent.size(); ++v) parent[v] = find(v);
-  return parent;
+  UnionFind sets = joined_nodes(mesh.nodes.size(), mesh.tets);
+  std::vector<std::uint32_t> root(mesh.nodes.size());
+  for (std::uint32_t v = 0; v < root.size(); ++v) root[v] = sets.find(v);
+  return root;
 }
 
 /// Per node, its part (numbered in order of the parts' first surface triangle), kUnset for a
@@ -89,22 +89,11 @@ void check_components(const TetMesh& mesh, const Surface& surface, const std::st
   const std::vector<std::uint32_t> part = node_parts(mesh, surface, count);
   // Closed surfaces per component: triangles joined through shared nodes (the surface is
   // vertex-manifold here, so this is edge-connectivity).
-  std::vector<std::uint32_t> parent(mesh.nodes.size());
-  std::iota(parent.begin(), parent.end(), 0u);
-  auto find = [&](std::uint32_t x) {
-    while (parent[x] != x) x = parent[x] = parent[parent[x]];
-    return x;
-  };
-  for (const Tri& t : surface.triangles)
-    for (int k = 1; k < 3; ++k) {
-      const std::uint32_t a = find(t[0]);
-      const std::uint32_t b = find(t[static_cast<std::size_t>(k)]);
-      if (a != b) parent[std::max(a, b)] = std::min(a, b);
-    }
+  UnionFind shell_sets = joined_nodes(mesh.nodes.size(), surface.triangles);
   std::vector<std::uint32_t> shells(count, 0);
   std::vector<std::uint32_t> first_node(count, kUnset);
   for (std::uint32_t v : surface.surface_nodes) {
-    if (find(v) == v) ++shells[part[v]];
+    if (shell_sets.find(v) == v) ++shells[part[v]];
     if (first_node[part[v]] == kUnset) first_node[part[v]] = v;
   }
   for (std::uint32_t c = 0; c < count; ++c)
@@ -164,23 +153,12 @@ void check_not_nested(const std::vector<Vec3>& points, const std::vector<Tri>& t
 }
 
 void check_surface_not_nested(const TriangleMesh& mesh, const std::string& file) {
-  std::vector<std::uint32_t> parent(mesh.vertices.size());
-  std::iota(parent.begin(), parent.end(), 0u);
-  auto find = [&](std::uint32_t x) {
-    while (parent[x] != x) x = parent[x] = parent[parent[x]];
-    return x;
-  };
-  for (const Tri& t : mesh.triangles)
-    for (int k = 1; k < 3; ++k) {
-      const std::uint32_t a = find(t[0]);
-      const std::uint32_t b = find(t[static_cast<std::size_t>(k)]);
-      if (a != b) parent[std::max(a, b)] = std::min(a, b);
-    }
+  UnionFind sets = joined_nodes(mesh.vertices.size(), mesh.triangles);
   std::vector<std::uint32_t> component_of_root(mesh.vertices.size(), kUnset);
   std::vector<std::uint32_t> triangle_component;
   std::uint32_t count = 0;
   for (const Tri& t : mesh.triangles) {
-    std::uint32_t& c = component_of_root[find(t[0])];
+    std::uint32_t& c = component_of_root[sets.find(t[0])];
     if (c == kUnset) c = count++;
     triangle_component.push_back(c);
   }

@@ -130,14 +130,19 @@ std::set<std::uint32_t> clusters_of(const format::Asset& a, std::uint32_t split,
   return out;
 }
 
+/// Two interlocked tori, 32 x 3 x 3 hexes each.
+TetMesh small_tori() {
+  preprocess::StructuredOptions options;
+  options.resolution = 32;
+  options.layers = 3;
+  return preprocess::generate_structured(StructuredShape::kTori, options);
+}
+
 }  // namespace
 
 TEST_CASE("Two interlocked tori build into one asset with clusters per component",
           "[components][pipeline]") {
-  preprocess::StructuredOptions options;
-  options.resolution = 32;
-  options.layers = 3;
-  const TetMesh tori = preprocess::generate_structured(StructuredShape::kTori, options);
+  const TetMesh tori = small_tori();
   const auto half = static_cast<std::uint32_t>(tori.nodes.size() / 2);
   preprocess::BuildReport report;
   const format::Asset a =
@@ -175,10 +180,7 @@ TEST_CASE("Two interlocked tori build into one asset with clusters per component
 
 TEST_CASE("The runtime finds the contacts between two components as brute force does",
           "[components][collider]") {
-  preprocess::StructuredOptions options;
-  options.resolution = 32;
-  options.layers = 3;
-  const TetMesh tori = preprocess::generate_structured(StructuredShape::kTori, options);
+  const TetMesh tori = small_tori();
   const std::size_t half = tori.nodes.size() / 2;
   const Asset asset = load(build(tori));
   // The second torus slides along -x until its tube hits the first torus's tube at x = -1.
