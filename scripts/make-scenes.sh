@@ -145,4 +145,4 @@ thin torus-drop torus -- --sphere=0,0,-0.5,1.1 --drop 0.7 --tilt-x 20 --frames 6
 thin tori-drop tori -- --drop 0.1 --tilt-x 60 --frames 60
 fi
 
-echo "make-scenes: done: $out/{pawn,dumbbell,elephant,armadillo,dino}{,-charge,-single}.tetseg and .tsf, {pile$balls,characters,drape,mat-drape,plate-drape,mat-twist,bar-drape,torus-drop,tori-drop}.tsscene and .tsf" >&2
+echo "make-scenes: done: $out/{pawn,dumbbell,elephant,armadillo,dino}{,-charge,-single}.tetseg and .tsf, {pile${balls:-N},characters,drape,mat-drape,plate-drape,mat-twist,bar-drape,torus-drop,tori-drop}.tsscene and .tsf" >&2
