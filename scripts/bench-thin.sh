@@ -18,8 +18,8 @@ for t in tetseg tetseg-dump tetseg-sim tetseg-bench; do
 done
 TETSEG_SCENES=thin "$repo/scripts/make-scenes.sh" "$build" "$out"
 cd "$out"
-echo "| shape | nodes | interior nodes | surface triangles | components | build s | clusters | detectors inside tets | overlap-only |"
-echo "|---|---|---|---|---|---|---|---|---|"
+echo "| shape | nodes | interior nodes | surface triangles | components | build s | clusters | detectors inside tets | overlap-only | lowest rest visibility |"
+echo "|---|---|---|---|---|---|---|---|---|---|"
 for shape in mat plate bar torus tori; do
   "$build/tools/tetseg-dump" --json "$shape.tetseg" > "$shape.dump.json"
   python3 - "$shape" <<'PY'
@@ -30,9 +30,10 @@ d = json.load(open(s + ".dump.json"))
 c = r["counts"]
 inside = sum(1 for k in d["clusters"] if k["detector"].get("tet", None) is not None)
 flagged = sum(1 for k in d["clusters"] if k["overlap_only"])
-print("| %s | %d | %d | %d | %d | %.2f | %d | %d | %d |" % (
+lowest = min(k["rest_positive_fraction"] for k in d["clusters"])
+print("| %s | %d | %d | %d | %d | %.2f | %d | %d | %d | %.3f |" % (
     s, c["nodes"], c["interior_nodes"], c["surface_triangles"], c["components"],
-    r["seconds"]["total"], c["clusters"], inside, flagged))
+    r["seconds"]["total"], c["clusters"], inside, flagged, lowest))
 PY
 done
 scenes=()

@@ -31,7 +31,7 @@ enum class StructuredShape {
 
 /// Parameters of generate_structured; 0 = the shape's default.
 struct StructuredOptions {
-  int resolution = 0;  ///< hexes along the long direction (mat/plate 40, bar 45, tori 48)
+  int resolution = 0;  ///< hexes along the long direction (mat, plate, torus 40; bar 45; tori 48)
   int layers = 0;      ///< hexes through the thickness (1; plate and tori 3)
 };
 
