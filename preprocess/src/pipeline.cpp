@@ -321,7 +321,10 @@ format::Asset build_asset(const TetMesh& mesh, const std::string& source,
     if (options.clusters == ClusterMethod::kRefined && !surface.interior_nodes.empty()) {
       segmentation = timer.run("refinement", [&](std::string& summary) {
         for (std::size_t p = 0; p < parts.size(); ++p) {
-          if (parts[p].surface.interior_nodes.empty()) continue;
+          if (parts[p].surface.interior_nodes.empty()) {  // kept as segmented
+            report.refinement.clusters_before += pieces[p].cluster_count;
+            continue;
+          }
           RefinementCounts counts;
           pieces[p] = refine_clusters(mesh.nodes, parts[p].surface, equalized[p], pieces[p],
                                       options.refinement, &counts);

@@ -302,3 +302,30 @@ TEST_CASE("Flat faces of thin shapes turned off the axes are not taken for rest 
   REQUIRE(rest.status == ColliderStatus::kOk);
   CHECK_FALSE(rest.intersecting);
 }
+
+TEST_CASE("Components with and without interior nodes build together", "[components][pipeline]") {
+  // The linked tori (interior nodes, refined) beside a mat one tet thick (none: its clusters
+  // keep the charge segmentation and get detector points inside its own tets).
+  TetMesh mesh = small_tori();
+  const auto mat_first = static_cast<std::uint32_t>(mesh.nodes.size());
+  preprocess::StructuredOptions options;
+  options.resolution = 12;
+  const TetMesh mat = preprocess::generate_structured(StructuredShape::kMat, options);
+  for (const Vec3& p : mat.nodes) mesh.nodes.push_back({p[0] + 4.0, p[1], p[2]});
+  for (preprocess::Tet t : mat.tets) {
+    for (std::uint32_t& v : t) v += mat_first;
+    mesh.tets.push_back(t);
+  }
+  preprocess::BuildReport report;
+  const format::Asset a =
+      preprocess::build_asset(mesh, "mixed.mesh", preprocess::BuildOptions{}, report);
+  CHECK(report.components == 3);
+  CHECK(report.refinement.clusters_before + report.refinement.splits ==
+        a.clusters.size() + report.refinement.merges);
+  for (std::size_t t = 0; t < a.triangles.size(); ++t) {
+    if (a.triangles[t][0] < mat_first) continue;
+    const format::DetectorPoint& d = a.clusters[a.triangle_cluster[t]].detector;
+    CHECK(d.tet >= mesh.tets.size() - mat.tets.size());  // a tet of the mat
+    CHECK(d.tet < mesh.tets.size());
+  }
+}
