@@ -12,7 +12,13 @@
 #
 #   scripts/make-scenes.sh [BUILD_DIR] [OUT_DIR]      (BUILD_DIR default: ./build)
 #
-# Environment: TETSEG_SCENES=multibody makes only the scenes with several bodies;
+# Then the thin and multi-part bodies of issue 13 ("Thin and multi-part bodies"): structured
+# shapes from `tetseg generate` (a 40 x 40 mat, a plate, a bar and a torus one tet thick, two
+# interlocked tori in one mesh) draped over a still sphere or dropped, and the mat twisted by
+# its ends, each a frame sequence plus a scene description (NAME.tsscene).
+#
+# Environment: TETSEG_SCENES=multibody makes only the scenes with several bodies, =thin only
+# the thin ones;
 # TETSEG_PILE_BALLS=N (default 8) balls in the pile, in layers of four (16: the pile of
 # docs/benchmarks.md, about 3 minutes more).
 # Needs tetseg and tetseg-sim built in BUILD_DIR (Release). A few minutes on 2 cores.
@@ -40,7 +46,7 @@ scene() {  # scene NAME SIM-OPTIONS...  (NAME.mesh exists)
   echo "make-scenes: $name: $(cat "$name.sim.json")" >&2
 }
 
-if [ "${TETSEG_SCENES:-all}" != multibody ]; then
+if [ "${TETSEG_SCENES:-all}" = all ]; then
 # Pawn: 5275 nodes, 4942 surface triangles (paper: 3454 vertices, 5130 faces); tilted so it
 # falls on its side and the collar bends onto the head and base.
 "$tetseg" generate pawn -o pawn.mesh 2>/dev/null
@@ -84,6 +90,7 @@ multibody() {  # multibody NAME SIM-OPTIONS...: NAME.tsf and NAME.tsscene
   echo "make-scenes: $name: $(cat "$name.sim.json")" >&2
 }
 
+if [ "${TETSEG_SCENES:-all}" != thin ]; then
 # Pile: soft balls of radius 0.15 (tetseg generate sphere --size 0.6: 1544 nodes) dropped in
 # layers of four, staggered, into a still bin open at the top (its floor just below the
 # ground, so the ground plane carries the pile and the walls hold it).
@@ -114,4 +121,31 @@ multibody characters --body pawn.mesh,pawn.tetseg,0,0,0 \
 multibody drape --body pancake.mesh,pancake.tetseg,0.7,0,0 --sphere=0,0,0.35,0.3 --frames 120 \
   --edge-compliance 2e-3
 
-echo "make-scenes: done: $out/{pawn,dumbbell,elephant,armadillo,dino}{,-charge,-single}.tetseg and .tsf, {pile$balls,characters,drape}.tsscene and .tsf" >&2
+fi
+
+if [ "${TETSEG_SCENES:-all}" != multibody ]; then
+thin() {  # thin NAME SHAPE GENERATE-OPTIONS -- SIM-OPTIONS...: NAME.tsf and NAME.tsscene
+  local name=$1 shape=$2; shift 2
+  local gen=()
+  while [ "$1" != -- ]; do gen+=("$1"); shift; done
+  shift
+  "$tetseg" generate "$shape" "${gen[@]}" -o "$shape.mesh" 2>/dev/null
+  "$tetseg" build "$shape.mesh" -o "$shape.tetseg" -q --report "$shape.build.json"
+  multibody "$name" --body "$shape.mesh,$shape.tetseg" "$@"
+}
+# Mats and plates: 1 x 1, one (mat) or three (plate) tets thick, over a sphere of radius 0.3.
+thin mat-drape mat -- --sphere=0.5,0.5,0.3,0.3 --drop 0.65 --frames 60
+thin plate-drape plate -- --sphere=0.5,0.5,0.3,0.3 --drop 0.65 --frames 60
+# The mat held 1 above the ground by its ends (5% of its length each), which turn 480 degrees
+# per second against each other: it sags and wraps into itself.
+thin mat-twist mat -- --drop 1.0 --twist 480 --frames 90
+# A bar (1 long, one tet thick) over the sphere; a torus (radius 1, one tet thick) over a
+# sphere of radius 1.1 mostly below the ground.
+thin bar-drape bar -- --sphere=0.5,0.0125,0.3,0.15 --drop 0.5 --frames 60
+thin torus-drop torus -- --sphere=0,0,-0.5,1.1 --drop 0.7 --tilt-x 20 --frames 60
+# Two interlocked tori in one mesh (one body, two components), tilted: the upper link falls
+# into the lower one, which lands on the ground.
+thin tori-drop tori -- --drop 0.1 --tilt-x 60 --frames 60
+fi
+
+echo "make-scenes: done: $out/{pawn,dumbbell,elephant,armadillo,dino}{,-charge,-single}.tetseg and .tsf, {pile${balls:-N},characters,drape,mat-drape,plate-drape,mat-twist,bar-drape,torus-drop,tori-drop}.tsscene and .tsf" >&2

@@ -301,6 +301,14 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"rvbc", "bvh"}));
   app.add_flag("--no-self-contact{false}", opt.self_contact,
                "Skip all contact handling (frames may intersect; for comparisons)");
+  app.add_option("--twist", opt.twist_rate,
+                 "Twist every soft body by its ends: degrees per second the two ends turn "
+                 "against each other (default 0: off)");
+  app.add_option("--twist-axis", opt.twist_axis, "Twist axis: 0 = x (default), 1 = y, 2 = z")
+      ->check(CLI::Range(0, 2));
+  app.add_option("--twist-ends", opt.twist_ends,
+                 "Share of the body's length held at each end (default 0.05)")
+      ->check(CLI::Range(0.001, 0.499));
   app.add_flag("--json", a.json, "Print the counters as JSON on stdout");
   try {
     app.parse(argc, argv);

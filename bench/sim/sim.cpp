@@ -90,6 +90,40 @@ SoftBody::SoftBody(const preprocess::TetMesh& mesh, const std::vector<double>& s
   m_x = start;
   m_x_prev = start;
   m_v.assign(m_node_count * 3, 0.0);
+
+  if (options.twist_rate != 0) {
+    if (options.twist_axis < 0 || options.twist_axis > 2 || !(options.twist_ends > 0) ||
+        !(options.twist_ends < 0.5))
+      throw InputError(what, "twist axis must be 0..2 and the held ends in (0, 0.5)");
+    const int a = options.twist_axis;
+    double lo = INFINITY, hi = -INFINITY;
+    for (std::size_t i = 0; i < m_node_count; ++i) {
+      lo = std::min(lo, start[i * 3 + a]);
+      hi = std::max(hi, start[i * 3 + a]);
+      for (int k = 0; k < 3; ++k) m_center[k] += start[i * 3 + k] / double(m_node_count);
+    }
+    const double band = options.twist_ends * (hi - lo);
+    for (std::uint32_t i = 0; i < m_node_count; ++i) {
+      const double c = start[i * 3 + a];
+      if (c > lo + band && c < hi - band) continue;
+      m_held.push_back(
+          {i, c >= hi - band ? 1.0 : -1.0, {start[i * 3], start[i * 3 + 1], start[i * 3 + 2]}});
+      m_inv_mass[i] = 0;
+    }
+  }
+}
+
+void SoftBody::hold_twisted_ends() {
+  const int a = m_opt.twist_axis, u = (a + 1) % 3, v = (a + 2) % 3;
+  for (const HeldNode& n : m_held) {
+    const double angle = n.sign * 0.5 * m_opt.twist_rate * (std::acos(-1.0) / 180.0) * m_time;
+    const double c = std::cos(angle), s = std::sin(angle);
+    const double du = n.start[u] - m_center[u], dv = n.start[v] - m_center[v];
+    double* p = m_x.data() + std::size_t(n.node) * 3;
+    p[a] = n.start[a];
+    p[u] = m_center[u] + c * du - s * dv;
+    p[v] = m_center[v] + s * du + c * dv;
+  }
 }
 
 void SoftBody::predict(double h, SimCounters& counters) {
@@ -104,6 +138,8 @@ void SoftBody::predict(double h, SimCounters& counters) {
       m_x[i * 3 + k] += m_v[i * 3 + k] * h;
     }
   }
+  m_time += h;
+  hold_twisted_ends();
   for (std::uint32_t it = 0; it < m_opt.iterations; ++it) solve_constraints(h);
   apply_ground(counters);
 }

@@ -44,6 +44,14 @@ struct SimOptions {
   tetseg::ColliderMode collider_mode = tetseg::ColliderMode::kRvbc;
   std::size_t contact_capacity = 1 << 14;  ///< contacts read per query round
   bool self_contact = true;  ///< false: no contact handling at all (for tests and comparisons)
+  /// Twisting by the ends: when non-zero, the nodes of every soft body within
+  /// `twist_ends` x its length of either end along `twist_axis` (at the start) are kinematic
+  /// (no gravity, no constraint moves them): they turn about the axis line through the body's
+  /// start centroid, the two ends in opposite directions, each at twist_rate / 2 degrees per
+  /// second (so the ends turn twist_rate against each other).
+  double twist_rate = 0;
+  int twist_axis = 0;        ///< 0 = x, 1 = y, 2 = z
+  double twist_ends = 0.05;  ///< share of the body's length held at each end, in (0, 0.5)
 };
 
 /// Totals over a run.
@@ -84,6 +92,16 @@ class SoftBody {
  private:
   void solve_constraints(double h);
   void apply_ground(SimCounters& counters);
+  void hold_twisted_ends();
+
+  struct HeldNode {
+    std::uint32_t node;
+    double sign;  // +1 at the far end, -1 at the near end
+    double start[3];
+  };
+  std::vector<HeldNode> m_held;  // twist: kinematic end nodes
+  double m_center[3] = {0, 0, 0};
+  double m_time = 0;
 
   SimOptions m_opt;
   std::size_t m_node_count = 0;

@@ -11,6 +11,7 @@
 #include <utility>
 #include <vector>
 
+#include "components.hpp"
 #include "meshing_internal.hpp"
 #include "repair_internal.hpp"
 #include "tetseg/preprocess/surface.hpp"
@@ -280,6 +281,7 @@ TetMesh validate_and_mesh(const TriangleMesh& source, const MeshingOptions& mesh
   TriangleMesh split;
   detail::SurfaceCheck check;
   check.allow_pinched_vertices = true;
+  check.allow_components = true;  // Mesh_3 meshes each closed component; the tets are checked
   try {
     detail::validate_closed_surface(source, file, check, &split);
   } catch (const InputError& e) {
@@ -288,6 +290,7 @@ TetMesh validate_and_mesh(const TriangleMesh& source, const MeshingOptions& mesh
                                ", left after --repair fix; --repair wrap makes a closed surface "
                                "of any input (docs/cli.md)");
   }
+  detail::check_surface_not_nested(source, file);
   return mesh_closed_surface(split.triangles.empty() ? source : split, meshing, file, notes);
 }
 

@@ -61,6 +61,16 @@ const std::vector<EnumName<Shape>>& enum_names<Shape>() {
 }
 
 template <>
+const std::vector<EnumName<StructuredShape>>& enum_names<StructuredShape>() {
+  static const std::vector<EnumName<StructuredShape>> table = {{"mat", StructuredShape::kMat},
+                                                               {"plate", StructuredShape::kPlate},
+                                                               {"bar", StructuredShape::kBar},
+                                                               {"torus", StructuredShape::kTorus},
+                                                               {"tori", StructuredShape::kTori}};
+  return table;
+}
+
+template <>
 const std::vector<EnumName<MeshingOptions::Repair>>& enum_names<MeshingOptions::Repair>() {
   using Repair = MeshingOptions::Repair;
   static const std::vector<EnumName<Repair>> table = {

@@ -13,6 +13,7 @@
 
 #include <sys/resource.h>
 
+#include "components.hpp"
 #include "tetseg/format/asset_io.hpp"
 #include "tetseg/preprocess/names.hpp"
 #include "tetseg/preprocess/surface.hpp"
@@ -290,23 +291,26 @@ format::Asset build_asset(const TetMesh& mesh, const std::string& source,
   report.nodes = static_cast<std::uint32_t>(mesh.nodes.size());
   report.tets = static_cast<std::uint32_t>(mesh.tets.size());
 
+  std::vector<detail::SurfacePart> parts;  // one per component (docs/segmentation.md)
   const Surface surface = timer.run("surface", [&](std::string& summary) {
     Surface s = extract_valid_surface(mesh, source);
+    parts = detail::split_surface(mesh, s);
     summary = std::to_string(s.triangles.size()) + " triangles, " +
-              std::to_string(s.interior_nodes.size()) + " interior nodes";
+              std::to_string(s.interior_nodes.size()) + " interior nodes, " +
+              std::to_string(parts.size()) + (parts.size() == 1 ? " component" : " components");
     return s;
   });
   report.surface_triangles = static_cast<std::uint32_t>(surface.triangles.size());
   report.interior_nodes = static_cast<std::uint32_t>(surface.interior_nodes.size());
+  report.components = static_cast<std::uint32_t>(parts.size());
 
   Segmentation segmentation;
   if (options.clusters == ClusterMethod::kSingle) {
-    segmentation.triangle_cluster.assign(surface.triangles.size(), 0);
-    segmentation.cluster_count = 1;
-    segmentation.counts.clusters = 1;
+    segmentation = detail::one_cluster_per_part(parts, surface.triangles.size());
   } else {
     ChargeResult charge = timer.run("charge", [&](std::string& summary) {
-      ChargeResult r = compute_charge(mesh.nodes, surface.triangles, options.charge, source);
+      ChargeResult r = detail::charge_by_part(mesh.nodes, parts, surface.triangles.size(),
+                                              options.charge, source);
       std::ostringstream text;
       text << r.solver << ", " << r.iterations << " iterations, residual " << r.residual
            << " (tolerance " << r.tolerance << ")"
@@ -314,14 +318,22 @@ format::Asset build_asset(const TetMesh& mesh, const std::string& source,
       summary = text.str();
       return r;
     });
-    const std::vector<double> equalized = timer.run("equalize", [&](std::string& summary) {
+    std::vector<std::vector<double>> equalized;  // per part
+    timer.run("equalize", [&](std::string& summary) {
       summary = name_of(options.segmentation.equalization);
-      return equalize(charge.density, options.segmentation.equalization);
+      for (const detail::SurfacePart& part : parts)
+        equalized.push_back(
+            equalize(detail::part_values(charge.density, part), options.segmentation.equalization));
+      return 0;
     });
     charge.density.clear();
     report.charge = std::move(charge);
+    std::vector<Segmentation> pieces;  // per part
     segmentation = timer.run("segmentation", [&](std::string& summary) {
-      Segmentation s = segment_surface(mesh.nodes, surface, equalized, options.segmentation);
+      for (std::size_t p = 0; p < parts.size(); ++p)
+        pieces.push_back(
+            segment_surface(mesh.nodes, parts[p].surface, equalized[p], options.segmentation));
+      Segmentation s = detail::join_segmentations(parts, pieces, surface.triangles.size());
       summary = std::to_string(s.counts.segments_found) + " segments, " +
                 std::to_string(s.boundary_loops.size()) + " boundaries, " +
                 std::to_string(s.cluster_count) + " clusters";
@@ -331,8 +343,19 @@ format::Asset build_asset(const TetMesh& mesh, const std::string& source,
     // charge segmentation, and its detectors are points inside tets.
     if (options.clusters == ClusterMethod::kRefined && !surface.interior_nodes.empty()) {
       segmentation = timer.run("refinement", [&](std::string& summary) {
-        Segmentation s = refine_clusters(mesh.nodes, surface, equalized, segmentation,
-                                         options.refinement, &report.refinement);
+        for (std::size_t p = 0; p < parts.size(); ++p) {
+          if (parts[p].surface.interior_nodes.empty()) {  // kept as segmented
+            report.refinement.clusters_before += pieces[p].cluster_count;
+            continue;
+          }
+          RefinementCounts counts;
+          pieces[p] = refine_clusters(mesh.nodes, parts[p].surface, equalized[p], pieces[p],
+                                      options.refinement, &counts);
+          report.refinement.clusters_before += counts.clusters_before;
+          report.refinement.splits += counts.splits;
+          report.refinement.merges += counts.merges;
+        }
+        Segmentation s = detail::join_segmentations(parts, pieces, surface.triangles.size());
         summary = std::to_string(report.refinement.splits) + " splits, " +
                   std::to_string(report.refinement.merges) + " merges, " +
                   std::to_string(s.cluster_count) + " clusters";
@@ -347,9 +370,8 @@ format::Asset build_asset(const TetMesh& mesh, const std::string& source,
   const std::vector<DetectorChoice> detectors = timer.run("detectors", [&](std::string& summary) {
     std::vector<DetectorChoice> d;
     try {
-      d = choose_detector_points(mesh, surface, segmentation.triangle_cluster,
-                                 segmentation.cluster_count, options.segmentation.detector,
-                                 options.segmentation.min_visibility);
+      d = detail::detectors_by_part(mesh, parts, segmentation, options.segmentation.detector,
+                                    options.segmentation.min_visibility);
     } catch (const InputError& e) {
       throw InputError(source, e.what());
     }

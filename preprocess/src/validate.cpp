@@ -9,6 +9,7 @@
 #include <tuple>
 #include <vector>
 
+#include "components.hpp"
 #include "tetseg/preprocess/surface.hpp"
 #include "validate_internal.hpp"
 #include "vec3_math.hpp"
@@ -49,7 +50,8 @@ void check_finite(const std::vector<Vec3>& points, const std::string& file, cons
 }
 
 /// The checks shared by tet-mesh boundaries and triangle surfaces: closed, edge-manifold,
-/// consistently oriented, vertex-manifold, one component, no self-intersection.
+/// consistently oriented, vertex-manifold, one component (unless allowed), no
+/// self-intersection.
 void check_surface(const std::vector<Vec3>& points, const std::vector<Tri>& triangles,
                    const std::string& file, const detail::SurfaceCheck& options,
                    TriangleMesh* split) {
@@ -147,7 +149,7 @@ void check_surface(const std::vector<Vec3>& points, const std::vector<Tri>& tria
   std::size_t count = 0;
   for (std::uint32_t t = 0; t < triangles.size(); ++t)
     if (components.find(t) == t) ++count;
-  if (count > 1)
+  if (count > 1 && !options.allow_components)
     throw InputError(file,
                      "surface has " + std::to_string(count) + " connected components (expected 1)");
   // Pinched vertices: one copy per extra fan, so the surface becomes a manifold mesh.
@@ -293,7 +295,10 @@ void detail::validate_tet_mesh(const TetMesh& mesh, const Surface& surface, cons
     for (std::uint32_t v : t)
       if (v >= n)
         throw InputError(file, "surface refers to node " + std::to_string(v) + " out of range");
-  check_surface(mesh.nodes, surface.triangles, file, detail::SurfaceCheck{}, nullptr);
+  detail::SurfaceCheck options;
+  options.allow_components = true;
+  check_surface(mesh.nodes, surface.triangles, file, options, nullptr);
+  detail::check_components(mesh, surface, file);
 }
 
 void validate_closed_surface(const TriangleMesh& mesh, const std::string& file) {

@@ -47,6 +47,9 @@ struct SurfaceCheck {
   /// a modelled surface that coincide): the Mesh_3 domain oracle handles them, and triangle
   /// pairs that only meet at such a point are not reported as self-intersections.
   bool allow_pinched_vertices = false;
+  /// Accept several connected components (tet-mesh boundaries: check_components then checks
+  /// that each component is one closed surface and none lies inside another).
+  bool allow_components = false;
 };
 
 /// validate_closed_surface with options. When pinches are allowed and found, `split`

@@ -198,6 +198,7 @@ py::dict report_dict(const std::string& source, const BuildReport& report,
   counts["tets"] = report.tets;
   counts["surface_triangles"] = report.surface_triangles;
   counts["interior_nodes"] = report.interior_nodes;
+  counts["components"] = report.components;
   counts["clusters"] = report.clusters;
   counts["boundaries"] = report.boundaries;
   const SegmentationCounts& seg = report.segmentation;

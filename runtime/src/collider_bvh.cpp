@@ -52,7 +52,10 @@ int orient(const double* o, const double* a, const double* b, const double* c) n
 
 // Can segment pq meet triangle abc? False only when proven disjoint (floating point, with
 // error bounds); near-degenerate and coplanar configurations count as meeting unless a 2D
-// separation in the coplanar case is clear.
+// separation is clear. The 2D test runs whenever the 3D tests prove nothing: a flat face of a
+// rotated body is coplanar only up to rounding, so its points may even lie certainly on both
+// sides of a neighbour's plane. A projection of meeting sets meets, so a clear separation in
+// the projection proves them disjoint in any configuration.
 bool segment_meets_triangle(const double* p, const double* q, const double* a, const double* b,
                             const double* c) noexcept {
   const int sp = orient(a, b, c, p), sq = orient(a, b, c, q);
@@ -60,8 +63,8 @@ bool segment_meets_triangle(const double* p, const double* q, const double* a, c
   const int s0 = orient(p, q, a, b), s1 = orient(p, q, b, c), s2 = orient(p, q, c, a);
   if ((s0 > 0 && (s1 < 0 || s2 < 0)) || (s0 < 0 && (s1 > 0 || s2 > 0)) || (s1 * s2 < 0))
     return false;
-  if (sp == 0 && sq == 0) {
-    // Coplanar (up to rounding): separate in the projection along the dominant normal axis.
+  {
+    // Separate in the projection along the triangle's dominant normal axis.
     const double e1[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
     const double e2[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
     const double n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],

@@ -147,4 +147,26 @@ data[len(data) - 5] ^= 0x40
 open(sys.argv[2], "wb").write(data)
 PY
 expect_exit 3 "checksum" -- "$bin/tetseg-dump" flipped.tetseg
+# Structured thin shapes: a mat one tet thick builds (detector points inside tets); two
+# interlocked tori build into one asset of two components; tori that would touch are a usage
+# error.
+"$bin/tetseg" generate mat --resolution 12 -o mat.mesh 2>gen.txt
+"$bin/tetseg" build mat.mesh -o mat.tetseg --report mat.json -q
+"$bin/tetseg" generate tori --resolution 24 --layers 2 -o tori.mesh 2>gen.txt
+"$bin/tetseg" build tori.mesh -o tori.tetseg --report tori.json -q
+"$bin/tetseg-dump" tori.tetseg --json >tori.dump.json
+"$bin/tetseg-dump" mat.tetseg --json >mat.dump.json
+python3 - <<'PY'
+import json
+mat, mat_dump = json.load(open("mat.json")), json.load(open("mat.dump.json"))
+assert mat["counts"]["nodes"] == 13 * 13 * 2 and mat["counts"]["interior_nodes"] == 0, mat["counts"]
+assert all(c["detector"]["tet"] is not None for c in mat_dump["clusters"])
+tori, tori_dump = json.load(open("tori.json")), json.load(open("tori.dump.json"))
+assert tori["counts"]["components"] == 2 and tori_dump["components"] == 2
+half = tori["counts"]["nodes"] // 2
+for c in tori_dump["clusters"]:
+    assert len({n < half for n in c["detector"]["nodes"]}) == 1, c
+PY
+expect_exit 2 "would touch" -- "$bin/tetseg" generate tori --resolution 24 --layers 4 -o x.mesh
+[ ! -e x.mesh ] || fail "a refused generate left a mesh"
 echo "build.sh: all checks passed"

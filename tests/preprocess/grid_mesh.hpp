@@ -1,12 +1,13 @@
 #pragma once
 // Kuhn-triangulated grids of cubes: small, valid tet meshes built in code for the import,
-// surface and validation tests.
+// surface and validation tests (preprocess::hex_grid).
 
 #include <cstdint>
 #include <functional>
 #include <utility>
 
 #include "tetseg/preprocess/mesh.hpp"
+#include "tetseg/preprocess/structured.hpp"
 
 namespace tetseg::test {
 
@@ -25,30 +26,7 @@ inline double orient(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d)
 /// nx x ny x nz cubes, 6 tets each (Kuhn), node (i, j, k) placed at map(i, j, k) (node id
 /// (i * (ny + 1) + j) * (nz + 1) + k); tets are oriented positively after mapping.
 inline TetMesh kuhn_grid(int nx, int ny, int nz, const std::function<Vec3(int, int, int)>& map) {
-  TetMesh m;
-  auto id = [=](int i, int j, int k) {
-    return static_cast<std::uint32_t>((i * (ny + 1) + j) * (nz + 1) + k);
-  };
-  for (int i = 0; i <= nx; ++i)
-    for (int j = 0; j <= ny; ++j)
-      for (int k = 0; k <= nz; ++k) m.nodes.push_back(map(i, j, k));
-  const int perms[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
-  for (int i = 0; i < nx; ++i)
-    for (int j = 0; j < ny; ++j)
-      for (int k = 0; k < nz; ++k)
-        for (const auto& p : perms) {
-          int c[3] = {i, j, k};
-          preprocess::Tet t;
-          t[0] = id(c[0], c[1], c[2]);
-          for (int s = 0; s < 3; ++s) {
-            ++c[p[s]];
-            t[static_cast<std::size_t>(s + 1)] = id(c[0], c[1], c[2]);
-          }
-          if (orient(m.nodes[t[0]], m.nodes[t[1]], m.nodes[t[2]], m.nodes[t[3]]) < 0)
-            std::swap(t[2], t[3]);
-          m.tets.push_back(t);
-        }
-  return m;
+  return preprocess::hex_grid(nx, ny, nz, map);
 }
 
 /// An n^3 grid of unit cubes.

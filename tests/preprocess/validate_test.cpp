@@ -108,12 +108,30 @@ TEST_CASE("Each tet mesh defect is reported with a clear message", "[validate]")
                Catch::Contains("surface has 1 non-manifold vertex (several fans of triangles meet "
                                "there), first is vertex 0"));
   }
-  SECTION("Two separate blocks are two components.") {
+  SECTION("Two separate blocks are two components, which is valid.") {
     const TetMesh other = tetseg::test::kuhn_grid(1, 1, 1, [](int i, int j, int k) {
       return Vec3{double(i) + 5.0, double(j), double(k)};
     });
-    CHECK_THAT(tet_error(join(m, other)),
-               Catch::Contains("surface has 2 connected components (expected 1)"));
+    CHECK(tet_error(join(m, other)) == "(valid)");
+  }
+  SECTION("A block inside another block's volume overlaps it at rest.") {
+    const TetMesh big = tetseg::test::kuhn_grid(3, 3, 3, [](int i, int j, int k) {
+      return Vec3{2.0 * i, 2.0 * j, 2.0 * k};
+    });
+    const TetMesh small = tetseg::test::kuhn_grid(1, 1, 1, [](int i, int j, int k) {
+      return Vec3{2.5 + i, 2.5 + j, 2.5 + k};
+    });
+    CHECK_THAT(tet_error(join(big, small)),
+               Catch::Contains("component 2 (node 68) lies inside component 1 of 2: their "
+                               "volumes overlap at rest"));
+  }
+  SECTION("A hollow block (a cavity) is refused.") {
+    // 3^3 cubes without the middle one: one component bounded by two closed surfaces.
+    TetMesh hollow = block(3);
+    hollow.tets.erase(hollow.tets.begin() + 6 * 13, hollow.tets.begin() + 6 * 14);
+    CHECK_THAT(tet_error(hollow),
+               Catch::Contains("component 1 of 1 (node 0) is bounded by 2 closed surfaces: "
+                               "bodies with a cavity are not supported"));
   }
   SECTION("A bar coiled past a full turn intersects itself at rest.") {
     // 12 cubes around 1.25 turns of a circle of radius 3 in the xz plane: both ends overlap.

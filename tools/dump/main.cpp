@@ -44,6 +44,34 @@ std::vector<std::uint32_t> boundary_edges_per_cluster(const Asset& asset) {
   return counts;
 }
 
+/// Connected components of the surface (triangles joined through shared nodes): the bodies
+/// of an asset built from a tet mesh with several components.
+std::size_t surface_components(const Asset& asset) {
+  std::vector<std::uint32_t> parent(asset.node_count);
+  for (std::uint32_t v = 0; v < asset.node_count; ++v) parent[v] = v;
+  auto find = [&](std::uint32_t x) {
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];
+    return x;
+  };
+  std::size_t count = 0;
+  std::vector<char> used(asset.node_count, 0);
+  for (const auto& tri : asset.triangles)
+    for (std::uint32_t v : tri) {
+      count += used[v] ? 0 : 1;
+      used[v] = 1;
+    }
+  for (const auto& tri : asset.triangles)
+    for (int k = 1; k < 3; ++k) {
+      const std::uint32_t a = find(tri[0]);
+      const std::uint32_t b = find(tri[k]);
+      if (a != b) {
+        parent[std::max(a, b)] = std::min(a, b);
+        --count;
+      }
+    }
+  return count;
+}
+
 /// "major.minor" as the file's envelope declares it (the file has loaded, so it is valid).
 std::string version_string(const std::vector<std::uint8_t>& bytes) {
   std::uint16_t major = 0;
@@ -67,6 +95,7 @@ void print_summary(const std::string& path, const std::string& version, const As
   std::printf("  nodes               %u%s\n", asset.node_count,
               asset.rest_positions.empty() ? " (no rest positions)" : "");
   std::printf("  surface triangles   %zu\n", asset.triangles.size());
+  std::printf("  components          %zu\n", surface_components(asset));
   std::printf("  clusters            %zu\n", asset.clusters.size());
   std::printf("  segment boundaries  %zu (%zu boundary nodes)\n", asset.boundaries.size(),
               asset.boundary_nodes.size());
@@ -106,6 +135,7 @@ void print_json(const std::string& version, const Asset& asset) {
   out << "  \"nodes\": " << asset.node_count << ",\n";
   out << "  \"rest_positions\": " << (asset.rest_positions.empty() ? "false" : "true") << ",\n";
   out << "  \"surface_triangles\": " << asset.triangles.size() << ",\n";
+  out << "  \"components\": " << surface_components(asset) << ",\n";
   out << "  \"bvh_nodes\": " << asset.bvh_nodes.size() << ",\n";
   out << "  \"clusters\": [";
   for (std::size_t c = 0; c < asset.clusters.size(); ++c) {

@@ -63,7 +63,8 @@ std::string report_json(const BuildArgs& args, const BuildReport& report,
   out << "},\n";
   out << "  \"counts\": {\"nodes\": " << report.nodes << ", \"tets\": " << report.tets
       << ", \"surface_triangles\": " << report.surface_triangles
-      << ", \"interior_nodes\": " << report.interior_nodes << ", \"clusters\": " << report.clusters
+      << ", \"interior_nodes\": " << report.interior_nodes
+      << ", \"components\": " << report.components << ", \"clusters\": " << report.clusters
       << ", \"boundaries\": " << report.boundaries << "},\n";
   const SegmentationCounts& seg = report.segmentation;
   out << "  \"segmentation\": {\"segments_found\": " << seg.segments_found

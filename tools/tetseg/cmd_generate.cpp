@@ -1,4 +1,5 @@
-// `tetseg generate`: procedural tet meshes (sphere, ellipsoid, dumbbell, pawn) with CGAL Mesh_3.
+// `tetseg generate`: procedural tet meshes (sphere, ellipsoid, dumbbell, pawn) with CGAL Mesh_3,
+// and structured thin shapes (mat, plate, bar, torus, tori) built directly from hexes.
 // Also defines the meshing-option and output helpers shared with cmd_tetrahedralize.cpp.
 
 #include <chrono>
@@ -12,6 +13,7 @@
 #include "tetseg/preprocess/io.hpp"
 #include "tetseg/preprocess/meshing.hpp"
 #include "tetseg/preprocess/names.hpp"
+#include "tetseg/preprocess/structured.hpp"
 #include "tetseg/preprocess/surface.hpp"
 #include "tool_support.hpp"
 
@@ -180,6 +182,7 @@ struct GenerateArgs {
   std::string shape;
   std::string output;
   preprocess::ShapeOptions shape_options;
+  preprocess::StructuredOptions structured;
   std::vector<double> axes;
   preprocess::MeshingOptions meshing;
   mesh_cli::MshOutput msh;
@@ -187,6 +190,20 @@ struct GenerateArgs {
 
 void run_generate(const GenerateArgs& args) {
   mesh_cli::check_output_path(args.output);
+  preprocess::StructuredShape structured;
+  if (preprocess::parse_name(args.shape, structured)) {
+    mesh_cli::Stage stage("building " + args.shape);
+    preprocess::TetMesh mesh;
+    try {
+      mesh = preprocess::generate_structured(structured, args.structured);
+    } catch (const std::invalid_argument& e) {
+      throw CLI::ValidationError(args.shape, e.what());
+    }
+    stage.done(std::to_string(mesh.nodes.size()) + " nodes, " + std::to_string(mesh.tets.size()) +
+               " tets");
+    mesh_cli::finish_tet_mesh(mesh, args.output, args.msh, args.shape);
+    return;
+  }
   preprocess::ShapeOptions shape_options = args.shape_options;
   if (!args.axes.empty())
     for (int k = 0; k < 3; ++k) shape_options.axes[k] = args.axes[static_cast<std::size_t>(k)];
@@ -203,10 +220,19 @@ void run_generate(const GenerateArgs& args) {
 void add_generate_command(CLI::App& root) {
   auto args = std::make_shared<GenerateArgs>();
   CLI::App* cmd = root.add_subcommand(
-      "generate", "Mesh a procedural shape (sphere, ellipsoid, dumbbell, pawn) into tets");
-  cmd->add_option("shape", args->shape, preprocess::name_list<preprocess::Shape>(" | "))
+      "generate",
+      "Mesh a procedural shape (sphere, ellipsoid, dumbbell, pawn) into tets, or build a "
+      "structured thin one (mat, plate, bar, torus, tori)");
+  std::vector<std::string> shapes;
+  for (const auto& entry : preprocess::enum_names<preprocess::Shape>())
+    shapes.push_back(entry.name);
+  for (const auto& entry : preprocess::enum_names<preprocess::StructuredShape>())
+    shapes.push_back(entry.name);
+  cmd->add_option("shape", args->shape,
+                  preprocess::name_list<preprocess::Shape>(" | ") + " | " +
+                      preprocess::name_list<preprocess::StructuredShape>(" | "))
       ->required()
-      ->check(CLI::IsMember(preprocess::name_map<preprocess::Shape>()));
+      ->check(CLI::IsMember(shapes));
   cmd->add_option("-o,--output", args->output, "Output tet mesh (.mesh, .node/.ele, .msh)")
       ->required();
   cmd->add_option("--size", args->shape_options.size,
@@ -217,6 +243,14 @@ void add_generate_command(CLI::App& root) {
   cmd->add_option("--axes", args->axes, "Ellipsoid semi-axes a b c")
       ->expected(3)
       ->check(CLI::PositiveNumber);
+  cmd->add_option("--resolution", args->structured.resolution,
+                  "mat, plate, bar, torus, tori: hexes along the long direction (0 = the "
+                  "shape's default; docs/cli.md)")
+      ->check(CLI::Range(0, 1000));
+  cmd->add_option("--layers", args->structured.layers,
+                  "mat, plate, bar, torus, tori: hexes through the thickness (0 = default: 1, "
+                  "plate and tori 3)")
+      ->check(CLI::Range(0, 64));
   mesh_cli::add_meshing_options(*cmd, args->meshing, args->msh);
   cmd->callback([args] { run_naming_file(args->output, [&] { run_generate(*args); }); });
 }

@@ -12,6 +12,7 @@
 #include "tetseg/preprocess/meshing.hpp"
 #include "tetseg/preprocess/pipeline.hpp"
 #include "tetseg/preprocess/segmentation.hpp"
+#include "tetseg/preprocess/structured.hpp"
 
 namespace tetseg::preprocess {
 
@@ -23,7 +24,7 @@ struct EnumName {
 
 /// The table of `Enum`: every value once under its canonical name, in declaration order, then
 /// the aliases. Defined for ChargeSolver, ChargePreconditioner, Equalization, DetectorStrategy,
-/// ClusterMethod, Shape and MeshingOptions::Repair.
+/// ClusterMethod, Shape, StructuredShape and MeshingOptions::Repair.
 template <typename Enum>
 const std::vector<EnumName<Enum>>& enum_names();
 
@@ -39,6 +40,9 @@ template <>
 const std::vector<EnumName<ClusterMethod>>& enum_names<ClusterMethod>();
 template <>
 const std::vector<EnumName<Shape>>& enum_names<Shape>();
+template <>
+const std::vector<EnumName<StructuredShape>>& enum_names<StructuredShape>();
+
 template <>
 const std::vector<EnumName<MeshingOptions::Repair>>& enum_names<MeshingOptions::Repair>();
 

@@ -65,6 +65,7 @@ struct BuildReport {
   std::uint32_t tets = 0;
   std::uint32_t surface_triangles = 0;
   std::uint32_t interior_nodes = 0;
+  std::uint32_t components = 0;  ///< connected components (bodies), each with its own clusters
   std::uint32_t clusters = 0;
   std::uint32_t boundaries = 0;
   SegmentationCounts segmentation;

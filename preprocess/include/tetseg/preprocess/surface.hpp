@@ -23,8 +23,10 @@ Surface extract_surface(const TetMesh& mesh);
 /// no degenerate tet (|6 volume| <= 1e-12 x longest edge^3) and no inverted tet (counts and
 /// the first index are reported); no face shared by more than two tets; then the surface:
 /// closed (border edges counted), edge-manifold, consistently oriented, vertex-manifold (one
-/// fan of triangles per vertex), one connected component (the count is reported), free of
-/// self-intersection at rest (CGAL box-intersection broad phase with exact predicates).
+/// fan of triangles per vertex), free of self-intersection at rest (CGAL box-intersection
+/// broad phase with exact predicates); then per component (nodes joined through tets; a mesh
+/// may have several): bounded by exactly one closed surface (no cavity), not inside another
+/// component (docs/segmentation.md, "Several components").
 /// Throws InputError(`file`, message) naming the first defect found, e.g. "surface is not
 /// closed (3 border edges, first between vertices 4 and 7)". Cost: the face matching of
 /// extract_surface, O(T) checks of the tets, O(B log B) checks of the B boundary triangles
@@ -39,7 +41,8 @@ Surface extract_valid_surface(const TetMesh& mesh, const std::string& file);
 /// The same surface checks for a triangle mesh that is about to be tetrahedralised or used as
 /// a conductor: finite coordinates, indices in range, no zero-area triangle (|2 area| <=
 /// 1e-12 x longest edge^2, or a repeated vertex), then closed, edge-manifold, consistently
-/// oriented, vertex-manifold, one component, no self-intersection. Orientation (inward or
+/// oriented, vertex-manifold, one component, no self-intersection. (tetrahedralize accepts
+/// several components that are not nested.) Orientation (inward or
 /// outward) is not checked. Throws InputError(`file`, message). Thread-safe.
 void validate_closed_surface(const TriangleMesh& mesh, const std::string& file);
 
