@@ -322,7 +322,10 @@ TEST_CASE("StageTimer reports the peak RSS a stage reached and how much it raise
   const StageReport& allocate = report.stages[1];
   CHECK(allocate.peak_rss_bytes >= resident + size - (4u << 20));
   CHECK(allocate.peak_rss_growth_bytes >= kRaise - (4u << 20));
-  CHECK(allocate.peak_rss_growth_bytes == allocate.peak_rss_bytes - peak_before);
+  // Growth counts from the peak when the stage started, which the test's own code between
+  // the two stages may have raised a little.
+  CHECK(allocate.peak_rss_growth_bytes <= allocate.peak_rss_bytes - peak_before);
+  CHECK(allocate.peak_rss_growth_bytes + (1u << 20) >= allocate.peak_rss_bytes - peak_before);
   // The buffer is gone: the next stage keeps the peak and does not raise it.
   CHECK(report.stages[2].peak_rss_bytes == allocate.peak_rss_bytes);
   CHECK(report.stages[2].peak_rss_growth_bytes == 0);

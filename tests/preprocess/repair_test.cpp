@@ -196,7 +196,8 @@ TEST_CASE("Wrap closes holes, open surfaces and self-intersections", "[meshing][
   }
 }
 
-TEST_CASE("--keep-largest-component drops floating debris and keeps the largest part", "[meshing][repair]") {
+TEST_CASE("Keeping the largest component drops floating debris and keeps the largest part",
+          "[meshing][repair]") {
   // A small cube (side 0.2) listed first, then the unit cube 2 units away: the kept component
   // must be the unit cube by area, not the first one.
   TriangleMesh s;
