@@ -123,6 +123,11 @@ void Collider::Impl::construct(std::shared_ptr<const BodyShape> sh, const Collid
   nmov.assign(nn, 0);
   cluster_err.resize(cluster_count());
 
+  single_triangle_leaves = asset != nullptr;
+  if (asset) {
+    for (const format::BvhNode& n : asset->bvh_nodes)
+      if (n.count > 1) single_triangle_leaves = false;
+  }
   skip_adjacent = uses_global_bvh();
   if (skip_adjacent) build_orphan_sets();
 

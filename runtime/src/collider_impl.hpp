@@ -342,6 +342,15 @@ struct Collider::Impl {
   bool run_query(Contact* out, std::size_t out_cap) noexcept;
   bool non_culled(std::uint32_t t1, std::uint32_t t2) const noexcept;
   void process_triangle_pair(Worker& w, std::uint32_t t1, std::uint32_t t2) const noexcept;
+  /// process_triangle_pair of a pair known to be non-culled (not in the rest check).
+  void process_non_culled_pair(Worker& w, std::uint32_t t1, std::uint32_t t2) const noexcept;
+  /// Every leaf of the cluster BVHs holds one triangle (construction).
+  bool single_triangle_leaves = false;
+  /// True when tree t is a cluster tree of single-triangle leaves traversed outside the rest
+  /// check: its leaf box and counters are its triangle's swept box and flags, so a leaf pair
+  /// that passed the traversal's live test (movement, boxes, and within a cluster the
+  /// orientation rule) is a non-culled triangle pair and needs no second check.
+  bool leaf_pairs_non_culled(const TreeView& t) const noexcept;
   bool traverse_self(Worker& w, const TreeView& tree) const noexcept;
   bool traverse_pair(Worker& w, const TreeView& ta, const TreeView& tb) const noexcept;
   void brute_vertex_faces(Worker& w, std::uint32_t i) const noexcept;

@@ -362,6 +362,11 @@ void Collider::Impl::process_triangle_pair(Worker& w, std::uint32_t t1,
     rest_triangle_pair(w, *this, t1, *this, t2);
     return;
   }
+  process_non_culled_pair(w, t1, t2);
+}
+
+void Collider::Impl::process_non_culled_pair(Worker& w, std::uint32_t t1,
+                                             std::uint32_t t2) const noexcept {
   ++w.stats.triangle_pairs;
   const std::uint64_t key = pair_key(t1, t2);
   if (skip_adjacent) {
@@ -468,8 +473,19 @@ bool traverse_tree_pair(Worker& w, const TreeView& ta, const TreeView& tb, doubl
   return true;
 }
 
+bool Collider::Impl::leaf_pairs_non_culled(const TreeView& t) const noexcept {
+  return single_triangle_leaves && orientation_mode() && t.nneg != nullptr;
+}
+
 bool Collider::Impl::traverse_pair(Worker& w, const TreeView& ta,
                                    const TreeView& tb) const noexcept {
+  // Two clusters' trees: their triangles are of different clusters, so a live leaf pair of
+  // single triangles is a non-culled triangle pair (leaf_pairs_non_culled).
+  if (leaf_pairs_non_culled(ta) && leaf_pairs_non_culled(tb)) {
+    return traverse_tree_pair(
+        w, ta, tb, opt.ccd.min_separation, rest_mode,
+        [&](std::uint32_t t1, std::uint32_t t2) { process_non_culled_pair(w, t1, t2); });
+  }
   return traverse_tree_pair(
       w, ta, tb, opt.ccd.min_separation, rest_mode,
       [&](std::uint32_t t1, std::uint32_t t2) { process_triangle_pair(w, t1, t2); });
@@ -523,7 +539,15 @@ bool Collider::Impl::traverse_self(Worker& w, const TreeView& t) const noexcept 
     }
     return true;
   };
-  auto self_pair = [&](std::uint32_t t1, std::uint32_t t2) { process_triangle_pair(w, t1, t2); };
+  // Leaves of single triangles: a live leaf pair is a non-culled triangle pair.
+  const bool leaves_non_culled = leaf_pairs_non_culled(t);
+  auto self_pair = [&](std::uint32_t t1, std::uint32_t t2) {
+    if (leaves_non_culled) {
+      process_non_culled_pair(w, t1, t2);
+    } else {
+      process_triangle_pair(w, t1, t2);
+    }
+  };
   std::size_t top = 0;
   w.stack[top++] = {0, kNone};
   while (top > 0 && !w.stop) {
