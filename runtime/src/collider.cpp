@@ -118,8 +118,7 @@ void Collider::Impl::construct(std::shared_ptr<const BodyShape> sh, const Collid
   closure_ring.reserve(tri_count);
   closure_mark.assign(tri_count, 0);
   nbox.resize(nn);
-  nneg.assign(nn, 0);
-  nunc.assign(nn, 0);
+  nsign.assign(nn, 0);
   nmov.assign(nn, 0);
   cluster_err.resize(cluster_count());
 
@@ -306,26 +305,26 @@ void Collider::Impl::refit_and_classify() noexcept {
   stats.triangles_positive = count[0];
   stats.triangles_negative = count[1];
   stats.triangles_uncertain = count[2];
-  // Per-node counters of negative and uncertain triangles, bottom-up, from this step.
+  // Per-node sign bits, bottom-up, from this step: a node is all positive (all negative) when
+  // every triangle under it is.
+  auto triangle_sign = [&](std::uint32_t t) -> std::uint8_t {
+    const std::uint8_t c = tcls[t];
+    return c == static_cast<std::uint8_t>(Orientation::kPositive)   ? kNodeAllPositive
+           : c == static_cast<std::uint8_t>(Orientation::kNegative) ? kNodeAllNegative
+                                                                    : 0;
+  };
   for (const format::Cluster& cl : asset->clusters) {
     const format::BvhNode* nodes = asset->bvh_nodes.data() + cl.bvh_offset;
     const std::uint32_t* leaf = asset->cluster_triangles.data() + cl.triangle_offset;
-    std::uint32_t* ng = nneg.data() + cl.bvh_offset;
-    std::uint32_t* nu = nunc.data() + cl.bvh_offset;
+    std::uint8_t* sign = nsign.data() + cl.bvh_offset;
     for (std::uint32_t i = cl.bvh_count; i-- > 0;) {
       const format::BvhNode& n = nodes[i];
       if (n.count > 0) {
-        std::uint32_t g = 0, u = 0;
-        for (std::uint32_t k = 0; k < n.count; ++k) {
-          const std::uint8_t c = tcls[leaf[n.first + k]];
-          g += c == static_cast<std::uint8_t>(Orientation::kNegative);
-          u += c == static_cast<std::uint8_t>(Orientation::kUncertain);
-        }
-        ng[i] = g;
-        nu[i] = u;
+        std::uint8_t s = kNodeAllPositive | kNodeAllNegative;
+        for (std::uint32_t k = 0; k < n.count; ++k) s &= triangle_sign(leaf[n.first + k]);
+        sign[i] = s;
       } else {
-        ng[i] = ng[n.first] + ng[n.second];
-        nu[i] = nu[n.first] + nu[n.second];
+        sign[i] = sign[n.first] & sign[n.second];
       }
     }
   }

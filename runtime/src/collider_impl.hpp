@@ -49,12 +49,18 @@ struct TreeView {
   const Box* box = nullptr;
   const Box* tri_box = nullptr;  // swept box of each triangle (by global id), this step
   const std::uint32_t* ntris = nullptr;
-  const std::uint32_t* nneg = nullptr;  // null: no orientation culling
-  const std::uint32_t* nunc = nullptr;
+  // Per node, this step: kNodeAllPositive / kNodeAllNegative when every triangle under it has
+  // that orientation class, 0 otherwise. Null: no orientation culling.
+  const std::uint8_t* nsign = nullptr;
   const std::uint32_t* nmov = nullptr;
   const ConeData* cone = nullptr;  // non-null: node self-tests may be culled by normal cones
   std::uint32_t cone_base = 0;     // cone index of node 0
 };
+
+/// Node sign bits (TreeView::nsign): two nodes whose bits share one cannot produce a first
+/// contact between their triangles (one orientation class throughout).
+inline constexpr std::uint8_t kNodeAllPositive = 1;
+inline constexpr std::uint8_t kNodeAllNegative = 2;
 
 struct StackItem {
   std::uint32_t a;
@@ -294,7 +300,8 @@ struct Collider::Impl {
   std::vector<std::array<std::uint32_t, 2>> orphan_vf;  // (node, triangle)
   std::vector<std::array<std::uint32_t, 2>> orphan_ee;  // (edge, edge), first < second
   std::vector<Box> nbox;                                // per asset BVH node
-  std::vector<std::uint32_t> nneg, nunc, nmov;
+  std::vector<std::uint32_t> nmov;
+  std::vector<std::uint8_t> nsign;                         // per asset BVH node: TreeView::nsign
   std::vector<orientation_detail::StaticErr> cluster_err;  // per cluster, this step (classify)
   std::vector<Worker> workers;
   // Contact closure scratch (capacity tri_count, reserved at construction).

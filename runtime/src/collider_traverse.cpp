@@ -50,8 +50,7 @@ TreeView Collider::Impl::cluster_view(std::uint32_t c) const noexcept {
   v.ntris = topo->cluster_node_ntris.data() + cl.bvh_offset;
   v.nmov = nmov.data() + cl.bvh_offset;
   if (orientation_mode()) {
-    v.nneg = nneg.data() + cl.bvh_offset;
-    v.nunc = nunc.data() + cl.bvh_offset;
+    v.nsign = nsign.data() + cl.bvh_offset;
   }
   return v;
 }
@@ -474,7 +473,7 @@ bool traverse_tree_pair(Worker& w, const TreeView& ta, const TreeView& tb, doubl
 }
 
 bool Collider::Impl::leaf_pairs_non_culled(const TreeView& t) const noexcept {
-  return single_triangle_leaves && orientation_mode() && t.nneg != nullptr;
+  return single_triangle_leaves && orientation_mode() && t.nsign != nullptr;
 }
 
 bool Collider::Impl::traverse_pair(Worker& w, const TreeView& ta,
@@ -521,19 +520,15 @@ bool traverse_bodies(Worker& w, const Collider::Impl& A, const Collider::Impl& B
 }
 
 bool Collider::Impl::traverse_self(Worker& w, const TreeView& t) const noexcept {
-  const bool orient = t.nneg != nullptr;
+  const bool orient = t.nsign != nullptr;
   const double ms = opt.ccd.min_separation;
-  auto one_sign = [&](std::uint32_t n) {
-    return orient && (t.nunc[n] == 0 && (t.nneg[n] == 0 || t.nneg[n] == t.ntris[n]));
-  };
+  auto one_sign = [&](std::uint32_t n) { return orient && t.nsign[n] != 0; };
   // Pair items are tested (not both still, boxes overlap, not culled by orientation) before
   // they are pushed, so popped pair items are live.
   auto live_pair = [&](std::uint32_t a, std::uint32_t b) {
     if (!rest_mode && t.nmov[a] == 0 && t.nmov[b] == 0) return false;
     if (!boxes_overlap(t.box[a], t.box[b], ms)) return false;
-    if (orient && t.nunc[a] == 0 && t.nunc[b] == 0 &&
-        ((t.nneg[a] == 0 && t.nneg[b] == 0) ||
-         (t.nneg[a] == t.ntris[a] && t.nneg[b] == t.ntris[b]))) {
+    if (orient && (t.nsign[a] & t.nsign[b]) != 0) {
       ++w.stats.node_pairs_orientation_culled;
       return false;
     }
@@ -610,8 +605,7 @@ bool Collider::Impl::cluster_tasks(Worker& w, std::uint32_t c1, bool count_skips
   const std::uint32_t nc = cluster_count();
   const TreeView v1 = cluster_view(c1);
   const bool still = !rest_mode && v1.nmov[0] == 0;
-  const bool one_sign =
-      v1.nneg && v1.nunc[0] == 0 && (v1.nneg[0] == 0 || v1.nneg[0] == v1.ntris[0]);
+  const bool one_sign = v1.nsign && v1.nsign[0] != 0;
   if (still || one_sign) {
     if (count_skips) ++w.stats.clusters_skipped;
   } else if (!traverse_self(w, v1)) {
