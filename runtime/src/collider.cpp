@@ -298,10 +298,10 @@ void Collider::Impl::refit_and_classify() noexcept {
                                                        o1, pos1(tri[0]), pos1(tri[1]), pos1(tri[2]),
                                                        cluster_err[c]));
   };
-#if defined(__GNUC__)
+#if defined(TETSEG_HAVE_LANES2)
   // Two triangles at once, one per lane of a vector of two doubles: the coefficients are the
   // same operations lane by lane (bitwise classify_one's); the sign per lane as classify_one.
-  typedef double Lanes2 __attribute__((vector_size(16)));
+  using orientation_detail::Lanes2;
   auto classify_two = [&](std::int64_t t) {
     const std::uint32_t c[2] = {asset->triangle_cluster[t], asset->triangle_cluster[t + 1]};
     if (!det_ok[c[0]] || !det_ok[c[1]]) {

@@ -105,6 +105,13 @@ inline void bernstein_k(const V& u0, const V& u1, const M& m00, const M& m10, co
   k[3] = det(u1, m11);
 }
 
+#if defined(__GNUC__)
+#define TETSEG_HAVE_LANES2 1
+/// Two doubles computed lane by lane with the scalar operations (GCC/Clang vector extension):
+/// each lane is bitwise the scalar result.
+typedef double Lanes2 __attribute__((vector_size(16)));
+#endif
+
 template <class T>
 struct Vec3T {
   T x, y, z;
