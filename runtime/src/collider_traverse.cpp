@@ -429,6 +429,10 @@ inline void leaf_pair(Worker& w, const TreeView& ta, std::uint32_t a, const Tree
                       std::uint32_t b, double ms, TrianglePair&& triangle_pair) noexcept {
   const format::BvhNode& na = ta.nodes[a];
   const format::BvhNode& nb = tb.nodes[b];
+  if (na.count == 1 && nb.count == 1) {  // rvbc's cluster leaves
+    triangle_pair(ta.leaf_tris[na.first], tb.leaf_tris[nb.first]);
+    return;
+  }
   for (std::uint32_t i = 0; i < na.count && !w.stop; ++i) {
     const std::uint32_t t1 = ta.leaf_tris[na.first + i];
     if (nb.count > 1 && !boxes_overlap(ta.tri_box[t1], tb.box[b], ms)) continue;
