@@ -118,11 +118,15 @@ void Collider::Impl::construct(std::shared_ptr<const BodyShape> sh, const Collid
   closure_ring.reserve(tri_count);
   closure_mark.assign(tri_count, 0);
   nbox.resize(nn);
-  nneg.assign(nn, 0);
-  nunc.assign(nn, 0);
+  nsign.assign(nn, 0);
   nmov.assign(nn, 0);
   cluster_err.resize(cluster_count());
 
+  single_triangle_leaves = asset != nullptr;
+  if (asset) {
+    for (const format::BvhNode& n : asset->bvh_nodes)
+      if (n.count > 1) single_triangle_leaves = false;
+  }
   skip_adjacent = uses_global_bvh();
   if (skip_adjacent) build_orphan_sets();
 
@@ -280,47 +284,99 @@ void Collider::Impl::refit_and_classify() noexcept {
     const double extent[3] = {box.hi[0] - box.lo[0], box.hi[1] - box.lo[1], box.hi[2] - box.lo[2]};
     cluster_err[c] = orientation_detail::StaticErr::of(extent);
   }
-#if defined(TETSEG_HAVE_OPENMP)
-#pragma omp parallel for if (opt.use_openmp && nt > 2048)
-#endif
-  for (std::int64_t t = 0; t < nt; ++t) {
+  // Triangle t against its cluster's detector (uncertain when the detector is not usable).
+  auto classify_one = [&](std::int64_t t) {
     const auto& tri = tris[t];
     const std::uint32_t c = asset->triangle_cluster[t];
     if (!det_ok[c]) {
       tcls[t] = static_cast<std::uint8_t>(Orientation::kUncertain);
-      continue;
+      return;
     }
     const double* o0 = det0.data() + 3 * std::size_t(c);
     const double* o1 = det1.data() + 3 * std::size_t(c);
     tcls[t] = static_cast<std::uint8_t>(orientation_of(o0, pos0(tri[0]), pos0(tri[1]), pos0(tri[2]),
                                                        o1, pos1(tri[0]), pos1(tri[1]), pos1(tri[2]),
                                                        cluster_err[c]));
-  }
+  };
+#if defined(TETSEG_HAVE_LANES2)
+  // Two triangles at once, one per lane of a vector of two doubles: the coefficients are the
+  // same operations lane by lane (bitwise classify_one's); the sign per lane as classify_one.
+  using orientation_detail::Lanes2;
+  auto classify_two = [&](std::int64_t t) {
+    const std::uint32_t c[2] = {asset->triangle_cluster[t], asset->triangle_cluster[t + 1]};
+    if (!det_ok[c[0]] || !det_ok[c[1]]) {
+      classify_one(t);
+      classify_one(t + 1);
+      return;
+    }
+    const double* q0[2][4];
+    const double* q1[2][4];
+    for (int l = 0; l < 2; ++l) {
+      const auto& tri = tris[t + l];
+      q0[l][0] = det0.data() + 3 * std::size_t(c[l]);
+      q1[l][0] = det1.data() + 3 * std::size_t(c[l]);
+      for (int j = 0; j < 3; ++j) {
+        q0[l][j + 1] = pos0(tri[j]);
+        q1[l][j + 1] = pos1(tri[j]);
+      }
+    }
+    using orientation_detail::Vec3T;
+    Vec3T<Lanes2> p0[4], p1[4];
+    for (int j = 0; j < 4; ++j) {
+      p0[j] = {Lanes2{q0[0][j][0], q0[1][j][0]}, Lanes2{q0[0][j][1], q0[1][j][1]},
+               Lanes2{q0[0][j][2], q0[1][j][2]}};
+      p1[j] = {Lanes2{q1[0][j][0], q1[1][j][0]}, Lanes2{q1[0][j][1], q1[1][j][1]},
+               Lanes2{q1[0][j][2], q1[1][j][2]}};
+    }
+    Lanes2 k[4];
+    orientation_detail::orientation_k(p0, p1, k);
+    for (int l = 0; l < 2; ++l) {
+      const double kl[4] = {k[0][l], k[1][l], k[2][l], k[3][l]};
+      bool decided;
+      const Orientation o = orientation_detail::static_sign(kl, cluster_err[c[l]], decided);
+      tcls[t + l] = static_cast<std::uint8_t>(decided ? o
+                                                      : orientation_of(q0[l][0], q0[l][1], q0[l][2],
+                                                                       q0[l][3], q1[l][0], q1[l][1],
+                                                                       q1[l][2], q1[l][3]));
+    }
+  };
+  const std::int64_t pairs = nt / 2;
+#if defined(TETSEG_HAVE_OPENMP)
+#pragma omp parallel for if (opt.use_openmp && nt > 2048)
+#endif
+  for (std::int64_t i = 0; i < pairs; ++i) classify_two(2 * i);
+  if (nt % 2 != 0) classify_one(nt - 1);
+#else
+#if defined(TETSEG_HAVE_OPENMP)
+#pragma omp parallel for if (opt.use_openmp && nt > 2048)
+#endif
+  for (std::int64_t t = 0; t < nt; ++t) classify_one(t);
+#endif
   std::uint64_t count[3] = {0, 0, 0};
   for (std::uint32_t t = 0; t < tri_count; ++t) ++count[tcls[t]];
   stats.triangles_positive = count[0];
   stats.triangles_negative = count[1];
   stats.triangles_uncertain = count[2];
-  // Per-node counters of negative and uncertain triangles, bottom-up, from this step.
+  // Per-node sign bits, bottom-up, from this step: a node is all positive (all negative) when
+  // every triangle under it is.
+  auto triangle_sign = [&](std::uint32_t t) -> std::uint8_t {
+    const std::uint8_t c = tcls[t];
+    return c == static_cast<std::uint8_t>(Orientation::kPositive)   ? kNodeAllPositive
+           : c == static_cast<std::uint8_t>(Orientation::kNegative) ? kNodeAllNegative
+                                                                    : 0;
+  };
   for (const format::Cluster& cl : asset->clusters) {
     const format::BvhNode* nodes = asset->bvh_nodes.data() + cl.bvh_offset;
     const std::uint32_t* leaf = asset->cluster_triangles.data() + cl.triangle_offset;
-    std::uint32_t* ng = nneg.data() + cl.bvh_offset;
-    std::uint32_t* nu = nunc.data() + cl.bvh_offset;
+    std::uint8_t* sign = nsign.data() + cl.bvh_offset;
     for (std::uint32_t i = cl.bvh_count; i-- > 0;) {
       const format::BvhNode& n = nodes[i];
       if (n.count > 0) {
-        std::uint32_t g = 0, u = 0;
-        for (std::uint32_t k = 0; k < n.count; ++k) {
-          const std::uint8_t c = tcls[leaf[n.first + k]];
-          g += c == static_cast<std::uint8_t>(Orientation::kNegative);
-          u += c == static_cast<std::uint8_t>(Orientation::kUncertain);
-        }
-        ng[i] = g;
-        nu[i] = u;
+        std::uint8_t s = kNodeAllPositive | kNodeAllNegative;
+        for (std::uint32_t k = 0; k < n.count; ++k) s &= triangle_sign(leaf[n.first + k]);
+        sign[i] = s;
       } else {
-        ng[i] = ng[n.first] + ng[n.second];
-        nu[i] = nu[n.first] + nu[n.second];
+        sign[i] = sign[n.first] & sign[n.second];
       }
     }
   }

@@ -8,6 +8,9 @@
 #include <cstdint>
 #include <memory>
 #include <vector>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 #include "body_shape_data.hpp"
 #include "normal_cone.hpp"
@@ -29,9 +32,19 @@ struct Box {
 inline bool boxes_overlap(const Box& a, const Box& b, double margin) noexcept {
   // Written so that NaN never yields "disjoint" (positions are checked finite anyway). All six
   // comparisons combined without branches: the traversal's outcomes are hard to predict.
+#if defined(__SSE2__)
+  // x and y in one pair of packed comparisons (the same comparisons, lane by lane).
+  const __m128d m = _mm_set1_pd(margin);
+  const __m128d apart_xy =
+      _mm_or_pd(_mm_cmpgt_pd(_mm_loadu_pd(a.lo), _mm_add_pd(_mm_loadu_pd(b.hi), m)),
+                _mm_cmpgt_pd(_mm_loadu_pd(b.lo), _mm_add_pd(_mm_loadu_pd(a.hi), m)));
+  const bool apart = (_mm_movemask_pd(apart_xy) != 0) | (a.lo[2] > b.hi[2] + margin) |
+                     (b.lo[2] > a.hi[2] + margin);
+#else
   const bool apart = (a.lo[0] > b.hi[0] + margin) | (b.lo[0] > a.hi[0] + margin) |
                      (a.lo[1] > b.hi[1] + margin) | (b.lo[1] > a.hi[1] + margin) |
                      (a.lo[2] > b.hi[2] + margin) | (b.lo[2] > a.hi[2] + margin);
+#endif
   return !apart;
 }
 
@@ -49,12 +62,18 @@ struct TreeView {
   const Box* box = nullptr;
   const Box* tri_box = nullptr;  // swept box of each triangle (by global id), this step
   const std::uint32_t* ntris = nullptr;
-  const std::uint32_t* nneg = nullptr;  // null: no orientation culling
-  const std::uint32_t* nunc = nullptr;
+  // Per node, this step: kNodeAllPositive / kNodeAllNegative when every triangle under it has
+  // that orientation class, 0 otherwise. Null: no orientation culling.
+  const std::uint8_t* nsign = nullptr;
   const std::uint32_t* nmov = nullptr;
   const ConeData* cone = nullptr;  // non-null: node self-tests may be culled by normal cones
   std::uint32_t cone_base = 0;     // cone index of node 0
 };
+
+/// Node sign bits (TreeView::nsign): two nodes whose bits share one cannot produce a first
+/// contact between their triangles (one orientation class throughout).
+inline constexpr std::uint8_t kNodeAllPositive = 1;
+inline constexpr std::uint8_t kNodeAllNegative = 2;
 
 struct StackItem {
   std::uint32_t a;
@@ -294,7 +313,8 @@ struct Collider::Impl {
   std::vector<std::array<std::uint32_t, 2>> orphan_vf;  // (node, triangle)
   std::vector<std::array<std::uint32_t, 2>> orphan_ee;  // (edge, edge), first < second
   std::vector<Box> nbox;                                // per asset BVH node
-  std::vector<std::uint32_t> nneg, nunc, nmov;
+  std::vector<std::uint32_t> nmov;
+  std::vector<std::uint8_t> nsign;                         // per asset BVH node: TreeView::nsign
   std::vector<orientation_detail::StaticErr> cluster_err;  // per cluster, this step (classify)
   std::vector<Worker> workers;
   // Contact closure scratch (capacity tri_count, reserved at construction).
@@ -342,6 +362,15 @@ struct Collider::Impl {
   bool run_query(Contact* out, std::size_t out_cap) noexcept;
   bool non_culled(std::uint32_t t1, std::uint32_t t2) const noexcept;
   void process_triangle_pair(Worker& w, std::uint32_t t1, std::uint32_t t2) const noexcept;
+  /// process_triangle_pair of a pair known to be non-culled (not in the rest check).
+  void process_non_culled_pair(Worker& w, std::uint32_t t1, std::uint32_t t2) const noexcept;
+  /// Every leaf of the cluster BVHs holds one triangle (construction).
+  bool single_triangle_leaves = false;
+  /// True when tree t is a cluster tree of single-triangle leaves traversed outside the rest
+  /// check: its leaf box and counters are its triangle's swept box and flags, so a leaf pair
+  /// that passed the traversal's live test (movement, boxes, and within a cluster the
+  /// orientation rule) is a non-culled triangle pair and needs no second check.
+  bool leaf_pairs_non_culled(const TreeView& t) const noexcept;
   bool traverse_self(Worker& w, const TreeView& tree) const noexcept;
   bool traverse_pair(Worker& w, const TreeView& ta, const TreeView& tb) const noexcept;
   void brute_vertex_faces(Worker& w, std::uint32_t i) const noexcept;

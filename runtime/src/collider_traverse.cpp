@@ -50,8 +50,7 @@ TreeView Collider::Impl::cluster_view(std::uint32_t c) const noexcept {
   v.ntris = topo->cluster_node_ntris.data() + cl.bvh_offset;
   v.nmov = nmov.data() + cl.bvh_offset;
   if (orientation_mode()) {
-    v.nneg = nneg.data() + cl.bvh_offset;
-    v.nunc = nunc.data() + cl.bvh_offset;
+    v.nsign = nsign.data() + cl.bvh_offset;
   }
   return v;
 }
@@ -362,6 +361,11 @@ void Collider::Impl::process_triangle_pair(Worker& w, std::uint32_t t1,
     rest_triangle_pair(w, *this, t1, *this, t2);
     return;
   }
+  process_non_culled_pair(w, t1, t2);
+}
+
+void Collider::Impl::process_non_culled_pair(Worker& w, std::uint32_t t1,
+                                             std::uint32_t t2) const noexcept {
   ++w.stats.triangle_pairs;
   const std::uint64_t key = pair_key(t1, t2);
   if (skip_adjacent) {
@@ -425,6 +429,10 @@ inline void leaf_pair(Worker& w, const TreeView& ta, std::uint32_t a, const Tree
                       std::uint32_t b, double ms, TrianglePair&& triangle_pair) noexcept {
   const format::BvhNode& na = ta.nodes[a];
   const format::BvhNode& nb = tb.nodes[b];
+  if (na.count == 1 && nb.count == 1) {  // rvbc's cluster leaves
+    triangle_pair(ta.leaf_tris[na.first], tb.leaf_tris[nb.first]);
+    return;
+  }
   for (std::uint32_t i = 0; i < na.count && !w.stop; ++i) {
     const std::uint32_t t1 = ta.leaf_tris[na.first + i];
     if (nb.count > 1 && !boxes_overlap(ta.tri_box[t1], tb.box[b], ms)) continue;
@@ -468,8 +476,19 @@ bool traverse_tree_pair(Worker& w, const TreeView& ta, const TreeView& tb, doubl
   return true;
 }
 
+bool Collider::Impl::leaf_pairs_non_culled(const TreeView& t) const noexcept {
+  return single_triangle_leaves && orientation_mode() && t.nsign != nullptr;
+}
+
 bool Collider::Impl::traverse_pair(Worker& w, const TreeView& ta,
                                    const TreeView& tb) const noexcept {
+  // Two clusters' trees: their triangles are of different clusters, so a live leaf pair of
+  // single triangles is a non-culled triangle pair (leaf_pairs_non_culled).
+  if (leaf_pairs_non_culled(ta) && leaf_pairs_non_culled(tb)) {
+    return traverse_tree_pair(
+        w, ta, tb, opt.ccd.min_separation, rest_mode,
+        [&](std::uint32_t t1, std::uint32_t t2) { process_non_culled_pair(w, t1, t2); });
+  }
   return traverse_tree_pair(
       w, ta, tb, opt.ccd.min_separation, rest_mode,
       [&](std::uint32_t t1, std::uint32_t t2) { process_triangle_pair(w, t1, t2); });
@@ -505,25 +524,29 @@ bool traverse_bodies(Worker& w, const Collider::Impl& A, const Collider::Impl& B
 }
 
 bool Collider::Impl::traverse_self(Worker& w, const TreeView& t) const noexcept {
-  const bool orient = t.nneg != nullptr;
+  const bool orient = t.nsign != nullptr;
   const double ms = opt.ccd.min_separation;
-  auto one_sign = [&](std::uint32_t n) {
-    return orient && (t.nunc[n] == 0 && (t.nneg[n] == 0 || t.nneg[n] == t.ntris[n]));
-  };
+  auto one_sign = [&](std::uint32_t n) { return orient && t.nsign[n] != 0; };
   // Pair items are tested (not both still, boxes overlap, not culled by orientation) before
   // they are pushed, so popped pair items are live.
   auto live_pair = [&](std::uint32_t a, std::uint32_t b) {
     if (!rest_mode && t.nmov[a] == 0 && t.nmov[b] == 0) return false;
     if (!boxes_overlap(t.box[a], t.box[b], ms)) return false;
-    if (orient && t.nunc[a] == 0 && t.nunc[b] == 0 &&
-        ((t.nneg[a] == 0 && t.nneg[b] == 0) ||
-         (t.nneg[a] == t.ntris[a] && t.nneg[b] == t.ntris[b]))) {
+    if (orient && (t.nsign[a] & t.nsign[b]) != 0) {
       ++w.stats.node_pairs_orientation_culled;
       return false;
     }
     return true;
   };
-  auto self_pair = [&](std::uint32_t t1, std::uint32_t t2) { process_triangle_pair(w, t1, t2); };
+  // Leaves of single triangles: a live leaf pair is a non-culled triangle pair.
+  const bool leaves_non_culled = leaf_pairs_non_culled(t);
+  auto self_pair = [&](std::uint32_t t1, std::uint32_t t2) {
+    if (leaves_non_culled) {
+      process_non_culled_pair(w, t1, t2);
+    } else {
+      process_triangle_pair(w, t1, t2);
+    }
+  };
   std::size_t top = 0;
   w.stack[top++] = {0, kNone};
   while (top > 0 && !w.stop) {
@@ -586,8 +609,7 @@ bool Collider::Impl::cluster_tasks(Worker& w, std::uint32_t c1, bool count_skips
   const std::uint32_t nc = cluster_count();
   const TreeView v1 = cluster_view(c1);
   const bool still = !rest_mode && v1.nmov[0] == 0;
-  const bool one_sign =
-      v1.nneg && v1.nunc[0] == 0 && (v1.nneg[0] == 0 || v1.nneg[0] == v1.ntris[0]);
+  const bool one_sign = v1.nsign && v1.nsign[0] != 0;
   if (still || one_sign) {
     if (count_skips) ++w.stats.clusters_skipped;
   } else if (!traverse_self(w, v1)) {

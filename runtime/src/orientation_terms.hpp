@@ -93,13 +93,48 @@ struct StaticErr {
 };
 
 /// Bernstein coefficients only (no error terms), the same operations as `bernstein`.
-inline void bernstein_k(const V3& u0, const V3& u1, const Minors& m00, const Minors& m10,
-                        const Minors& m01, const Minors& m11, double k[4]) noexcept {
-  auto det = [](const V3& u, const Minors& m) { return u.x * m.m0 - u.y * m.m1 + u.z * m.m2; };
+/// Generic in the number type T (double, or a vector of doubles computing lane by lane the
+/// same operations): V has members x, y, z and M members m0, m1, m2 of type T.
+template <class V, class M, class T>
+inline void bernstein_k(const V& u0, const V& u1, const M& m00, const M& m10, const M& m01,
+                        const M& m11, T k[4]) noexcept {
+  auto det = [](const V& u, const M& m) { return u.x * m.m0 - u.y * m.m1 + u.z * m.m2; };
   k[0] = det(u0, m00);
   k[1] = det(u1, m00) + det(u0, m10) + det(u0, m01);
   k[2] = det(u0, m11) + det(u1, m01) + det(u1, m10);
   k[3] = det(u1, m11);
+}
+
+#if defined(__GNUC__)
+#define TETSEG_HAVE_LANES2 1
+/// Two doubles computed lane by lane with the scalar operations (GCC/Clang vector extension):
+/// each lane is bitwise the scalar result.
+typedef double Lanes2 __attribute__((vector_size(16)));
+#endif
+
+template <class T>
+struct Vec3T {
+  T x, y, z;
+};
+template <class T>
+struct MinorTerms {
+  T m0, m1, m2;
+};
+
+/// The Bernstein coefficients of det[a - o, b - o, c - o] over the step, for the points
+/// p0 = {o, a, b, c} at the start and p1 at the end, without error terms: the operations of
+/// `bernstein_k` over the `minors` m terms, in T (double, or a vector of doubles).
+template <class T>
+inline void orientation_k(const Vec3T<T> p0[4], const Vec3T<T> p1[4], T k[4]) noexcept {
+  auto d = [](const Vec3T<T>& a, const Vec3T<T>& b) {
+    return Vec3T<T>{a.x - b.x, a.y - b.y, a.z - b.z};
+  };
+  auto m = [](const Vec3T<T>& v, const Vec3T<T>& w) {
+    return MinorTerms<T>{v.y * w.z - v.z * w.y, v.x * w.z - v.z * w.x, v.x * w.y - v.y * w.x};
+  };
+  const Vec3T<T> v0 = d(p0[2], p0[0]), w0 = d(p0[3], p0[0]), v1 = d(p1[2], p1[0]),
+                 w1 = d(p1[3], p1[0]);
+  bernstein_k(d(p0[1], p0[0]), d(p1[1], p1[0]), m(v0, w0), m(v1, w0), m(v0, w1), m(v1, w1), k);
 }
 
 /// The sign `sign(bernstein(...))` would give, decided from the coefficients and a static bound
@@ -159,12 +194,10 @@ inline Orientation orientation_of(const double* o0, const double* a0, const doub
                                   const double* b1, const double* c1,
                                   const orientation_detail::StaticErr& e) noexcept {
   using namespace orientation_detail;
-  const V3 v0 = sub(b0, o0), w0 = sub(c0, o0), v1 = sub(b1, o1), w1 = sub(c1, o1);
-  auto m = [](const V3& v, const V3& w) {  // the minors' m terms only, as `minors`
-    return Minors{v.y * w.z - v.z * w.y, v.x * w.z - v.z * w.x, v.x * w.y - v.y * w.x, 0, 0, 0};
-  };
+  auto p = [](const double* q) { return Vec3T<double>{q[0], q[1], q[2]}; };
+  const Vec3T<double> p0[4] = {p(o0), p(a0), p(b0), p(c0)}, p1[4] = {p(o1), p(a1), p(b1), p(c1)};
   double k[4];
-  bernstein_k(sub(a0, o0), sub(a1, o1), m(v0, w0), m(v1, w0), m(v0, w1), m(v1, w1), k);
+  orientation_k(p0, p1, k);
   bool decided;
   const Orientation o = static_sign(k, e, decided);
   return decided ? o : sign(cubic(o0, a0, b0, c0, o1, a1, b1, c1));

@@ -400,3 +400,40 @@ TEST_CASE("Only the detector nodes that are read must be finite", "[detector][co
   Collider rvbc = collider_for(flagged, ColliderMode::kRvbc);
   CHECK(rvbc.step(flagged.rest.data(), x1.data()) == ColliderStatus::kOk);
 }
+
+TEST_CASE("The collider's triangle classes are classify_orientation's against the detector",
+          "[detector][collider][rvbc][classify]") {
+  // Classification runs two triangles at once (vector lanes) with a static error bound: each
+  // class must be bitwise the scalar library function's, on pressing and inverted-detector
+  // steps.
+  for (double fling : {0.0, 3.0}) {
+    for (int clusters : {1, 2}) {
+      CAPTURE(fling, clusters);
+      const Scene scene = with_detector_tets(sphere_scene(clusters), 0.05);
+      auto frames = make_frames(scene, 6, press_poles);
+      invert_detector_tets(scene, frames, fling);
+      const format::Asset& a = scene.asset.data();
+      Collider rvbc = collider_for(scene, ColliderMode::kRvbc);
+      std::uint64_t definite = 0;
+      for (std::size_t f = 0; f + 1 < frames.size(); ++f) {
+        CAPTURE(f);
+        const double* x0 = frames[f].data();
+        const double* x1 = frames[f + 1].data();
+        REQUIRE(rvbc.step(x0, x1) == ColliderStatus::kOk);
+        for (std::size_t t = 0; t < a.triangles.size(); ++t) {
+          const format::Cluster& cl = a.clusters[a.triangle_cluster[t]];
+          const auto o0 = format::detector_position(cl.detector, x0);
+          const auto o1 = format::detector_position(cl.detector, x1);
+          const auto& tri = a.triangles[t];
+          auto p = [](const double* x, std::uint32_t n) { return x + std::size_t(n) * 3; };
+          const Orientation expected =
+              classify_orientation(o0.data(), p(x0, tri[0]), p(x0, tri[1]), p(x0, tri[2]),
+                                   o1.data(), p(x1, tri[0]), p(x1, tri[1]), p(x1, tri[2]));
+          REQUIRE(rvbc.triangle_class(t) == expected);
+          definite += expected != Orientation::kUncertain;
+        }
+      }
+      CHECK(definite > 0);
+    }
+  }
+}
