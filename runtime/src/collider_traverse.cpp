@@ -201,54 +201,49 @@ const FacePlaneMinors& face_minors(Worker& w, const Collider::Impl& body, std::u
   return m;
 }
 
+// The `count` nodes of body O stay strictly on one side of the plane of triangle t of body T
+// for the whole step, each side proven by the error-bounded orientation cubic. `box` holds the
+// nodes at both ends of the step (with t's swept box: the static error bound).
+bool nodes_off_plane(Worker& w, const Collider::Impl& T, std::uint32_t t, const Collider::Impl& O,
+                     const std::uint32_t* nodes, int count, const Box& box) noexcept {
+  Box u = T.tbox[t];
+  box_union(u, box);
+  const double extent[3] = {u.hi[0] - u.lo[0], u.hi[1] - u.lo[1], u.hi[2] - u.lo[2]};
+  const orientation_detail::StaticErr err = orientation_detail::StaticErr::of(extent);
+  FacePlaneMinors local;
+  const FacePlaneMinors& plane = face_minors(w, T, t, local);
+  const std::uint32_t a = T.tris[t][0];
+  Orientation side = Orientation::kUncertain;
+  for (int i = 0; i < count; ++i) {
+    const Orientation o = plane.side(T.pos0(a), T.pos1(a), O.pos0(nodes[i]), O.pos1(nodes[i]), err);
+    if (o == Orientation::kUncertain || (i > 0 && o != side)) return false;
+    side = o;
+  }
+  return true;
+}
+
 // Edge-pair plane filter (exact contact only): both nodes of edge e2 of B stay strictly on one
-// side of the plane of a triangle of A around edge e1 for the whole step, each side proven by
-// the error-bounded orientation cubic. e1 lies in that plane, so the edges never touch.
+// side of the plane of a triangle of A around edge e1. e1 lies in that plane at every t of
+// the step, so the edges never touch.
 bool edge_off_face_planes(Worker& w, const Collider::Impl& A, std::uint32_t e1,
                           const Collider::Impl& B, std::uint32_t e2) noexcept {
-  const auto& E2 = B.topo->edges[e2];
   const auto& et_offset = A.topo->et_offset;
-  for (std::uint32_t k = et_offset[e1]; k < et_offset[e1 + 1]; ++k) {
-    const std::uint32_t t = A.topo->et_list[k];
-    // The triangle and the edge lie in the union of their swept boxes (static error bound).
-    Box u = A.tbox[t];
-    box_union(u, B.ebox[e2]);
-    const double extent[3] = {u.hi[0] - u.lo[0], u.hi[1] - u.lo[1], u.hi[2] - u.lo[2]};
-    const orientation_detail::StaticErr err = orientation_detail::StaticErr::of(extent);
-    FacePlaneMinors local;
-    const FacePlaneMinors& plane = face_minors(w, A, t, local);
-    const std::uint32_t a = A.tris[t][0];
-    const Orientation s = plane.side(A.pos0(a), A.pos1(a), B.pos0(E2[0]), B.pos1(E2[0]), err);
-    if (s != Orientation::kUncertain &&
-        plane.side(A.pos0(a), A.pos1(a), B.pos0(E2[1]), B.pos1(E2[1]), err) == s)
+  for (std::uint32_t k = et_offset[e1]; k < et_offset[e1 + 1]; ++k)
+    if (nodes_off_plane(w, A, A.topo->et_list[k], B, B.topo->edges[e2].data(), 2, B.ebox[e2]))
       return true;
-  }
   return false;
 }
 
 // Vertex-face plane filter (exact contact only): the three nodes of face `face` of F stay
-// strictly on one side of the plane of a triangle of P around node p for the whole step. p
-// lies in that plane, so it never touches the face.
+// strictly on one side of the plane of a triangle of P around node p. p lies in that plane at
+// every t of the step, so it never touches the face.
 bool face_off_vertex_planes(Worker& w, const Collider::Impl& P, std::uint32_t p,
                             const Collider::Impl& F, std::uint32_t face) noexcept {
-  const auto& f = F.tris[face];
   const std::uint32_t ip = P.topo->surf_index[p];
   const auto& vt_offset = P.topo->vt_offset;
-  for (std::uint32_t k = vt_offset[ip]; k < vt_offset[ip + 1]; ++k) {
-    const std::uint32_t t = P.topo->vt_list[k];
-    Box u = P.tbox[t];
-    box_union(u, F.tbox[face]);
-    const double extent[3] = {u.hi[0] - u.lo[0], u.hi[1] - u.lo[1], u.hi[2] - u.lo[2]};
-    const orientation_detail::StaticErr err = orientation_detail::StaticErr::of(extent);
-    FacePlaneMinors local;
-    const FacePlaneMinors& plane = face_minors(w, P, t, local);
-    const std::uint32_t a = P.tris[t][0];
-    const Orientation s = plane.side(P.pos0(a), P.pos1(a), F.pos0(f[0]), F.pos1(f[0]), err);
-    if (s != Orientation::kUncertain &&
-        plane.side(P.pos0(a), P.pos1(a), F.pos0(f[1]), F.pos1(f[1]), err) == s &&
-        plane.side(P.pos0(a), P.pos1(a), F.pos0(f[2]), F.pos1(f[2]), err) == s)
+  for (std::uint32_t k = vt_offset[ip]; k < vt_offset[ip + 1]; ++k)
+    if (nodes_off_plane(w, P, P.topo->vt_list[k], F, F.tris[face].data(), 3, F.tbox[face]))
       return true;
-  }
   return false;
 }
 
