@@ -176,29 +176,31 @@ void Worker::record(const Contact& c) noexcept {
 
 namespace {
 
-// Whether w caches the plane minors of `body`'s triangles; its entry of triangle t.
-inline bool caches_planes(const Worker& w, const Collider::Impl& body) noexcept {
-  return w.plane_owner == &body || body.body_id < w.plane_base.size();
-}
-inline std::size_t plane_entry(const Worker& w, const Collider::Impl& body,
-                               std::uint32_t t) noexcept {
-  return w.plane_owner == &body ? t : std::size_t(w.plane_base[body.body_id]) + t;
+// The plane minors of triangle t of `body` for this step (FacePlaneMinors::of its nodes).
+FacePlaneMinors minors_of(const Collider::Impl& body, std::uint32_t t) noexcept {
+  const auto& f = body.tris[t];
+  return FacePlaneMinors::of(body.pos0(f[0]), body.pos0(f[1]), body.pos0(f[2]), body.pos1(f[0]),
+                             body.pos1(f[1]), body.pos1(f[2]));
 }
 
 // Plane minors of triangle t of `body` for this step: from w's per-step cache when w caches
-// that body (computed there at first use), else into `local`. Same values either way (bitwise:
-// the same operations in the same order).
-const FacePlaneMinors& face_minors(Worker& w, const Collider::Impl& body, std::uint32_t t,
-                                   FacePlaneMinors& local) noexcept {
-  const auto& f = body.tris[t];
-  const bool cache = caches_planes(w, body);
-  const std::size_t i = cache ? plane_entry(w, body, t) : 0;
-  if (cache && w.plane_step[i] == body.step_serial) return w.plane[i];
-  FacePlaneMinors& m = cache ? w.plane[i] : local;
-  m = FacePlaneMinors::of(body.pos0(f[0]), body.pos0(f[1]), body.pos0(f[2]), body.pos1(f[0]),
-                          body.pos1(f[1]), body.pos1(f[2]));
-  if (cache) w.plane_step[i] = body.step_serial;
-  return m;
+// that body (its own collider's, or any body's for a scene worker; computed there at first
+// use), else into `local`. Same values either way (the same operations in the same order).
+inline const FacePlaneMinors& face_minors(Worker& w, const Collider::Impl& body, std::uint32_t t,
+                                          FacePlaneMinors& local) noexcept {
+  std::size_t i = t;
+  if (w.plane_owner != &body) {
+    if (body.body_id >= w.plane_base.size()) {
+      local = minors_of(body, t);
+      return local;
+    }
+    i += w.plane_base[body.body_id];
+  }
+  if (w.plane_step[i] != body.step_serial) {
+    w.plane[i] = minors_of(body, t);
+    w.plane_step[i] = body.step_serial;
+  }
+  return w.plane[i];
 }
 
 // The `count` nodes of body O stay strictly on one side of the plane of triangle t of body T
@@ -344,11 +346,10 @@ bool plane_separated(Worker& w, const Collider::Impl& A, std::uint32_t t1, const
   const double extent[3] = {u.hi[0] - u.lo[0], u.hi[1] - u.lo[1], u.hi[2] - u.lo[2]};
   const orientation_detail::StaticErr err = orientation_detail::StaticErr::of(extent);
   FacePlaneMinors local1, local2;
-  MovingTriangle m1{A.tris[t1], A.x0, A.x1,
-                    caches_planes(w, A) ? &face_minors(w, A, t1, local1) : nullptr};
+  MovingTriangle m1{A.tris[t1], A.x0, A.x1, &face_minors(w, A, t1, local1)};
   MovingTriangle m2{B.tris[t2], B.x0, B.x1};
   if (nodes_strictly_on_one_side(m1, m2, same, &err)) return true;  // plane_separated
-  if (caches_planes(w, B)) m2.minors = &face_minors(w, B, t2, local2);
+  m2.minors = &face_minors(w, B, t2, local2);
   return nodes_strictly_on_one_side(m2, m1, same, &err);
 }
 
