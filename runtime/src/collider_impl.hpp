@@ -165,10 +165,12 @@ struct Worker {
   bool rest_hit = false;
   std::uint32_t rest_a = 0, rest_b = 0;
   QueryKind qkind = QueryKind::kFull;
-  // Lazy per-step cache of the plane minors of the owning collider's triangles (plane filter):
-  // entry t is valid when plane_step[t] == the collider's step_serial. Sized at construction,
-  // used only by the collider `plane_owner` (empty and null for scene workers).
+  // Lazy per-step cache of triangles' plane minors (plane filters): a collider's worker caches
+  // its collider `plane_owner`'s triangles (entry t); a scene's worker every body's (entry
+  // plane_base[body_id] + t; plane_owner null). An entry is valid when its plane_step equals
+  // the body's step_serial. Sized at construction (scene: add_body).
   const void* plane_owner = nullptr;
+  std::vector<std::uint32_t> plane_base;
   std::vector<FacePlaneMinors> plane;
   std::vector<std::uint64_t> plane_step;
   /// Counts a contact: stops the traversal for kAny, else keeps the earliest and fills `out`.

@@ -173,6 +173,83 @@ void Worker::record(const Contact& c) noexcept {
 // swept-box checks, the coplanarity filter, the elementary test, the contact. Options (ccd,
 // timing) are A's; a scene gives all its bodies the same.
 
+namespace {
+
+// The plane minors of triangle t of `body` for this step (FacePlaneMinors::of its nodes).
+FacePlaneMinors minors_of(const Collider::Impl& body, std::uint32_t t) noexcept {
+  const auto& f = body.tris[t];
+  return FacePlaneMinors::of(body.pos0(f[0]), body.pos0(f[1]), body.pos0(f[2]), body.pos1(f[0]),
+                             body.pos1(f[1]), body.pos1(f[2]));
+}
+
+// Plane minors of triangle t of `body` for this step: from w's per-step cache when w caches
+// that body (its own collider's, or any body's for a scene worker; computed there at first
+// use), else into `local`. Same values either way (the same operations in the same order).
+inline const FacePlaneMinors& face_minors(Worker& w, const Collider::Impl& body, std::uint32_t t,
+                                          FacePlaneMinors& local) noexcept {
+  std::size_t i = t;
+  if (w.plane_owner != &body) {
+    if (body.body_id >= w.plane_base.size()) {
+      local = minors_of(body, t);
+      return local;
+    }
+    i += w.plane_base[body.body_id];
+  }
+  if (w.plane_step[i] != body.step_serial) {
+    w.plane[i] = minors_of(body, t);
+    w.plane_step[i] = body.step_serial;
+  }
+  return w.plane[i];
+}
+
+// The `count` nodes of body O stay strictly on one side of the plane of triangle t of body T
+// for the whole step, each side proven by the error-bounded orientation cubic. `box` holds the
+// nodes at both ends of the step (with t's swept box: the static error bound).
+bool nodes_off_plane(Worker& w, const Collider::Impl& T, std::uint32_t t, const Collider::Impl& O,
+                     const std::uint32_t* nodes, int count, const Box& box) noexcept {
+  Box u = T.tbox[t];
+  box_union(u, box);
+  const double extent[3] = {u.hi[0] - u.lo[0], u.hi[1] - u.lo[1], u.hi[2] - u.lo[2]};
+  const orientation_detail::StaticErr err = orientation_detail::StaticErr::of(extent);
+  FacePlaneMinors local;
+  const FacePlaneMinors& plane = face_minors(w, T, t, local);
+  const std::uint32_t a = T.tris[t][0];
+  Orientation side = Orientation::kUncertain;
+  for (int i = 0; i < count; ++i) {
+    const Orientation o = plane.side(T.pos0(a), T.pos1(a), O.pos0(nodes[i]), O.pos1(nodes[i]), err);
+    if (o == Orientation::kUncertain || (i > 0 && o != side)) return false;
+    side = o;
+  }
+  return true;
+}
+
+// Edge-pair plane filter (exact contact only): both nodes of edge e2 of B stay strictly on one
+// side of the plane of a triangle of A around edge e1. e1 lies in that plane at every t of
+// the step, so the edges never touch.
+bool edge_off_face_planes(Worker& w, const Collider::Impl& A, std::uint32_t e1,
+                          const Collider::Impl& B, std::uint32_t e2) noexcept {
+  const auto& et_offset = A.topo->et_offset;
+  for (std::uint32_t k = et_offset[e1]; k < et_offset[e1 + 1]; ++k)
+    if (nodes_off_plane(w, A, A.topo->et_list[k], B, B.topo->edges[e2].data(), 2, B.ebox[e2]))
+      return true;
+  return false;
+}
+
+// Vertex-face plane filter (exact contact only): the three nodes of face `face` of F stay
+// strictly on one side of the plane of a triangle of P around node p. p lies in that plane at
+// every t of the step, so it never touches the face.
+bool face_off_vertex_planes(Worker& w, const Collider::Impl& P, std::uint32_t p,
+                            const Collider::Impl& F, std::uint32_t face) noexcept {
+  const std::uint32_t ip = P.topo->surf_index[p];
+  const auto& vt_offset = P.topo->vt_offset;
+  for (std::uint32_t k = vt_offset[ip]; k < vt_offset[ip + 1]; ++k)
+    if (nodes_off_plane(w, P, P.topo->vt_list[k], F, F.tris[face].data(), 3, F.tbox[face]))
+      return true;
+  return false;
+}
+
+}  // namespace
+
 void process_vertex_face(Worker& w, const Collider::Impl& P, std::uint32_t p,
                          const Collider::Impl& F, std::uint32_t face) noexcept {
   const auto& f = F.tris[face];
@@ -186,7 +263,7 @@ void process_vertex_face(Worker& w, const Collider::Impl& P, std::uint32_t p,
     // Coplanarity cubic det[b-a, c-a, p-a] with a proven strict sign: never coplanar.
     const Orientation o = orientation_of(F.pos0(f[0]), F.pos0(f[1]), F.pos0(f[2]), P.pos0(p),
                                          F.pos1(f[0]), F.pos1(f[1]), F.pos1(f[2]), P.pos1(p));
-    if (o != Orientation::kUncertain) {
+    if (o != Orientation::kUncertain || face_off_vertex_planes(w, P, p, F, face)) {
       ++w.stats.feature_pairs_filtered;
       return;
     }
@@ -229,7 +306,8 @@ void process_edge_edge(Worker& w, const Collider::Impl& A, std::uint32_t e1,
     // det[b-a, d-c, c-a] = det[b-a, d-a, c-a]: orientation of (a; b, d, c).
     const Orientation o = orientation_of(A.pos0(a), A.pos0(b), B.pos0(d), B.pos0(c), A.pos1(a),
                                          A.pos1(b), B.pos1(d), B.pos1(c));
-    if (o != Orientation::kUncertain) {
+    if (o != Orientation::kUncertain || edge_off_face_planes(w, A, e1, B, e2) ||
+        edge_off_face_planes(w, B, e2, A, e1)) {
       ++w.stats.feature_pairs_filtered;
       return;
     }
@@ -255,32 +333,22 @@ void process_edge_edge(Worker& w, const Collider::Impl& A, std::uint32_t e1,
 
 // Triangle-pair plane filter of triangle t1 of A and t2 of B (plane_filter.hpp; exact
 // contact only; docs/runtime.md, "Triangle-pair plane filter").
-// Within one body whose own worker `w` runs the traversal, each triangle's plane minors are
-// computed once per step, at first use, in w's cache; else per pair. Same answer either way
-// (bitwise: the same operations in the same order).
+// Each triangle's plane minors come from w's per-step cache when w caches its body
+// (face_minors), else are computed per pair. Same answer either way.
 bool plane_separated(Worker& w, const Collider::Impl& A, std::uint32_t t1, const Collider::Impl& B,
                      std::uint32_t t2) noexcept {
   const bool same = &A == &B;
-  const bool cache = same && w.plane_owner == &A;
-  auto cached = [&](std::uint32_t t) {
-    if (w.plane_step[t] != A.step_serial) {
-      const auto& f = A.tris[t];
-      w.plane[t] = FacePlaneMinors::of(A.pos0(f[0]), A.pos0(f[1]), A.pos0(f[2]), A.pos1(f[0]),
-                                       A.pos1(f[1]), A.pos1(f[2]));
-      w.plane_step[t] = A.step_serial;
-    }
-    return &w.plane[t];
-  };
   // Both triangles lie in the union of their swept boxes: its extents bound every coordinate
   // difference of the cubics (the static error bound).
   Box u = A.tbox[t1];
   box_union(u, B.tbox[t2]);
   const double extent[3] = {u.hi[0] - u.lo[0], u.hi[1] - u.lo[1], u.hi[2] - u.lo[2]};
   const orientation_detail::StaticErr err = orientation_detail::StaticErr::of(extent);
-  MovingTriangle m1{A.tris[t1], A.x0, A.x1, cache ? cached(t1) : nullptr};
+  FacePlaneMinors local1, local2;
+  MovingTriangle m1{A.tris[t1], A.x0, A.x1, &face_minors(w, A, t1, local1)};
   MovingTriangle m2{B.tris[t2], B.x0, B.x1};
   if (nodes_strictly_on_one_side(m1, m2, same, &err)) return true;  // plane_separated
-  if (cache) m2.minors = cached(t2);
+  m2.minors = &face_minors(w, B, t2, local2);
   return nodes_strictly_on_one_side(m2, m1, same, &err);
 }
 

@@ -130,8 +130,17 @@ ColliderStatus Scene::add_body(std::shared_ptr<const BodyShape> shape, const Bod
     body.options = options;
     // Inter-body descent depth is at most the sum of two trees' depths.
     const std::size_t depth = std::max<std::size_t>(body.core->topo->max_depth, 64) + 4;
-    for (Worker& w : s.workers)
+    for (Worker& w : s.workers) {
       if (s.opt.traversal_stack == 0 && w.stack.size() < 8 * depth) w.stack.resize(8 * depth);
+      // Plane-minor cache entries of the new body's triangles (inter-body plane filters),
+      // at plane_base[body id]; an earlier failed add_body may have left unused entries.
+      const std::size_t base = std::max(w.plane.size(), w.plane_step.size());
+      w.plane_base.reserve(s.bodies.size() + 1);
+      w.plane.resize(base + body.core->tri_count);
+      w.plane_step.resize(base + body.core->tri_count, 0);
+      w.plane_base.resize(s.bodies.size());  // drops a failed add_body's entry
+      w.plane_base.push_back(static_cast<std::uint32_t>(base));
+    }
     const std::size_t n = s.bodies.size() + 1;
     s.pair_enabled.resize(n * (n - 1) / 2, 1);
     s.pair_stats.resize(n * (n - 1) / 2);

@@ -5,6 +5,7 @@
 // (still against still skipped, yet a moving body touching a still one found), and the global
 // and per-body position layouts giving identical contacts.
 
+#include <algorithm>
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <map>
@@ -507,6 +508,47 @@ TEST_CASE("Scene: neighbouring triangles folding through each other", "[scene][p
   }
   CHECK(pairs == 0);         // every pair of the three triangles shares node 0
   CHECK(feature_pairs > 0);  // the orphan feature pairs were examined
+}
+
+TEST_CASE("Scene: random hinges tumbling through each other against the oracle", "[scene][plane]") {
+  // Two surface-only bodies, each a hinge of two triangles sharing an edge (so every edge and
+  // vertex has a neighbouring triangle's plane), rotating and passing through each other on
+  // random paths: the triangle-pair and feature-pair plane filters (docs/runtime.md) must drop
+  // no contact that brute force finds.
+  std::mt19937 rng(11);
+  auto u = [&] { return (rng() / 4294967296.0) * 2 - 1; };
+  int contact_steps = 0;
+  for (int trial = 0; trial < 300; ++trial) {
+    CAPTURE(trial);
+    std::vector<TestBody> bodies;
+    for (int b = 0; b < 2; ++b) {
+      Surface s;
+      s.verts = {
+          {-0.5, 0, 0}, {0.5, 0, 0}, {0.3 * u(), 0.8, 0.4 * u()}, {0.3 * u(), -0.8, 0.4 * u()}};
+      s.tris = {{0, 1, 2}, {1, 0, 3}};
+      P3 axis{u(), u(), u()};
+      const double len = std::sqrt(axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]);
+      for (double& c : axis) c /= std::max(len, 1e-3);
+      const double angle0 = 3 * u(), turn = 1.5 * u();
+      const double side = b == 0 ? 0.0 : 1.0;
+      const P3 from{side * 0.3 * u(), side * 0.3 * u(), side * -1.2};
+      const P3 to{side * 0.3 * u(), side * 0.3 * u(), side * (0.2 + 0.6 * u())};
+      Map move = [axis, angle0, turn, from, to](const P3& p, double t) {
+        // Rodrigues rotation by angle0 + t * turn about `axis`, then the path.
+        const double a = angle0 + t * turn, c = std::cos(a), sn = std::sin(a);
+        const double d = axis[0] * p[0] + axis[1] * p[1] + axis[2] * p[2];
+        const P3 x{axis[1] * p[2] - axis[2] * p[1], axis[2] * p[0] - axis[0] * p[2],
+                   axis[0] * p[1] - axis[1] * p[0]};
+        P3 r;
+        for (int k = 0; k < 3; ++k)
+          r[k] = p[k] * c + x[k] * sn + axis[k] * d * (1 - c) + from[k] + t * (to[k] - from[k]);
+        return r;
+      };
+      bodies.push_back(surface_body(s, 4, move));
+    }
+    contact_steps += compare_with_oracle(bodies, trial % 2 == 0);
+  }
+  CHECK(contact_steps >= 100);
 }
 
 TEST_CASE("Scene: OpenMP results equal serial results", "[scene][openmp]") {
