@@ -60,8 +60,8 @@ struct FrameCheck {
 };
 
 /// Steps `frames` through the asset's colliders in rvbc, bvh and cone modes until the first step
-/// with contacts. Each step: `any` agrees with brute force; bvh and cone report exactly the
-/// brute-force set;
+/// with contacts. Each step: `any` agrees with brute force; bvh and cone report a subset of
+/// the brute-force set that holds every contact up to the first;
 /// rvbc reports every brute-force contact up to the earliest one (the runtime's guarantee,
 /// docs/runtime.md) and the same earliest time.
 FrameCheck compare_with_oracle(const Asset& asset, const std::vector<std::vector<double>>& frames) {
@@ -101,10 +101,23 @@ FrameCheck compare_with_oracle(const Asset& asset, const std::vector<std::vector
       REQUIRE(r.found <= found[m].size());
       found[m].resize(r.found);
     }
+    // bvh and cone report nothing brute force does not, and every brute-force contact up to
+    // the first one. Later brute-force contacts may be missing: the feature-pair plane filters
+    // drop pairs proven never to touch that brute force's conservative test still flags (the
+    // folding torus's edge that lands within 5e-16 of another at t = 1: its coplanarity cubic
+    // stays above 3e-34 on [0, 1] in exact arithmetic, docs/runtime.md).
     for (int m = 1; m < 3; ++m) {
       CAPTURE(m);
-      REQUIRE(found[m].size() == brute.size());
-      for (std::size_t i = 0; i < brute.size(); ++i) REQUIRE(same_contact(found[m][i], brute[i]));
+      for (const Contact& c : found[m]) {
+        const bool in_brute = std::any_of(brute.begin(), brute.end(),
+                                          [&](const Contact& x) { return same_contact(x, c); });
+        CHECK(in_brute);
+      }
+      for (const Contact& c : brute) {
+        const bool seen = std::any_of(found[m].begin(), found[m].end(),
+                                      [&](const Contact& x) { return same_contact(x, c); });
+        if (!seen) CHECK(c.toi > brute.front().toi + 1e-9);
+      }
     }
     if (brute.empty()) continue;
     REQUIRE(!found[0].empty());
