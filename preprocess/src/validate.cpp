@@ -301,8 +301,11 @@ void detail::validate_tet_mesh(const TetMesh& mesh, const Surface& surface, cons
   detail::check_components(mesh, surface, file);
 }
 
-void validate_closed_surface(const TriangleMesh& mesh, const std::string& file) {
-  detail::validate_closed_surface(mesh, file, detail::SurfaceCheck{}, nullptr);
+void validate_closed_surface(const TriangleMesh& mesh, const std::string& file,
+                             bool allow_components) {
+  detail::SurfaceCheck check;
+  check.allow_components = allow_components;
+  detail::validate_closed_surface(mesh, file, check, nullptr);
 }
 
 void detail::validate_closed_surface(const TriangleMesh& mesh, const std::string& file,

@@ -345,7 +345,7 @@ py::tuple build(const py::object& mesh, const py::object& source, const std::str
         read_input(in);
         // As `tetseg build`: with repair "fix", tetrahedralize validates after repairing.
         if (meshing.repair == MeshingOptions::Repair::kNone)
-          validate_closed_surface(in.surface, in.source);
+          validate_closed_surface(in.surface, in.source, /*allow_components=*/true);
         summary = std::to_string(in.surface.vertices.size()) + " vertices, " +
                   std::to_string(in.surface.triangles.size()) + " triangles (surface)";
         return 0;

@@ -168,5 +168,14 @@ for c in tori_dump["clusters"]:
     assert len({n < half for n in c["detector"]["nodes"]}) == 1, c
 PY
 expect_exit 2 "would touch" -- "$bin/tetseg" generate tori --resolution 24 --layers 4 -o x.mesh
+# A surface of two closed components (libcgal-demo knot2.off) builds with every repair mode,
+# --repair none included (it used to be refused as "2 connected components" before meshing).
+if [[ -f "${TETSEG_CGAL_MESH_DIR:-/nonexistent}/knot2.off" ]]; then
+  "$bin/tetseg" build "$TETSEG_CGAL_MESH_DIR/knot2.off" -o knot2.tetseg --repair none -q \
+    --report knot2.json || fail "knot2.off (two components) with --repair none"
+  python3 -c 'import json; c = json.load(open("knot2.json"))["counts"]; assert c["components"] == 2, c'
+else
+  skip_without_data "CGAL demo mesh knot2.off (two components)"
+fi
 [ ! -e x.mesh ] || fail "a refused generate left a mesh"
 echo "build.sh: all checks passed"

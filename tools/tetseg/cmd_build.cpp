@@ -141,7 +141,7 @@ void run_build(const BuildArgs& args) {
       TriangleMesh s = read_triangle_mesh(args.input);
       // With --repair fix, tetrahedralize validates after repairing.
       if (args.meshing.repair == MeshingOptions::Repair::kNone)
-        validate_closed_surface(s, args.input);
+        validate_closed_surface(s, args.input, /*allow_components=*/true);
       summary = std::to_string(s.vertices.size()) + " vertices, " +
                 std::to_string(s.triangles.size()) + " triangles (surface)";
       return s;

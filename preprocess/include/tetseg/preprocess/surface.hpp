@@ -41,10 +41,12 @@ Surface extract_valid_surface(const TetMesh& mesh, const std::string& file);
 /// The same surface checks for a triangle mesh that is about to be tetrahedralised or used as
 /// a conductor: finite coordinates, indices in range, no zero-area triangle (|2 area| <=
 /// 1e-12 x longest edge^2, or a repeated vertex), then closed, edge-manifold, consistently
-/// oriented, vertex-manifold, one component, no self-intersection. (tetrahedralize accepts
-/// several components that are not nested.) Orientation (inward or
-/// outward) is not checked. Throws InputError(`file`, message). Thread-safe.
-void validate_closed_surface(const TriangleMesh& mesh, const std::string& file);
+/// oriented, vertex-manifold, one component (several with `allow_components`, as
+/// tetrahedralize accepts: it meshes each closed component and refuses nested ones), no
+/// self-intersection. Orientation (inward or outward) is not checked. Throws
+/// InputError(`file`, message). Thread-safe.
+void validate_closed_surface(const TriangleMesh& mesh, const std::string& file,
+                             bool allow_components = false);
 
 /// Signed volume enclosed by outward triangles (positive for a valid surface).
 double enclosed_volume(const std::vector<Vec3>& points, const std::vector<Tri>& triangles);
