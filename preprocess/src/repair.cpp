@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "repair_internal.hpp"
+#include "segment_topology.hpp"
 
 namespace tetseg::preprocess::detail {
 namespace {
@@ -69,17 +70,13 @@ std::size_t fill_small_holes(std::vector<Point>& points, std::vector<Polygon>& p
   return filled;
 }
 
-/// Keeps the triangles of the edge-connected component of largest area (ties broken by a
-/// fixed rule, so the result is deterministic). Returns the number of components removed.
+/// Keeps the triangles of the edge-connected component of largest area (ties: the component
+/// with the smallest triangle id). Returns the number of components removed.
 std::size_t keep_largest_component(const std::vector<Point>& points,
                                    std::vector<Polygon>& polygons) {
-  // Union-find over triangles; two triangles are joined when they share an edge.
-  std::vector<std::size_t> parent(polygons.size());
-  for (std::size_t i = 0; i < parent.size(); ++i) parent[i] = i;
-  const auto root = [&parent](std::size_t i) {
-    while (parent[i] != i) i = parent[i] = parent[parent[i]];
-    return i;
-  };
+  // Triangles joined when they share an edge; a component's root is its smallest triangle id.
+  UnionFind sets(static_cast<std::uint32_t>(polygons.size()));
+  const auto root = [&sets](std::size_t t) { return sets.find(static_cast<std::uint32_t>(t)); };
   std::vector<std::pair<std::pair<std::size_t, std::size_t>, std::size_t>> edges;
   edges.reserve(3 * polygons.size());
   for (std::size_t t = 0; t < polygons.size(); ++t)
@@ -91,7 +88,8 @@ std::size_t keep_largest_component(const std::vector<Point>& points,
   std::sort(edges.begin(), edges.end());
   for (std::size_t i = 1; i < edges.size(); ++i)
     if (edges[i].first == edges[i - 1].first)
-      parent[root(edges[i].second)] = root(edges[i - 1].second);
+      sets.unite(static_cast<std::uint32_t>(edges[i].second),
+                 static_cast<std::uint32_t>(edges[i - 1].second));
   std::vector<double> area(polygons.size(), 0.0);
   for (std::size_t t = 0; t < polygons.size(); ++t) {
     const Point& a = points[polygons[t][0]];

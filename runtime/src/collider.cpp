@@ -274,14 +274,10 @@ void Collider::Impl::refit_and_classify() noexcept {
     }
     det_ok[c] = ok ? 1 : 0;  // an overflowing combination: the cluster's triangles uncertain
     if (!ok || cl.bvh_count == 0) continue;
-    Box box = nbox[cl.bvh_offset];
-    for (const std::array<double, 3>* p : {&a, &b}) {
-      for (int k = 0; k < 3; ++k) {
-        box.lo[k] = std::min(box.lo[k], (*p)[k]);
-        box.hi[k] = std::max(box.hi[k], (*p)[k]);
-      }
-    }
-    const double extent[3] = {box.hi[0] - box.lo[0], box.hi[1] - box.lo[1], box.hi[2] - box.lo[2]};
+    const Box& root = nbox[cl.bvh_offset];
+    double extent[3];
+    for (int k = 0; k < 3; ++k)
+      extent[k] = std::max({root.hi[k], a[k], b[k]}) - std::min({root.lo[k], a[k], b[k]});
     cluster_err[c] = orientation_detail::StaticErr::of(extent);
   }
   // Triangle t against its cluster's detector (uncertain when the detector is not usable).
