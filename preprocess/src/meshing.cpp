@@ -256,7 +256,7 @@ std::pair<double, double> area_and_volume(const TriangleMesh& s) {
 ///   kThinProbeDepth x offset inside along the vertex normal is outside the wrap (generalised
 ///   winding number below 1/2). On libcgal-demo (docs/benchmarks.md, "Real meshes") the
 ///   wraps of closed solids have shares 0-0.09; wraps of open surfaces that Mesh_3 meshed at
-///   most 0.50; cube-ouvert's partly entered wrap (alpha 0.16) 0.63, which the volume test
+///   most 0.50; cube-ouvert's partly entered wrap (alpha 0.16) 0.61, which the volume test
 ///   lets through.
 constexpr double kThinShell = 4.0;
 constexpr double kThinShare = 0.55;
@@ -336,8 +336,29 @@ TetMesh validate_and_mesh(const TriangleMesh& source, const MeshingOptions& mesh
   return mesh_closed_surface(split.triangles.empty() ? source : split, meshing, file, notes);
 }
 
+/// An input that encloses no volume (its wrap is a thin shell even with alpha = the diagonal:
+/// a flat or open sheet) is wrapped again, with --wrap-alpha and the larger offset
+/// --wrap-sheet-offset, into a closed slab about 2 x that offset thick, and meshed.
 TetMesh mesh_sheet_slab(const TriangleMesh& surface, const MeshingOptions& meshing, double diagonal,
-                        const std::string& file, TetrahedralizeNotes& notes);
+                        const std::string& file, TetrahedralizeNotes& notes) {
+  const TriangleMesh slab =
+      wrapped_surface(surface, meshing.wrap_alpha, meshing.wrap_sheet_offset, diagonal, file);
+  TetMesh mesh;
+  try {
+    mesh = validate_and_mesh(slab, meshing, file, notes);
+  } catch (const InputError& e) {
+    throw InputError(file, std::string(e.what()) +
+                               " (meshing the slab wrapped around an input that encloses no "
+                               "volume, --wrap-sheet-offset " +
+                               std::to_string(meshing.wrap_sheet_offset) + ")");
+  }
+  notes.repairs = {
+      {"surface replaced by an alpha wrap of this many triangles", slab.triangles.size()},
+      {"sheet enclosing no volume wrapped as a slab this many ten thousandths of the diagonal "
+       "thick",
+       static_cast<std::size_t>(std::lround(2.0 * meshing.wrap_sheet_offset * 1e4))}};
+  return mesh;
+}
 
 /// --repair wrap: wraps and meshes; while the wrap is a thin shell (is_thin_shell) or does not
 /// mesh (thin parts), alpha is doubled (at most kMaxAlphaDoublings times, up to the whole
@@ -380,30 +401,6 @@ TetMesh wrap_and_mesh(const TriangleMesh& surface, const MeshingOptions& meshing
     }
     alpha = std::min(2.0 * alpha, 1.0);
   }
-}
-
-/// An input that encloses no volume (its wrap is a thin shell even with alpha = the diagonal:
-/// a flat or open sheet) is wrapped again, with --wrap-alpha and the larger offset
-/// --wrap-sheet-offset, into a closed slab about 2 x that offset thick, and meshed.
-TetMesh mesh_sheet_slab(const TriangleMesh& surface, const MeshingOptions& meshing, double diagonal,
-                        const std::string& file, TetrahedralizeNotes& notes) {
-  const TriangleMesh slab =
-      wrapped_surface(surface, meshing.wrap_alpha, meshing.wrap_sheet_offset, diagonal, file);
-  TetMesh mesh;
-  try {
-    mesh = validate_and_mesh(slab, meshing, file, notes);
-  } catch (const InputError& e) {
-    throw InputError(file, std::string(e.what()) +
-                               " (meshing the slab wrapped around an input that encloses no "
-                               "volume, --wrap-sheet-offset " +
-                               std::to_string(meshing.wrap_sheet_offset) + ")");
-  }
-  notes.repairs = {
-      {"surface replaced by an alpha wrap of this many triangles", slab.triangles.size()},
-      {"sheet enclosing no volume wrapped as a slab this many ten thousandths of the diagonal "
-       "thick",
-       static_cast<std::size_t>(std::lround(2.0 * meshing.wrap_sheet_offset * 1e4))}};
-  return mesh;
 }
 
 }  // namespace
