@@ -130,7 +130,7 @@ PanelSet make_panels(const std::vector<Vec3>& points, const std::vector<Tri>& tr
   }
   for (std::size_t j = 0; j < n; ++j) {
     const double dj = s.diameter[j];
-    if (!(s.area[j] > 1e-12 * max_edge * max_edge) || !(s.area[j] > 1e-10 * dj * dj)) {
+    if (detail::is_degenerate_panel(s.area[j], dj, max_edge)) {
       std::ostringstream msg;
       msg << "triangle " << j << " (vertices " << triangles[j][0] << ", " << triangles[j][1] << ", "
           << triangles[j][2] << ") is degenerate (area " << s.area[j] << ", longest edge " << dj

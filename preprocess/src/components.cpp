@@ -46,15 +46,6 @@ std::vector<std::uint32_t> node_parts(const TetMesh& mesh, const Surface& surfac
   return part;
 }
 
-/// Solid angle of triangle (a, b, c) seen from p (Van Oosterom and Strackee), signed.
-double solid_angle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
-  const Vec3 x = sub(a, p), y = sub(b, p), z = sub(c, p);
-  const double lx = std::sqrt(dot(x, x)), ly = std::sqrt(dot(y, y)), lz = std::sqrt(dot(z, z));
-  const double numerator = dot(x, cross(y, z));
-  const double denominator = lx * ly * lz + dot(x, y) * lz + dot(y, z) * lx + dot(z, x) * ly;
-  return 2.0 * std::atan2(numerator, denominator);
-}
-
 }  // namespace
 
 std::vector<SurfacePart> split_surface(const TetMesh& mesh, const Surface& surface) {

@@ -212,6 +212,8 @@ const std::vector<ProvenanceField>& provenance_fields() {
                      [](O& o) -> double& { return meshing_of(o).wrap_alpha; }),
       number<double>("meshing.wrap_offset", wrapped,
                      [](O& o) -> double& { return meshing_of(o).wrap_offset; }),
+      number<double>("meshing.wrap_sheet_offset", wrapped,
+                     [](O& o) -> double& { return meshing_of(o).wrap_sheet_offset; }),
   };
   return fields;
 }

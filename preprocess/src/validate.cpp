@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdint>
 #include <numeric>
+#include <sstream>
 #include <string>
 #include <tuple>
 #include <vector>
@@ -208,6 +209,40 @@ void check_surface(const std::vector<Vec3>& points, const std::vector<Tri>& tria
   }
 }
 
+/// Throws InputError when a boundary triangle is too thin for the charge solver
+/// (detail::is_degenerate_panel: the test charge applies, so that a mesh this validation
+/// accepts never fails later in charge).
+void check_boundary_panels(const std::vector<Vec3>& points, const std::vector<Tri>& triangles,
+                           const std::string& file) {
+  std::vector<double> area(triangles.size()), longest(triangles.size());
+  double surface_longest = 0.0;
+  for (std::size_t t = 0; t < triangles.size(); ++t) {
+    const Vec3& a = points[triangles[t][0]];
+    const Vec3& b = points[triangles[t][1]];
+    const Vec3& c = points[triangles[t][2]];
+    area[t] = 0.5 * detail::norm(detail::cross(detail::sub(b, a), detail::sub(c, a)));
+    longest[t] = std::max({detail::distance_between(a, b), detail::distance_between(b, c),
+                           detail::distance_between(c, a)});
+    surface_longest = std::max(surface_longest, longest[t]);
+  }
+  std::size_t degenerate = 0;
+  std::size_t first = 0;
+  for (std::size_t t = 0; t < triangles.size(); ++t)
+    if (detail::is_degenerate_panel(area[t], longest[t], surface_longest) && degenerate++ == 0)
+      first = t;
+  if (degenerate > 0) {
+    std::ostringstream msg;
+    msg << "boundary has "
+        << plural(degenerate, "near-zero-area triangle", "near-zero-area triangles")
+        << " (area at most 1e-12 of the longest boundary edge squared, or 1e-10 of its own), "
+           "first is triangle "
+        << first << " (nodes " << triangles[first][0] << " " << triangles[first][1] << " "
+        << triangles[first][2] << ", area " << area[first] << ", longest edge " << longest[first]
+        << ")";
+    throw InputError(file, msg.str());
+  }
+}
+
 }  // namespace
 
 void validate_tet_mesh(const TetMesh& mesh, const Surface& surface, const std::string& file) {
@@ -298,6 +333,7 @@ void detail::validate_tet_mesh(const TetMesh& mesh, const Surface& surface, cons
   detail::SurfaceCheck options;
   options.allow_components = true;
   check_surface(mesh.nodes, surface.triangles, file, options, nullptr);
+  check_boundary_panels(mesh.nodes, surface.triangles, file);
   detail::check_components(mesh, surface, file);
 }
 

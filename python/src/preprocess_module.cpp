@@ -270,7 +270,8 @@ py::tuple build(const py::object& mesh, const py::object& source, const std::str
                 double min_visibility, const std::string& solver, double tolerance,
                 double cell_size, double facet_size, double facet_distance, bool optimize,
                 int threads, const std::string& repair, double wrap_alpha, double wrap_offset,
-                bool keep_largest_component, bool rest_positions, const py::object& on_stage) {
+                double wrap_sheet_offset, bool keep_largest_component, bool rest_positions,
+                const py::object& on_stage) {
   BuildOptions options;
   options.clusters = enum_from_name<ClusterMethod>("clusters", clusters);
   check_range("refine_visibility", refine_visibility, 0.0, 1.0);
@@ -309,8 +310,10 @@ py::tuple build(const py::object& mesh, const py::object& source, const std::str
   meshing.repair = enum_from_name<MeshingOptions::Repair>("repair", repair);
   check_range("wrap_alpha", wrap_alpha, 1e-4, 1.0);
   check_range("wrap_offset", wrap_offset, 1e-4, 1.0);
+  check_range("wrap_sheet_offset", wrap_sheet_offset, 1e-4, 1.0);
   meshing.wrap_alpha = wrap_alpha;
   meshing.wrap_offset = wrap_offset;
+  meshing.wrap_sheet_offset = wrap_sheet_offset;
   meshing.keep_largest_component = keep_largest_component;
 
   Input in = input_from(mesh, source);
@@ -518,13 +521,14 @@ PYBIND11_MODULE(preprocess, m) {
         py::arg("threads") = meshing.threads,
         py::arg("repair") = std::string(name_of(meshing.repair)),
         py::arg("wrap_alpha") = meshing.wrap_alpha, py::arg("wrap_offset") = meshing.wrap_offset,
+        py::arg("wrap_sheet_offset") = meshing.wrap_sheet_offset,
         py::arg("keep_largest_component") = meshing.keep_largest_component,
         py::arg("rest_positions") = b.keep_rest_positions, py::arg("on_stage") = py::none(),
         "Returns (asset bytes, report dict). "
         "Runs the whole pipeline as `tetseg build` does. mesh: a tet mesh file (.mesh, "
         ".node/.ele, .msh), a closed surface file (.obj, .ply, .stl, .off, ...; tetrahedralised "
         "first with cell_size, facet_size, facet_distance, optimize, threads, repair, "
-        "wrap_alpha, wrap_offset, keep_largest_component), or a pair of arrays "
+        "wrap_alpha, wrap_offset, wrap_sheet_offset, keep_largest_component), or a pair of arrays "
         "(nodes (N, 3), tets (M, 4)) or (points (N, 3), triangles (M, 3)). source: the name "
         "recorded in the asset's provenance and used in messages (default: the path, or "
         "'arrays'). Every other option is the `tetseg build` option of the same name "

@@ -183,6 +183,8 @@ def test_bad_meshes_raise_clear_errors(pp, sphere_mesh, tmp_path):
         pp.build(open_surface, repair="none")
     with pytest.raises(ValueError, match="wrap_alpha must be in"):
         pp.build(open_surface, repair="wrap", wrap_alpha=0)
+    with pytest.raises(ValueError, match="wrap_sheet_offset must be in"):
+        pp.build(open_surface, repair="wrap", wrap_sheet_offset=2)
     with pytest.raises(ValueError, match="outside"):
         pp.build((nodes, tets.astype(np.int64) - 1))
     with pytest.raises(TypeError, match="integer array"):
@@ -217,3 +219,18 @@ def test_wrap_repair_is_recorded_in_the_provenance(pp):
     assert provenance["meshing.repair"] == "wrap"
     assert float(provenance["meshing.wrap_alpha"]) == 0.1
     assert report["counts"]["surface_triangles"] > 12  # the wrap, not the 12 input triangles
+
+
+def test_wrap_meshes_a_flat_sheet_as_a_slab(pp):
+    """A square of two triangles encloses no volume: repair="wrap" meshes it as a slab
+    2 x wrap_sheet_offset thick and records that repair in the provenance."""
+    import tetseg
+    square = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]], float)
+    triangles = np.array([[0, 1, 2], [0, 2, 3]])
+    data, _ = pp.build((square, triangles), repair="wrap", wrap_sheet_offset=0.02,
+                       clusters="single")
+    kind = "sheet enclosing no volume wrapped as a slab this many ten thousandths of the " \
+        "diagonal thick"
+    provenance = tetseg.load_asset(data).provenance["options"]
+    assert float(provenance["meshing.wrap_sheet_offset"]) == 0.02
+    assert provenance["repairs." + kind.replace(" ", "_")] == "400"

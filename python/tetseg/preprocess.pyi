@@ -22,6 +22,7 @@ def build(mesh: _Mesh, *, source: Optional[str] = ..., clusters: str = ...,
           tolerance: float = ..., cell_size: float = ..., facet_size: float = ...,
           facet_distance: float = ..., optimize: bool = ..., threads: int = ...,
           repair: str = ..., wrap_alpha: float = ..., wrap_offset: float = ...,
+          wrap_sheet_offset: float = ...,
           keep_largest_component: bool = ...,
           rest_positions: bool = ...,
           on_stage: Optional[Callable[[str, float, str], Any]] = ...) -> Tuple[bytes, dict]: ...

@@ -97,11 +97,20 @@ grep -q '"surface replaced by an alpha wrap of this many triangles": [1-9]' hole
 "$bin/tetseg-dump" holed.tetseg | grep -q 'meshing.wrap_alpha *0.5' ||
   fail "the provenance lacks the wrap options"
 expect_exit 2 "wrap-alpha" -- "$bin/tetseg" build holed.off -o x.tetseg --repair wrap --wrap-alpha 0
-# A flat sheet encloses nothing: wrap says so at once (Mesh_3 never sees the thin shell).
+# A flat sheet encloses nothing: wrap meshes it as a slab (2 x --wrap-sheet-offset thick) and
+# reports it (stderr, report, provenance); the option is range-checked.
 printf 'OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n' >sheet.off
-expect_exit 3 "tetseg: error: sheet.off: tetrahedralize: the input encloses no volume" -- \
-  "$bin/tetseg" build sheet.off -o sheet.tetseg --repair wrap
-[ ! -e sheet.tetseg ] && [ ! -e dump-bug.mesh ] || fail "a refused sheet left a file"
+expect_exit 0 "tetseg: repaired sheet.off: .*400 sheet enclosing no volume wrapped as a slab" -- \
+  "$bin/tetseg" build sheet.off -o sheet.tetseg --clusters single --repair wrap \
+  --wrap-sheet-offset 0.02 --report sheet.json
+grep -q '"sheet enclosing no volume wrapped as a slab this many ten thousandths of the diagonal thick": 400' sheet.json ||
+  fail "the report lacks the slab"
+"$bin/tetseg-dump" sheet.tetseg | grep -q 'meshing.wrap_sheet_offset *0.02' ||
+  fail "the provenance lacks the sheet offset"
+"$bin/tetseg-dump" sheet.tetseg | grep -q 'repairs.sheet_enclosing_no_volume_wrapped_as_a_slab' ||
+  fail "the provenance lacks the slab repair"
+expect_exit 2 "wrap-sheet-offset" -- "$bin/tetseg" build sheet.off -o x.tetseg --repair wrap \
+  --wrap-sheet-offset 2
 
 # Hostile variants of each kind of file: truncations, huge and negative counts, NaN, byte
 # flips. The small facet size bounds the time of those that still read.

@@ -84,6 +84,14 @@ TEST_CASE("Each tet mesh defect is reported with a clear message", "[validate]")
     t.nodes[3][2] = 1e-3;
     CHECK(tet_error(t) == "(valid)");
   }
+  SECTION("A boundary triangle too thin for charge is refused; a thicker one is not.") {
+    // A tet of non-zero volume (above the degenerate-tet threshold) whose face (0, 1, 2) is a
+    // sliver: area 5e-12, under 1e-10 x its longest edge (1) squared, as charge refuses.
+    TetMesh t{{{0, 0, 0}, {1, 0, 0}, {0.5, 1e-11, 0}, {0, 0, 1}}, {{0, 1, 2, 3}}};
+    CHECK_THAT(tet_error(t), Catch::Contains("boundary has 1 near-zero-area triangle"));
+    t.nodes[2][1] = 1e-3;
+    CHECK(tet_error(t) == "(valid)");
+  }
   SECTION("A node used by no tet is reported.") {
     m.nodes.push_back({5, 5, 5});
     CHECK_THAT(tet_error(m), Catch::Contains("1 node is used by no tet, first is node 27"));

@@ -138,6 +138,12 @@ void add_repair_option(CLI::App& cmd, preprocess::MeshingOptions& m) {
                  "bounding-box diagonal")
       ->check(CLI::Range(1e-4, 1.0))
       ->capture_default_str();
+  cmd.add_option("--wrap-sheet-offset", m.wrap_sheet_offset,
+                 "--repair wrap, an input that encloses no volume (a flat or open sheet): the "
+                 "offset of the slab (about twice as thick) it is wrapped into, as a fraction "
+                 "of the bounding-box diagonal")
+      ->check(CLI::Range(1e-4, 1.0))
+      ->capture_default_str();
 }
 
 void print_repairs(const std::string& file, const preprocess::TetrahedralizeNotes& notes) {

@@ -30,6 +30,10 @@ struct MeshingOptions {
   /// from the input), as fractions of the input's bounding-box diagonal; > 0.
   double wrap_alpha = 0.02;
   double wrap_offset = 0.002;
+  /// kWrap, an input that encloses no volume (a flat or open sheet: its wrap stays a thin
+  /// shell even with alpha = the diagonal): the offset, a fraction of the diagonal, of the
+  /// slab (about twice as thick) it is wrapped into instead; in [1e-4, 1].
+  double wrap_sheet_offset = 0.01;
   /// kFix: after the other repairs, keep only the edge-connected component of largest area
   /// (drops floating debris and stray parts); off by default, since several closed
   /// components are a valid input.
@@ -98,9 +102,11 @@ struct TetrahedralizeNotes {
 /// self-intersections, several components and zero-area triangles with three distinct corners
 /// are not repaired: the error then ends by suggesting `--repair wrap`. With kWrap the surface
 /// is replaced by its CGAL alpha wrap (wrap_alpha, wrap_offset), which is closed, manifold and
-/// free of self-intersections for any soup; while that wrap is a thin shell or does not mesh,
-/// alpha is doubled (at most 6 times); a wrap still thin with alpha = the diagonal is refused
-/// (the input encloses no volume). When a repair changed the input, `notes` gets the Hausdorff
+/// free of self-intersections for any soup; while that wrap is a thin shell (all over, or half
+/// of it) or does not mesh, alpha is doubled (at most 6 times); an input whose wrap is still a
+/// thin shell with alpha = the diagonal encloses no volume (a sheet) and is wrapped again with
+/// wrap_sheet_offset into a slab (a repair in `notes`). When a repair changed the input,
+/// `notes` gets the Hausdorff
 /// distances between input and meshed boundary. The boundary is
 /// re-meshed (Mesh_3 does not keep the input triangles); Mesh_3 runs with its manifold option.
 /// Unlike validate_closed_surface, pinch points (separate fans of triangles touching at one

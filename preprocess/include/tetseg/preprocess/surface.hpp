@@ -24,7 +24,9 @@ Surface extract_surface(const TetMesh& mesh);
 /// the first index are reported); no face shared by more than two tets; then the surface:
 /// closed (border edges counted), edge-manifold, consistently oriented, vertex-manifold (one
 /// fan of triangles per vertex), free of self-intersection at rest (CGAL box-intersection
-/// broad phase with exact predicates); then per component (nodes joined through tets; a mesh
+/// broad phase with exact predicates); no boundary triangle too thin for the charge solver
+/// (area at most 1e-12 x the longest boundary edge^2 or 1e-10 x its own longest edge^2: what
+/// charge would refuse); then per component (nodes joined through tets; a mesh
 /// may have several): bounded by exactly one closed surface (no cavity), not inside another
 /// component (docs/segmentation.md, "Several components").
 /// Throws InputError(`file`, message) naming the first defect found, e.g. "surface is not
