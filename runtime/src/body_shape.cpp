@@ -92,6 +92,83 @@ void BodyShape::Data::build() {
       cnt[i] = nodes[i].count > 0 ? nodes[i].count : cnt[nodes[i].first] + cnt[nodes[i].second];
     }
   }
+  build_wide_bvhs();
+}
+
+namespace {
+
+// Collapses one binary cluster BVH into 4-wide nodes appended to `out` (parents first).
+struct WideBuilder {
+  const format::BvhNode* nodes;
+  const std::uint32_t* leaf;  // global triangle ids in leaf order
+  std::vector<WideNode>& out;
+  std::uint32_t depth = 0;
+
+  std::uint32_t add(std::uint32_t level) {
+    depth = std::max(depth, level);
+    out.push_back(WideNode{{kWideEmpty, kWideEmpty, kWideEmpty, kWideEmpty}, 0});
+    return static_cast<std::uint32_t>(out.size() - 1);
+  }
+  // A wide node over leaf positions [first, first + count): up to four triangles, else up to
+  // four nearly equal consecutive runs.
+  std::uint32_t range(std::uint32_t first, std::uint32_t count, std::uint32_t level) {
+    const std::uint32_t id = add(level);
+    const std::uint32_t per = count <= 4 ? 1 : (count + 3) / 4;
+    for (std::uint32_t k = 0, at = first; at < first + count; ++k, at += per) {
+      const std::uint32_t n = std::min(per, first + count - at);
+      const std::uint32_t child = n == 1 ? kWideLeaf | leaf[at] : range(at, n, level + 1);
+      out[id].child[k] = child;  // after the call: it may have grown `out`
+    }
+    return id;
+  }
+  // The child slot of binary node n: its triangle when it is a one-triangle leaf, else a node.
+  std::uint32_t slot(std::uint32_t n, std::uint32_t level) {
+    const format::BvhNode& b = nodes[n];
+    if (b.count == 1) return kWideLeaf | leaf[b.first];
+    return node(n, level);
+  }
+  // The wide node of binary node n: its grandchildren (a child leaf stands for itself).
+  std::uint32_t node(std::uint32_t n, std::uint32_t level) {
+    const format::BvhNode& b = nodes[n];
+    if (b.count > 0) return range(b.first, b.count, level);
+    const std::uint32_t id = add(level);
+    std::uint32_t k = 0;
+    for (std::uint32_t c : {b.first, b.second}) {
+      const format::BvhNode& cb = nodes[c];
+      const std::uint32_t grand[2] = {cb.count > 0 ? c : cb.first, cb.second};
+      for (int g = 0; g < (cb.count > 0 ? 1 : 2); ++g) {
+        const std::uint32_t child = slot(grand[g], level + 1);
+        out[id].child[k++] = child;  // after the call: it may have grown `out`
+      }
+    }
+    return id;
+  }
+};
+
+}  // namespace
+
+void BodyShape::Data::build_wide_bvhs() {
+  const format::Asset& fa = *asset;
+  wide_nodes.clear();
+  wide_root.assign(fa.clusters.size(), kWideEmpty);
+  wide_depth = 0;
+  for (std::size_t c = 0; c < fa.clusters.size(); ++c) {
+    const format::Cluster& cl = fa.clusters[c];
+    if (cl.bvh_count == 0) continue;
+    WideBuilder b{fa.bvh_nodes.data() + cl.bvh_offset,
+                  fa.cluster_triangles.data() + cl.triangle_offset, wide_nodes};
+    wide_root[c] = b.node(0, 0);
+    wide_depth = std::max(wide_depth, b.depth);
+  }
+  // Triangle counts bottom-up (children after their parent).
+  for (std::size_t i = wide_nodes.size(); i-- > 0;) {
+    WideNode& n = wide_nodes[i];
+    n.ntris = 0;
+    for (std::uint32_t c : n.child) {
+      if (c == kWideEmpty) continue;
+      n.ntris += (c & kWideLeaf) ? 1 : wide_nodes[c].ntris;
+    }
+  }
 }
 
 std::shared_ptr<const BodyShape> BodyShape::from_asset(const Asset& asset) noexcept {

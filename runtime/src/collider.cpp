@@ -85,10 +85,13 @@ void Collider::Impl::construct(std::shared_ptr<const BodyShape> sh, const Collid
   if (!asset && opt.mode == ColliderMode::kRvbc) opt.mode = ColliderMode::kBvh;  // no clusters
   const std::size_t nv = topo->surf_nodes.size();
   const std::size_t nn = asset ? asset->bvh_nodes.size() : 0;
-  // The kBvh tree is a median split: depth <= log2(triangles) + 1 < 64.
+  // The kBvh tree is a median split: depth <= log2(triangles) + 1 < 64. A 4-wide traversal
+  // pushes at most 10 items per level of its (at most 2 * wide_depth + 2) levels.
   const std::size_t stack_size =
-      opt.traversal_stack > 0 ? opt.traversal_stack
-                              : 4 * (std::size_t(std::max<std::uint32_t>(topo->max_depth, 64)) + 4);
+      opt.traversal_stack > 0
+          ? opt.traversal_stack
+          : std::max(4 * (std::size_t(std::max<std::uint32_t>(topo->max_depth, 64)) + 4),
+                     10 * (2 * std::size_t(topo->wide_depth) + 2));
   std::size_t threads = 1;
 #if defined(TETSEG_HAVE_OPENMP)
   if (opt.use_openmp) threads = static_cast<std::size_t>(std::max(1, omp_get_max_threads()));
@@ -118,15 +121,23 @@ void Collider::Impl::construct(std::shared_ptr<const BodyShape> sh, const Collid
   closure_ring.reserve(tri_count);
   closure_mark.assign(tri_count, 0);
   nbox.resize(nn);
-  nsign.assign(nn, 0);
   nmov.assign(nn, 0);
-  cluster_err.resize(cluster_count());
-
-  single_triangle_leaves = asset != nullptr;
-  if (asset) {
-    for (const format::BvhNode& n : asset->bvh_nodes)
-      if (n.count > 1) single_triangle_leaves = false;
+  const std::size_t nw = topo->wide_nodes.size();
+  wstep.resize(nw);
+  for (std::size_t i = 0; i < nw; ++i) {
+    for (int k = 0; k < 4; ++k) {
+      if (topo->wide_nodes[i].child[k] != kWideEmpty) continue;
+      for (int a = 0; a < 3; ++a) {  // never written again: overlaps nothing
+        wstep[i].lo[a][k] = INFINITY;
+        wstep[i].hi[a][k] = -INFINITY;
+      }
+    }
   }
+  wbox.resize(nw);
+  wmov.assign(nw, 0);
+  wsign.assign(nw, 0);
+  tsign.assign(asset ? tri_count : 0, 0);
+  cluster_err.resize(cluster_count());
   skip_adjacent = uses_global_bvh();
   if (skip_adjacent) build_orphan_sets();
 
@@ -232,7 +243,9 @@ void Collider::Impl::refit_and_classify() noexcept {
     emov[e] = vmoved[i0] | vmoved[i1];
   }
   if (uses_clusters()) {
-    for (std::uint32_t c = 0; c < cluster_count(); ++c) {
+    refit_wide();  // collider_traverse.cpp
+    // A scene body's binary cluster BVHs serve traverse_bodies.
+    for (std::uint32_t c = 0; c < cluster_count() && always_refit; ++c) {
       const format::Cluster& cl = asset->clusters[c];
       const format::BvhNode* nodes = asset->bvh_nodes.data() + cl.bvh_offset;
       const std::uint32_t* leaf = asset->cluster_triangles.data() + cl.triangle_offset;
@@ -273,8 +286,8 @@ void Collider::Impl::refit_and_classify() noexcept {
       ok = ok && std::isfinite(a[k]) && std::isfinite(b[k]);
     }
     det_ok[c] = ok ? 1 : 0;  // an overflowing combination: the cluster's triangles uncertain
-    if (!ok || cl.bvh_count == 0) continue;
-    const Box& root = nbox[cl.bvh_offset];
+    if (!ok || topo->wide_root[c] == kWideEmpty) continue;
+    const Box& root = wbox[topo->wide_root[c]];
     double extent[3];
     for (int k = 0; k < 3; ++k)
       extent[k] = std::max({root.hi[k], a[k], b[k]}) - std::min({root.lo[k], a[k], b[k]});
@@ -353,29 +366,7 @@ void Collider::Impl::refit_and_classify() noexcept {
   stats.triangles_positive = count[0];
   stats.triangles_negative = count[1];
   stats.triangles_uncertain = count[2];
-  // Per-node sign bits, bottom-up, from this step: a node is all positive (all negative) when
-  // every triangle under it is.
-  auto triangle_sign = [&](std::uint32_t t) -> std::uint8_t {
-    const std::uint8_t c = tcls[t];
-    return c == static_cast<std::uint8_t>(Orientation::kPositive)   ? kNodeAllPositive
-           : c == static_cast<std::uint8_t>(Orientation::kNegative) ? kNodeAllNegative
-                                                                    : 0;
-  };
-  for (const format::Cluster& cl : asset->clusters) {
-    const format::BvhNode* nodes = asset->bvh_nodes.data() + cl.bvh_offset;
-    const std::uint32_t* leaf = asset->cluster_triangles.data() + cl.triangle_offset;
-    std::uint8_t* sign = nsign.data() + cl.bvh_offset;
-    for (std::uint32_t i = cl.bvh_count; i-- > 0;) {
-      const format::BvhNode& n = nodes[i];
-      if (n.count > 0) {
-        std::uint8_t s = kNodeAllPositive | kNodeAllNegative;
-        for (std::uint32_t k = 0; k < n.count; ++k) s &= triangle_sign(leaf[n.first + k]);
-        sign[i] = s;
-      } else {
-        sign[i] = sign[n.first] & sign[n.second];
-      }
-    }
-  }
+  sign_wide();  // collider_traverse.cpp
   stats.classify_ms = ms_since(t_class);
 }
 

@@ -62,18 +62,26 @@ struct TreeView {
   const Box* box = nullptr;
   const Box* tri_box = nullptr;  // swept box of each triangle (by global id), this step
   const std::uint32_t* ntris = nullptr;
-  // Per node, this step: kNodeAllPositive / kNodeAllNegative when every triangle under it has
-  // that orientation class, 0 otherwise. Null: no orientation culling.
-  const std::uint8_t* nsign = nullptr;
   const std::uint32_t* nmov = nullptr;
   const ConeData* cone = nullptr;  // non-null: node self-tests may be culled by normal cones
   std::uint32_t cone_base = 0;     // cone index of node 0
 };
 
-/// Node sign bits (TreeView::nsign): two nodes whose bits share one cannot produce a first
-/// contact between their triangles (one orientation class throughout).
+/// Orientation sign bits of a triangle or a wide node (rvbc, this step): kNodeAllPositive /
+/// kNodeAllNegative when every triangle under it has that class. Two within one cluster whose
+/// bits share one cannot produce a first contact between their triangles.
 inline constexpr std::uint8_t kNodeAllPositive = 1;
 inline constexpr std::uint8_t kNodeAllNegative = 2;
+
+/// Per-step data of a 4-wide node (WideNode): its children's swept boxes in
+/// structure-of-arrays form (an empty slot holds an inverted infinite box, which overlaps
+/// nothing), and a bit per child: it holds a moving triangle, all its triangles are positive,
+/// all are negative.
+struct alignas(64) WideStep {
+  double lo[3][4];
+  double hi[3][4];
+  std::uint8_t mov = 0, pos = 0, neg = 0;
+};
 
 struct StackItem {
   std::uint32_t a;
@@ -314,9 +322,13 @@ struct Collider::Impl {
   bool skip_adjacent = false;
   std::vector<std::array<std::uint32_t, 2>> orphan_vf;  // (node, triangle)
   std::vector<std::array<std::uint32_t, 2>> orphan_ee;  // (edge, edge), first < second
-  std::vector<Box> nbox;                                // per asset BVH node
+  std::vector<Box> nbox;  // per asset BVH node (refit for a scene body: traverse_bodies)
   std::vector<std::uint32_t> nmov;
-  std::vector<std::uint8_t> nsign;                         // per asset BVH node: TreeView::nsign
+  // 4-wide cluster BVHs (topo->wide_nodes), this step: children's data, own box, own moving
+  // flag and own sign bits; and each triangle's sign bits (rvbc).
+  std::vector<WideStep> wstep;
+  std::vector<Box> wbox;
+  std::vector<std::uint8_t> wmov, wsign, tsign;
   std::vector<orientation_detail::StaticErr> cluster_err;  // per cluster, this step (classify)
   std::vector<Worker> workers;
   // Contact closure scratch (capacity tri_count, reserved at construction).
@@ -366,15 +378,14 @@ struct Collider::Impl {
   void process_triangle_pair(Worker& w, std::uint32_t t1, std::uint32_t t2) const noexcept;
   /// process_triangle_pair of a pair known to be non-culled (not in the rest check).
   void process_non_culled_pair(Worker& w, std::uint32_t t1, std::uint32_t t2) const noexcept;
-  /// Every leaf of the cluster BVHs holds one triangle (construction).
-  bool single_triangle_leaves = false;
-  /// True when tree t is a cluster tree of single-triangle leaves traversed outside the rest
-  /// check: its leaf box and counters are its triangle's swept box and flags, so a leaf pair
-  /// that passed the traversal's live test (movement, boxes, and within a cluster the
-  /// orientation rule) is a non-culled triangle pair and needs no second check.
-  bool leaf_pairs_non_culled(const TreeView& t) const noexcept;
   bool traverse_self(Worker& w, const TreeView& tree) const noexcept;
-  bool traverse_pair(Worker& w, const TreeView& ta, const TreeView& tb) const noexcept;
+  /// Traversal of the 4-wide cluster BVHs from `first` (a self item {node, kNone} or a pair of
+  /// child slots); `orient`: cull by the sign bits (within one cluster). False on overflow.
+  bool traverse_wide(Worker& w, StackItem first, bool orient) const noexcept;
+  /// Refits the 4-wide cluster BVHs from tbox / tmov (wstep boxes and moving bits, wbox, wmov).
+  void refit_wide() noexcept;
+  /// Sign bits of triangles (tsign) and of wide nodes and their children, from tcls.
+  void sign_wide() noexcept;
   void brute_vertex_faces(Worker& w, std::uint32_t i) const noexcept;
   void brute_edge_edges(Worker& w, std::uint32_t i) const noexcept;
   /// Builds orphan_vf / orphan_ee from the topology (construction; allocates, may throw).
