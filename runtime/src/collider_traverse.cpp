@@ -663,7 +663,8 @@ inline unsigned overlap_mask(const WideStep& s, const Box& b, double ms) noexcep
     apart01 = _mm_or_pd(apart01, _mm_cmpgt_pd(blo, _mm_add_pd(_mm_load_pd(s.hi[k]), m)));
     apart23 = _mm_or_pd(apart23, _mm_cmpgt_pd(blo, _mm_add_pd(_mm_load_pd(s.hi[k] + 2), m)));
   }
-  const unsigned apart = unsigned(_mm_movemask_pd(apart01)) | unsigned(_mm_movemask_pd(apart23)) << 2;
+  const unsigned apart = unsigned(_mm_movemask_pd(apart01)) | unsigned(_mm_movemask_pd(apart23))
+                                                                  << 2;
   return ~apart & 0xfu;
 #else
   unsigned mask = 0;
