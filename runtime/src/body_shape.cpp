@@ -70,6 +70,12 @@ void BodyShape::Data::build() {
     et_list.push_back(half[i][2] / 3);
   }
   et_offset.push_back(static_cast<std::uint32_t>(half.size()));
+  tri_verts.resize(tri_count);
+  for (std::uint32_t t = 0; t < tri_count; ++t)
+    for (int k = 0; k < 3; ++k) tri_verts[t][k] = surf_index[triangles[t][k]];
+  edge_verts.resize(edges.size());
+  for (std::size_t e = 0; e < edges.size(); ++e)
+    edge_verts[e] = {surf_index[edges[e][0]], surf_index[edges[e][1]]};
 
   if (!asset) return;
   // Per-node static triangle counts and BVH depth (children have larger indices).

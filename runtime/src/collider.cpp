@@ -221,9 +221,8 @@ void Collider::Impl::refit_and_classify() noexcept {
 #pragma omp parallel for if (opt.use_openmp && nt > 4096)
 #endif
   for (std::int64_t t = 0; t < nt; ++t) {
-    const auto& tri = tris[t];
-    const std::uint32_t i0 = topo->surf_index[tri[0]], i1 = topo->surf_index[tri[1]],
-                        i2 = topo->surf_index[tri[2]];
+    const std::uint32_t i0 = topo->tri_verts[t][0], i1 = topo->tri_verts[t][1],
+                        i2 = topo->tri_verts[t][2];
     Box b = vbox[i0];
     box_union(b, vbox[i1]);
     box_union(b, vbox[i2]);
@@ -235,8 +234,7 @@ void Collider::Impl::refit_and_classify() noexcept {
 #pragma omp parallel for if (opt.use_openmp && ne > 8192)
 #endif
   for (std::int64_t e = 0; e < ne; ++e) {
-    const std::uint32_t i0 = topo->surf_index[topo->edges[e][0]],
-                        i1 = topo->surf_index[topo->edges[e][1]];
+    const std::uint32_t i0 = topo->edge_verts[e][0], i1 = topo->edge_verts[e][1];
     Box b = vbox[i0];
     box_union(b, vbox[i1]);
     ebox[e] = b;

@@ -48,11 +48,26 @@ inline bool boxes_overlap(const Box& a, const Box& b, double margin) noexcept {
   return !apart;
 }
 
+/// a becomes the union of a and b: per coordinate, b's value where it is strictly below
+/// (lo) or above (hi) a's, else a's.
 inline void box_union(Box& a, const Box& b) noexcept {
+#if defined(__SSE2__)
+  // The six contiguous doubles as three pairs (lo0 lo1) (lo2 hi0) (hi1 hi2); _mm_min_pd(b, a)
+  // is b < a ? b : a lane by lane, so every value is the scalar form's.
+  static_assert(sizeof(Box) == 6 * sizeof(double), "Box: six contiguous doubles");
+  const double* pb = reinterpret_cast<const double*>(&b);
+  double* pa = reinterpret_cast<double*>(&a);
+  const __m128d b0 = _mm_loadu_pd(pb), b1 = _mm_loadu_pd(pb + 2), b2 = _mm_loadu_pd(pb + 4);
+  const __m128d a0 = _mm_loadu_pd(pa), a1 = _mm_loadu_pd(pa + 2), a2 = _mm_loadu_pd(pa + 4);
+  _mm_storeu_pd(pa, _mm_min_pd(b0, a0));
+  _mm_storeu_pd(pa + 2, _mm_move_sd(_mm_max_pd(b1, a1), _mm_min_pd(b1, a1)));
+  _mm_storeu_pd(pa + 4, _mm_max_pd(b2, a2));
+#else
   for (int k = 0; k < 3; ++k) {
     if (b.lo[k] < a.lo[k]) a.lo[k] = b.lo[k];
     if (b.hi[k] > a.hi[k]) a.hi[k] = b.hi[k];
   }
+#endif
 }
 
 /// A BVH seen by the traversal: node topology plus per-step node data.
