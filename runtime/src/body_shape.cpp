@@ -112,7 +112,7 @@ struct WideBuilder {
 
   std::uint32_t add(std::uint32_t level) {
     depth = std::max(depth, level);
-    out.push_back(WideNode{{kWideEmpty, kWideEmpty, kWideEmpty, kWideEmpty}, 0});
+    out.push_back(WideNode{{kWideEmpty, kWideEmpty, kWideEmpty, kWideEmpty}});
     return static_cast<std::uint32_t>(out.size() - 1);
   }
   // A wide node over leaf positions [first, first + count): up to four triangles, else up to
@@ -165,15 +165,6 @@ void BodyShape::Data::build_wide_bvhs() {
                   fa.cluster_triangles.data() + cl.triangle_offset, wide_nodes};
     wide_root[c] = b.node(0, 0);
     wide_depth = std::max(wide_depth, b.depth);
-  }
-  // Triangle counts bottom-up (children after their parent).
-  for (std::size_t i = wide_nodes.size(); i-- > 0;) {
-    WideNode& n = wide_nodes[i];
-    n.ntris = 0;
-    for (std::uint32_t c : n.child) {
-      if (c == kWideEmpty) continue;
-      n.ntris += (c & kWideLeaf) ? 1 : wide_nodes[c].ntris;
-    }
   }
 }
 

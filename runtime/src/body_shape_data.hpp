@@ -20,7 +20,6 @@ inline constexpr std::uint32_t kWideEmpty = 0xffffffffu;
 /// collapsed, so each node holds up to four children (docs/runtime.md, "4-wide cluster BVHs").
 struct WideNode {
   std::uint32_t child[4];
-  std::uint32_t ntris;  // triangles under the node
 };
 
 struct BodyShape::Data {

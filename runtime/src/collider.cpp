@@ -86,12 +86,12 @@ void Collider::Impl::construct(std::shared_ptr<const BodyShape> sh, const Collid
   const std::size_t nv = topo->surf_nodes.size();
   const std::size_t nn = asset ? asset->bvh_nodes.size() : 0;
   // The kBvh tree is a median split: depth <= log2(triangles) + 1 < 64. A 4-wide traversal
-  // pushes at most 10 items per level of its (at most 2 * wide_depth + 2) levels.
+  // pushes at most 16 items per level of its (at most 2 * wide_depth + 2) levels.
   const std::size_t stack_size =
       opt.traversal_stack > 0
           ? opt.traversal_stack
           : std::max(4 * (std::size_t(std::max<std::uint32_t>(topo->max_depth, 64)) + 4),
-                     10 * (2 * std::size_t(topo->wide_depth) + 2));
+                     16 * (2 * std::size_t(topo->wide_depth) + 2));
   std::size_t threads = 1;
 #if defined(TETSEG_HAVE_OPENMP)
   if (opt.use_openmp) threads = static_cast<std::size_t>(std::max(1, omp_get_max_threads()));

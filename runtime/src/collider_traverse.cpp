@@ -783,7 +783,7 @@ bool Collider::Impl::traverse_wide(Worker& w, StackItem first, bool orient) cons
   while (top > 0 && !w.stop) {
     const StackItem it = stack[--top];
     ++w.stats.node_pairs_visited;
-    if (top + 10 > cap) return false;  // a self item pushes up to 4 + 6 items
+    if (top + 16 > cap) return false;  // a pair of nodes pushes up to 4 x 4 items
     if (it.b == kNone) {
       const WideNode& nd = nodes[it.a];
       const WideStep& s = wstep[it.a];
@@ -813,26 +813,45 @@ bool Collider::Impl::traverse_wide(Worker& w, StackItem first, bool orient) cons
       }
       continue;
     }
-    // A pair: split the node (the one with more triangles when both are nodes).
-    const bool split_a =
-        !wide_leaf(it.a) && (wide_leaf(it.b) || nodes[it.a].ntris >= nodes[it.b].ntris);
-    const std::uint32_t split = split_a ? it.a : it.b, other = split_a ? it.b : it.a;
-    const bool other_leaf = wide_leaf(other);
-    const std::uint32_t ot = wide_triangle(other);
-    unsigned live = other_leaf ? live_children(split, tbox[ot], tmov[ot] != 0, tsign[ot])
-                               : live_children(split, wbox[other], wmov[other] != 0, wsign[other]);
-    const WideNode& nd = nodes[split];
-    while (live != 0) {
-      const std::uint32_t c = nd.child[__builtin_ctz(live)];
-      live &= live - 1;
-      if (other_leaf && wide_leaf(c)) {
-        if (split_a) {
-          triangle_pair(wide_triangle(c), ot);
+    // A pair with a triangle: the node's children against the triangle.
+    if (wide_leaf(it.a) || wide_leaf(it.b)) {
+      const bool a_leaf = wide_leaf(it.a);
+      const std::uint32_t node = a_leaf ? it.b : it.a, t = wide_triangle(a_leaf ? it.a : it.b);
+      const WideNode& nd = nodes[node];
+      unsigned live = live_children(node, tbox[t], tmov[t] != 0, tsign[t]);
+      while (live != 0) {
+        const std::uint32_t c = nd.child[__builtin_ctz(live)];
+        live &= live - 1;
+        if (!wide_leaf(c)) {
+          stack[top++] = a_leaf ? StackItem{it.a, c} : StackItem{c, it.b};
+        } else if (a_leaf) {
+          triangle_pair(t, wide_triangle(c));
         } else {
-          triangle_pair(ot, wide_triangle(c));
+          triangle_pair(wide_triangle(c), t);
         }
-      } else {
-        stack[top++] = split_a ? StackItem{c, other} : StackItem{other, c};
+      }
+      continue;
+    }
+    // Two nodes: both descend at once. A's children against B, then each live child of A
+    // against B's children.
+    const WideNode& na = nodes[it.a];
+    const WideNode& nb = nodes[it.b];
+    const WideStep& sa = wstep[it.a];
+    unsigned live_a = live_children(it.a, wbox[it.b], wmov[it.b] != 0, wsign[it.b]);
+    while (live_a != 0) {
+      const int k = __builtin_ctz(live_a);
+      live_a &= live_a - 1;
+      const std::uint32_t ca = na.child[k];
+      const std::uint8_t sign = std::uint8_t(((sa.pos >> k) & 1u) | (((sa.neg >> k) & 1u) << 1));
+      unsigned live = live_children(it.b, slot_box(sa, k), (sa.mov >> k) & 1u, sign);
+      while (live != 0) {
+        const std::uint32_t cb = nb.child[__builtin_ctz(live)];
+        live &= live - 1;
+        if (wide_leaf(ca) && wide_leaf(cb)) {
+          triangle_pair(wide_triangle(ca), wide_triangle(cb));
+        } else {
+          stack[top++] = {ca, cb};
+        }
       }
     }
   }
