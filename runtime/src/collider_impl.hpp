@@ -70,6 +70,27 @@ inline void box_union(Box& a, const Box& b) noexcept {
 #endif
 }
 
+/// The swept box of edge e, computed where it is read from its end vertices' swept boxes (the
+/// union a per-step pass over all edges would store): few edges are read in a step.
+struct EdgeBoxes {
+  const Box* vbox = nullptr;                           // per surface vertex, this step
+  const std::array<std::uint32_t, 2>* ends = nullptr;  // surface vertex ids of each edge
+  Box operator[](std::size_t e) const noexcept {
+    Box b = vbox[ends[e][0]];
+    box_union(b, vbox[ends[e][1]]);
+    return b;
+  }
+};
+
+/// 1 when an end node of edge e moves in this step, else 0 (read through the vertices' flags).
+struct EdgeMoving {
+  const std::uint8_t* vmoved = nullptr;
+  const std::array<std::uint32_t, 2>* ends = nullptr;
+  std::uint8_t operator[](std::size_t e) const noexcept {
+    return vmoved[ends[e][0]] | vmoved[ends[e][1]];
+  }
+};
+
 /// A BVH seen by the traversal: node topology plus per-step node data.
 struct TreeView {
   const format::BvhNode* nodes = nullptr;
@@ -323,8 +344,8 @@ struct Collider::Impl {
   std::vector<std::uint8_t> vmoved;  // per surface vertex
   std::vector<Box> vbox;             // per surface vertex, swept
   std::vector<Box> tbox;
-  std::vector<Box> ebox;           // per edge, swept (refit)
-  std::vector<std::uint8_t> emov;  // per edge: an end node moved
+  EdgeBoxes ebox;                  // per edge, swept (read through vbox)
+  EdgeMoving emov;                 // per edge: an end node moved (read through vmoved)
   std::vector<std::uint8_t> tcls;  // Orientation
   // Per cluster, this step: the detector point at the start and end (3 doubles each), and
   // whether the cluster is classified at all (0: overlap-only, or a non-finite detector).
