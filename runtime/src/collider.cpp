@@ -136,7 +136,6 @@ void Collider::Impl::construct(std::shared_ptr<const BodyShape> sh, const Collid
   wbox.resize(nw);
   wmov.assign(nw, 0);
   wsign.assign(nw, 0);
-  tsign.assign(asset ? tri_count : 0, 0);
   cluster_err.resize(cluster_count());
   skip_adjacent = uses_global_bvh();
   if (skip_adjacent) build_orphan_sets();

@@ -361,10 +361,10 @@ struct Collider::Impl {
   std::vector<Box> nbox;  // per asset BVH node (refit for a scene body: traverse_bodies)
   std::vector<std::uint32_t> nmov;
   // 4-wide cluster BVHs (topo->wide_nodes), this step: children's data, own box, own moving
-  // flag and own sign bits; and each triangle's sign bits (rvbc).
+  // flag and own sign bits (rvbc).
   std::vector<WideStep> wstep;
   std::vector<Box> wbox;
-  std::vector<std::uint8_t> wmov, wsign, tsign;
+  std::vector<std::uint8_t> wmov, wsign;
   std::vector<orientation_detail::StaticErr> cluster_err;  // per cluster, this step (classify)
   std::vector<Worker> workers;
   // Contact closure scratch (capacity tri_count, reserved at construction).
@@ -420,7 +420,15 @@ struct Collider::Impl {
   bool traverse_wide(Worker& w, StackItem first, bool orient) const noexcept;
   /// Refits the 4-wide cluster BVHs from tbox / tmov (wstep boxes and moving bits, wbox, wmov).
   void refit_wide() noexcept;
-  /// Sign bits of triangles (tsign) and of wide nodes and their children, from tcls.
+  /// Sign bits of triangle t (kNodeAllPositive / kNodeAllNegative / 0) from its class tcls[t].
+  std::uint8_t triangle_sign(std::uint32_t t) const noexcept {
+    static_assert(static_cast<int>(Orientation::kPositive) == 0 &&
+                      static_cast<int>(Orientation::kNegative) == 1 &&
+                      static_cast<int>(Orientation::kUncertain) == 2,
+                  "sign bits by class: 1 << class, uncertain none");
+    return std::uint8_t((1u << tcls[t]) & (kNodeAllPositive | kNodeAllNegative));
+  }
+  /// Sign bits of wide nodes and of their children, from tcls.
   void sign_wide() noexcept;
   void brute_vertex_faces(Worker& w, std::uint32_t i) const noexcept;
   void brute_edge_edges(Worker& w, std::uint32_t i) const noexcept;

@@ -719,12 +719,6 @@ void Collider::Impl::refit_wide() noexcept {
 }
 
 void Collider::Impl::sign_wide() noexcept {
-  static_assert(static_cast<int>(Orientation::kPositive) == 0 &&
-                    static_cast<int>(Orientation::kNegative) == 1 &&
-                    static_cast<int>(Orientation::kUncertain) == 2,
-                "sign bits by class");
-  static constexpr std::uint8_t kSignOf[3] = {kNodeAllPositive, kNodeAllNegative, 0};
-  for (std::uint32_t t = 0; t < tri_count; ++t) tsign[t] = kSignOf[tcls[t]];
   const WideNode* nodes = topo->wide_nodes.data();
   for (std::size_t i = topo->wide_nodes.size(); i-- > 0;) {
     WideStep& s = wstep[i];
@@ -732,7 +726,7 @@ void Collider::Impl::sign_wide() noexcept {
     for (int k = 0; k < 4; ++k) {
       const std::uint32_t c = nodes[i].child[k];
       if (c == kWideEmpty) break;
-      const std::uint8_t sign = wide_leaf(c) ? tsign[wide_triangle(c)] : wsign[c];
+      const std::uint8_t sign = wide_leaf(c) ? triangle_sign(wide_triangle(c)) : wsign[c];
       pos |= std::uint8_t((sign & kNodeAllPositive) << k);
       neg |= std::uint8_t(((sign & kNodeAllNegative) >> 1) << k);
       own &= sign;
@@ -818,7 +812,7 @@ bool Collider::Impl::traverse_wide(Worker& w, StackItem first, bool orient) cons
       const bool a_leaf = wide_leaf(it.a);
       const std::uint32_t node = a_leaf ? it.b : it.a, t = wide_triangle(a_leaf ? it.a : it.b);
       const WideNode& nd = nodes[node];
-      unsigned live = live_children(node, tbox[t], tmov[t] != 0, tsign[t]);
+      unsigned live = live_children(node, tbox[t], tmov[t] != 0, triangle_sign(t));
       while (live != 0) {
         const std::uint32_t c = nd.child[__builtin_ctz(live)];
         live &= live - 1;
