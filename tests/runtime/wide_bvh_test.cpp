@@ -1,9 +1,9 @@
 // The 4-wide cluster BVHs (docs/runtime.md, "4-wide cluster BVHs") against brute force: rvbc's
 // traversal must hand on exactly the non-culled triangle pairs, counted here over all triangle
-// pairs from the positions and the collider's triangle classes, whatever the asset's binary
-// trees look like (leaves of 1, 2, 3 or 7 triangles, or chains of single-triangle leaves), on
-// adversarial motions; and the contacts must agree with brute force
-// (tests/runtime/support/compare.hpp).
+// pairs from the positions and the collider's triangle classes, whether the trees are built
+// from rest positions (surface-area splits) or collapsed from the asset's binary trees (leaves
+// of 1, 2, 3 or 7 triangles, or chains of single-triangle leaves), on adversarial motions; and
+// the contacts must agree with brute force (tests/runtime/support/compare.hpp).
 
 #include <algorithm>
 #include <catch2/catch.hpp>
@@ -36,6 +36,16 @@ Scene axial_scene(const Surface& s, const std::vector<double>& cuts,
   std::vector<P3> det;
   for (double z : detector_z) det.push_back({0.0, 0.0, z});
   return make_scene(s, cluster_of, det, leaf_size);
+}
+
+// The scene's asset without rest positions (the same frames): the wide trees are then the
+// asset's binary trees collapsed, not the surface-area trees built from rest positions.
+Scene without_rest_positions(const Scene& scene) {
+  format::Asset a = scene.asset.data();
+  a.rest_positions.clear();
+  Scene out = load_scene(a, scene.surface_nodes);
+  out.rest = scene.rest;
+  return out;
 }
 
 // The triangle pairs rvbc must examine in the step x0 -> x1, by brute force over all pairs:
@@ -83,11 +93,13 @@ TEST_CASE("The 4-wide cluster traversal examines exactly the non-culled triangle
   const std::uint32_t leaf_size = GENERATE(0u, 1u, 2u, 3u, 7u);
   const unsigned seed = GENERATE(1u, 2u, 3u);
   const int shape = GENERATE(0, 1);
-  CAPTURE(leaf_size, seed, shape);
+  const bool rest = GENERATE(true, false);
+  CAPTURE(leaf_size, seed, shape, rest);
   const Surface s = shape == 0 ? sphere(1.0, 16, 9) : dumbbell(12, 18);
-  const Scene scene = shape == 0
-                          ? axial_scene(s, {-0.3, 0.4}, {-0.7, 0.0, 0.7}, leaf_size)
-                          : axial_scene(s, {-0.8, 0.0, 0.8}, {-1.5, -0.4, 0.4, 1.5}, leaf_size);
+  const Scene with_rest = shape == 0
+                              ? axial_scene(s, {-0.3, 0.4}, {-0.7, 0.0, 0.7}, leaf_size)
+                              : axial_scene(s, {-0.8, 0.0, 0.8}, {-1.5, -0.4, 0.4, 1.5}, leaf_size);
+  const Scene scene = rest ? with_rest : without_rest_positions(with_rest);
   // Large waves: the surface folds through itself, so boxes overlap everywhere and classes
   // are mixed; every step is counted, contacts or not.
   const Waves waves(seed, 1.2, 4.0);
@@ -109,13 +121,15 @@ TEST_CASE("The 4-wide cluster traversal examines exactly the non-culled triangle
   CHECK(culled > 0);  // the sign bits did cull
 }
 
-TEST_CASE("rvbc over 4-wide trees of deep or multi-triangle asset BVHs agrees with brute force",
+TEST_CASE("rvbc over 4-wide trees (surface-area, or collapsed asset BVHs) agrees with brute force",
           "[collider][rvbc][wide]") {
   const std::uint32_t leaf_size = GENERATE(0u, 3u, 7u);
   const unsigned seed = GENERATE(4u, 5u);
-  CAPTURE(leaf_size, seed);
+  const bool rest = GENERATE(true, false);
+  CAPTURE(leaf_size, seed, rest);
   const Surface s = dumbbell(14, 22);
-  const Scene scene = axial_scene(s, {-1.0, 0.0, 1.0}, {-1.6, -0.5, 0.5, 1.6}, leaf_size);
+  const Scene with_rest = axial_scene(s, {-1.0, 0.0, 1.0}, {-1.6, -0.5, 0.5, 1.6}, leaf_size);
+  const Scene scene = rest ? with_rest : without_rest_positions(with_rest);
   const Waves waves(seed, 0.9, 4.0);
   const SequenceReport rep = compare_with_brute(scene, make_frames(scene, 12, waves));
   CHECK(rep.frames_compared > 0);
