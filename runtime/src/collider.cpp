@@ -216,17 +216,24 @@ void Collider::Impl::refit_and_classify() noexcept {
     return;  // every feature pair is still: no test can run this step
   }
   const std::int64_t nt = tri_count;
+  {
+    // Local pointers: the stores cannot then be taken to alias the collider's members.
+    const std::array<std::uint32_t, 3>* tv = topo->tri_verts.data();
+    const Box* vb = vbox.data();
+    const std::uint8_t* vm = vmoved.data();
+    Box* tb = tbox.data();
+    std::uint8_t* tm = tmov.data();
 #if defined(TETSEG_HAVE_OPENMP)
 #pragma omp parallel for if (opt.use_openmp && nt > 4096)
 #endif
-  for (std::int64_t t = 0; t < nt; ++t) {
-    const std::uint32_t i0 = topo->tri_verts[t][0], i1 = topo->tri_verts[t][1],
-                        i2 = topo->tri_verts[t][2];
-    Box b = vbox[i0];
-    box_union(b, vbox[i1]);
-    box_union(b, vbox[i2]);
-    tbox[t] = b;
-    tmov[t] = (vmoved[i0] | vmoved[i1] | vmoved[i2]) ? 1 : 0;
+    for (std::int64_t t = 0; t < nt; ++t) {
+      const std::uint32_t i0 = tv[t][0], i1 = tv[t][1], i2 = tv[t][2];
+      Box b = vb[i0];
+      box_union(b, vb[i1]);
+      box_union(b, vb[i2]);
+      tb[t] = b;
+      tm[t] = (vm[i0] | vm[i1] | vm[i2]) ? 1 : 0;
+    }
   }
   if (uses_clusters()) {
     refit_wide();  // collider_traverse.cpp

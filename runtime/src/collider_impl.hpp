@@ -109,6 +109,16 @@ struct TreeView {
 inline constexpr std::uint8_t kNodeAllPositive = 1;
 inline constexpr std::uint8_t kNodeAllNegative = 2;
 
+/// Sign bits of a triangle of class `cls` (an Orientation): kNodeAllPositive, kNodeAllNegative,
+/// or 0 when uncertain.
+inline std::uint8_t class_sign_bits(std::uint8_t cls) noexcept {
+  static_assert(static_cast<int>(Orientation::kPositive) == 0 &&
+                    static_cast<int>(Orientation::kNegative) == 1 &&
+                    static_cast<int>(Orientation::kUncertain) == 2,
+                "sign bits by class: 1 << class, uncertain none");
+  return std::uint8_t((1u << cls) & (kNodeAllPositive | kNodeAllNegative));
+}
+
 /// Per-step data of a 4-wide node (WideNode): its children's swept boxes in
 /// structure-of-arrays form (an empty slot holds an inverted infinite box, which overlaps
 /// nothing), and a bit per child: it holds a moving triangle, all its triangles are positive,
@@ -420,14 +430,8 @@ struct Collider::Impl {
   bool traverse_wide(Worker& w, StackItem first, bool orient) const noexcept;
   /// Refits the 4-wide cluster BVHs from tbox / tmov (wstep boxes and moving bits, wbox, wmov).
   void refit_wide() noexcept;
-  /// Sign bits of triangle t (kNodeAllPositive / kNodeAllNegative / 0) from its class tcls[t].
-  std::uint8_t triangle_sign(std::uint32_t t) const noexcept {
-    static_assert(static_cast<int>(Orientation::kPositive) == 0 &&
-                      static_cast<int>(Orientation::kNegative) == 1 &&
-                      static_cast<int>(Orientation::kUncertain) == 2,
-                  "sign bits by class: 1 << class, uncertain none");
-    return std::uint8_t((1u << tcls[t]) & (kNodeAllPositive | kNodeAllNegative));
-  }
+  /// Sign bits of triangle t from its class tcls[t] (class_sign_bits).
+  std::uint8_t triangle_sign(std::uint32_t t) const noexcept { return class_sign_bits(tcls[t]); }
   /// Sign bits of wide nodes and of their children, from tcls.
   void sign_wide() noexcept;
   void brute_vertex_faces(Worker& w, std::uint32_t i) const noexcept;

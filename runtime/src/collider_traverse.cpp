@@ -685,25 +685,31 @@ inline Box slot_box(const WideStep& s, int k) noexcept {
 }  // namespace
 
 void Collider::Impl::refit_wide() noexcept {
+  // Local pointers: the byte stores cannot then be taken to alias the collider's members.
   const WideNode* nodes = topo->wide_nodes.data();
+  const Box* tb = tbox.data();
+  const std::uint8_t* tm = tmov.data();
+  WideStep* step = wstep.data();
+  Box* nbox_w = wbox.data();
+  std::uint8_t* nmov_w = wmov.data();
   for (std::size_t i = topo->wide_nodes.size(); i-- > 0;) {
-    WideStep& s = wstep[i];
+    WideStep& s = step[i];
     std::uint8_t mov = 0;
     for (int k = 0; k < 4; ++k) {
       const std::uint32_t c = nodes[i].child[k];
       if (c == kWideEmpty) break;
       const bool leaf = wide_leaf(c);
-      const Box& b = leaf ? tbox[wide_triangle(c)] : wbox[c];
+      const Box& b = leaf ? tb[wide_triangle(c)] : nbox_w[c];
       for (int a = 0; a < 3; ++a) {
         s.lo[a][k] = b.lo[a];
         s.hi[a][k] = b.hi[a];
       }
-      mov |= std::uint8_t((leaf ? tmov[wide_triangle(c)] : wmov[c]) << k);
+      mov |= std::uint8_t((leaf ? tm[wide_triangle(c)] : nmov_w[c]) << k);
     }
     s.mov = mov;
-    wmov[i] = mov != 0;
+    nmov_w[i] = mov != 0;
     // The node's box: the children's, reduced over the lanes (empty slots are neutral).
-    Box& own = wbox[i];
+    Box& own = nbox_w[i];
     for (int a = 0; a < 3; ++a) {
 #if defined(__SSE2__)
       const __m128d lo = _mm_min_pd(_mm_load_pd(s.lo[a]), _mm_load_pd(s.lo[a] + 2));
@@ -719,21 +725,25 @@ void Collider::Impl::refit_wide() noexcept {
 }
 
 void Collider::Impl::sign_wide() noexcept {
+  // Local pointers, as in refit_wide.
   const WideNode* nodes = topo->wide_nodes.data();
+  const std::uint8_t* cls = tcls.data();
+  WideStep* step = wstep.data();
+  std::uint8_t* nsign_w = wsign.data();
   for (std::size_t i = topo->wide_nodes.size(); i-- > 0;) {
-    WideStep& s = wstep[i];
+    WideStep& s = step[i];
     std::uint8_t pos = 0, neg = 0, own = kNodeAllPositive | kNodeAllNegative;
     for (int k = 0; k < 4; ++k) {
       const std::uint32_t c = nodes[i].child[k];
       if (c == kWideEmpty) break;
-      const std::uint8_t sign = wide_leaf(c) ? triangle_sign(wide_triangle(c)) : wsign[c];
+      const std::uint8_t sign = wide_leaf(c) ? class_sign_bits(cls[wide_triangle(c)]) : nsign_w[c];
       pos |= std::uint8_t((sign & kNodeAllPositive) << k);
       neg |= std::uint8_t(((sign & kNodeAllNegative) >> 1) << k);
       own &= sign;
     }
     s.pos = pos;
     s.neg = neg;
-    wsign[i] = own;
+    nsign_w[i] = own;
   }
 }
 
