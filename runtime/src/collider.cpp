@@ -190,22 +190,27 @@ void Collider::Impl::refit_and_classify() noexcept {
   const auto t_refit = Clock::now();
   const std::int64_t nv = static_cast<std::int64_t>(topo->surf_nodes.size());
   std::uint64_t moved = 0;
+  {
+    // Local pointers: the byte stores cannot then be taken to alias the collider's members.
+    // A still node's box is its point either way (min and max of equal values return it).
+    const std::uint32_t* nodes = topo->surf_nodes.data();
+    const double* p0 = x0;
+    const double* p1 = x1;
+    Box* vb = vbox.data();
+    std::uint8_t* vm = vmoved.data();
+    const bool at_rest = rest_mode;
 #if defined(TETSEG_HAVE_OPENMP)
 #pragma omp parallel for reduction(+ : moved) if (opt.use_openmp && nv > 4096)
 #endif
-  for (std::int64_t i = 0; i < nv; ++i) {
-    const double* a = pos0(topo->surf_nodes[i]);
-    const double* b = pos1(topo->surf_nodes[i]);
-    Box& box = vbox[i];
-    const bool m = !rest_mode && (a[0] != b[0] || a[1] != b[1] || a[2] != b[2]);
-    vmoved[i] = m ? 1 : 0;
-    moved += m ? 1 : 0;
-    if (!m) {
-      for (int k = 0; k < 3; ++k) box.lo[k] = box.hi[k] = a[k];
-    } else {
+    for (std::int64_t i = 0; i < nv; ++i) {
+      const double* a = p0 + std::size_t(nodes[i]) * 3;
+      const double* b = p1 + std::size_t(nodes[i]) * 3;
+      const bool m = !at_rest && (a[0] != b[0] || a[1] != b[1] || a[2] != b[2]);
+      vm[i] = m ? 1 : 0;
+      moved += m ? 1 : 0;
       for (int k = 0; k < 3; ++k) {
-        box.lo[k] = std::min(a[k], b[k]);
-        box.hi[k] = std::max(a[k], b[k]);
+        vb[i].lo[k] = std::min(a[k], b[k]);
+        vb[i].hi[k] = std::max(a[k], b[k]);
       }
     }
   }
