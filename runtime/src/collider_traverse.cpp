@@ -782,6 +782,23 @@ bool Collider::Impl::traverse_wide(Worker& w, StackItem first, bool orient) cons
   StackItem* stack = w.stack.data();
   const std::size_t cap = w.stack.size();
   std::size_t top = 0;
+  // Child k of node n against the children of node m selected by `select`: live pairs of two
+  // triangles processed, other live pairs pushed.
+  auto child_against_children = [&](std::uint32_t n, int k, std::uint32_t m, unsigned select) {
+    const WideStep& s = wstep[n];
+    const std::uint32_t c = nodes[n].child[k];
+    const std::uint8_t sign = std::uint8_t(((s.pos >> k) & 1u) | (((s.neg >> k) & 1u) << 1));
+    unsigned live = live_children(m, slot_box(s, k), (s.mov >> k) & 1u, sign) & select;
+    while (live != 0) {
+      const std::uint32_t c2 = nodes[m].child[__builtin_ctz(live)];
+      live &= live - 1;
+      if (wide_leaf(c) && wide_leaf(c2)) {
+        triangle_pair(wide_triangle(c), wide_triangle(c2));
+      } else {
+        stack[top++] = {c, c2};
+      }
+    }
+  };
   if (cap == 0) return false;
   stack[top++] = first;
   while (top > 0 && !w.stop) {
@@ -803,17 +820,7 @@ bool Collider::Impl::traverse_wide(Worker& w, StackItem first, bool orient) cons
             stack[top++] = {c, kNone};
           }
         }
-        const std::uint8_t sign = std::uint8_t(((s.pos >> k) & 1u) | (((s.neg >> k) & 1u) << 1));
-        unsigned live = live_children(it.a, slot_box(s, k), mov, sign) & ~((bit << 1) - 1);
-        while (live != 0) {
-          const std::uint32_t c2 = nd.child[__builtin_ctz(live)];
-          live &= live - 1;
-          if (wide_leaf(c) && wide_leaf(c2)) {
-            triangle_pair(wide_triangle(c), wide_triangle(c2));
-          } else {
-            stack[top++] = {c, c2};
-          }
-        }
+        child_against_children(it.a, k, it.a, ~((bit << 1) - 1));  // the later siblings
       }
       continue;
     }
@@ -838,25 +845,11 @@ bool Collider::Impl::traverse_wide(Worker& w, StackItem first, bool orient) cons
     }
     // Two nodes: both descend at once. A's children against B, then each live child of A
     // against B's children.
-    const WideNode& na = nodes[it.a];
-    const WideNode& nb = nodes[it.b];
-    const WideStep& sa = wstep[it.a];
     unsigned live_a = live_children(it.a, wbox[it.b], wmov[it.b] != 0, wsign[it.b]);
     while (live_a != 0) {
       const int k = __builtin_ctz(live_a);
       live_a &= live_a - 1;
-      const std::uint32_t ca = na.child[k];
-      const std::uint8_t sign = std::uint8_t(((sa.pos >> k) & 1u) | (((sa.neg >> k) & 1u) << 1));
-      unsigned live = live_children(it.b, slot_box(sa, k), (sa.mov >> k) & 1u, sign);
-      while (live != 0) {
-        const std::uint32_t cb = nb.child[__builtin_ctz(live)];
-        live &= live - 1;
-        if (wide_leaf(ca) && wide_leaf(cb)) {
-          triangle_pair(wide_triangle(ca), wide_triangle(cb));
-        } else {
-          stack[top++] = {ca, cb};
-        }
-      }
+      child_against_children(it.a, k, it.b, 0xfu);
     }
   }
   return true;

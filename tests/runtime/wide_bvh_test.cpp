@@ -22,22 +22,6 @@ using namespace tetseg::test;
 
 namespace {
 
-// Clusters by centroid z (cut at `cuts`), detectors on the axis at `detector_z`, BVH leaves of
-// `leaf_size` triangles (0: chains).
-Scene axial_scene(const Surface& s, const std::vector<double>& cuts,
-                  const std::vector<double>& detector_z, std::uint32_t leaf_size) {
-  std::vector<std::uint32_t> cluster_of(s.tris.size());
-  for (std::size_t t = 0; t < s.tris.size(); ++t) {
-    const double z =
-        (s.verts[s.tris[t][0]][2] + s.verts[s.tris[t][1]][2] + s.verts[s.tris[t][2]][2]) / 3;
-    cluster_of[t] =
-        static_cast<std::uint32_t>(std::upper_bound(cuts.begin(), cuts.end(), z) - cuts.begin());
-  }
-  std::vector<P3> det;
-  for (double z : detector_z) det.push_back({0.0, 0.0, z});
-  return make_scene(s, cluster_of, det, leaf_size);
-}
-
 // The scene's asset without rest positions (the same frames): the wide trees are then the
 // asset's binary trees collapsed, not the surface-area trees built from rest positions.
 Scene without_rest_positions(const Scene& scene) {
@@ -96,9 +80,9 @@ TEST_CASE("The 4-wide cluster traversal examines exactly the non-culled triangle
   const bool rest = GENERATE(true, false);
   CAPTURE(leaf_size, seed, shape, rest);
   const Surface s = shape == 0 ? sphere(1.0, 16, 9) : dumbbell(12, 18);
-  const Scene with_rest = shape == 0
-                              ? axial_scene(s, {-0.3, 0.4}, {-0.7, 0.0, 0.7}, leaf_size)
-                              : axial_scene(s, {-0.8, 0.0, 0.8}, {-1.5, -0.4, 0.4, 1.5}, leaf_size);
+  const Scene with_rest =
+      shape == 0 ? make_axial_scene(s, {-0.3, 0.4}, {-0.7, 0.0, 0.7}, leaf_size)
+                 : make_axial_scene(s, {-0.8, 0.0, 0.8}, {-1.5, -0.4, 0.4, 1.5}, leaf_size);
   const Scene scene = rest ? with_rest : without_rest_positions(with_rest);
   // Large waves: the surface folds through itself, so boxes overlap everywhere and classes
   // are mixed; every step is counted, contacts or not.
@@ -128,7 +112,7 @@ TEST_CASE("rvbc over 4-wide trees (surface-area, or collapsed asset BVHs) agrees
   const bool rest = GENERATE(true, false);
   CAPTURE(leaf_size, seed, rest);
   const Surface s = dumbbell(14, 22);
-  const Scene with_rest = axial_scene(s, {-1.0, 0.0, 1.0}, {-1.6, -0.5, 0.5, 1.6}, leaf_size);
+  const Scene with_rest = make_axial_scene(s, {-1.0, 0.0, 1.0}, {-1.6, -0.5, 0.5, 1.6}, leaf_size);
   const Scene scene = rest ? with_rest : without_rest_positions(with_rest);
   const Waves waves(seed, 0.9, 4.0);
   const SequenceReport rep = compare_with_brute(scene, make_frames(scene, 12, waves));
