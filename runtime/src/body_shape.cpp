@@ -1,6 +1,7 @@
 // BodyShape: the immutable surface topology of a body, built once (body_shape.hpp).
 
 #include <algorithm>
+#include <cmath>
 #include <new>
 
 #include "body_shape_data.hpp"
@@ -70,6 +71,12 @@ void BodyShape::Data::build() {
     et_list.push_back(half[i][2] / 3);
   }
   et_offset.push_back(static_cast<std::uint32_t>(half.size()));
+  tri_verts.resize(tri_count);
+  for (std::uint32_t t = 0; t < tri_count; ++t)
+    for (int k = 0; k < 3; ++k) tri_verts[t][k] = surf_index[triangles[t][k]];
+  edge_verts.resize(edges.size());
+  for (std::size_t e = 0; e < edges.size(); ++e)
+    edge_verts[e] = {surf_index[edges[e][0]], surf_index[edges[e][1]]};
 
   if (!asset) return;
   // Per-node static triangle counts and BVH depth (children have larger indices).
@@ -91,6 +98,201 @@ void BodyShape::Data::build() {
     for (std::uint32_t i = c.bvh_count; i-- > 0;) {
       cnt[i] = nodes[i].count > 0 ? nodes[i].count : cnt[nodes[i].first] + cnt[nodes[i].second];
     }
+  }
+  build_wide_bvhs();
+}
+
+namespace {
+
+// Collapses one binary cluster BVH into 4-wide nodes appended to `out` (parents first).
+struct WideBuilder {
+  const format::BvhNode* nodes;
+  const std::uint32_t* leaf;  // global triangle ids in leaf order
+  std::vector<WideNode>& out;
+  std::uint32_t depth = 0;
+
+  std::uint32_t add(std::uint32_t level) {
+    depth = std::max(depth, level);
+    out.push_back(WideNode{{kWideEmpty, kWideEmpty, kWideEmpty, kWideEmpty}});
+    return static_cast<std::uint32_t>(out.size() - 1);
+  }
+  // A wide node over leaf positions [first, first + count): up to four triangles, else up to
+  // four nearly equal consecutive runs.
+  std::uint32_t range(std::uint32_t first, std::uint32_t count, std::uint32_t level) {
+    const std::uint32_t id = add(level);
+    const std::uint32_t per = count <= 4 ? 1 : (count + 3) / 4;
+    for (std::uint32_t k = 0, at = first; at < first + count; ++k, at += per) {
+      const std::uint32_t n = std::min(per, first + count - at);
+      const std::uint32_t child = n == 1 ? kWideLeaf | leaf[at] : range(at, n, level + 1);
+      out[id].child[k] = child;  // after the call: it may have grown `out`
+    }
+    return id;
+  }
+  // The child slot of binary node n: its triangle when it is a one-triangle leaf, else a node.
+  std::uint32_t slot(std::uint32_t n, std::uint32_t level) {
+    const format::BvhNode& b = nodes[n];
+    if (b.count == 1) return kWideLeaf | leaf[b.first];
+    return node(n, level);
+  }
+  // The wide node of binary node n: its grandchildren (a child leaf stands for itself).
+  std::uint32_t node(std::uint32_t n, std::uint32_t level) {
+    const format::BvhNode& b = nodes[n];
+    if (b.count > 0) return range(b.first, b.count, level);
+    const std::uint32_t id = add(level);
+    std::uint32_t k = 0;
+    for (std::uint32_t c : {b.first, b.second}) {
+      const format::BvhNode& cb = nodes[c];
+      const std::uint32_t grand[2] = {cb.count > 0 ? c : cb.first, cb.second};
+      for (int g = 0; g < (cb.count > 0 ? 1 : 2); ++g) {
+        const std::uint32_t child = slot(grand[g], level + 1);
+        out[id].child[k++] = child;  // after the call: it may have grown `out`
+      }
+    }
+    return id;
+  }
+};
+
+// Binary BVH over the triangles `order` (global ids; reordered into leaf order), one triangle
+// per leaf, split by a binned surface-area heuristic over the triangles' boxes at `rest`;
+// below depth 2 log2(n) + 4 by the median centroid instead, so the depth stays under
+// 3 log2(n) + 6 whatever the geometry.
+void build_sah_bvh(const format::Triangle* tris, const std::array<double, 3>* rest,
+                   std::vector<std::uint32_t>& order, std::vector<format::BvhNode>& nodes) {
+  struct Item {
+    std::uint32_t id;
+    double lo[3], hi[3], c[3];
+  };
+  const std::uint32_t n = static_cast<std::uint32_t>(order.size());
+  std::vector<Item> items(n);
+  for (std::uint32_t i = 0; i < n; ++i) {
+    Item& it = items[i];
+    it.id = order[i];
+    for (int k = 0; k < 3; ++k) {
+      it.lo[k] = INFINITY;
+      it.hi[k] = -INFINITY;
+      for (std::uint32_t v : tris[it.id]) {
+        it.lo[k] = std::min(it.lo[k], rest[v][k]);
+        it.hi[k] = std::max(it.hi[k], rest[v][k]);
+      }
+      it.c[k] = 0.5 * (it.lo[k] + it.hi[k]);
+    }
+  }
+  auto area = [](const double* lo, const double* hi) {
+    const double d[3] = {hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]};
+    return d[0] * d[1] + d[1] * d[2] + d[2] * d[0];
+  };
+  constexpr int kBins = 16;
+  struct Task {
+    std::uint32_t node, begin, end, depth;
+  };
+  std::uint32_t sah_depth = 4;
+  for (std::uint32_t m = n; m > 1; m = (m + 1) / 2) sah_depth += 2;
+  nodes.assign(1, format::BvhNode{});
+  std::vector<Task> stack{{0, 0, n, 0}};
+  while (!stack.empty()) {
+    const Task t = stack.back();
+    stack.pop_back();
+    if (t.end - t.begin <= 1) {
+      nodes[t.node] = {t.begin, 0, t.end - t.begin};
+      continue;
+    }
+    double clo[3] = {INFINITY, INFINITY, INFINITY}, chi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (std::uint32_t i = t.begin; i < t.end; ++i)
+      for (int k = 0; k < 3; ++k) {
+        clo[k] = std::min(clo[k], items[i].c[k]);
+        chi[k] = std::max(chi[k], items[i].c[k]);
+      }
+    int best_axis = -1, best_bin = 0;
+    double best_cost = INFINITY;
+    for (int k = 0; k < 3 && t.depth < sah_depth; ++k) {
+      if (!(chi[k] > clo[k])) continue;
+      const double scale = kBins / (chi[k] - clo[k]);
+      struct Bin {
+        double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+        std::uint32_t count = 0;
+      } bins[kBins];
+      for (std::uint32_t i = t.begin; i < t.end; ++i) {
+        const int b = std::min(kBins - 1, static_cast<int>((items[i].c[k] - clo[k]) * scale));
+        Bin& bin = bins[b];
+        ++bin.count;
+        for (int a = 0; a < 3; ++a) {
+          bin.lo[a] = std::min(bin.lo[a], items[i].lo[a]);
+          bin.hi[a] = std::max(bin.hi[a], items[i].hi[a]);
+        }
+      }
+      // Cost of splitting after bin b: area(left) * count(left) + area(right) * count(right).
+      double right_cost[kBins] = {};
+      Bin acc;
+      for (int b = kBins - 1; b > 0; --b) {
+        acc.count += bins[b].count;
+        for (int a = 0; a < 3; ++a) {
+          acc.lo[a] = std::min(acc.lo[a], bins[b].lo[a]);
+          acc.hi[a] = std::max(acc.hi[a], bins[b].hi[a]);
+        }
+        right_cost[b] = acc.count > 0 ? area(acc.lo, acc.hi) * acc.count : 0.0;
+      }
+      Bin left;
+      for (int b = 0; b + 1 < kBins; ++b) {
+        left.count += bins[b].count;
+        for (int a = 0; a < 3; ++a) {
+          left.lo[a] = std::min(left.lo[a], bins[b].lo[a]);
+          left.hi[a] = std::max(left.hi[a], bins[b].hi[a]);
+        }
+        if (left.count == 0 || left.count == t.end - t.begin) continue;
+        const double cost = area(left.lo, left.hi) * left.count + right_cost[b + 1];
+        if (cost < best_cost) best_cost = cost, best_axis = k, best_bin = b;
+      }
+    }
+    std::uint32_t mid;
+    if (best_axis < 0) {  // deep, or all centroids in one point: the median on the longest axis
+      mid = t.begin + (t.end - t.begin) / 2;
+      int axis = 0;
+      for (int k = 1; k < 3; ++k)
+        if (chi[k] - clo[k] > chi[axis] - clo[axis]) axis = k;
+      std::nth_element(items.data() + t.begin, items.data() + mid, items.data() + t.end,
+                       [axis](const Item& a, const Item& b) {
+                         return a.c[axis] < b.c[axis] || (a.c[axis] == b.c[axis] && a.id < b.id);
+                       });
+    } else {
+      const double scale = kBins / (chi[best_axis] - clo[best_axis]);
+      Item* split =
+          std::partition(items.data() + t.begin, items.data() + t.end, [&](const Item& it) {
+            return std::min(kBins - 1, static_cast<int>((it.c[best_axis] - clo[best_axis]) *
+                                                        scale)) <= best_bin;
+          });
+      mid = static_cast<std::uint32_t>(split - items.data());
+    }
+    const std::uint32_t left = static_cast<std::uint32_t>(nodes.size());
+    nodes.push_back({});
+    nodes.push_back({});
+    nodes[t.node] = {left, left + 1, 0};
+    stack.push_back({left + 1, mid, t.end, t.depth + 1});
+    stack.push_back({left, t.begin, mid, t.depth + 1});
+  }
+  for (std::uint32_t i = 0; i < n; ++i) order[i] = items[i].id;
+}
+
+}  // namespace
+
+void BodyShape::Data::build_wide_bvhs() {
+  const format::Asset& fa = *asset;
+  wide_nodes.clear();
+  wide_root.assign(fa.clusters.size(), kWideEmpty);
+  wide_depth = 0;
+  for (std::size_t c = 0; c < fa.clusters.size(); ++c) {
+    const format::Cluster& cl = fa.clusters[c];
+    if (cl.bvh_count == 0) continue;
+    std::vector<std::uint32_t> order(
+        fa.cluster_triangles.begin() + cl.triangle_offset,
+        fa.cluster_triangles.begin() + cl.triangle_offset + cl.triangle_count);
+    std::vector<format::BvhNode> sah;
+    const bool rest = fa.rest_positions.size() == fa.node_count && !order.empty();
+    if (rest) build_sah_bvh(fa.triangles.data(), fa.rest_positions.data(), order, sah);
+    WideBuilder b{rest ? sah.data() : fa.bvh_nodes.data() + cl.bvh_offset,
+                  rest ? order.data() : fa.cluster_triangles.data() + cl.triangle_offset,
+                  wide_nodes};
+    wide_root[c] = b.node(0, 0);
+    wide_depth = std::max(wide_depth, b.depth);
   }
 }
 

@@ -85,10 +85,13 @@ void Collider::Impl::construct(std::shared_ptr<const BodyShape> sh, const Collid
   if (!asset && opt.mode == ColliderMode::kRvbc) opt.mode = ColliderMode::kBvh;  // no clusters
   const std::size_t nv = topo->surf_nodes.size();
   const std::size_t nn = asset ? asset->bvh_nodes.size() : 0;
-  // The kBvh tree is a median split: depth <= log2(triangles) + 1 < 64.
+  // The kBvh tree is a median split: depth <= log2(triangles) + 1 < 64. A 4-wide traversal
+  // pushes at most 16 items per level of its (at most 2 * wide_depth + 2) levels.
   const std::size_t stack_size =
-      opt.traversal_stack > 0 ? opt.traversal_stack
-                              : 4 * (std::size_t(std::max<std::uint32_t>(topo->max_depth, 64)) + 4);
+      opt.traversal_stack > 0
+          ? opt.traversal_stack
+          : std::max(4 * (std::size_t(std::max<std::uint32_t>(topo->max_depth, 64)) + 4),
+                     16 * (2 * std::size_t(topo->wide_depth) + 2));
   std::size_t threads = 1;
 #if defined(TETSEG_HAVE_OPENMP)
   if (opt.use_openmp) threads = static_cast<std::size_t>(std::max(1, omp_get_max_threads()));
@@ -108,8 +111,8 @@ void Collider::Impl::construct(std::shared_ptr<const BodyShape> sh, const Collid
   vmoved.assign(nv, 0);
   vbox.resize(nv);
   tbox.resize(tri_count);
-  ebox.resize(topo->edges.size());
-  emov.assign(topo->edges.size(), 0);
+  ebox = {vbox.data(), topo->edge_verts.data()};
+  emov = {vmoved.data(), topo->edge_verts.data()};
   tcls.assign(tri_count, static_cast<std::uint8_t>(Orientation::kUncertain));
   det0.assign(3 * std::size_t(cluster_count()), 0.0);
   det1.assign(3 * std::size_t(cluster_count()), 0.0);
@@ -118,15 +121,22 @@ void Collider::Impl::construct(std::shared_ptr<const BodyShape> sh, const Collid
   closure_ring.reserve(tri_count);
   closure_mark.assign(tri_count, 0);
   nbox.resize(nn);
-  nsign.assign(nn, 0);
   nmov.assign(nn, 0);
-  cluster_err.resize(cluster_count());
-
-  single_triangle_leaves = asset != nullptr;
-  if (asset) {
-    for (const format::BvhNode& n : asset->bvh_nodes)
-      if (n.count > 1) single_triangle_leaves = false;
+  const std::size_t nw = topo->wide_nodes.size();
+  wstep.resize(nw);
+  for (std::size_t i = 0; i < nw; ++i) {
+    for (int k = 0; k < 4; ++k) {
+      if (topo->wide_nodes[i].child[k] != kWideEmpty) continue;
+      for (int a = 0; a < 3; ++a) {  // never written again: overlaps nothing
+        wstep[i].lo[a][k] = INFINITY;
+        wstep[i].hi[a][k] = -INFINITY;
+      }
+    }
   }
+  wbox.resize(nw);
+  wmov.assign(nw, 0);
+  wsign.assign(nw, 0);
+  cluster_err.resize(cluster_count());
   skip_adjacent = uses_global_bvh();
   if (skip_adjacent) build_orphan_sets();
 
@@ -180,22 +190,27 @@ void Collider::Impl::refit_and_classify() noexcept {
   const auto t_refit = Clock::now();
   const std::int64_t nv = static_cast<std::int64_t>(topo->surf_nodes.size());
   std::uint64_t moved = 0;
+  {
+    // Local pointers: the byte stores cannot then be taken to alias the collider's members.
+    // A still node's box is its point either way (min and max of equal values return it).
+    const std::uint32_t* nodes = topo->surf_nodes.data();
+    const double* p0 = x0;
+    const double* p1 = x1;
+    Box* vb = vbox.data();
+    std::uint8_t* vm = vmoved.data();
+    const bool at_rest = rest_mode;
 #if defined(TETSEG_HAVE_OPENMP)
 #pragma omp parallel for reduction(+ : moved) if (opt.use_openmp && nv > 4096)
 #endif
-  for (std::int64_t i = 0; i < nv; ++i) {
-    const double* a = pos0(topo->surf_nodes[i]);
-    const double* b = pos1(topo->surf_nodes[i]);
-    Box& box = vbox[i];
-    const bool m = !rest_mode && (a[0] != b[0] || a[1] != b[1] || a[2] != b[2]);
-    vmoved[i] = m ? 1 : 0;
-    moved += m ? 1 : 0;
-    if (!m) {
-      for (int k = 0; k < 3; ++k) box.lo[k] = box.hi[k] = a[k];
-    } else {
+    for (std::int64_t i = 0; i < nv; ++i) {
+      const double* a = p0 + std::size_t(nodes[i]) * 3;
+      const double* b = p1 + std::size_t(nodes[i]) * 3;
+      const bool m = !at_rest && (a[0] != b[0] || a[1] != b[1] || a[2] != b[2]);
+      vm[i] = m ? 1 : 0;
+      moved += m ? 1 : 0;
       for (int k = 0; k < 3; ++k) {
-        box.lo[k] = std::min(a[k], b[k]);
-        box.hi[k] = std::max(a[k], b[k]);
+        vb[i].lo[k] = std::min(a[k], b[k]);
+        vb[i].hi[k] = std::max(a[k], b[k]);
       }
     }
   }
@@ -206,33 +221,29 @@ void Collider::Impl::refit_and_classify() noexcept {
     return;  // every feature pair is still: no test can run this step
   }
   const std::int64_t nt = tri_count;
+  {
+    // Local pointers: the stores cannot then be taken to alias the collider's members.
+    const std::array<std::uint32_t, 3>* tv = topo->tri_verts.data();
+    const Box* vb = vbox.data();
+    const std::uint8_t* vm = vmoved.data();
+    Box* tb = tbox.data();
+    std::uint8_t* tm = tmov.data();
 #if defined(TETSEG_HAVE_OPENMP)
 #pragma omp parallel for if (opt.use_openmp && nt > 4096)
 #endif
-  for (std::int64_t t = 0; t < nt; ++t) {
-    const auto& tri = tris[t];
-    const std::uint32_t i0 = topo->surf_index[tri[0]], i1 = topo->surf_index[tri[1]],
-                        i2 = topo->surf_index[tri[2]];
-    Box b = vbox[i0];
-    box_union(b, vbox[i1]);
-    box_union(b, vbox[i2]);
-    tbox[t] = b;
-    tmov[t] = (vmoved[i0] | vmoved[i1] | vmoved[i2]) ? 1 : 0;
-  }
-  const std::int64_t ne = static_cast<std::int64_t>(topo->edges.size());
-#if defined(TETSEG_HAVE_OPENMP)
-#pragma omp parallel for if (opt.use_openmp && ne > 8192)
-#endif
-  for (std::int64_t e = 0; e < ne; ++e) {
-    const std::uint32_t i0 = topo->surf_index[topo->edges[e][0]],
-                        i1 = topo->surf_index[topo->edges[e][1]];
-    Box b = vbox[i0];
-    box_union(b, vbox[i1]);
-    ebox[e] = b;
-    emov[e] = vmoved[i0] | vmoved[i1];
+    for (std::int64_t t = 0; t < nt; ++t) {
+      const std::uint32_t i0 = tv[t][0], i1 = tv[t][1], i2 = tv[t][2];
+      Box b = vb[i0];
+      box_union(b, vb[i1]);
+      box_union(b, vb[i2]);
+      tb[t] = b;
+      tm[t] = (vm[i0] | vm[i1] | vm[i2]) ? 1 : 0;
+    }
   }
   if (uses_clusters()) {
-    for (std::uint32_t c = 0; c < cluster_count(); ++c) {
+    refit_wide();  // collider_traverse.cpp
+    // A scene body's binary cluster BVHs serve traverse_bodies.
+    for (std::uint32_t c = 0; c < cluster_count() && always_refit; ++c) {
       const format::Cluster& cl = asset->clusters[c];
       const format::BvhNode* nodes = asset->bvh_nodes.data() + cl.bvh_offset;
       const std::uint32_t* leaf = asset->cluster_triangles.data() + cl.triangle_offset;
@@ -273,8 +284,8 @@ void Collider::Impl::refit_and_classify() noexcept {
       ok = ok && std::isfinite(a[k]) && std::isfinite(b[k]);
     }
     det_ok[c] = ok ? 1 : 0;  // an overflowing combination: the cluster's triangles uncertain
-    if (!ok || cl.bvh_count == 0) continue;
-    const Box& root = nbox[cl.bvh_offset];
+    if (!ok || topo->wide_root[c] == kWideEmpty) continue;
+    const Box& root = wbox[topo->wide_root[c]];
     double extent[3];
     for (int k = 0; k < 3; ++k)
       extent[k] = std::max({root.hi[k], a[k], b[k]}) - std::min({root.lo[k], a[k], b[k]});
@@ -353,29 +364,7 @@ void Collider::Impl::refit_and_classify() noexcept {
   stats.triangles_positive = count[0];
   stats.triangles_negative = count[1];
   stats.triangles_uncertain = count[2];
-  // Per-node sign bits, bottom-up, from this step: a node is all positive (all negative) when
-  // every triangle under it is.
-  auto triangle_sign = [&](std::uint32_t t) -> std::uint8_t {
-    const std::uint8_t c = tcls[t];
-    return c == static_cast<std::uint8_t>(Orientation::kPositive)   ? kNodeAllPositive
-           : c == static_cast<std::uint8_t>(Orientation::kNegative) ? kNodeAllNegative
-                                                                    : 0;
-  };
-  for (const format::Cluster& cl : asset->clusters) {
-    const format::BvhNode* nodes = asset->bvh_nodes.data() + cl.bvh_offset;
-    const std::uint32_t* leaf = asset->cluster_triangles.data() + cl.triangle_offset;
-    std::uint8_t* sign = nsign.data() + cl.bvh_offset;
-    for (std::uint32_t i = cl.bvh_count; i-- > 0;) {
-      const format::BvhNode& n = nodes[i];
-      if (n.count > 0) {
-        std::uint8_t s = kNodeAllPositive | kNodeAllNegative;
-        for (std::uint32_t k = 0; k < n.count; ++k) s &= triangle_sign(leaf[n.first + k]);
-        sign[i] = s;
-      } else {
-        sign[i] = sign[n.first] & sign[n.second];
-      }
-    }
-  }
+  sign_wide();  // collider_traverse.cpp
   stats.classify_ms = ms_since(t_class);
 }
 

@@ -48,12 +48,48 @@ inline bool boxes_overlap(const Box& a, const Box& b, double margin) noexcept {
   return !apart;
 }
 
+/// a becomes the union of a and b: per coordinate, b's value where it is strictly below
+/// (lo) or above (hi) a's, else a's.
 inline void box_union(Box& a, const Box& b) noexcept {
+#if defined(__SSE2__)
+  // The six contiguous doubles as three pairs (lo0 lo1) (lo2 hi0) (hi1 hi2); _mm_min_pd(b, a)
+  // is b < a ? b : a lane by lane, so every value is the scalar form's.
+  static_assert(sizeof(Box) == 6 * sizeof(double), "Box: six contiguous doubles");
+  const double* pb = reinterpret_cast<const double*>(&b);
+  double* pa = reinterpret_cast<double*>(&a);
+  const __m128d b0 = _mm_loadu_pd(pb), b1 = _mm_loadu_pd(pb + 2), b2 = _mm_loadu_pd(pb + 4);
+  const __m128d a0 = _mm_loadu_pd(pa), a1 = _mm_loadu_pd(pa + 2), a2 = _mm_loadu_pd(pa + 4);
+  _mm_storeu_pd(pa, _mm_min_pd(b0, a0));
+  _mm_storeu_pd(pa + 2, _mm_move_sd(_mm_max_pd(b1, a1), _mm_min_pd(b1, a1)));
+  _mm_storeu_pd(pa + 4, _mm_max_pd(b2, a2));
+#else
   for (int k = 0; k < 3; ++k) {
     if (b.lo[k] < a.lo[k]) a.lo[k] = b.lo[k];
     if (b.hi[k] > a.hi[k]) a.hi[k] = b.hi[k];
   }
+#endif
 }
+
+/// The swept box of edge e, computed where it is read from its end vertices' swept boxes (the
+/// union a per-step pass over all edges would store): few edges are read in a step.
+struct EdgeBoxes {
+  const Box* vbox = nullptr;                           // per surface vertex, this step
+  const std::array<std::uint32_t, 2>* ends = nullptr;  // surface vertex ids of each edge
+  Box operator[](std::size_t e) const noexcept {
+    Box b = vbox[ends[e][0]];
+    box_union(b, vbox[ends[e][1]]);
+    return b;
+  }
+};
+
+/// 1 when an end node of edge e moves in this step, else 0 (read through the vertices' flags).
+struct EdgeMoving {
+  const std::uint8_t* vmoved = nullptr;
+  const std::array<std::uint32_t, 2>* ends = nullptr;
+  std::uint8_t operator[](std::size_t e) const noexcept {
+    return vmoved[ends[e][0]] | vmoved[ends[e][1]];
+  }
+};
 
 /// A BVH seen by the traversal: node topology plus per-step node data.
 struct TreeView {
@@ -62,18 +98,36 @@ struct TreeView {
   const Box* box = nullptr;
   const Box* tri_box = nullptr;  // swept box of each triangle (by global id), this step
   const std::uint32_t* ntris = nullptr;
-  // Per node, this step: kNodeAllPositive / kNodeAllNegative when every triangle under it has
-  // that orientation class, 0 otherwise. Null: no orientation culling.
-  const std::uint8_t* nsign = nullptr;
   const std::uint32_t* nmov = nullptr;
   const ConeData* cone = nullptr;  // non-null: node self-tests may be culled by normal cones
   std::uint32_t cone_base = 0;     // cone index of node 0
 };
 
-/// Node sign bits (TreeView::nsign): two nodes whose bits share one cannot produce a first
-/// contact between their triangles (one orientation class throughout).
+/// Orientation sign bits of a triangle or a wide node (rvbc, this step): kNodeAllPositive /
+/// kNodeAllNegative when every triangle under it has that class. Two within one cluster whose
+/// bits share one cannot produce a first contact between their triangles.
 inline constexpr std::uint8_t kNodeAllPositive = 1;
 inline constexpr std::uint8_t kNodeAllNegative = 2;
+
+/// Sign bits of a triangle of class `cls` (an Orientation): kNodeAllPositive, kNodeAllNegative,
+/// or 0 when uncertain.
+inline std::uint8_t class_sign_bits(std::uint8_t cls) noexcept {
+  static_assert(static_cast<int>(Orientation::kPositive) == 0 &&
+                    static_cast<int>(Orientation::kNegative) == 1 &&
+                    static_cast<int>(Orientation::kUncertain) == 2,
+                "sign bits by class: 1 << class, uncertain none");
+  return std::uint8_t((1u << cls) & (kNodeAllPositive | kNodeAllNegative));
+}
+
+/// Per-step data of a 4-wide node (WideNode): its children's swept boxes in
+/// structure-of-arrays form (an empty slot holds an inverted infinite box, which overlaps
+/// nothing), and a bit per child: it holds a moving triangle, all its triangles are positive,
+/// all are negative.
+struct alignas(64) WideStep {
+  double lo[3][4];
+  double hi[3][4];
+  std::uint8_t mov = 0, pos = 0, neg = 0;
+};
 
 struct StackItem {
   std::uint32_t a;
@@ -300,8 +354,8 @@ struct Collider::Impl {
   std::vector<std::uint8_t> vmoved;  // per surface vertex
   std::vector<Box> vbox;             // per surface vertex, swept
   std::vector<Box> tbox;
-  std::vector<Box> ebox;           // per edge, swept (refit)
-  std::vector<std::uint8_t> emov;  // per edge: an end node moved
+  EdgeBoxes ebox;                  // per edge, swept (read through vbox)
+  EdgeMoving emov;                 // per edge: an end node moved (read through vmoved)
   std::vector<std::uint8_t> tcls;  // Orientation
   // Per cluster, this step: the detector point at the start and end (3 doubles each), and
   // whether the cluster is classified at all (0: overlap-only, or a non-finite detector).
@@ -314,9 +368,13 @@ struct Collider::Impl {
   bool skip_adjacent = false;
   std::vector<std::array<std::uint32_t, 2>> orphan_vf;  // (node, triangle)
   std::vector<std::array<std::uint32_t, 2>> orphan_ee;  // (edge, edge), first < second
-  std::vector<Box> nbox;                                // per asset BVH node
+  std::vector<Box> nbox;  // per asset BVH node (refit for a scene body: traverse_bodies)
   std::vector<std::uint32_t> nmov;
-  std::vector<std::uint8_t> nsign;                         // per asset BVH node: TreeView::nsign
+  // 4-wide cluster BVHs (topo->wide_nodes), this step: children's data, own box, own moving
+  // flag and own sign bits (rvbc).
+  std::vector<WideStep> wstep;
+  std::vector<Box> wbox;
+  std::vector<std::uint8_t> wmov, wsign;
   std::vector<orientation_detail::StaticErr> cluster_err;  // per cluster, this step (classify)
   std::vector<Worker> workers;
   // Contact closure scratch (capacity tri_count, reserved at construction).
@@ -366,15 +424,16 @@ struct Collider::Impl {
   void process_triangle_pair(Worker& w, std::uint32_t t1, std::uint32_t t2) const noexcept;
   /// process_triangle_pair of a pair known to be non-culled (not in the rest check).
   void process_non_culled_pair(Worker& w, std::uint32_t t1, std::uint32_t t2) const noexcept;
-  /// Every leaf of the cluster BVHs holds one triangle (construction).
-  bool single_triangle_leaves = false;
-  /// True when tree t is a cluster tree of single-triangle leaves traversed outside the rest
-  /// check: its leaf box and counters are its triangle's swept box and flags, so a leaf pair
-  /// that passed the traversal's live test (movement, boxes, and within a cluster the
-  /// orientation rule) is a non-culled triangle pair and needs no second check.
-  bool leaf_pairs_non_culled(const TreeView& t) const noexcept;
   bool traverse_self(Worker& w, const TreeView& tree) const noexcept;
-  bool traverse_pair(Worker& w, const TreeView& ta, const TreeView& tb) const noexcept;
+  /// Traversal of the 4-wide cluster BVHs from `first` (a self item {node, kNone} or a pair of
+  /// child slots); `orient`: cull by the sign bits (within one cluster). False on overflow.
+  bool traverse_wide(Worker& w, StackItem first, bool orient) const noexcept;
+  /// Refits the 4-wide cluster BVHs from tbox / tmov (wstep boxes and moving bits, wbox, wmov).
+  void refit_wide() noexcept;
+  /// Sign bits of triangle t from its class tcls[t] (class_sign_bits).
+  std::uint8_t triangle_sign(std::uint32_t t) const noexcept { return class_sign_bits(tcls[t]); }
+  /// Sign bits of wide nodes and of their children, from tcls.
+  void sign_wide() noexcept;
   void brute_vertex_faces(Worker& w, std::uint32_t i) const noexcept;
   void brute_edge_edges(Worker& w, std::uint32_t i) const noexcept;
   /// Builds orphan_vf / orphan_ee from the topology (construction; allocates, may throw).

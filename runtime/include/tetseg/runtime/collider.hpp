@@ -121,7 +121,7 @@ struct ColliderStats {
   /// kRvbc: orientation-culled triangle pairs around the earliest contacts re-examined by the
   /// contact closure (docs/runtime.md)
   std::uint64_t closure_pairs = 0;
-  std::uint64_t node_pairs_visited = 0;  ///< BVH node pairs popped by traversal
+  std::uint64_t node_pairs_visited = 0;  ///< BVH node pairs popped (rvbc: 4-wide items)
   std::uint64_t node_pairs_orientation_culled = 0;
   std::uint64_t triangle_pairs = 0;  ///< non-culled triangle pairs examined
   /// of those, dropped by the triangle-pair plane filter (no feature pair can touch;

@@ -255,9 +255,9 @@ inline Scene with_cluster_flags(const Scene& scene, std::uint32_t flags) {
 }
 
 /// Clusters by triangle-centroid z: cut at `cuts` (ascending); detectors on the axis at
-/// `detector_z` (one more than cuts).
+/// `detector_z` (one more than cuts); BVH leaves as make_scene's `leaf_size`.
 inline Scene make_axial_scene(const Surface& s, const std::vector<double>& cuts,
-                              const std::vector<double>& detector_z) {
+                              const std::vector<double>& detector_z, std::uint32_t leaf_size = 2) {
   std::vector<std::uint32_t> cluster_of(s.tris.size());
   for (std::size_t t = 0; t < s.tris.size(); ++t) {
     const double z =
@@ -267,7 +267,7 @@ inline Scene make_axial_scene(const Surface& s, const std::vector<double>& cuts,
   }
   std::vector<P3> det;
   for (double z : detector_z) det.push_back({0.0, 0.0, z});
-  return make_scene(s, cluster_of, det);
+  return make_scene(s, cluster_of, det, leaf_size);
 }
 
 /// Frames of a deformation: frame f = map(rest position, f / (frames - 1)) for every node.
