@@ -108,8 +108,6 @@ void Collider::Impl::construct(std::shared_ptr<const BodyShape> sh, const Collid
   vmoved.assign(nv, 0);
   vbox.resize(nv);
   tbox.resize(tri_count);
-  ebox.resize(topo->edges.size());
-  emov.assign(topo->edges.size(), 0);
   tcls.assign(tri_count, static_cast<std::uint8_t>(Orientation::kUncertain));
   det0.assign(3 * std::size_t(cluster_count()), 0.0);
   det1.assign(3 * std::size_t(cluster_count()), 0.0);
@@ -218,18 +216,6 @@ void Collider::Impl::refit_and_classify() noexcept {
     box_union(b, vbox[i2]);
     tbox[t] = b;
     tmov[t] = (vmoved[i0] | vmoved[i1] | vmoved[i2]) ? 1 : 0;
-  }
-  const std::int64_t ne = static_cast<std::int64_t>(topo->edges.size());
-#if defined(TETSEG_HAVE_OPENMP)
-#pragma omp parallel for if (opt.use_openmp && ne > 8192)
-#endif
-  for (std::int64_t e = 0; e < ne; ++e) {
-    const std::uint32_t i0 = topo->surf_index[topo->edges[e][0]],
-                        i1 = topo->surf_index[topo->edges[e][1]];
-    Box b = vbox[i0];
-    box_union(b, vbox[i1]);
-    ebox[e] = b;
-    emov[e] = vmoved[i0] | vmoved[i1];
   }
   if (uses_clusters()) {
     for (std::uint32_t c = 0; c < cluster_count(); ++c) {

@@ -300,8 +300,6 @@ struct Collider::Impl {
   std::vector<std::uint8_t> vmoved;  // per surface vertex
   std::vector<Box> vbox;             // per surface vertex, swept
   std::vector<Box> tbox;
-  std::vector<Box> ebox;           // per edge, swept (refit)
-  std::vector<std::uint8_t> emov;  // per edge: an end node moved
   std::vector<std::uint8_t> tcls;  // Orientation
   // Per cluster, this step: the detector point at the start and end (3 doubles each), and
   // whether the cluster is classified at all (0: overlap-only, or a non-finite detector).
@@ -356,6 +354,18 @@ struct Collider::Impl {
   ColliderStatus query_status() const noexcept;
   const double* pos0(std::uint32_t node) const noexcept { return x0 + std::size_t(node) * 3; }
   const double* pos1(std::uint32_t node) const noexcept { return x1 + std::size_t(node) * 3; }
+  /// Swept box of edge e this step: the union of its end nodes' boxes (computed when asked:
+  /// only edges of the few triangle pairs past the plane filter are ever read).
+  Box edge_box(std::uint32_t e) const noexcept {
+    Box b = vbox[topo->surf_index[topo->edges[e][0]]];
+    box_union(b, vbox[topo->surf_index[topo->edges[e][1]]]);
+    return b;
+  }
+  /// An end node of edge e moved this step.
+  bool edge_moving(std::uint32_t e) const noexcept {
+    return vmoved[topo->surf_index[topo->edges[e][0]]] |
+           vmoved[topo->surf_index[topo->edges[e][1]]];
+  }
 
   // --- collider_traverse.cpp
   /// Runs the query over all candidates into workers (merged into stats/results); stops early

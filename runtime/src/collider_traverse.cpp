@@ -230,7 +230,7 @@ bool edge_off_face_planes(Worker& w, const Collider::Impl& A, std::uint32_t e1,
                           const Collider::Impl& B, std::uint32_t e2) noexcept {
   const auto& et_offset = A.topo->et_offset;
   for (std::uint32_t k = et_offset[e1]; k < et_offset[e1 + 1]; ++k)
-    if (nodes_off_plane(w, A, A.topo->et_list[k], B, B.topo->edges[e2].data(), 2, B.ebox[e2]))
+    if (nodes_off_plane(w, A, A.topo->et_list[k], B, B.topo->edges[e2].data(), 2, B.edge_box(e2)))
       return true;
   return false;
 }
@@ -289,8 +289,8 @@ void process_vertex_face(Worker& w, const Collider::Impl& P, std::uint32_t p,
 // Swept boxes of two edges overlap and not all four nodes are still.
 inline bool edge_boxes_overlap(const Collider::Impl& A, std::uint32_t e1, const Collider::Impl& B,
                                std::uint32_t e2) noexcept {
-  if (!A.emov[e1] && !B.emov[e2]) return false;
-  return boxes_overlap(A.ebox[e1], B.ebox[e2], A.opt.ccd.min_separation);
+  if (!A.edge_moving(e1) && !B.edge_moving(e2)) return false;
+  return boxes_overlap(A.edge_box(e1), B.edge_box(e2), A.opt.ccd.min_separation);
 }
 
 void process_edge_edge(Worker& w, const Collider::Impl& A, std::uint32_t e1,
@@ -398,7 +398,7 @@ void test_features(Worker& w, const Collider::Impl& A, std::uint32_t t1, const C
   for (std::uint32_t i = 0; i < 3; ++i) {
     const std::uint32_t e1 = A.topo->tri_edges[t1][i];
     // tbox[t2] contains the boxes of t2's edges: one check rejects all three.
-    if (!boxes_overlap(A.ebox[e1], B.tbox[t2], ms)) continue;
+    if (!boxes_overlap(A.edge_box(e1), B.tbox[t2], ms)) continue;
     for (std::uint32_t j = 0; j < 3; ++j) {
       const std::uint32_t e2 = B.topo->tri_edges[t2][j];
       const auto& E1 = EA[e1];
