@@ -165,13 +165,13 @@ struct Worker {
   bool rest_hit = false;
   std::uint32_t rest_a = 0, rest_b = 0;
   QueryKind qkind = QueryKind::kFull;
-  // Lazy per-step cache of triangles' plane minors (plane filters): a collider's worker caches
-  // its collider `plane_owner`'s triangles (entry t); a scene's worker every body's (entry
+  // Lazy per-step cache of triangles' planes (FacePlaneStatic, plane filters): a collider's worker
+  // caches its collider `plane_owner`'s triangles (entry t); a scene's worker every body's (entry
   // plane_base[body_id] + t; plane_owner null). An entry is valid when its plane_step equals
   // the body's step_serial. Sized at construction (scene: add_body).
   const void* plane_owner = nullptr;
   std::vector<std::uint32_t> plane_base;
-  std::vector<FacePlaneMinors> plane;
+  std::vector<FacePlaneStatic> plane;
   std::vector<std::uint64_t> plane_step;
   /// Counts a contact: stops the traversal for kAny, else keeps the earliest and fills `out`.
   void record(const Contact& c) noexcept;

@@ -175,31 +175,29 @@ void Worker::record(const Contact& c) noexcept {
 
 namespace {
 
-// The plane minors of triangle t of `body` for this step (FacePlaneMinors::of its nodes).
-FacePlaneMinors minors_of(const Collider::Impl& body, std::uint32_t t) noexcept {
+// The plane of triangle t of `body` for this step (FacePlaneStatic::of its nodes).
+FacePlaneStatic plane_of(const Collider::Impl& body, std::uint32_t t) noexcept {
   const auto& f = body.tris[t];
-  return FacePlaneMinors::of(body.pos0(f[0]), body.pos0(f[1]), body.pos0(f[2]), body.pos1(f[0]),
+  return FacePlaneStatic::of(body.pos0(f[0]), body.pos0(f[1]), body.pos0(f[2]), body.pos1(f[0]),
                              body.pos1(f[1]), body.pos1(f[2]));
 }
 
-// Plane minors of triangle t of `body` for this step: from w's per-step cache when w caches
-// that body (its own collider's, or any body's for a scene worker; computed there at first
-// use), else into `local`. Same values either way (the same operations in the same order).
-inline const FacePlaneMinors& face_minors(Worker& w, const Collider::Impl& body, std::uint32_t t,
-                                          FacePlaneMinors& local) noexcept {
+// Plane of triangle t of `body` for this step: from w's per-step cache when w caches that
+// body (its own collider's, or any body's for a scene worker; computed there at first use),
+// else null (FaceSides computes it). Same values either way (the same operations in the same
+// order).
+inline const FacePlaneStatic* face_plane(Worker& w, const Collider::Impl& body,
+                                         std::uint32_t t) noexcept {
   std::size_t i = t;
   if (w.plane_owner != &body) {
-    if (body.body_id >= w.plane_base.size()) {
-      local = minors_of(body, t);
-      return local;
-    }
+    if (body.body_id >= w.plane_base.size()) return nullptr;
     i += w.plane_base[body.body_id];
   }
   if (w.plane_step[i] != body.step_serial) {
-    w.plane[i] = minors_of(body, t);
+    w.plane[i] = plane_of(body, t);
     w.plane_step[i] = body.step_serial;
   }
-  return w.plane[i];
+  return &w.plane[i];
 }
 
 // The `count` nodes of body O stay strictly on one side of the plane of triangle t of body T
@@ -207,16 +205,21 @@ inline const FacePlaneMinors& face_minors(Worker& w, const Collider::Impl& body,
 // nodes at both ends of the step (with t's swept box: the static error bound).
 bool nodes_off_plane(Worker& w, const Collider::Impl& T, std::uint32_t t, const Collider::Impl& O,
                      const std::uint32_t* nodes, int count, const Box& box) noexcept {
+  // A node of the triangle itself has a zero cubic, never a proven side: the answer is false
+  // (as the cubics would give it, found without them).
+  const auto& tn = T.tris[t];
+  if (&T == &O)
+    for (int i = 0; i < count; ++i)
+      if (nodes[i] == tn[0] || nodes[i] == tn[1] || nodes[i] == tn[2]) return false;
   Box u = T.tbox[t];
   box_union(u, box);
   const double extent[3] = {u.hi[0] - u.lo[0], u.hi[1] - u.lo[1], u.hi[2] - u.lo[2]};
   const orientation_detail::StaticErr err = orientation_detail::StaticErr::of(extent);
-  FacePlaneMinors local;
-  const FacePlaneMinors& plane = face_minors(w, T, t, local);
-  const std::uint32_t a = T.tris[t][0];
+  const MovingTriangle face{tn, T.x0, T.x1, face_plane(w, T, t)};
+  FaceSides sides(face, &err);
   Orientation side = Orientation::kUncertain;
   for (int i = 0; i < count; ++i) {
-    const Orientation o = plane.side(T.pos0(a), T.pos1(a), O.pos0(nodes[i]), O.pos1(nodes[i]), err);
+    const Orientation o = sides.of(O.pos0(nodes[i]), O.pos1(nodes[i]));
     if (o == Orientation::kUncertain || (i > 0 && o != side)) return false;
     side = o;
   }
@@ -333,8 +336,8 @@ void process_edge_edge(Worker& w, const Collider::Impl& A, std::uint32_t e1,
 
 // Triangle-pair plane filter of triangle t1 of A and t2 of B (plane_filter.hpp; exact
 // contact only; docs/runtime.md, "Triangle-pair plane filter").
-// Each triangle's plane minors come from w's per-step cache when w caches its body
-// (face_minors), else are computed per pair. Same answer either way.
+// Each triangle's plane comes from w's per-step cache when w caches its body (face_plane),
+// else is computed per pair. Same answer either way.
 bool plane_separated(Worker& w, const Collider::Impl& A, std::uint32_t t1, const Collider::Impl& B,
                      std::uint32_t t2) noexcept {
   const bool same = &A == &B;
@@ -344,11 +347,10 @@ bool plane_separated(Worker& w, const Collider::Impl& A, std::uint32_t t1, const
   box_union(u, B.tbox[t2]);
   const double extent[3] = {u.hi[0] - u.lo[0], u.hi[1] - u.lo[1], u.hi[2] - u.lo[2]};
   const orientation_detail::StaticErr err = orientation_detail::StaticErr::of(extent);
-  FacePlaneMinors local1, local2;
-  MovingTriangle m1{A.tris[t1], A.x0, A.x1, &face_minors(w, A, t1, local1)};
-  MovingTriangle m2{B.tris[t2], B.x0, B.x1};
-  if (nodes_strictly_on_one_side(m1, m2, same, &err)) return true;  // plane_separated
-  m2.minors = &face_minors(w, B, t2, local2);
+  const MovingTriangle m1{A.tris[t1], A.x0, A.x1, face_plane(w, A, t1)};
+  if (nodes_strictly_on_one_side(m1, MovingTriangle{B.tris[t2], B.x0, B.x1}, same, &err))
+    return true;  // plane_separated
+  const MovingTriangle m2{B.tris[t2], B.x0, B.x1, face_plane(w, B, t2)};
   return nodes_strictly_on_one_side(m2, m1, same, &err);
 }
 
