@@ -200,6 +200,26 @@ inline const FacePlaneStatic* face_plane(Worker& w, const Collider::Impl& body,
   return &w.plane[i];
 }
 
+// StaticErr::of the extents of the union of boxes a and b (box_union's values: the smaller
+// lower bound, the larger upper bound, per axis).
+inline orientation_detail::StaticErr union_static_err(const Box& a, const Box& b) noexcept {
+#if defined(__SSE2__)
+  // min(b, a) and max(b, a) lane by lane pick as box_union's comparisons do.
+  const __m128d lo = _mm_min_pd(_mm_loadu_pd(b.lo), _mm_loadu_pd(a.lo));
+  const __m128d hi = _mm_max_pd(_mm_loadu_pd(b.hi), _mm_loadu_pd(a.hi));
+  double xy[2];
+  _mm_storeu_pd(xy, _mm_sub_pd(hi, lo));
+  const double z_lo = b.lo[2] < a.lo[2] ? b.lo[2] : a.lo[2];
+  const double z_hi = b.hi[2] > a.hi[2] ? b.hi[2] : a.hi[2];
+  const double extent[3] = {xy[0], xy[1], z_hi - z_lo};
+#else
+  Box u = a;
+  box_union(u, b);
+  const double extent[3] = {u.hi[0] - u.lo[0], u.hi[1] - u.lo[1], u.hi[2] - u.lo[2]};
+#endif
+  return orientation_detail::StaticErr::of(extent);
+}
+
 // The `count` nodes of body O stay strictly on one side of the plane of triangle t of body T
 // for the whole step, each side proven by the error-bounded orientation cubic. `box` holds the
 // nodes at both ends of the step (with t's swept box: the static error bound).
@@ -211,10 +231,7 @@ bool nodes_off_plane(Worker& w, const Collider::Impl& T, std::uint32_t t, const 
   if (&T == &O)
     for (int i = 0; i < count; ++i)
       if (nodes[i] == tn[0] || nodes[i] == tn[1] || nodes[i] == tn[2]) return false;
-  Box u = T.tbox[t];
-  box_union(u, box);
-  const double extent[3] = {u.hi[0] - u.lo[0], u.hi[1] - u.lo[1], u.hi[2] - u.lo[2]};
-  const orientation_detail::StaticErr err = orientation_detail::StaticErr::of(extent);
+  const orientation_detail::StaticErr err = union_static_err(T.tbox[t], box);
   const MovingTriangle face{tn, T.x0, T.x1, face_plane(w, T, t)};
   FaceSides sides(face, &err);
   Orientation side = Orientation::kUncertain;
@@ -343,15 +360,15 @@ bool plane_separated(Worker& w, const Collider::Impl& A, std::uint32_t t1, const
   const bool same = &A == &B;
   // Both triangles lie in the union of their swept boxes: its extents bound every coordinate
   // difference of the cubics (the static error bound).
-  Box u = A.tbox[t1];
-  box_union(u, B.tbox[t2]);
-  const double extent[3] = {u.hi[0] - u.lo[0], u.hi[1] - u.lo[1], u.hi[2] - u.lo[2]};
-  const orientation_detail::StaticErr err = orientation_detail::StaticErr::of(extent);
-  const MovingTriangle m1{A.tris[t1], A.x0, A.x1, face_plane(w, A, t1)};
-  if (nodes_strictly_on_one_side(m1, MovingTriangle{B.tris[t2], B.x0, B.x1}, same, &err))
+  const orientation_detail::StaticErr err = union_static_err(A.tbox[t1], B.tbox[t2]);
+  const auto& n1 = A.tris[t1];
+  const auto& n2 = B.tris[t2];
+  const MovingTriangle m1{n1, A.x0, A.x1, face_plane(w, A, t1)};
+  if (nodes_strictly_on_one_side(m1, MovingTriangle{n2, B.x0, B.x1},
+                                 same ? shared_node_mask(n2, n1) : 0, &err))
     return true;  // plane_separated
-  const MovingTriangle m2{B.tris[t2], B.x0, B.x1, face_plane(w, B, t2)};
-  return nodes_strictly_on_one_side(m2, m1, same, &err);
+  const MovingTriangle m2{n2, B.x0, B.x1, face_plane(w, B, t2)};
+  return nodes_strictly_on_one_side(m2, m1, same ? shared_node_mask(n1, n2) : 0, &err);
 }
 
 // Tests the feature pairs of triangle t1 of A and t2 of B (t1 != t2 within one body):

@@ -38,16 +38,24 @@ class FaceSides {
     }
   }
   Orientation of(const double* p0, const double* p1) noexcept {
-    bool decided = false;
     if (err_) {
+      bool decided;
       const Orientation o = plane_->static_side(p0, p1, *err_, decided);
       if (decided) return o;
     }
-    if (!have_full_) set_full();
-    return full_.side(f_.p0(f_.nodes[0]), f_.p1(f_.nodes[0]), p0, p1);
+    return full_side(p0, p1);
   }
 
  private:
+  // The full cubic (kept out of line: the static bound usually decides).
+#if defined(__GNUC__)
+  __attribute__((noinline))
+#endif
+  Orientation
+  full_side(const double* p0, const double* p1) noexcept {
+    if (!have_full_) set_full();
+    return full_.side(f_.p0(f_.nodes[0]), f_.p1(f_.nodes[0]), p0, p1);
+  }
   void set_full() noexcept {
     const auto& n = f_.nodes;
     full_ = FacePlaneMinors::of(f_.p0(n[0]), f_.p0(n[1]), f_.p0(n[2]), f_.p1(n[0]), f_.p1(n[1]),
@@ -62,19 +70,28 @@ class FaceSides {
   bool have_full_ = false;
 };
 
-/// True when the nodes of `q` that are not nodes of `f` (node ids compared only when
-/// `shared_nodes`, i.e. both triangles of one body) stay strictly on one side of f's plane for
-/// the whole step, each side proven by the error-bounded orientation cubic (FaceSides).
-/// `static_err` (optional): StaticErr::of the extents of a box holding both triangles at both
-/// ends of the step; the answer is the same, found with less work.
+/// Bit i set when node i of `q` is a node of `f` (node ids of one body).
+inline unsigned shared_node_mask(const std::array<std::uint32_t, 3>& q,
+                                 const std::array<std::uint32_t, 3>& f) noexcept {
+  unsigned mask = 0;
+  for (unsigned i = 0; i < 3; ++i)
+    mask |= unsigned((q[i] == f[0]) | (q[i] == f[1]) | (q[i] == f[2])) << i;
+  return mask;
+}
+
+/// True when the nodes of `q` outside `skip` (bit i: node i; the nodes q shares with f, see
+/// shared_node_mask) stay strictly on one side of f's plane for the whole step, each side
+/// proven by the error-bounded orientation cubic (FaceSides). `static_err` (optional):
+/// StaticErr::of the extents of a box holding both triangles at both ends of the step; the
+/// answer is the same, found with less work.
 inline bool nodes_strictly_on_one_side(
-    const MovingTriangle& f, const MovingTriangle& q, bool shared_nodes,
+    const MovingTriangle& f, const MovingTriangle& q, unsigned skip,
     const orientation_detail::StaticErr* static_err = nullptr) noexcept {
-  const auto& fn = f.nodes;
   FaceSides sides(f, static_err);
   Orientation side = Orientation::kUncertain;
-  for (std::uint32_t n : q.nodes) {
-    if (shared_nodes && (n == fn[0] || n == fn[1] || n == fn[2])) continue;
+  for (unsigned i = 0; i < 3; ++i) {
+    if (skip & (1u << i)) continue;
+    const std::uint32_t n = q.nodes[i];
     const Orientation o = sides.of(q.p0(n), q.p1(n));
     if (o == Orientation::kUncertain || (side != Orientation::kUncertain && o != side))
       return false;
@@ -90,8 +107,10 @@ inline bool nodes_strictly_on_one_side(
 /// `static_err` (optional): as for nodes_strictly_on_one_side; the same answer.
 inline bool plane_separated(const MovingTriangle& t1, const MovingTriangle& t2, bool shared_nodes,
                             const orientation_detail::StaticErr* static_err = nullptr) noexcept {
-  return nodes_strictly_on_one_side(t1, t2, shared_nodes, static_err) ||
-         nodes_strictly_on_one_side(t2, t1, shared_nodes, static_err);
+  const unsigned skip2 = shared_nodes ? shared_node_mask(t2.nodes, t1.nodes) : 0;
+  const unsigned skip1 = shared_nodes ? shared_node_mask(t1.nodes, t2.nodes) : 0;
+  return nodes_strictly_on_one_side(t1, t2, skip2, static_err) ||
+         nodes_strictly_on_one_side(t2, t1, skip1, static_err);
 }
 
 }  // namespace tetseg
