@@ -280,9 +280,11 @@ void process_vertex_face(Worker& w, const Collider::Impl& P, std::uint32_t p,
   if (!boxes_overlap(P.vbox[ip], F.tbox[face], ms)) return;
   ++w.stats.feature_pairs;
   if (ms <= 0) {
-    // Coplanarity cubic det[b-a, c-a, p-a] with a proven strict sign: never coplanar.
+    // Coplanarity cubic det[b-a, c-a, p-a] with a proven strict sign: never coplanar. Its
+    // points lie in the union of the vertex's and the face's swept boxes (static bound).
     const Orientation o = orientation_of(F.pos0(f[0]), F.pos0(f[1]), F.pos0(f[2]), P.pos0(p),
-                                         F.pos1(f[0]), F.pos1(f[1]), F.pos1(f[2]), P.pos1(p));
+                                         F.pos1(f[0]), F.pos1(f[1]), F.pos1(f[2]), P.pos1(p),
+                                         union_static_err(P.vbox[ip], F.tbox[face]));
     if (o != Orientation::kUncertain || face_off_vertex_planes(w, P, p, F, face)) {
       ++w.stats.feature_pairs_filtered;
       return;
@@ -323,9 +325,11 @@ void process_edge_edge(Worker& w, const Collider::Impl& A, std::uint32_t e1,
   if (!edge_boxes_overlap(A, e1, B, e2)) return;  // also: all four nodes still
   ++w.stats.feature_pairs;
   if (ms <= 0) {
-    // det[b-a, d-c, c-a] = det[b-a, d-a, c-a]: orientation of (a; b, d, c).
-    const Orientation o = orientation_of(A.pos0(a), A.pos0(b), B.pos0(d), B.pos0(c), A.pos1(a),
-                                         A.pos1(b), B.pos1(d), B.pos1(c));
+    // det[b-a, d-c, c-a] = det[b-a, d-a, c-a]: orientation of (a; b, d, c), its points in the
+    // union of the two edges' swept boxes (static bound).
+    const Orientation o =
+        orientation_of(A.pos0(a), A.pos0(b), B.pos0(d), B.pos0(c), A.pos1(a), A.pos1(b), B.pos1(d),
+                       B.pos1(c), union_static_err(A.edge_box(e1), B.edge_box(e2)));
     if (o != Orientation::kUncertain || edge_off_face_planes(w, A, e1, B, e2) ||
         edge_off_face_planes(w, B, e2, A, e1)) {
       ++w.stats.feature_pairs_filtered;

@@ -3,6 +3,9 @@
 
 #include <array>
 #include <cstdint>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 #include "orientation_terms.hpp"
 
@@ -73,10 +76,19 @@ class FaceSides {
 /// Bit i set when node i of `q` is a node of `f` (node ids of one body).
 inline unsigned shared_node_mask(const std::array<std::uint32_t, 3>& q,
                                  const std::array<std::uint32_t, 3>& f) noexcept {
+#if defined(__SSE2__)
+  // q's ids in lanes 0-2 (lane 3 repeats q[2] and is masked off) against each id of f.
+  const __m128i qv = _mm_setr_epi32(int(q[0]), int(q[1]), int(q[2]), int(q[2]));
+  const __m128i eq = _mm_or_si128(_mm_or_si128(_mm_cmpeq_epi32(qv, _mm_set1_epi32(int(f[0]))),
+                                               _mm_cmpeq_epi32(qv, _mm_set1_epi32(int(f[1])))),
+                                  _mm_cmpeq_epi32(qv, _mm_set1_epi32(int(f[2]))));
+  return unsigned(_mm_movemask_ps(_mm_castsi128_ps(eq))) & 7u;
+#else
   unsigned mask = 0;
   for (unsigned i = 0; i < 3; ++i)
     mask |= unsigned((q[i] == f[0]) | (q[i] == f[1]) | (q[i] == f[2])) << i;
   return mask;
+#endif
 }
 
 /// True when the nodes of `q` outside `skip` (bit i: node i; the nodes q shares with f, see

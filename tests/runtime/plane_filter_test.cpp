@@ -202,3 +202,21 @@ TEST_CASE("Plane-separated triangle pairs have no feature pair in contact (brute
   CHECK(touching > 500);
   CHECK(touching_shared > 200);
 }
+
+TEST_CASE("shared_node_mask marks exactly the nodes of one triangle found in the other",
+          "[plane-filter]") {
+  std::mt19937_64 rng(5);
+  std::uniform_int_distribution<std::uint32_t> id(0, 6);
+  for (int trial = 0; trial < 5000; ++trial) {
+    std::array<std::uint32_t, 3> q, f;
+    for (auto& n : q) n = id(rng);
+    for (auto& n : f) n = id(rng);
+    if (trial % 3 == 0) q[trial % 2] = 0xffffffffu;  // large ids
+    if (trial % 5 == 0) f[2] = 0xffffffffu;
+    unsigned want = 0;
+    for (unsigned i = 0; i < 3; ++i)
+      if (has_node(f, q[i])) want |= 1u << i;
+    CAPTURE(q[0], q[1], q[2], f[0], f[1], f[2]);
+    REQUIRE(shared_node_mask(q, f) == want);
+  }
+}
