@@ -111,8 +111,6 @@ void Collider::Impl::construct(std::shared_ptr<const BodyShape> sh, const Collid
   vmoved.assign(nv, 0);
   vbox.resize(nv);
   tbox.resize(tri_count);
-  ebox = {vbox.data(), topo->edge_verts.data()};
-  emov = {vmoved.data(), topo->edge_verts.data()};
   tcls.assign(tri_count, static_cast<std::uint8_t>(Orientation::kUncertain));
   det0.assign(3 * std::size_t(cluster_count()), 0.0);
   det1.assign(3 * std::size_t(cluster_count()), 0.0);

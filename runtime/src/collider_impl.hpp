@@ -70,27 +70,6 @@ inline void box_union(Box& a, const Box& b) noexcept {
 #endif
 }
 
-/// The swept box of edge e, computed where it is read from its end vertices' swept boxes (the
-/// union a per-step pass over all edges would store): few edges are read in a step.
-struct EdgeBoxes {
-  const Box* vbox = nullptr;                           // per surface vertex, this step
-  const std::array<std::uint32_t, 2>* ends = nullptr;  // surface vertex ids of each edge
-  Box operator[](std::size_t e) const noexcept {
-    Box b = vbox[ends[e][0]];
-    box_union(b, vbox[ends[e][1]]);
-    return b;
-  }
-};
-
-/// 1 when an end node of edge e moves in this step, else 0 (read through the vertices' flags).
-struct EdgeMoving {
-  const std::uint8_t* vmoved = nullptr;
-  const std::array<std::uint32_t, 2>* ends = nullptr;
-  std::uint8_t operator[](std::size_t e) const noexcept {
-    return vmoved[ends[e][0]] | vmoved[ends[e][1]];
-  }
-};
-
 /// A BVH seen by the traversal: node topology plus per-step node data.
 struct TreeView {
   const format::BvhNode* nodes = nullptr;
@@ -219,13 +198,13 @@ struct Worker {
   bool rest_hit = false;
   std::uint32_t rest_a = 0, rest_b = 0;
   QueryKind qkind = QueryKind::kFull;
-  // Lazy per-step cache of triangles' plane minors (plane filters): a collider's worker caches
-  // its collider `plane_owner`'s triangles (entry t); a scene's worker every body's (entry
+  // Lazy per-step cache of triangles' planes (FacePlaneStatic, plane filters): a collider's worker
+  // caches its collider `plane_owner`'s triangles (entry t); a scene's worker every body's (entry
   // plane_base[body_id] + t; plane_owner null). An entry is valid when its plane_step equals
   // the body's step_serial. Sized at construction (scene: add_body).
   const void* plane_owner = nullptr;
   std::vector<std::uint32_t> plane_base;
-  std::vector<FacePlaneMinors> plane;
+  std::vector<FacePlaneStatic> plane;
   std::vector<std::uint64_t> plane_step;
   /// Counts a contact: stops the traversal for kAny, else keeps the earliest and fills `out`.
   void record(const Contact& c) noexcept;
@@ -354,8 +333,6 @@ struct Collider::Impl {
   std::vector<std::uint8_t> vmoved;  // per surface vertex
   std::vector<Box> vbox;             // per surface vertex, swept
   std::vector<Box> tbox;
-  EdgeBoxes ebox;                  // per edge, swept (read through vbox)
-  EdgeMoving emov;                 // per edge: an end node moved (read through vmoved)
   std::vector<std::uint8_t> tcls;  // Orientation
   // Per cluster, this step: the detector point at the start and end (3 doubles each), and
   // whether the cluster is classified at all (0: overlap-only, or a non-finite detector).
@@ -414,6 +391,19 @@ struct Collider::Impl {
   ColliderStatus query_status() const noexcept;
   const double* pos0(std::uint32_t node) const noexcept { return x0 + std::size_t(node) * 3; }
   const double* pos1(std::uint32_t node) const noexcept { return x1 + std::size_t(node) * 3; }
+  /// Swept box of edge e this step: the union of its end nodes' boxes (computed when asked:
+  /// only edges of the few triangle pairs past the plane filter are ever read).
+  Box edge_box(std::uint32_t e) const noexcept {
+    const std::array<std::uint32_t, 2>& ends = topo->edge_verts[e];
+    Box b = vbox[ends[0]];
+    box_union(b, vbox[ends[1]]);
+    return b;
+  }
+  /// An end node of edge e moved this step.
+  bool edge_moving(std::uint32_t e) const noexcept {
+    const std::array<std::uint32_t, 2>& ends = topo->edge_verts[e];
+    return vmoved[ends[0]] | vmoved[ends[1]];
+  }
 
   // --- collider_traverse.cpp
   /// Runs the query over all candidates into workers (merged into stats/results); stops early

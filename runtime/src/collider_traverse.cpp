@@ -173,31 +173,49 @@ void Worker::record(const Contact& c) noexcept {
 
 namespace {
 
-// The plane minors of triangle t of `body` for this step (FacePlaneMinors::of its nodes).
-FacePlaneMinors minors_of(const Collider::Impl& body, std::uint32_t t) noexcept {
+// The plane of triangle t of `body` for this step (FacePlaneStatic::of its nodes).
+FacePlaneStatic plane_of(const Collider::Impl& body, std::uint32_t t) noexcept {
   const auto& f = body.tris[t];
-  return FacePlaneMinors::of(body.pos0(f[0]), body.pos0(f[1]), body.pos0(f[2]), body.pos1(f[0]),
+  return FacePlaneStatic::of(body.pos0(f[0]), body.pos0(f[1]), body.pos0(f[2]), body.pos1(f[0]),
                              body.pos1(f[1]), body.pos1(f[2]));
 }
 
-// Plane minors of triangle t of `body` for this step: from w's per-step cache when w caches
-// that body (its own collider's, or any body's for a scene worker; computed there at first
-// use), else into `local`. Same values either way (the same operations in the same order).
-inline const FacePlaneMinors& face_minors(Worker& w, const Collider::Impl& body, std::uint32_t t,
-                                          FacePlaneMinors& local) noexcept {
+// Plane of triangle t of `body` for this step: from w's per-step cache when w caches that
+// body (its own collider's, or any body's for a scene worker; computed there at first use),
+// else null (FaceSides computes it). Same values either way (the same operations in the same
+// order).
+inline const FacePlaneStatic* face_plane(Worker& w, const Collider::Impl& body,
+                                         std::uint32_t t) noexcept {
   std::size_t i = t;
   if (w.plane_owner != &body) {
-    if (body.body_id >= w.plane_base.size()) {
-      local = minors_of(body, t);
-      return local;
-    }
+    if (body.body_id >= w.plane_base.size()) return nullptr;
     i += w.plane_base[body.body_id];
   }
   if (w.plane_step[i] != body.step_serial) {
-    w.plane[i] = minors_of(body, t);
+    w.plane[i] = plane_of(body, t);
     w.plane_step[i] = body.step_serial;
   }
-  return w.plane[i];
+  return &w.plane[i];
+}
+
+// StaticErr::of the extents of the union of boxes a and b (box_union's values: the smaller
+// lower bound, the larger upper bound, per axis).
+inline orientation_detail::StaticErr union_static_err(const Box& a, const Box& b) noexcept {
+#if defined(__SSE2__)
+  // min(b, a) and max(b, a) lane by lane pick as box_union's comparisons do.
+  const __m128d lo = _mm_min_pd(_mm_loadu_pd(b.lo), _mm_loadu_pd(a.lo));
+  const __m128d hi = _mm_max_pd(_mm_loadu_pd(b.hi), _mm_loadu_pd(a.hi));
+  double xy[2];
+  _mm_storeu_pd(xy, _mm_sub_pd(hi, lo));
+  const double z_lo = b.lo[2] < a.lo[2] ? b.lo[2] : a.lo[2];
+  const double z_hi = b.hi[2] > a.hi[2] ? b.hi[2] : a.hi[2];
+  const double extent[3] = {xy[0], xy[1], z_hi - z_lo};
+#else
+  Box u = a;
+  box_union(u, b);
+  const double extent[3] = {u.hi[0] - u.lo[0], u.hi[1] - u.lo[1], u.hi[2] - u.lo[2]};
+#endif
+  return orientation_detail::StaticErr::of(extent);
 }
 
 // The `count` nodes of body O stay strictly on one side of the plane of triangle t of body T
@@ -205,16 +223,18 @@ inline const FacePlaneMinors& face_minors(Worker& w, const Collider::Impl& body,
 // nodes at both ends of the step (with t's swept box: the static error bound).
 bool nodes_off_plane(Worker& w, const Collider::Impl& T, std::uint32_t t, const Collider::Impl& O,
                      const std::uint32_t* nodes, int count, const Box& box) noexcept {
-  Box u = T.tbox[t];
-  box_union(u, box);
-  const double extent[3] = {u.hi[0] - u.lo[0], u.hi[1] - u.lo[1], u.hi[2] - u.lo[2]};
-  const orientation_detail::StaticErr err = orientation_detail::StaticErr::of(extent);
-  FacePlaneMinors local;
-  const FacePlaneMinors& plane = face_minors(w, T, t, local);
-  const std::uint32_t a = T.tris[t][0];
+  // A node of the triangle itself has a zero cubic, never a proven side: the answer is false
+  // (as the cubics would give it, found without them).
+  const auto& tn = T.tris[t];
+  if (&T == &O)
+    for (int i = 0; i < count; ++i)
+      if (nodes[i] == tn[0] || nodes[i] == tn[1] || nodes[i] == tn[2]) return false;
+  const orientation_detail::StaticErr err = union_static_err(T.tbox[t], box);
+  const MovingTriangle face{tn, T.x0, T.x1, face_plane(w, T, t)};
+  FaceSides sides(face, &err);
   Orientation side = Orientation::kUncertain;
   for (int i = 0; i < count; ++i) {
-    const Orientation o = plane.side(T.pos0(a), T.pos1(a), O.pos0(nodes[i]), O.pos1(nodes[i]), err);
+    const Orientation o = sides.of(O.pos0(nodes[i]), O.pos1(nodes[i]));
     if (o == Orientation::kUncertain || (i > 0 && o != side)) return false;
     side = o;
   }
@@ -228,7 +248,7 @@ bool edge_off_face_planes(Worker& w, const Collider::Impl& A, std::uint32_t e1,
                           const Collider::Impl& B, std::uint32_t e2) noexcept {
   const auto& et_offset = A.topo->et_offset;
   for (std::uint32_t k = et_offset[e1]; k < et_offset[e1 + 1]; ++k)
-    if (nodes_off_plane(w, A, A.topo->et_list[k], B, B.topo->edges[e2].data(), 2, B.ebox[e2]))
+    if (nodes_off_plane(w, A, A.topo->et_list[k], B, B.topo->edges[e2].data(), 2, B.edge_box(e2)))
       return true;
   return false;
 }
@@ -258,9 +278,11 @@ void process_vertex_face(Worker& w, const Collider::Impl& P, std::uint32_t p,
   if (!boxes_overlap(P.vbox[ip], F.tbox[face], ms)) return;
   ++w.stats.feature_pairs;
   if (ms <= 0) {
-    // Coplanarity cubic det[b-a, c-a, p-a] with a proven strict sign: never coplanar.
+    // Coplanarity cubic det[b-a, c-a, p-a] with a proven strict sign: never coplanar. Its
+    // points lie in the union of the vertex's and the face's swept boxes (static bound).
     const Orientation o = orientation_of(F.pos0(f[0]), F.pos0(f[1]), F.pos0(f[2]), P.pos0(p),
-                                         F.pos1(f[0]), F.pos1(f[1]), F.pos1(f[2]), P.pos1(p));
+                                         F.pos1(f[0]), F.pos1(f[1]), F.pos1(f[2]), P.pos1(p),
+                                         union_static_err(P.vbox[ip], F.tbox[face]));
     if (o != Orientation::kUncertain || face_off_vertex_planes(w, P, p, F, face)) {
       ++w.stats.feature_pairs_filtered;
       return;
@@ -287,8 +309,8 @@ void process_vertex_face(Worker& w, const Collider::Impl& P, std::uint32_t p,
 // Swept boxes of two edges overlap and not all four nodes are still.
 inline bool edge_boxes_overlap(const Collider::Impl& A, std::uint32_t e1, const Collider::Impl& B,
                                std::uint32_t e2) noexcept {
-  if (!A.emov[e1] && !B.emov[e2]) return false;
-  return boxes_overlap(A.ebox[e1], B.ebox[e2], A.opt.ccd.min_separation);
+  if (!A.edge_moving(e1) && !B.edge_moving(e2)) return false;
+  return boxes_overlap(A.edge_box(e1), B.edge_box(e2), A.opt.ccd.min_separation);
 }
 
 void process_edge_edge(Worker& w, const Collider::Impl& A, std::uint32_t e1,
@@ -301,9 +323,11 @@ void process_edge_edge(Worker& w, const Collider::Impl& A, std::uint32_t e1,
   if (!edge_boxes_overlap(A, e1, B, e2)) return;  // also: all four nodes still
   ++w.stats.feature_pairs;
   if (ms <= 0) {
-    // det[b-a, d-c, c-a] = det[b-a, d-a, c-a]: orientation of (a; b, d, c).
-    const Orientation o = orientation_of(A.pos0(a), A.pos0(b), B.pos0(d), B.pos0(c), A.pos1(a),
-                                         A.pos1(b), B.pos1(d), B.pos1(c));
+    // det[b-a, d-c, c-a] = det[b-a, d-a, c-a]: orientation of (a; b, d, c), its points in the
+    // union of the two edges' swept boxes (static bound).
+    const Orientation o =
+        orientation_of(A.pos0(a), A.pos0(b), B.pos0(d), B.pos0(c), A.pos1(a), A.pos1(b), B.pos1(d),
+                       B.pos1(c), union_static_err(A.edge_box(e1), B.edge_box(e2)));
     if (o != Orientation::kUncertain || edge_off_face_planes(w, A, e1, B, e2) ||
         edge_off_face_planes(w, B, e2, A, e1)) {
       ++w.stats.feature_pairs_filtered;
@@ -331,23 +355,22 @@ void process_edge_edge(Worker& w, const Collider::Impl& A, std::uint32_t e1,
 
 // Triangle-pair plane filter of triangle t1 of A and t2 of B (plane_filter.hpp; exact
 // contact only; docs/runtime.md, "Triangle-pair plane filter").
-// Each triangle's plane minors come from w's per-step cache when w caches its body
-// (face_minors), else are computed per pair. Same answer either way.
+// Each triangle's plane comes from w's per-step cache when w caches its body (face_plane),
+// else is computed per pair. Same answer either way.
 bool plane_separated(Worker& w, const Collider::Impl& A, std::uint32_t t1, const Collider::Impl& B,
                      std::uint32_t t2) noexcept {
   const bool same = &A == &B;
   // Both triangles lie in the union of their swept boxes: its extents bound every coordinate
   // difference of the cubics (the static error bound).
-  Box u = A.tbox[t1];
-  box_union(u, B.tbox[t2]);
-  const double extent[3] = {u.hi[0] - u.lo[0], u.hi[1] - u.lo[1], u.hi[2] - u.lo[2]};
-  const orientation_detail::StaticErr err = orientation_detail::StaticErr::of(extent);
-  FacePlaneMinors local1, local2;
-  MovingTriangle m1{A.tris[t1], A.x0, A.x1, &face_minors(w, A, t1, local1)};
-  MovingTriangle m2{B.tris[t2], B.x0, B.x1};
-  if (nodes_strictly_on_one_side(m1, m2, same, &err)) return true;  // plane_separated
-  m2.minors = &face_minors(w, B, t2, local2);
-  return nodes_strictly_on_one_side(m2, m1, same, &err);
+  const orientation_detail::StaticErr err = union_static_err(A.tbox[t1], B.tbox[t2]);
+  const auto& n1 = A.tris[t1];
+  const auto& n2 = B.tris[t2];
+  const MovingTriangle m1{n1, A.x0, A.x1, face_plane(w, A, t1)};
+  if (nodes_strictly_on_one_side(m1, MovingTriangle{n2, B.x0, B.x1},
+                                 same ? shared_node_mask(n2, n1) : 0, &err))
+    return true;  // plane_separated
+  const MovingTriangle m2{n2, B.x0, B.x1, face_plane(w, B, t2)};
+  return nodes_strictly_on_one_side(m2, m1, same ? shared_node_mask(n1, n2) : 0, &err);
 }
 
 // Tests the feature pairs of triangle t1 of A and t2 of B (t1 != t2 within one body):
@@ -396,7 +419,7 @@ void test_features(Worker& w, const Collider::Impl& A, std::uint32_t t1, const C
   for (std::uint32_t i = 0; i < 3; ++i) {
     const std::uint32_t e1 = A.topo->tri_edges[t1][i];
     // tbox[t2] contains the boxes of t2's edges: one check rejects all three.
-    if (!boxes_overlap(A.ebox[e1], B.tbox[t2], ms)) continue;
+    if (!boxes_overlap(A.edge_box(e1), B.tbox[t2], ms)) continue;
     for (std::uint32_t j = 0; j < 3; ++j) {
       const std::uint32_t e2 = B.topo->tri_edges[t2][j];
       const auto& E1 = EA[e1];

@@ -9,6 +9,9 @@
 // bitwise the one orientation_bernstein computes for the same points.
 
 #include <cmath>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 #include "tetseg/runtime/classify.hpp"
 
@@ -142,16 +145,28 @@ inline void orientation_k(const Vec3T<T> p0[4], const Vec3T<T> p1[4], T k[4]) no
 /// opposite signs (then they clear the smaller computed bounds too). kUncertain with
 /// `decided = false` otherwise: the caller computes the full cubic.
 inline Orientation static_sign(const double k[4], const StaticErr& e, bool& decided) noexcept {
+  // Bit i of `above` (`below`): k[i] > err[i] (k[i] < -err[i]); NaN sets neither.
+#if defined(__SSE2__)
+  // The same eight comparisons, two per packed instruction.
+  const __m128d err01 = _mm_set_pd(e.err1, e.err0), err23 = _mm_set_pd(e.err0, e.err1);
+  const __m128d k01 = _mm_loadu_pd(k), k23 = _mm_loadu_pd(k + 2);
+  const __m128d zero = _mm_setzero_pd();
+  const int above =
+      _mm_movemask_pd(_mm_cmpgt_pd(k01, err01)) | (_mm_movemask_pd(_mm_cmpgt_pd(k23, err23)) << 2);
+  const int below = _mm_movemask_pd(_mm_cmplt_pd(k01, _mm_sub_pd(zero, err01))) |
+                    (_mm_movemask_pd(_mm_cmplt_pd(k23, _mm_sub_pd(zero, err23))) << 2);
+#else
   const double err[4] = {e.err0, e.err1, e.err1, e.err0};
-  int pos = 0, neg = 0;
+  int above = 0, below = 0;
   for (int i = 0; i < 4; ++i) {
-    pos += k[i] > err[i];
-    neg += k[i] < -err[i];
+    above |= int(k[i] > err[i]) << i;
+    below |= int(k[i] < -err[i]) << i;
   }
-  decided = pos == 4 || neg == 4 || (pos > 0 && neg > 0);
-  return pos == 4   ? Orientation::kPositive
-         : neg == 4 ? Orientation::kNegative
-                    : Orientation::kUncertain;
+#endif
+  decided = above == 15 || below == 15 || (above != 0 && below != 0);
+  return above == 15   ? Orientation::kPositive
+         : below == 15 ? Orientation::kNegative
+                       : Orientation::kUncertain;
 }
 
 /// The sign of a cubic proven by its four Bernstein coefficients (sign_of in classify.cpp).
@@ -221,17 +236,83 @@ struct FacePlaneMinors {
     using namespace orientation_detail;
     return sign(bernstein(sub(p0, a0), sub(p1, a1), m00, m10, m01, m11));
   }
-  /// Bitwise `side(a0, a1, p0, p1)` when the triangle's and the point's positions at both ends
-  /// lie in a box whose extents give `e` (StaticErr::of); cheaper when the static bound decides.
-  Orientation side(const double* a0, const double* a1, const double* p0, const double* p1,
-                   const orientation_detail::StaticErr& e) const noexcept {
+};
+
+/// The plane of a moving triangle (a, b, c) prepared for the static-bound side of many points:
+/// its node a at both ends and the m terms of its minors (FacePlaneMinors without the sums of
+/// absolute products), laid out for `static_side`. A collider's workers cache one per triangle
+/// and step (the plane filters).
+struct FacePlaneStatic {
+#if defined(TETSEG_HAVE_LANES2)
+  // Two lanes, each lane bitwise the scalar operations of FacePlaneMinors::of: lane 0 / 1 of
+  // `a` hold a0 / a1; of `ma` m00 / m11, of `mb` m10 / m01, of `mc` m01 / m10.
+  orientation_detail::Vec3T<orientation_detail::Lanes2> a;
+  orientation_detail::MinorTerms<orientation_detail::Lanes2> ma, mb, mc;
+#else
+  double a0[3], a1[3];
+  orientation_detail::Minors m00, m10, m01, m11;
+#endif
+  static FacePlaneStatic of(const double* a0, const double* b0, const double* c0, const double* a1,
+                            const double* b1, const double* c1) noexcept {
     using namespace orientation_detail;
-    const V3 u0 = sub(p0, a0), u1 = sub(p1, a1);
+    FacePlaneStatic f;
+#if defined(TETSEG_HAVE_LANES2)
+    using L = Vec3T<Lanes2>;
+    auto both = [](const double* p, const double* q) {
+      return L{Lanes2{p[0], q[0]}, Lanes2{p[1], q[1]}, Lanes2{p[2], q[2]}};
+    };
+    auto diff = [](const L& p, const L& q) { return L{p.x - q.x, p.y - q.y, p.z - q.z}; };
+    auto swapped = [](const L& p) {
+      return L{Lanes2{p.x[1], p.x[0]}, Lanes2{p.y[1], p.y[0]}, Lanes2{p.z[1], p.z[0]}};
+    };
+    auto m = [](const L& v, const L& w) {
+      return MinorTerms<Lanes2>{v.y * w.z - v.z * w.y, v.x * w.z - v.z * w.x,
+                                v.x * w.y - v.y * w.x};
+    };
+    f.a = both(a0, a1);
+    const L v = diff(both(b0, b1), f.a), w = diff(both(c0, c1), f.a);  // lanes (v0, v1), (w0, w1)
+    f.ma = m(v, w);                                                    // (m00, m11)
+    f.mb = m(swapped(v), w);                                           // (m10, m01)
+    f.mc = m(v, swapped(w));                                           // (m01, m10)
+#else
+    const FacePlaneMinors full = FacePlaneMinors::of(a0, b0, c0, a1, b1, c1);
+    for (int k = 0; k < 3; ++k) {
+      f.a0[k] = a0[k];
+      f.a1[k] = a1[k];
+    }
+    f.m00 = full.m00;
+    f.m10 = full.m10;
+    f.m01 = full.m01;
+    f.m11 = full.m11;
+#endif
+    return f;
+  }
+  /// FacePlaneMinors::side(a0, a1, p0, p1) of the same triangle when the static bound `e`
+  /// decides it (`decided`; e = StaticErr::of the extents of a box holding the triangle and the
+  /// point at both ends of the step), found from the coefficients without their error terms;
+  /// else kUncertain with `decided = false`: the caller evaluates the full cubic.
+  Orientation static_side(const double* p0, const double* p1,
+                          const orientation_detail::StaticErr& e, bool& decided) const noexcept {
+    using namespace orientation_detail;
+#if defined(TETSEG_HAVE_LANES2)
+    // Lane 0 computes k0 and k1, lane 1 k3 and k2, each with bernstein_k's operations in its
+    // order: k0 = det(u0, m00), k1 = det(u1, m00) + det(u0, m10) + det(u0, m01), and the
+    // mirror image with the ends swapped.
+    using L = Vec3T<Lanes2>;
+    const L u{Lanes2{p0[0], p1[0]} - a.x, Lanes2{p0[1], p1[1]} - a.y,
+              Lanes2{p0[2], p1[2]} - a.z};  // (u0, u1)
+    const L us{Lanes2{u.x[1], u.x[0]}, Lanes2{u.y[1], u.y[0]}, Lanes2{u.z[1], u.z[0]}};
+    auto det = [](const L& w, const MinorTerms<Lanes2>& m) {
+      return w.x * m.m0 - w.y * m.m1 + w.z * m.m2;
+    };
+    const Lanes2 k03 = det(u, ma);
+    const Lanes2 k12 = det(us, ma) + det(u, mb) + det(u, mc);
+    const double k[4] = {k03[0], k12[0], k12[1], k03[1]};
+#else
     double k[4];
-    bernstein_k(u0, u1, m00, m10, m01, m11, k);
-    bool decided;
-    const Orientation o = static_sign(k, e, decided);
-    return decided ? o : sign(bernstein(u0, u1, m00, m10, m01, m11));
+    bernstein_k(sub(p0, a0), sub(p1, a1), m00, m10, m01, m11, k);
+#endif
+    return static_sign(k, e, decided);
   }
 };
 

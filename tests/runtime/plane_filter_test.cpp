@@ -121,8 +121,19 @@ TEST_CASE("The static error bound gives bitwise the orientation cubic's sign", "
     ++trials;
     const Orientation want = classify_orientation(p[0], p[3], p[1], p[2], p[4], p[7], p[5], p[6]);
     const FacePlane plane(p[0], p[1], p[2], p[4], p[5], p[6]);
-    const FacePlaneMinors minors = FacePlaneMinors::of(p[0], p[1], p[2], p[4], p[5], p[6]);
-    REQUIRE(minors.side(p[0], p[4], p[3], p[7], err) == want);
+    // The plane filters' form: the lanes of FacePlaneStatic, then the full cubic (FaceSides).
+    const FacePlaneStatic fast = FacePlaneStatic::of(p[0], p[1], p[2], p[4], p[5], p[6]);
+    bool fast_decided = false;
+    const Orientation fast_side = fast.static_side(p[3], p[7], err, fast_decided);
+    if (fast_decided) REQUIRE(fast_side == want);
+    REQUIRE(fast_decided == d);  // the same coefficients as orientation_bernstein's
+    const std::vector<double> x0 = {p[0][0], p[0][1], p[0][2], p[1][0], p[1][1], p[1][2],
+                                    p[2][0], p[2][1], p[2][2], p[3][0], p[3][1], p[3][2]};
+    const std::vector<double> x1 = {p[4][0], p[4][1], p[4][2], p[5][0], p[5][1], p[5][2],
+                                    p[6][0], p[6][1], p[6][2], p[7][0], p[7][1], p[7][2]};
+    const MovingTriangle face{{0, 1, 2}, x0.data(), x1.data(), &fast};
+    FaceSides sides(face, &err);
+    REQUIRE(sides.of(p[3], p[7]) == want);
     REQUIRE(plane.side(p[3], p[7]) == want);
     // Classification's form: detector o = p[3], triangle (p[0], p[1], p[2]).
     REQUIRE(orientation_of(p[3], p[0], p[1], p[2], p[7], p[4], p[5], p[6], err) ==
@@ -165,6 +176,20 @@ TEST_CASE("Plane-separated triangle pairs have no feature pair in contact (brute
       if (trial % 2) std::swap(t2[0], t2[2]);  // either winding
       const bool sep =
           plane_separated({t1, x0.data(), x1.data()}, {t2, x0.data(), x1.data()}, true);
+      // The runtime's form (static bound of the box of all nodes, FacePlaneStatic): the same.
+      double lo[3], hi[3];
+      for (int k = 0; k < 3; ++k) {
+        lo[k] = hi[k] = x0[k];
+        for (std::uint32_t n = 0; n < nodes; ++n)
+          for (const auto* x : {&x0, &x1}) {
+            lo[k] = std::min(lo[k], (*x)[3 * n + k]);
+            hi[k] = std::max(hi[k], (*x)[3 * n + k]);
+          }
+      }
+      const double extent[3] = {hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]};
+      const auto err = orientation_detail::StaticErr::of(extent);
+      REQUIRE(plane_separated({t1, x0.data(), x1.data()}, {t2, x0.data(), x1.data()}, true, &err) ==
+              sep);
       const bool contact = any_feature_contact(t1, t2, x0, x1);
       CAPTURE(shared, trial);
       if (sep) REQUIRE_FALSE(contact);
@@ -176,4 +201,22 @@ TEST_CASE("Plane-separated triangle pairs have no feature pair in contact (brute
   CHECK(separated > 1500);
   CHECK(touching > 500);
   CHECK(touching_shared > 200);
+}
+
+TEST_CASE("shared_node_mask marks exactly the nodes of one triangle found in the other",
+          "[plane-filter]") {
+  std::mt19937_64 rng(5);
+  std::uniform_int_distribution<std::uint32_t> id(0, 6);
+  for (int trial = 0; trial < 5000; ++trial) {
+    std::array<std::uint32_t, 3> q, f;
+    for (auto& n : q) n = id(rng);
+    for (auto& n : f) n = id(rng);
+    if (trial % 3 == 0) q[trial % 2] = 0xffffffffu;  // large ids
+    if (trial % 5 == 0) f[2] = 0xffffffffu;
+    unsigned want = 0;
+    for (unsigned i = 0; i < 3; ++i)
+      if (has_node(f, q[i])) want |= 1u << i;
+    CAPTURE(q[0], q[1], q[2], f[0], f[1], f[2]);
+    REQUIRE(shared_node_mask(q, f) == want);
+  }
 }
