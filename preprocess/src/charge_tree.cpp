@@ -207,6 +207,45 @@ bool cpu_has_avx2() {
 }
 #endif
 
+#if defined(TETSEG_CHARGE_AVX2)
+#define TETSEG_CHARGE_CLONES __attribute__((target_clones("avx2", "default")))
+#else
+#define TETSEG_CHARGE_CLONES
+#endif
+
+/// Four doubles, one per source cluster of an M2L batch (GCC vector extension: one 256-bit
+/// register in the AVX2 clone, two 128-bit halves otherwise).
+typedef double Doubles4 __attribute__((vector_size(32), aligned(8)));
+
+/// The Taylor coefficients D_k of 1 / |R_p + w| for the four separations R_p = (rx, ry, rz)[p]
+/// of a batch, interleaved (lane p of slot k at k * 4 + p): raw holds D_k ((kc + 1) * 4,
+/// slot kc the zero predecessor), scaled receives k! D_k (kc * 4).
+TETSEG_CHARGE_CLONES void taylor_batch(std::size_t kc, const TaylorRecurrence* recurrence,
+                                       const double* rx, const double* ry, const double* rz,
+                                       const double* inv_r2, const double* fact, double* raw,
+                                       double* scaled) {
+  // Explicit Doubles4 pointers throughout: a deduced type would drop the reduced alignment.
+  Doubles4* const d = reinterpret_cast<Doubles4*>(raw);
+  Doubles4* const out = reinterpret_cast<Doubles4*>(scaled);
+  const Doubles4 vx = *reinterpret_cast<const Doubles4*>(rx);
+  const Doubles4 vy = *reinterpret_cast<const Doubles4*>(ry);
+  const Doubles4 vz = *reinterpret_cast<const Doubles4*>(rz);
+  const Doubles4 vi = *reinterpret_cast<const Doubles4*>(inv_r2);
+  Doubles4 d0 = vi;
+  for (int p = 0; p < 4; ++p) d0[p] = std::sqrt(inv_r2[p]);
+  d[0] = d0;
+  d[kc] = Doubles4{0.0, 0.0, 0.0, 0.0};
+  out[0] = d0 * fact[0];
+  for (std::size_t k = 1; k < kc; ++k) {
+    const TaylorRecurrence& rc = recurrence[k];
+    const Doubles4 s1 = vx * d[rc.m1[0]] + vy * d[rc.m1[1]] + vz * d[rc.m1[2]];
+    const Doubles4 s2 = d[rc.m2[0]] + d[rc.m2[1]] + d[rc.m2[2]];
+    const Doubles4 v = (rc.alpha * s1 + rc.beta * s2) * vi;
+    d[k] = v;
+    out[k] = v * fact[k];
+  }
+}
+
 }  // namespace
 
 ClusterTree build_cluster_tree(const PanelSet& panels, int leaf_size) {
@@ -402,7 +441,7 @@ TreecodeOperator::TreecodeOperator(const PanelSet& panels, const ClusterTree& tr
   m_recurrence.resize(m_index.size());
   for (std::size_t k = 1; k < m_index.size(); ++k) {
     const int o = m_index[k][0] + m_index[k][1] + m_index[k][2];
-    Recurrence& rc = m_recurrence[k];
+    TaylorRecurrence& rc = m_recurrence[k];
     for (std::size_t i = 0; i < 3; ++i) {
       rc.m1[i] = m_minus1[k][i] >= 0 ? static_cast<std::uint32_t>(m_minus1[k][i])
                                      : static_cast<std::uint32_t>(m_index.size());
@@ -411,6 +450,14 @@ TreecodeOperator::TreecodeOperator(const PanelSet& panels, const ClusterTree& tr
     }
     rc.alpha = -(2.0 * o - 1.0) / o;
     rc.beta = -(o - 1.0) / o;
+  }
+  m_mono_from.assign(m_index.size(), 0);
+  m_mono_axis.assign(m_index.size(), 0);
+  for (std::size_t k = 1; k < m_index.size(); ++k) {
+    const auto& m1 = m_minus1[k];
+    const int i = m1[0] >= 0 ? 0 : (m1[1] >= 0 ? 1 : 2);
+    m_mono_axis[k] = static_cast<std::uint8_t>(i);
+    m_mono_from[k] = static_cast<std::uint32_t>(m1[static_cast<std::size_t>(i)]);
   }
   auto binom = [](int a, int b) {
     double r = 1.0;
@@ -579,11 +626,7 @@ void TreecodeOperator::apply(const double* x, double* y) const {
   auto monomials = [&](double wx, double wy, double wz, double* out) {
     out[0] = 1.0;
     const double w[3] = {wx, wy, wz};
-    for (std::size_t k = 1; k < kc; ++k) {
-      const auto& m1 = m_minus1[k];
-      const int i = m1[0] >= 0 ? 0 : (m1[1] >= 0 ? 1 : 2);
-      out[k] = out[m1[static_cast<std::size_t>(i)]] * w[i];
-    }
+    for (std::size_t k = 1; k < kc; ++k) out[k] = out[m_mono_from[k]] * w[m_mono_axis[k]];
   };
   // to[a] += sum over a's terms of coef * d^c * from[b], one register sum per a.
   auto shift = [&](const std::vector<Term>& terms, const std::vector<std::size_t>& start,
@@ -602,8 +645,8 @@ void TreecodeOperator::apply(const double* x, double* y) const {
 #endif
   {
     constexpr std::size_t kBatch = 4;
-    std::vector<double> mono(kc), deriv((kc + 1) * kBatch), moments(kc * kBatch), pot,
-        zeros(kc, 0.0);
+    std::vector<double> mono(kc), raw((kc + 1) * kBatch), deriv(kc * kBatch), moments(kc * kBatch),
+        pot, zeros(kc, 0.0);
     // Upward pass: leaf moments from the members.
 #if defined(TETSEG_HAVE_OPENMP)
 #pragma omp for schedule(dynamic, 16)
@@ -698,30 +741,9 @@ void TreecodeOperator::apply(const double* x, double* y) const {
           inv_r2[p] = 1.0 / (rx[p] * rx[p] + ry[p] * ry[p] + rz[p] * rz[p]);
           mom[p] = real ? m_scaled.data() + static_cast<std::size_t>(sid) * kc : zeros.data();
         }
-        // Taylor coefficients of 1 / |R + w| in w (Duan & Krasny recurrence).
-        // Branch-free: missing predecessors point at slot kc, which holds 0.
-        for (std::size_t p = 0; p < kBatch; ++p) {
-          deriv[p] = std::sqrt(inv_r2[p]);
-          deriv[kc * kBatch + p] = 0.0;
-        }
-        for (std::size_t k = 1; k < kc; ++k) {
-          const Recurrence& rc = m_recurrence[k];
-          const double* x0 = deriv.data() + rc.m1[0] * kBatch;
-          const double* x1 = deriv.data() + rc.m1[1] * kBatch;
-          const double* x2 = deriv.data() + rc.m1[2] * kBatch;
-          const double* y0 = deriv.data() + rc.m2[0] * kBatch;
-          const double* y1 = deriv.data() + rc.m2[1] * kBatch;
-          const double* y2 = deriv.data() + rc.m2[2] * kBatch;
-          double* out = deriv.data() + k * kBatch;
-          for (std::size_t p = 0; p < kBatch; ++p) {
-            const double s1 = rx[p] * x0[p] + ry[p] * x1[p] + rz[p] * x2[p];
-            const double s2 = y0[p] + y1[p] + y2[p];
-            out[p] = (rc.alpha * s1 + rc.beta * s2) * inv_r2[p];
-          }
-        }
-        for (std::size_t k = 0; k < kc; ++k) {
-          for (std::size_t p = 0; p < kBatch; ++p) deriv[k * kBatch + p] *= m_fact[k];
-        }
+        // Taylor coefficients of 1 / |R + w| in w (Duan & Krasny recurrence), times k!.
+        taylor_batch(kc, m_recurrence.data(), rx, ry, rz, inv_r2, m_fact.data(), raw.data(),
+                     deriv.data());
         // The batch's moments interleaved like deriv (lane p of slot b), so that every term is
         // one product of two contiguous kBatch-vectors.
         for (std::size_t b = 0; b < kc; ++b) {
