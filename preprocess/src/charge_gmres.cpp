@@ -312,6 +312,23 @@ inline void subtract_scaled(float* dst, const float* src, float f, std::size_t k
   }
 }
 
+/// subtract_scaled on four rows at once (one load of src per block of eight).
+inline void subtract_scaled4(float* const* dst, const float* src, const float* f, std::size_t keep,
+                             std::size_t end) {
+  std::size_t j = keep & ~std::size_t{7};
+  if (j < keep && j < end) {
+    for (int r = 0; r < 4; ++r) subtract_scaled(dst[r], src, f[r], keep, j + 8);
+    j += 8;
+  }
+  for (; j < end; j += 8) {
+    const Floats8 v = *reinterpret_cast<const Floats8*>(src + j);
+    *reinterpret_cast<Floats8*>(dst[0] + j) -= f[0] * v;
+    *reinterpret_cast<Floats8*>(dst[1] + j) -= f[1] * v;
+    *reinterpret_cast<Floats8*>(dst[2] + j) -= f[2] * v;
+    *reinterpret_cast<Floats8*>(dst[3] + j) -= f[3] * v;
+  }
+}
+
 /// Rows s - m .. s - 1 of A^-1 for the dense s x s matrix A (row-major, stride ld, destroyed),
 /// into rows (m x ld, row t = row s - m + t of A^-1); `upper` is scratch of m x m. LU with partial
 /// pivoting, P A = L U, so A^-1 = U^-1 L^-1 P; the last m rows of the upper triangular U^-1 are
@@ -336,11 +353,19 @@ __attribute__((target_clones("avx2", "default"))) bool inverse_rows_of_last(
     if (p != k) std::swap_ranges(a + k * ld, a + k * ld + s, a + p * ld);
     const float* rk = a + k * ld;
     const float inv = 1.0f / rk[k];
-    for (std::size_t i = k + 1; i < s; ++i) {
+    // Columns s..ld-1 are 0 and stay 0; four rows at a time.
+    std::size_t i = k + 1;
+    for (; i + 4 <= s; i += 4) {
+      float* const ri[4] = {a + i * ld, a + (i + 1) * ld, a + (i + 2) * ld, a + (i + 3) * ld};
+      float l[4];
+      for (int q = 0; q < 4; ++q) l[q] = ri[q][k] = ri[q][k] * inv;
+      subtract_scaled4(ri, rk, l, k + 1, ld);
+    }
+    for (; i < s; ++i) {
       float* ri = a + i * ld;
       const float l = ri[k] * inv;
       ri[k] = l;
-      subtract_scaled(ri, rk, l, k + 1, ld);  // columns s..ld-1 are 0 and stay 0
+      subtract_scaled(ri, rk, l, k + 1, ld);
     }
   }
   // Y = last m rows of L^-1: row t solves y L = e_{r+t} (L unit lower triangular), from the
