@@ -534,22 +534,50 @@ TreecodeOperator::TreecodeOperator(const PanelSet& panels, const ClusterTree& tr
       m_parent[static_cast<std::size_t>(c.right)] = static_cast<std::int32_t>(id);
     }
   }
-  // Nodes by depth (children have larger ids than their parent), for the level-parallel
-  // upward and downward passes.
+  // The upward and downward passes run over kSubtrees subtrees in parallel (each in post-order
+  // in one thread) and over the few nodes above them in one thread: two barriers per pass at
+  // any tree size (they went level by level before; at 5k every level was below the parallel
+  // threshold, so the whole pass ran in one thread).
   {
-    std::vector<std::size_t> depth(node_count, 0);
-    std::size_t deepest = 0;
-    for (std::size_t id = 1; id < node_count; ++id) {
-      depth[id] = depth[static_cast<std::size_t>(m_parent[id])] + 1;
-      deepest = std::max(deepest, depth[id]);
+    constexpr std::size_t kSubtrees = 32;
+    std::vector<std::int32_t> cut = {0};
+    m_top_nodes.clear();
+    while (cut.size() < kSubtrees) {
+      std::vector<std::int32_t> next;
+      bool split = false;
+      for (const std::int32_t id : cut) {
+        const Cluster& c = tree.nodes[static_cast<std::size_t>(id)];
+        if (c.left >= 0) {
+          next.push_back(c.left);
+          next.push_back(c.right);
+          m_top_nodes.push_back(id);
+          split = true;
+        } else {
+          next.push_back(id);
+        }
+      }
+      if (!split) break;
+      cut.swap(next);
     }
-    m_level_start.assign(deepest + 2, 0);
-    for (std::size_t id = 0; id < node_count; ++id) ++m_level_start[depth[id] + 1];
-    for (std::size_t d = 0; d <= deepest; ++d) m_level_start[d + 1] += m_level_start[d];
-    m_level_nodes.resize(node_count);
-    std::vector<std::size_t> fill(m_level_start.begin(), m_level_start.end() - 1);
-    for (std::size_t id = 0; id < node_count; ++id) {
-      m_level_nodes[fill[depth[id]]++] = static_cast<std::int32_t>(id);
+    // m_top_nodes is parents first; the upward pass walks it backwards.
+    m_subtree_start.assign(1, 0);
+    m_subtree_nodes.clear();
+    std::vector<std::pair<std::int32_t, bool>> stack;
+    for (const std::int32_t root : cut) {
+      stack.assign(1, {root, false});
+      while (!stack.empty()) {
+        const auto [id, expanded] = stack.back();
+        stack.pop_back();
+        const Cluster& c = tree.nodes[static_cast<std::size_t>(id)];
+        if (expanded || c.left < 0) {
+          m_subtree_nodes.push_back(id);
+        } else {
+          stack.push_back({id, true});
+          stack.push_back({c.right, false});
+          stack.push_back({c.left, false});
+        }
+      }
+      m_subtree_start.push_back(m_subtree_nodes.size());
     }
   }
   m_leaf_of_node.assign(node_count, -1);
@@ -647,36 +675,20 @@ void TreecodeOperator::apply(const double* x, double* y) const {
     constexpr std::size_t kBatch = 4;
     std::vector<double> mono(kc), raw((kc + 1) * kBatch), deriv(kc * kBatch), moments(kc * kBatch),
         pot, zeros(kc, 0.0);
-    // Upward pass: leaf moments from the members.
-#if defined(TETSEG_HAVE_OPENMP)
-#pragma omp for schedule(dynamic, 16)
-#endif
-    for (std::ptrdiff_t ll = 0; ll < static_cast<std::ptrdiff_t>(leaves.size()); ++ll) {
-      const std::size_t id = static_cast<std::size_t>(leaves[static_cast<std::size_t>(ll)]);
-      const Cluster& c = nodes[id];
-      double* mom = m_moments.data() + id * kc;
-      std::fill(mom, mom + kc, 0.0);
-      for (std::uint32_t k = c.begin; k < c.end; ++k) {
-        monomials(px[k] - c.center[0], py[k] - c.center[1], pz[k] - c.center[2], mono.data());
-        const double q = m_area[k] * x[order[k]];
-        charge[k] = q;
-        for (std::size_t e = 0; e < kc; ++e) mom[e] += q * mono[e];
-      }
-    }
-    // Parents after children, one level at a time (deepest first); levels of fewer than
-    // kParallelLevel nodes together in one thread (fewer barriers).
-    constexpr std::size_t kParallelLevel = 256;
-    const std::size_t levels = m_level_start.size() - 1;
-    std::size_t first_wide = 0;  // levels >= first_wide have at least kParallelLevel nodes
-    while (first_wide < levels &&
-           m_level_start[first_wide + 1] - m_level_start[first_wide] < kParallelLevel) {
-      ++first_wide;
-    }
+    // Upward pass: leaf moments from the members, parents from their children.
     auto upward = [&](std::size_t id) {
       const Cluster& c = nodes[id];
-      if (c.left < 0) return;
       double* mom = m_moments.data() + id * kc;
       std::fill(mom, mom + kc, 0.0);
+      if (c.left < 0) {
+        for (std::uint32_t k = c.begin; k < c.end; ++k) {
+          monomials(px[k] - c.center[0], py[k] - c.center[1], pz[k] - c.center[2], mono.data());
+          const double q = m_area[k] * x[order[k]];
+          charge[k] = q;
+          for (std::size_t e = 0; e < kc; ++e) mom[e] += q * mono[e];
+        }
+        return;
+      }
       for (const std::int32_t child : {c.left, c.right}) {
         const Cluster& ch = nodes[static_cast<std::size_t>(child)];
         monomials(ch.center[0] - c.center[0], ch.center[1] - c.center[1],
@@ -693,20 +705,21 @@ void TreecodeOperator::apply(const double* x, double* y) const {
       shift(m_l2l, m_l2l_start, mono.data(),
             m_local.data() + static_cast<std::size_t>(m_parent[id]) * kc, m_local.data() + id * kc);
     };
-    for (std::size_t level = levels; level-- > first_wide;) {
+    const std::ptrdiff_t subtrees = static_cast<std::ptrdiff_t>(m_subtree_start.size()) - 1;
 #if defined(TETSEG_HAVE_OPENMP)
-#pragma omp for schedule(dynamic, 16)
+#pragma omp for schedule(dynamic, 1)
 #endif
-      for (std::ptrdiff_t at = static_cast<std::ptrdiff_t>(m_level_start[level]);
-           at < static_cast<std::ptrdiff_t>(m_level_start[level + 1]); ++at) {
-        upward(static_cast<std::size_t>(m_level_nodes[static_cast<std::size_t>(at)]));
+    for (std::ptrdiff_t t = 0; t < subtrees; ++t) {
+      for (std::size_t at = m_subtree_start[static_cast<std::size_t>(t)];
+           at < m_subtree_start[static_cast<std::size_t>(t) + 1]; ++at) {
+        upward(static_cast<std::size_t>(m_subtree_nodes[at]));
       }
     }
 #if defined(TETSEG_HAVE_OPENMP)
 #pragma omp single
 #endif
-    for (std::size_t at = m_level_start[first_wide]; at-- > 0;) {
-      upward(static_cast<std::size_t>(m_level_nodes[at]));
+    for (std::size_t at = m_top_nodes.size(); at-- > 0;) {
+      upward(static_cast<std::size_t>(m_top_nodes[at]));
     }
 #if defined(TETSEG_HAVE_OPENMP)
 #pragma omp for schedule(static)
@@ -758,20 +771,21 @@ void TreecodeOperator::apply(const double* x, double* y) const {
         }
       }
     }
-    // Downward pass: parents before children, the narrow levels in one thread first.
+    // Downward pass: parents before children, the nodes above the subtrees in one thread.
 #if defined(TETSEG_HAVE_OPENMP)
 #pragma omp single
 #endif
-    for (std::size_t at = 1; at < m_level_start[first_wide]; ++at) {
-      downward(static_cast<std::size_t>(m_level_nodes[at]));
+    for (const std::int32_t id : m_top_nodes) {
+      if (id != 0) downward(static_cast<std::size_t>(id));
     }
-    for (std::size_t level = std::max<std::size_t>(first_wide, 1); level < levels; ++level) {
 #if defined(TETSEG_HAVE_OPENMP)
-#pragma omp for schedule(dynamic, 16)
+#pragma omp for schedule(dynamic, 1)
 #endif
-      for (std::ptrdiff_t at = static_cast<std::ptrdiff_t>(m_level_start[level]);
-           at < static_cast<std::ptrdiff_t>(m_level_start[level + 1]); ++at) {
-        downward(static_cast<std::size_t>(m_level_nodes[static_cast<std::size_t>(at)]));
+    for (std::ptrdiff_t t = 0; t < subtrees; ++t) {
+      for (std::size_t at = m_subtree_start[static_cast<std::size_t>(t) + 1];
+           at-- > m_subtree_start[static_cast<std::size_t>(t)];) {
+        const std::int32_t id = m_subtree_nodes[at];
+        if (id != 0) downward(static_cast<std::size_t>(id));
       }
     }
     // Leaves: evaluate the local expansion and the direct sums.

@@ -104,8 +104,9 @@ class TreecodeOperator {
   std::vector<Term> m_m2m;  ///< M_a(parent) += coef * d^c * M_b(child), c = a - b
   std::vector<Term> m_l2l;  ///< L_a(child) += coef * d^c * L_b(parent), c = b - a
   std::vector<std::size_t> m_m2m_start, m_l2l_start;  ///< first term of each a
-  std::vector<std::size_t> m_level_start;             ///< per depth (CSR) into m_level_nodes
-  std::vector<std::int32_t> m_level_nodes;            ///< node ids by depth
+  std::vector<std::int32_t> m_top_nodes;              ///< nodes above the subtrees, parents first
+  std::vector<std::size_t> m_subtree_start;           ///< per subtree (CSR) into m_subtree_nodes
+  std::vector<std::int32_t> m_subtree_nodes;          ///< each subtree's nodes in post-order
   mutable std::vector<double> m_charge;
   mutable std::vector<double> m_moments;  ///< nodes x index count
   mutable std::vector<double> m_local;    ///< nodes x index count
