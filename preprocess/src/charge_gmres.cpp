@@ -335,9 +335,9 @@ inline void subtract_scaled4(float* const* dst, const float* src, const float* f
 /// zero left of column s - m, so they need only the trailing m x m block of U and the last m rows
 /// of L^-1: about s^3 / 3 + m s^2 / 2 multiply-adds, all row operations (vectorised). Returns false
 /// if a pivot is zero or not finite.
-__attribute__((target_clones("avx2", "default"))) bool inverse_rows_of_last(
-    std::size_t s, std::size_t ld, std::size_t m, float* a, std::uint32_t* pivot, float* upper,
-    float* rows) {
+TETSEG_CHARGE_CLONES bool inverse_rows_of_last(std::size_t s, std::size_t ld, std::size_t m,
+                                               float* a, std::uint32_t* pivot, float* upper,
+                                               float* rows) {
   for (std::size_t k = 0; k < s; ++k) {
     std::size_t p = k;
     float best = std::abs(a[k * ld + k]);

@@ -217,12 +217,6 @@ bool cpu_has_avx2() {
 }
 #endif
 
-#if defined(TETSEG_CHARGE_AVX2)
-#define TETSEG_CHARGE_CLONES __attribute__((target_clones("avx2", "default")))
-#else
-#define TETSEG_CHARGE_CLONES
-#endif
-
 /// Four doubles, one per source cluster of an M2L batch (GCC vector extension: one 256-bit
 /// register in the AVX2 clone, two 128-bit halves otherwise).
 typedef double Doubles4 __attribute__((vector_size(32), aligned(8)));
