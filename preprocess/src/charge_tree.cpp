@@ -26,16 +26,6 @@ double box_distance_sq(const Cluster& c, const Vec3& p) {
   return s;
 }
 
-/// Squared distance between the bounding boxes of two clusters (0 if they overlap).
-double box_box_distance_sq(const Cluster& a, const Cluster& b) {
-  double s = 0.0;
-  for (int k = 0; k < 3; ++k) {
-    const double d = std::max({a.box_min[k] - b.box_max[k], b.box_min[k] - a.box_max[k], 0.0});
-    s += d * d;
-  }
-  return s;
-}
-
 /// sum over j in [begin, end) of q[j] / |t - p_j|, skipping p_j == t. `inv_scale2` (1 / R^2,
 /// R of the order of the mesh size) keeps r^2 / R^2 inside single-precision range for the
 /// SSE path: 1/r from the single-precision rsqrt estimate (relative error < 4e-4) refined by
@@ -334,55 +324,33 @@ ClusterTree build_cluster_tree(const PanelSet& panels, int leaf_size) {
 NearField build_near_field(const PanelSet& panels, const ClusterTree& tree) {
   const std::size_t n = panels.size();
   std::vector<std::vector<std::uint32_t>> cols(n);
-  // Per target leaf, the source leaves that can hold a near column of one of its members
-  // (box-to-box test, conservative), then per member the exact test; the same rows as a
-  // tree walk per target, without the walk.
-  const std::size_t leaf_count = tree.leaves.size();
 #if defined(TETSEG_HAVE_OPENMP)
-#pragma omp parallel
+#pragma omp parallel for schedule(dynamic, 64)
 #endif
-  {
-    std::vector<std::int32_t> stack, candidates;
-#if defined(TETSEG_HAVE_OPENMP)
-#pragma omp for schedule(dynamic, 4)
-#endif
-    for (std::ptrdiff_t ll = 0; ll < static_cast<std::ptrdiff_t>(leaf_count); ++ll) {
-      const Cluster& target =
-          tree.nodes[static_cast<std::size_t>(tree.leaves[static_cast<std::size_t>(ll)])];
-      candidates.clear();
-      stack.assign(1, 0);
-      while (!stack.empty()) {
-        const std::int32_t id = stack.back();
-        stack.pop_back();
-        const Cluster& c = tree.nodes[static_cast<std::size_t>(id)];
-        const double limit = kNearFactor * c.max_diameter;
-        if (box_box_distance_sq(c, target) > limit * limit) continue;
-        if (c.left >= 0) {
-          stack.push_back(c.right);
-          stack.push_back(c.left);
-        } else {
-          candidates.push_back(id);
-        }
+  for (std::ptrdiff_t ii = 0; ii < static_cast<std::ptrdiff_t>(n); ++ii) {
+    const std::size_t i = static_cast<std::size_t>(ii);
+    const Vec3& p = panels.centroid[i];
+    std::vector<std::int32_t> stack = {0};
+    auto& row = cols[i];
+    while (!stack.empty()) {
+      const Cluster& c = tree.nodes[static_cast<std::size_t>(stack.back())];
+      stack.pop_back();
+      const double limit = kNearFactor * c.max_diameter;
+      if (box_distance_sq(c, p) > limit * limit) continue;
+      if (c.left >= 0) {
+        stack.push_back(c.right);
+        stack.push_back(c.left);
+        continue;
       }
-      for (std::uint32_t t = target.begin; t < target.end; ++t) {
-        const std::size_t i = tree.order[t];
-        const Vec3& p = panels.centroid[i];
-        auto& row = cols[i];
-        for (const std::int32_t id : candidates) {
-          const Cluster& c = tree.nodes[static_cast<std::size_t>(id)];
-          const double limit = kNearFactor * c.max_diameter;
-          if (box_distance_sq(c, p) > limit * limit) continue;
-          for (std::uint32_t k = c.begin; k < c.end; ++k) {
-            const std::uint32_t j = tree.order[k];
-            const Vec3& q = panels.centroid[j];
-            const double dx = p[0] - q[0], dy = p[1] - q[1], dz = p[2] - q[2];
-            const double lim = kNearFactor * panels.diameter[j];
-            if (j == i || dx * dx + dy * dy + dz * dz <= lim * lim) row.push_back(j);
-          }
-        }
-        std::sort(row.begin(), row.end());
+      for (std::uint32_t k = c.begin; k < c.end; ++k) {
+        const std::uint32_t j = tree.order[k];
+        const Vec3& q = panels.centroid[j];
+        const double dx = p[0] - q[0], dy = p[1] - q[1], dz = p[2] - q[2];
+        const double lim = kNearFactor * panels.diameter[j];
+        if (j == i || dx * dx + dy * dy + dz * dz <= lim * lim) row.push_back(j);
       }
     }
+    std::sort(row.begin(), row.end());
   }
   NearField near;
   near.row_start.resize(n + 1, 0);
