@@ -3,6 +3,10 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#if defined(__SSE2__)
+#include <immintrin.h>
+#endif
 
 #include "charge_solvers.hpp"
 
@@ -237,6 +241,172 @@ void BlockJacobi::apply(const double* in, double* out) const {
 
 namespace tetseg::preprocess::charge_detail {
 
+namespace {
+
+/// Per-thread buffers of the Schwarz setup.
+struct SchwarzScratch {
+  std::vector<float> a, rows, upper, x, y, z, area;
+  std::vector<std::uint32_t> perm, pivot;
+  void resize(std::size_t s, std::size_t ld, std::size_t members) {
+    a.resize(s * ld);
+    rows.resize(members * ld);
+    upper.resize(members * members);
+    for (auto* v : {&x, &y, &z, &area}) v->resize(s);
+    perm.resize(s);
+    pivot.resize(s);
+  }
+};
+
+/// a[u * ld + v] = area[v] / |p_u - p_v| (0 for u == v), single precision; columns s..ld-1
+/// are set to 0. Four entries per step (SSE: exact square root and division).
+void point_charge_matrix(std::size_t s, std::size_t ld, const float* x, const float* y,
+                         const float* z, const float* area, float* a) {
+  for (std::size_t u = 0; u < s; ++u) {
+    float* row = a + u * ld;
+    const float px = x[u], py = y[u], pz = z[u];
+    std::size_t v = 0;
+#if defined(__SSE2__)
+    const __m128 vx = _mm_set1_ps(px), vy = _mm_set1_ps(py), vz = _mm_set1_ps(pz);
+    const __m128 zero = _mm_setzero_ps(), one = _mm_set1_ps(1.0f);
+    for (; v + 4 <= s; v += 4) {
+      const __m128 dx = _mm_sub_ps(vx, _mm_loadu_ps(x + v));
+      const __m128 dy = _mm_sub_ps(vy, _mm_loadu_ps(y + v));
+      const __m128 dz = _mm_sub_ps(vz, _mm_loadu_ps(z + v));
+      const __m128 r2 =
+          _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)), _mm_mul_ps(dz, dz));
+      const __m128 live = _mm_cmpgt_ps(r2, zero);
+      const __m128 safe = _mm_or_ps(_mm_and_ps(live, r2), _mm_andnot_ps(live, one));
+      const __m128 w = _mm_div_ps(_mm_loadu_ps(area + v), _mm_sqrt_ps(safe));
+      _mm_storeu_ps(row + v, _mm_and_ps(live, w));
+    }
+#endif
+    for (; v < s; ++v) {
+      const float dx = px - x[v], dy = py - y[v], dz = pz - z[v];
+      const float r2 = dx * dx + dy * dy + dz * dz;
+      row[v] = r2 > 0.0f ? area[v] / std::sqrt(r2) : 0.0f;
+    }
+    std::fill(row + s, row + ld, 0.0f);
+  }
+}
+
+/// Eight floats, loaded and stored without alignment (GCC vector extension: 256-bit
+/// instructions in the AVX2 clone below, two 128-bit halves otherwise).
+typedef float Floats8 __attribute__((vector_size(32), aligned(4)));
+typedef std::int32_t Ints8 __attribute__((vector_size(32)));
+
+/// dst[j] -= f * src[j] for keep <= j < end, in blocks of eight from keep rounded down to a
+/// multiple of 8 (end is one): the lanes of the first block below `keep` keep their values.
+inline void subtract_scaled(float* dst, const float* src, float f, std::size_t keep,
+                            std::size_t end) {
+  std::size_t j = keep & ~std::size_t{7};
+  if (j < keep && j < end) {
+    const Ints8 lane = {0, 1, 2, 3, 4, 5, 6, 7};
+    Floats8* d = reinterpret_cast<Floats8*>(dst + j);
+    const Floats8 v = *d - f * *reinterpret_cast<const Floats8*>(src + j);
+    *d = lane + static_cast<std::int32_t>(j) >= static_cast<std::int32_t>(keep) ? v : *d;
+    j += 8;
+  }
+  for (; j < end; j += 8) {
+    Floats8* d = reinterpret_cast<Floats8*>(dst + j);
+    *d -= f * *reinterpret_cast<const Floats8*>(src + j);
+  }
+}
+
+/// subtract_scaled on four rows at once (one load of src per block of eight).
+inline void subtract_scaled4(float* const* dst, const float* src, const float* f, std::size_t keep,
+                             std::size_t end) {
+  std::size_t j = keep & ~std::size_t{7};
+  if (j < keep && j < end) {
+    for (int r = 0; r < 4; ++r) subtract_scaled(dst[r], src, f[r], keep, j + 8);
+    j += 8;
+  }
+  for (; j < end; j += 8) {
+    const Floats8 v = *reinterpret_cast<const Floats8*>(src + j);
+    *reinterpret_cast<Floats8*>(dst[0] + j) -= f[0] * v;
+    *reinterpret_cast<Floats8*>(dst[1] + j) -= f[1] * v;
+    *reinterpret_cast<Floats8*>(dst[2] + j) -= f[2] * v;
+    *reinterpret_cast<Floats8*>(dst[3] + j) -= f[3] * v;
+  }
+}
+
+/// Rows s - m .. s - 1 of A^-1 for the dense s x s matrix A (row-major, stride ld, destroyed),
+/// into rows (m x ld, row t = row s - m + t of A^-1); `upper` is scratch of m x m. LU with partial
+/// pivoting, P A = L U, so A^-1 = U^-1 L^-1 P; the last m rows of the upper triangular U^-1 are
+/// zero left of column s - m, so they need only the trailing m x m block of U and the last m rows
+/// of L^-1: about s^3 / 3 + m s^2 / 2 multiply-adds, all row operations (vectorised). Returns false
+/// if a pivot is zero or not finite.
+TETSEG_CHARGE_CLONES bool inverse_rows_of_last(std::size_t s, std::size_t ld, std::size_t m,
+                                               float* a, std::uint32_t* pivot, float* upper,
+                                               float* rows) {
+  for (std::size_t k = 0; k < s; ++k) {
+    std::size_t p = k;
+    float best = std::abs(a[k * ld + k]);
+    for (std::size_t i = k + 1; i < s; ++i) {
+      const float v = std::abs(a[i * ld + k]);
+      if (v > best) {
+        best = v;
+        p = i;
+      }
+    }
+    if (!(best > 0.0f) || !std::isfinite(best)) return false;
+    pivot[k] = static_cast<std::uint32_t>(p);
+    if (p != k) std::swap_ranges(a + k * ld, a + k * ld + s, a + p * ld);
+    const float* rk = a + k * ld;
+    const float inv = 1.0f / rk[k];
+    // Columns s..ld-1 are 0 and stay 0; four rows at a time.
+    std::size_t i = k + 1;
+    for (; i + 4 <= s; i += 4) {
+      float* const ri[4] = {a + i * ld, a + (i + 1) * ld, a + (i + 2) * ld, a + (i + 3) * ld};
+      float l[4];
+      for (int q = 0; q < 4; ++q) l[q] = ri[q][k] = ri[q][k] * inv;
+      subtract_scaled4(ri, rk, l, k + 1, ld);
+    }
+    for (; i < s; ++i) {
+      float* ri = a + i * ld;
+      const float l = ri[k] * inv;
+      ri[k] = l;
+      subtract_scaled(ri, rk, l, k + 1, ld);
+    }
+  }
+  // Y = last m rows of L^-1: row t solves y L = e_{r+t} (L unit lower triangular), from the
+  // right: y_k is final once the rows below k have been subtracted. L is copied with zeros on
+  // and above the diagonal first, so that whole rows can be subtracted.
+  const std::size_t r = s - m;
+  for (std::size_t t = 0; t < m; ++t) {
+    std::copy(a + (r + t) * ld + r, a + (r + t) * ld + s, upper + t * m);
+  }
+  for (std::size_t k = 0; k < s; ++k) {
+    float* row = a + k * ld;
+    std::fill(row + k, row + ld, 0.0f);
+  }
+  for (std::size_t t = 0; t < m; ++t) {
+    float* y = rows + t * ld;
+    std::fill(y, y + ld, 0.0f);
+    y[r + t] = 1.0f;
+    for (std::size_t k = r + t; k > 0; --k) subtract_scaled(y, a + k * ld, y[k], 0, k);
+  }
+  // X = U_mm^-1 Y (U_mm the trailing m x m block of U), back substitution by rows.
+  for (std::size_t t = m; t-- > 0;) {
+    float* x = rows + t * ld;
+    const float* ut = upper + t * m;
+    for (std::size_t v = t + 1; v < m; ++v) {
+      const float f = ut[v];
+      const float* xv = rows + v * ld;
+      subtract_scaled(x, xv, f, 0, s);
+    }
+    const float inv = 1.0f / ut[t];
+    for (std::size_t j = 0; j < s; ++j) x[j] *= inv;
+  }
+  // X P: the row swaps of the factorisation become column swaps, last first.
+  for (std::size_t k = s; k-- > 0;) {
+    if (pivot[k] == k) continue;
+    for (std::size_t t = 0; t < m; ++t) std::swap(rows[t * ld + k], rows[t * ld + pivot[k]]);
+  }
+  return true;
+}
+
+}  // namespace
+
 NearFieldSchwarz::NearFieldSchwarz(const PanelSet& panels, const ClusterTree& tree,
                                    const NearField& near, std::size_t max_set)
     : m_tree(tree) {
@@ -296,12 +466,15 @@ NearFieldSchwarz::NearFieldSchwarz(const PanelSet& panels, const ClusterTree& tr
   m_rows.resize(m_rows_start[leaves]);
   m_mean_set =
       static_cast<double>(m_set.size()) / static_cast<double>(std::max<std::size_t>(leaves, 1));
-  // Pass 2: factorise M_SS and keep the members' rows of its inverse.
+  // Pass 2: factorise M_SS and keep the members' rows of its inverse. Unknowns (and
+  // equations) in the order [others, members], so that the members' rows of the inverse come
+  // from the last rows of U^-1 (inverse_rows_of_last).
 #if defined(TETSEG_HAVE_OPENMP)
 #pragma omp parallel
 #endif
   {
     std::vector<std::int32_t> pos(n, -1);
+    SchwarzScratch scratch;
 #if defined(TETSEG_HAVE_OPENMP)
 #pragma omp for schedule(dynamic, 4)
 #endif
@@ -311,32 +484,54 @@ NearFieldSchwarz::NearFieldSchwarz(const PanelSet& panels, const ClusterTree& tr
       const auto& set = sets[l];
       std::copy(set.begin(), set.end(),
                 m_set.begin() + static_cast<std::ptrdiff_t>(m_set_start[l]));
-      const Eigen::Index s = static_cast<Eigen::Index>(set.size());
-      const Eigen::Index members = static_cast<Eigen::Index>(c.end - c.begin);
-      for (Eigen::Index a = 0; a < s; ++a)
-        pos[set[static_cast<std::size_t>(a)]] = static_cast<std::int32_t>(a);
-      // The transpose of M_SS, so that the solve below yields rows of M_SS^-1. Single
-      // precision: a preconditioner needs a few digits, and the LU is twice as fast.
-      Eigen::MatrixXf at(s, s);
-      for (Eigen::Index a = 0; a < s; ++a) {
-        const std::size_t i = set[static_cast<std::size_t>(a)];
-        const Vec3& p = panels.centroid[i];
-        for (Eigen::Index b = 0; b < s; ++b) {
-          const std::size_t j = set[static_cast<std::size_t>(b)];
-          const Vec3& q = panels.centroid[j];
-          const double dx = p[0] - q[0], dy = p[1] - q[1], dz = p[2] - q[2];
-          const double r2 = dx * dx + dy * dy + dz * dz;
-          at(b, a) = static_cast<float>(r2 > 0.0 ? panels.area[j] / std::sqrt(r2) : 0.0);
-        }
+      const std::size_t s = set.size();
+      const std::size_t members = c.end - c.begin;
+      const std::size_t others = s - members;
+      const std::size_t ld = (s + 7) & ~std::size_t{7};
+      // perm[u]: the set position of unknown (and equation) u.
+      scratch.resize(s, ld, members);
+      for (std::size_t u = 0; u < s; ++u) {
+        scratch.perm[u] = static_cast<std::uint32_t>(u < others ? members + u : u - others);
+      }
+      // Point charges in single precision about the leaf centre (the preconditioner needs a
+      // few digits), then the analytic near-field entries over them.
+      for (std::size_t u = 0; u < s; ++u) {
+        const std::size_t j = set[scratch.perm[u]];
+        const Vec3& q = panels.centroid[j];
+        scratch.x[u] = static_cast<float>(q[0] - c.center[0]);
+        scratch.y[u] = static_cast<float>(q[1] - c.center[1]);
+        scratch.z[u] = static_cast<float>(q[2] - c.center[2]);
+        scratch.area[u] = static_cast<float>(panels.area[j]);
+        pos[j] = static_cast<std::int32_t>(u);
+      }
+      point_charge_matrix(s, ld, scratch.x.data(), scratch.y.data(), scratch.z.data(),
+                          scratch.area.data(), scratch.a.data());
+      for (std::size_t u = 0; u < s; ++u) {
+        const std::size_t i = set[scratch.perm[u]];
+        float* row = scratch.a.data() + u * ld;
         for (std::size_t e = near.row_start[i]; e < near.row_start[i + 1]; ++e) {
           const std::int32_t b = pos[near.column[e]];
-          if (b >= 0) at(b, a) = static_cast<float>(near.value[e]);
+          if (b >= 0) row[b] = static_cast<float>(near.value[e]);
         }
       }
       for (const std::uint32_t j : set) pos[j] = -1;
-      const Eigen::MatrixXf rows =
-          at.partialPivLu().solve(Eigen::MatrixXf::Identity(s, members));  // s x members
-      Eigen::Map<Eigen::MatrixXf>(m_rows.data() + m_rows_start[l], s, members) = rows;
+      float* rows = m_rows.data() + m_rows_start[l];
+      if (!inverse_rows_of_last(s, ld, members, scratch.a.data(), scratch.pivot.data(),
+                                scratch.upper.data(), scratch.rows.data())) {
+        // Singular block (not seen on valid input): this leaf falls back to Jacobi.
+        std::fill(rows, rows + members * s, 0.0f);
+        for (std::size_t a = 0; a < members; ++a) {
+          rows[a * s + a] = static_cast<float>(1.0 / near.diagonal[set[a]]);
+        }
+        continue;
+      }
+      // Row t of the result belongs to unknown others + t, i.e. member t; its columns are
+      // equations in perm order.
+      for (std::size_t t = 0; t < members; ++t) {
+        const float* from = scratch.rows.data() + t * ld;
+        float* to = rows + t * s;
+        for (std::size_t u = 0; u < s; ++u) to[scratch.perm[u]] = from[u];
+      }
     }
   }
 }

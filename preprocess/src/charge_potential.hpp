@@ -10,6 +10,14 @@
 
 #include "tetseg/preprocess/mesh.hpp"
 
+/// Compiles a function twice, for AVX2 and for the baseline, and picks one at load time
+/// (GCC's target_clones): for the charge kernels written as plain loops or vector extensions.
+#if defined(__x86_64__) && defined(__GNUC__)
+#define TETSEG_CHARGE_CLONES __attribute__((target_clones("avx2", "default")))
+#else
+#define TETSEG_CHARGE_CLONES
+#endif
+
 namespace tetseg::preprocess::charge_detail {
 
 /// Integral over triangle (a, b, c) of 1 / |r - y| dS_y (unit surface density; length units of

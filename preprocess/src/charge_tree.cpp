@@ -207,6 +207,39 @@ bool cpu_has_avx2() {
 }
 #endif
 
+/// Four doubles, one per source cluster of an M2L batch (GCC vector extension: one 256-bit
+/// register in the AVX2 clone, two 128-bit halves otherwise).
+typedef double Doubles4 __attribute__((vector_size(32), aligned(8)));
+
+/// The Taylor coefficients D_k of 1 / |R_p + w| for the four separations R_p = (rx, ry, rz)[p]
+/// of a batch, interleaved (lane p of slot k at k * 4 + p): raw holds D_k ((kc + 1) * 4,
+/// slot kc the zero predecessor), scaled receives k! D_k (kc * 4).
+TETSEG_CHARGE_CLONES void taylor_batch(std::size_t kc, const TaylorRecurrence* recurrence,
+                                       const double* rx, const double* ry, const double* rz,
+                                       const double* inv_r2, const double* fact, double* raw,
+                                       double* scaled) {
+  // Explicit Doubles4 pointers throughout: a deduced type would drop the reduced alignment.
+  Doubles4* const d = reinterpret_cast<Doubles4*>(raw);
+  Doubles4* const out = reinterpret_cast<Doubles4*>(scaled);
+  const Doubles4 vx = *reinterpret_cast<const Doubles4*>(rx);
+  const Doubles4 vy = *reinterpret_cast<const Doubles4*>(ry);
+  const Doubles4 vz = *reinterpret_cast<const Doubles4*>(rz);
+  const Doubles4 vi = *reinterpret_cast<const Doubles4*>(inv_r2);
+  Doubles4 d0 = vi;
+  for (int p = 0; p < 4; ++p) d0[p] = std::sqrt(inv_r2[p]);
+  d[0] = d0;
+  d[kc] = Doubles4{0.0, 0.0, 0.0, 0.0};
+  out[0] = d0 * fact[0];
+  for (std::size_t k = 1; k < kc; ++k) {
+    const TaylorRecurrence& rc = recurrence[k];
+    const Doubles4 s1 = vx * d[rc.m1[0]] + vy * d[rc.m1[1]] + vz * d[rc.m1[2]];
+    const Doubles4 s2 = d[rc.m2[0]] + d[rc.m2[1]] + d[rc.m2[2]];
+    const Doubles4 v = (rc.alpha * s1 + rc.beta * s2) * vi;
+    d[k] = v;
+    out[k] = v * fact[k];
+  }
+}
+
 }  // namespace
 
 ClusterTree build_cluster_tree(const PanelSet& panels, int leaf_size) {
@@ -402,7 +435,7 @@ TreecodeOperator::TreecodeOperator(const PanelSet& panels, const ClusterTree& tr
   m_recurrence.resize(m_index.size());
   for (std::size_t k = 1; k < m_index.size(); ++k) {
     const int o = m_index[k][0] + m_index[k][1] + m_index[k][2];
-    Recurrence& rc = m_recurrence[k];
+    TaylorRecurrence& rc = m_recurrence[k];
     for (std::size_t i = 0; i < 3; ++i) {
       rc.m1[i] = m_minus1[k][i] >= 0 ? static_cast<std::uint32_t>(m_minus1[k][i])
                                      : static_cast<std::uint32_t>(m_index.size());
@@ -411,6 +444,14 @@ TreecodeOperator::TreecodeOperator(const PanelSet& panels, const ClusterTree& tr
     }
     rc.alpha = -(2.0 * o - 1.0) / o;
     rc.beta = -(o - 1.0) / o;
+  }
+  m_mono_from.assign(m_index.size(), 0);
+  m_mono_axis.assign(m_index.size(), 0);
+  for (std::size_t k = 1; k < m_index.size(); ++k) {
+    const auto& m1 = m_minus1[k];
+    const int i = m1[0] >= 0 ? 0 : (m1[1] >= 0 ? 1 : 2);
+    m_mono_axis[k] = static_cast<std::uint8_t>(i);
+    m_mono_from[k] = static_cast<std::uint32_t>(m1[static_cast<std::size_t>(i)]);
   }
   auto binom = [](int a, int b) {
     double r = 1.0;
@@ -487,22 +528,50 @@ TreecodeOperator::TreecodeOperator(const PanelSet& panels, const ClusterTree& tr
       m_parent[static_cast<std::size_t>(c.right)] = static_cast<std::int32_t>(id);
     }
   }
-  // Nodes by depth (children have larger ids than their parent), for the level-parallel
-  // upward and downward passes.
+  // The upward and downward passes run over kSubtrees subtrees in parallel (each in post-order
+  // in one thread) and over the few nodes above them in one thread: two barriers per pass at
+  // any tree size (they went level by level before; at 5k every level was below the parallel
+  // threshold, so the whole pass ran in one thread).
   {
-    std::vector<std::size_t> depth(node_count, 0);
-    std::size_t deepest = 0;
-    for (std::size_t id = 1; id < node_count; ++id) {
-      depth[id] = depth[static_cast<std::size_t>(m_parent[id])] + 1;
-      deepest = std::max(deepest, depth[id]);
+    constexpr std::size_t kSubtrees = 32;
+    std::vector<std::int32_t> cut = {0};
+    m_top_nodes.clear();
+    while (cut.size() < kSubtrees) {
+      std::vector<std::int32_t> next;
+      bool split = false;
+      for (const std::int32_t id : cut) {
+        const Cluster& c = tree.nodes[static_cast<std::size_t>(id)];
+        if (c.left >= 0) {
+          next.push_back(c.left);
+          next.push_back(c.right);
+          m_top_nodes.push_back(id);
+          split = true;
+        } else {
+          next.push_back(id);
+        }
+      }
+      if (!split) break;
+      cut.swap(next);
     }
-    m_level_start.assign(deepest + 2, 0);
-    for (std::size_t id = 0; id < node_count; ++id) ++m_level_start[depth[id] + 1];
-    for (std::size_t d = 0; d <= deepest; ++d) m_level_start[d + 1] += m_level_start[d];
-    m_level_nodes.resize(node_count);
-    std::vector<std::size_t> fill(m_level_start.begin(), m_level_start.end() - 1);
-    for (std::size_t id = 0; id < node_count; ++id) {
-      m_level_nodes[fill[depth[id]]++] = static_cast<std::int32_t>(id);
+    // m_top_nodes is parents first; the upward pass walks it backwards.
+    m_subtree_start.assign(1, 0);
+    m_subtree_nodes.clear();
+    std::vector<std::pair<std::int32_t, bool>> stack;
+    for (const std::int32_t root : cut) {
+      stack.assign(1, {root, false});
+      while (!stack.empty()) {
+        const auto [id, expanded] = stack.back();
+        stack.pop_back();
+        const Cluster& c = tree.nodes[static_cast<std::size_t>(id)];
+        if (expanded || c.left < 0) {
+          m_subtree_nodes.push_back(id);
+        } else {
+          stack.push_back({id, true});
+          stack.push_back({c.right, false});
+          stack.push_back({c.left, false});
+        }
+      }
+      m_subtree_start.push_back(m_subtree_nodes.size());
     }
   }
   m_leaf_of_node.assign(node_count, -1);
@@ -579,11 +648,7 @@ void TreecodeOperator::apply(const double* x, double* y) const {
   auto monomials = [&](double wx, double wy, double wz, double* out) {
     out[0] = 1.0;
     const double w[3] = {wx, wy, wz};
-    for (std::size_t k = 1; k < kc; ++k) {
-      const auto& m1 = m_minus1[k];
-      const int i = m1[0] >= 0 ? 0 : (m1[1] >= 0 ? 1 : 2);
-      out[k] = out[m1[static_cast<std::size_t>(i)]] * w[i];
-    }
+    for (std::size_t k = 1; k < kc; ++k) out[k] = out[m_mono_from[k]] * w[m_mono_axis[k]];
   };
   // to[a] += sum over a's terms of coef * d^c * from[b], one register sum per a.
   auto shift = [&](const std::vector<Term>& terms, const std::vector<std::size_t>& start,
@@ -602,38 +667,22 @@ void TreecodeOperator::apply(const double* x, double* y) const {
 #endif
   {
     constexpr std::size_t kBatch = 4;
-    std::vector<double> mono(kc), deriv((kc + 1) * kBatch), moments(kc * kBatch), pot,
-        zeros(kc, 0.0);
-    // Upward pass: leaf moments from the members.
-#if defined(TETSEG_HAVE_OPENMP)
-#pragma omp for schedule(dynamic, 16)
-#endif
-    for (std::ptrdiff_t ll = 0; ll < static_cast<std::ptrdiff_t>(leaves.size()); ++ll) {
-      const std::size_t id = static_cast<std::size_t>(leaves[static_cast<std::size_t>(ll)]);
-      const Cluster& c = nodes[id];
-      double* mom = m_moments.data() + id * kc;
-      std::fill(mom, mom + kc, 0.0);
-      for (std::uint32_t k = c.begin; k < c.end; ++k) {
-        monomials(px[k] - c.center[0], py[k] - c.center[1], pz[k] - c.center[2], mono.data());
-        const double q = m_area[k] * x[order[k]];
-        charge[k] = q;
-        for (std::size_t e = 0; e < kc; ++e) mom[e] += q * mono[e];
-      }
-    }
-    // Parents after children, one level at a time (deepest first); levels of fewer than
-    // kParallelLevel nodes together in one thread (fewer barriers).
-    constexpr std::size_t kParallelLevel = 256;
-    const std::size_t levels = m_level_start.size() - 1;
-    std::size_t first_wide = 0;  // levels >= first_wide have at least kParallelLevel nodes
-    while (first_wide < levels &&
-           m_level_start[first_wide + 1] - m_level_start[first_wide] < kParallelLevel) {
-      ++first_wide;
-    }
+    std::vector<double> mono(kc), raw((kc + 1) * kBatch), deriv(kc * kBatch), moments(kc * kBatch),
+        pot, zeros(kc, 0.0);
+    // Upward pass: leaf moments from the members, parents from their children.
     auto upward = [&](std::size_t id) {
       const Cluster& c = nodes[id];
-      if (c.left < 0) return;
       double* mom = m_moments.data() + id * kc;
       std::fill(mom, mom + kc, 0.0);
+      if (c.left < 0) {
+        for (std::uint32_t k = c.begin; k < c.end; ++k) {
+          monomials(px[k] - c.center[0], py[k] - c.center[1], pz[k] - c.center[2], mono.data());
+          const double q = m_area[k] * x[order[k]];
+          charge[k] = q;
+          for (std::size_t e = 0; e < kc; ++e) mom[e] += q * mono[e];
+        }
+        return;
+      }
       for (const std::int32_t child : {c.left, c.right}) {
         const Cluster& ch = nodes[static_cast<std::size_t>(child)];
         monomials(ch.center[0] - c.center[0], ch.center[1] - c.center[1],
@@ -650,20 +699,21 @@ void TreecodeOperator::apply(const double* x, double* y) const {
       shift(m_l2l, m_l2l_start, mono.data(),
             m_local.data() + static_cast<std::size_t>(m_parent[id]) * kc, m_local.data() + id * kc);
     };
-    for (std::size_t level = levels; level-- > first_wide;) {
+    const std::ptrdiff_t subtrees = static_cast<std::ptrdiff_t>(m_subtree_start.size()) - 1;
 #if defined(TETSEG_HAVE_OPENMP)
-#pragma omp for schedule(dynamic, 16)
+#pragma omp for schedule(dynamic, 1)
 #endif
-      for (std::ptrdiff_t at = static_cast<std::ptrdiff_t>(m_level_start[level]);
-           at < static_cast<std::ptrdiff_t>(m_level_start[level + 1]); ++at) {
-        upward(static_cast<std::size_t>(m_level_nodes[static_cast<std::size_t>(at)]));
+    for (std::ptrdiff_t t = 0; t < subtrees; ++t) {
+      for (std::size_t at = m_subtree_start[static_cast<std::size_t>(t)];
+           at < m_subtree_start[static_cast<std::size_t>(t) + 1]; ++at) {
+        upward(static_cast<std::size_t>(m_subtree_nodes[at]));
       }
     }
 #if defined(TETSEG_HAVE_OPENMP)
 #pragma omp single
 #endif
-    for (std::size_t at = m_level_start[first_wide]; at-- > 0;) {
-      upward(static_cast<std::size_t>(m_level_nodes[at]));
+    for (std::size_t at = m_top_nodes.size(); at-- > 0;) {
+      upward(static_cast<std::size_t>(m_top_nodes[at]));
     }
 #if defined(TETSEG_HAVE_OPENMP)
 #pragma omp for schedule(static)
@@ -698,30 +748,9 @@ void TreecodeOperator::apply(const double* x, double* y) const {
           inv_r2[p] = 1.0 / (rx[p] * rx[p] + ry[p] * ry[p] + rz[p] * rz[p]);
           mom[p] = real ? m_scaled.data() + static_cast<std::size_t>(sid) * kc : zeros.data();
         }
-        // Taylor coefficients of 1 / |R + w| in w (Duan & Krasny recurrence).
-        // Branch-free: missing predecessors point at slot kc, which holds 0.
-        for (std::size_t p = 0; p < kBatch; ++p) {
-          deriv[p] = std::sqrt(inv_r2[p]);
-          deriv[kc * kBatch + p] = 0.0;
-        }
-        for (std::size_t k = 1; k < kc; ++k) {
-          const Recurrence& rc = m_recurrence[k];
-          const double* x0 = deriv.data() + rc.m1[0] * kBatch;
-          const double* x1 = deriv.data() + rc.m1[1] * kBatch;
-          const double* x2 = deriv.data() + rc.m1[2] * kBatch;
-          const double* y0 = deriv.data() + rc.m2[0] * kBatch;
-          const double* y1 = deriv.data() + rc.m2[1] * kBatch;
-          const double* y2 = deriv.data() + rc.m2[2] * kBatch;
-          double* out = deriv.data() + k * kBatch;
-          for (std::size_t p = 0; p < kBatch; ++p) {
-            const double s1 = rx[p] * x0[p] + ry[p] * x1[p] + rz[p] * x2[p];
-            const double s2 = y0[p] + y1[p] + y2[p];
-            out[p] = (rc.alpha * s1 + rc.beta * s2) * inv_r2[p];
-          }
-        }
-        for (std::size_t k = 0; k < kc; ++k) {
-          for (std::size_t p = 0; p < kBatch; ++p) deriv[k * kBatch + p] *= m_fact[k];
-        }
+        // Taylor coefficients of 1 / |R + w| in w (Duan & Krasny recurrence), times k!.
+        taylor_batch(kc, m_recurrence.data(), rx, ry, rz, inv_r2, m_fact.data(), raw.data(),
+                     deriv.data());
         // The batch's moments interleaved like deriv (lane p of slot b), so that every term is
         // one product of two contiguous kBatch-vectors.
         for (std::size_t b = 0; b < kc; ++b) {
@@ -736,20 +765,21 @@ void TreecodeOperator::apply(const double* x, double* y) const {
         }
       }
     }
-    // Downward pass: parents before children, the narrow levels in one thread first.
+    // Downward pass: parents before children, the nodes above the subtrees in one thread.
 #if defined(TETSEG_HAVE_OPENMP)
 #pragma omp single
 #endif
-    for (std::size_t at = 1; at < m_level_start[first_wide]; ++at) {
-      downward(static_cast<std::size_t>(m_level_nodes[at]));
+    for (const std::int32_t id : m_top_nodes) {
+      if (id != 0) downward(static_cast<std::size_t>(id));
     }
-    for (std::size_t level = std::max<std::size_t>(first_wide, 1); level < levels; ++level) {
 #if defined(TETSEG_HAVE_OPENMP)
-#pragma omp for schedule(dynamic, 16)
+#pragma omp for schedule(dynamic, 1)
 #endif
-      for (std::ptrdiff_t at = static_cast<std::ptrdiff_t>(m_level_start[level]);
-           at < static_cast<std::ptrdiff_t>(m_level_start[level + 1]); ++at) {
-        downward(static_cast<std::size_t>(m_level_nodes[static_cast<std::size_t>(at)]));
+    for (std::ptrdiff_t t = 0; t < subtrees; ++t) {
+      for (std::size_t at = m_subtree_start[static_cast<std::size_t>(t) + 1];
+           at-- > m_subtree_start[static_cast<std::size_t>(t)];) {
+        const std::int32_t id = m_subtree_nodes[at];
+        if (id != 0) downward(static_cast<std::size_t>(id));
       }
     }
     // Leaves: evaluate the local expansion and the direct sums.

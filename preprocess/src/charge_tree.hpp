@@ -44,6 +44,13 @@ struct NearField {
 
 NearField build_near_field(const PanelSet& panels, const ClusterTree& tree);
 
+/// One step of the Duan-Krasny recurrence for the Taylor coefficients of 1 / |R + w|: slot k
+/// from its predecessors k - e_i (m1) and k - 2 e_i (m2), or the zero slot when missing.
+struct TaylorRecurrence {
+  std::uint32_t m1[3], m2[3];
+  double alpha, beta;  ///< -(2|k| - 1) / |k|, -(|k| - 1) / |k|
+};
+
 /// y = M x with M's far part (point charges) approximated by a Cartesian Taylor fast
 /// multipole method on the binary cluster tree: moments up to total order `order` (leaves
 /// from their members, parents by exact shifts), a dual-tree traversal that turns every pair
@@ -80,11 +87,9 @@ class TreecodeOperator {
   std::vector<std::array<int, 3>> m_index;
   std::vector<std::array<int, 3>> m_minus1;  ///< index of k - e_i, or -1
   std::vector<std::array<int, 3>> m_minus2;  ///< index of k - 2 e_i, or -1
-  struct Recurrence {
-    std::uint32_t m1[3], m2[3];  ///< k - e_i, k - 2 e_i, or the zero slot
-    double alpha, beta;          ///< -(2|k| - 1) / |k|, -(|k| - 1) / |k|
-  };
-  std::vector<Recurrence> m_recurrence;
+  std::vector<TaylorRecurrence> m_recurrence;
+  std::vector<std::uint32_t> m_mono_from;  ///< per k > 0: the index of k - e_axis
+  std::vector<std::uint8_t> m_mono_axis;   ///< per k > 0: the first axis with k_axis > 0
   struct Term {
     int a, b, c;
     double coef;
@@ -99,8 +104,9 @@ class TreecodeOperator {
   std::vector<Term> m_m2m;  ///< M_a(parent) += coef * d^c * M_b(child), c = a - b
   std::vector<Term> m_l2l;  ///< L_a(child) += coef * d^c * L_b(parent), c = b - a
   std::vector<std::size_t> m_m2m_start, m_l2l_start;  ///< first term of each a
-  std::vector<std::size_t> m_level_start;             ///< per depth (CSR) into m_level_nodes
-  std::vector<std::int32_t> m_level_nodes;            ///< node ids by depth
+  std::vector<std::int32_t> m_top_nodes;              ///< nodes above the subtrees, parents first
+  std::vector<std::size_t> m_subtree_start;           ///< per subtree (CSR) into m_subtree_nodes
+  std::vector<std::int32_t> m_subtree_nodes;          ///< each subtree's nodes in post-order
   mutable std::vector<double> m_charge;
   mutable std::vector<double> m_moments;  ///< nodes x index count
   mutable std::vector<double> m_local;    ///< nodes x index count

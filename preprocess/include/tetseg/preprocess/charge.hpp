@@ -49,11 +49,11 @@ struct ChargeOptions {
   ChargePreconditioner preconditioner = ChargePreconditioner::kTwoLevel;
   /// FMM opening parameter: two clusters interact through expansions when
   /// (r_target + r_source) < theta * distance. Smaller is more accurate and slower; (0, 1),
-  /// or 0 for automatic: 0.5 below 10,000 triangles, 0.45 from there on (docs/charge.md).
+  /// or 0 for automatic: 0.4 below 10,000 triangles, 0.45 from there on (docs/charge.md).
   double fast_theta = 0.0;
   /// Total order of the fast solver's Taylor expansions, 0..16; error ~ theta^(order + 1).
-  /// Negative means automatic: 7 below 10,000 triangles (operator error ~8e-7, so the residual
-  /// against the exact matrix stays near the automatic 1e-6), 8 from there on (the density
+  /// Negative means automatic: 6 below 10,000 triangles (with theta 0.4 the residual against
+  /// the exact matrix stays below half the automatic 1e-6 at 5k), 8 from there on (the density
   /// error grows with N for a fixed operator error; docs/charge.md).
   int fast_order = -1;
   int leaf_size = 32;  ///< cluster-tree leaf size (fast solver)
