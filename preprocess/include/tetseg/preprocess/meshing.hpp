@@ -79,7 +79,8 @@ TetMesh generate_shape(Shape shape, const ShapeOptions& shape_options,
 /// What tetrahedralize did beyond one plain Mesh_3 run (see tetrahedralize).
 struct TetrahedralizeNotes {
   /// "" when the first mesh was valid; else the retry that gave the returned mesh:
-  /// "exudation only" or "no optimisation".
+  /// "exudation only", "no optimisation", or one of those or "optimised" followed by
+  /// ", sizes x0.7" or ", sizes x0.5" (every meshing size scaled by that factor).
   std::string optimization_used;
   std::string first_defect;          ///< the first mesh's boundary defect, when retried
   std::vector<RepairCount> repairs;  ///< repairs of the input (MeshingOptions::repair)
