@@ -160,6 +160,38 @@ TEST_CASE("Shape-keeping repairs fix small defects and say what they did", "[mes
   }
 }
 
+TEST_CASE("Fix removes a local self-intersection by CGAL's local remeshing", "[meshing][repair]") {
+  // A geodesic sphere (720 triangles) with one vertex slid along the surface past its
+  // neighbours: its fan folds over the next triangles, a few intersecting pairs in one place.
+  TriangleMesh s = tetseg::test::icosphere(6);
+  Vec3& p = s.vertices[0];
+  const Vec3 tangent = {-p[1], p[0], 0.0};  // p is not on the z axis
+  const double t = std::hypot(tangent[0], tangent[1]);
+  Vec3 moved;
+  for (int k = 0; k < 3; ++k) moved[k] = p[k] + 0.35 * tangent[k] / t;
+  const double r = std::hypot(moved[0], moved[1], moved[2]);
+  for (int k = 0; k < 3; ++k) p[k] = 1.02 * moved[k] / r;
+  std::size_t pairs = 0;  // what validation of the unrepaired surface reports
+  try {
+    tetrahedralize(s, coarse(MeshingOptions::Repair::kNone), "folded.off");
+    FAIL("the folded sphere was meshed without repair");
+  } catch (const InputError& e) {
+    const std::string message = e.what();
+    const std::string prefix = "surface self-intersects (";
+    REQUIRE(message.find(prefix) != std::string::npos);
+    pairs = std::stoul(message.substr(message.find(prefix) + prefix.size()));
+  }
+  TetrahedralizeNotes notes;
+  const TetMesh m = tetrahedralize(s, coarse(MeshingOptions::Repair::kFix), "folded.off", &notes);
+  validate_tet_mesh(m, extract_surface(m), "repaired");
+  const std::size_t removed = count_of(notes, "self-intersecting triangle pairs removed");
+  CHECK(removed > 0);
+  CHECK(removed == pairs);
+  // The rest of the sphere is kept: the volume of the unit ball within Mesh_3's facet error.
+  CHECK(total_tet_volume(m) == Approx(4.0 * std::acos(-1.0) / 3.0).epsilon(0.05));
+  CHECK(notes.hausdorff_input_to_mesh < 0.1);
+}
+
 TEST_CASE("Fix fills small holes, names what it cannot repair and points to wrap",
           "[meshing][repair]") {
   SECTION("A cube with a triangle missing is closed again.") {
