@@ -36,13 +36,13 @@ constexpr double kMinBudget = 200000.0;
 /// Edges whose two triangles' normals differ by more than this (degrees; CGAL
 /// detect_features' default) are sharp; they are protected before Mesh_3 refines the surface
 /// when the input is coarse against the facet size: its median edge at least
-/// kProtectEdgeFacets facet sizes (a polyhedron whose flat faces Mesh_3 refines, like the
-/// cube, the tetrahedra or the pyramid). Unprotected, Mesh_3's manifold refinement can loop
-/// forever at such a corner (colored_tetra.ply); on finely tessellated inputs (edges shorter
-/// than the facet size) the sharp edges are mostly tessellation noise, and protecting them made
-/// dino and femur run over 180 s and hand fail (docs/benchmarks.md).
+/// kProtectEdgeFacets facet sizes (at 4, mpi.off ran over 180 s protected; a polyhedron whose flat
+/// faces Mesh_3 refines, like the cube, the tetrahedra or the pyramid). Unprotected, Mesh_3's
+/// manifold refinement can loop forever at such a corner (colored_tetra.ply); on finely tessellated
+/// inputs (edges shorter than the facet size) the sharp edges are mostly tessellation noise, and
+/// protecting them made dino and femur run over 180 s and hand fail (docs/benchmarks.md).
 constexpr double kSharpEdgeDegrees = 60.0;
-constexpr double kProtectEdgeFacets = 4.0;
+constexpr double kProtectEdgeFacets = 8.0;
 /// When no optimisation gives a valid boundary, meshing is retried with every size (facet,
 /// cell, facet distance) times these factors in turn (the first is the asked size).
 constexpr double kRetrySizeFactors[] = {1.0, 0.7, 0.5};

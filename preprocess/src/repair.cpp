@@ -6,6 +6,7 @@
 #define CGAL_EIGEN3_ENABLED 1
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Polygon_mesh_processing/border.h>
+#include <CGAL/Polygon_mesh_processing/measure.h>
 #include <CGAL/Polygon_mesh_processing/orient_polygon_soup.h>
 #include <CGAL/Polygon_mesh_processing/polygon_mesh_to_polygon_soup.h>
 #include <CGAL/Polygon_mesh_processing/polygon_soup_to_polygon_mesh.h>
@@ -42,6 +43,9 @@ constexpr std::size_t kMaxHoleBorderEdges = 64;
 /// Self-intersections are removed locally only up to this many intersecting pairs of
 /// triangles (docs/cli.md); more is not a local defect.
 constexpr std::size_t kMaxLocalSelfIntersections = 64;
+/// A surface after self-intersection removal must enclose at least this volume over its area
+/// to the power 3/2 (a ball: 0.094; a 1 x 1 x 0.01 plate: 0.0035).
+constexpr double kMinVolumeOverArea = 1e-3;
 
 using Mesh = CGAL::Surface_mesh<Point>;
 
@@ -93,6 +97,10 @@ std::size_t remove_few_self_intersections(Mesh& mesh) {
     return 0;  // CGAL gave up on this input; the intersections are reported by validation
   }
   if (!CGAL::is_closed(attempt) || pmp::does_self_intersect(attempt)) return 0;
+  // A flat sheet whose filled border folded it onto itself (libcgal-demo negative.off) comes
+  // out closed but enclosing next to nothing, on which Mesh_3 never ends: refused.
+  const double area = pmp::area(attempt);
+  if (!(std::abs(pmp::volume(attempt)) >= kMinVolumeOverArea * area * std::sqrt(area))) return 0;
   attempt.collect_garbage();
   mesh = std::move(attempt);
   return pairs.size();
