@@ -101,9 +101,14 @@ TetMesh c3t3_to_tet_mesh(const C3t3& c3t3) {
 template <class Criteria>
 Criteria make_criteria(const Mesh3Criteria& c) {
   namespace params = CGAL::parameters;
-  return Criteria(params::facet_angle = c.facet_angle, params::facet_size = c.facet_size,
-                  params::facet_distance = c.facet_distance,
-                  params::facet_topology = CGAL::FACET_VERTICES_ON_SAME_SURFACE_PATCH,
+  // With protected sharp edges, a facet's vertices may lie on the edges (curves) and corners
+  // bounding its patch; the edge size only matters there.
+  const CGAL::Mesh_facet_topology topology =
+      c.sharp_edge_angle > 0 ? CGAL::FACET_VERTICES_ON_SAME_SURFACE_PATCH_WITH_ADJACENCY_CHECK
+                             : CGAL::FACET_VERTICES_ON_SAME_SURFACE_PATCH;
+  return Criteria(params::edge_size = c.facet_size, params::facet_angle = c.facet_angle,
+                  params::facet_size = c.facet_size, params::facet_distance = c.facet_distance,
+                  params::facet_topology = topology,
                   params::cell_radius_edge_ratio = c.cell_radius_edge_ratio,
                   params::cell_size = c.cell_size);
 }

@@ -1,11 +1,13 @@
-// CGAL Mesh_3 on a closed triangle surface (Polyhedral_mesh_domain_3 on a Surface_mesh).
-// Slow to compile; keep changes rare.
+// CGAL Mesh_3 on a closed triangle surface (Polyhedral_mesh_domain_3 on a Surface_mesh, or
+// Polyhedral_mesh_domain_with_features_3 when sharp edges are protected). Slow to compile;
+// keep changes rare.
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Mesh_complex_3_in_triangulation_3.h>
 #include <CGAL/Mesh_triangulation_3.h>
 #include <CGAL/Polygon_mesh_processing/polygon_soup_to_polygon_mesh.h>
 #include <CGAL/Polyhedral_mesh_domain_3.h>
+#include <CGAL/Polyhedral_mesh_domain_with_features_3.h>
 #include <CGAL/Surface_mesh.h>
 
 #include <array>
@@ -21,6 +23,7 @@ using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
 using Point = Kernel::Point_3;
 using SurfaceMesh = CGAL::Surface_mesh<Point>;
 using Domain = CGAL::Polyhedral_mesh_domain_3<SurfaceMesh, Kernel>;
+using FeaturesDomain = CGAL::Polyhedral_mesh_domain_with_features_3<Kernel, SurfaceMesh>;
 
 }  // namespace
 
@@ -36,6 +39,11 @@ TetMesh mesh_polyhedral_surface(const TriangleMesh& surface, const Mesh3Criteria
   if (mesh.number_of_faces() != surface.triangles.size())
     throw std::runtime_error("surface could not be converted to a polygon mesh");
   CGAL::Random rng(0);
+  if (criteria.sharp_edge_angle > 0) {
+    FeaturesDomain domain(mesh, &rng);
+    domain.detect_features(criteria.sharp_edge_angle);
+    return mesh_domain(domain, criteria);
+  }
   const Domain domain(mesh, &rng);
   return mesh_domain(domain, criteria);
 }

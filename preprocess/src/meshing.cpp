@@ -34,6 +34,19 @@ constexpr double kMaxDiagonalPerSize = 1e5;
 /// inserts nothing (colored_tetra.ply, docs/benchmarks.md).
 constexpr double kBudgetFactor = 8.0;
 constexpr double kMinBudget = 200000.0;
+/// Edges whose two triangles' normals differ by more than this (degrees; CGAL
+/// detect_features' default) are sharp; they are protected before Mesh_3 refines the surface
+/// when the input is coarse against the facet size: its median edge at least
+/// kProtectEdgeFacets facet sizes (at 4, mpi.off ran over 180 s protected; a polyhedron whose flat
+/// faces Mesh_3 refines, like the cube, the tetrahedra or the pyramid). Unprotected, Mesh_3's
+/// manifold refinement can loop forever at such a corner (colored_tetra.ply); on finely tessellated
+/// inputs (edges shorter than the facet size) the sharp edges are mostly tessellation noise, and
+/// protecting them made dino and femur run over 180 s and hand fail (docs/benchmarks.md).
+constexpr double kSharpEdgeDegrees = 60.0;
+constexpr double kProtectEdgeFacets = 8.0;
+/// When no optimisation gives a valid boundary, meshing is retried with every size (facet,
+/// cell, facet distance) times these factors in turn (the first is the asked size).
+constexpr double kRetrySizeFactors[] = {1.0, 0.7, 0.5};
 /// The smallest --wrap-alpha and --wrap-offset, as fractions of the diagonal.
 constexpr double kMinWrapFraction = 1e-4;
 
@@ -123,6 +136,48 @@ TetMesh generate_shape(Shape shape, const ShapeOptions& shape_options,
 
 namespace {
 
+/// Whether some edge shared by two triangles of `s` is sharp: their unit normals differ by
+/// more than `degrees` (the test of CGAL detect_sharp_edges; degenerate triangles ignored).
+bool has_sharp_edge(const TriangleMesh& s, double degrees) {
+  std::vector<Vec3> normal(s.triangles.size());
+  for (std::size_t t = 0; t < s.triangles.size(); ++t) {
+    const Vec3& a = s.vertices[s.triangles[t][0]];
+    const Vec3 n = detail::cross(detail::sub(s.vertices[s.triangles[t][1]], a),
+                                 detail::sub(s.vertices[s.triangles[t][2]], a));
+    const double length = detail::norm(n);
+    normal[t] = length > 0 ? Vec3{n[0] / length, n[1] / length, n[2] / length} : Vec3{0, 0, 0};
+  }
+  std::vector<std::pair<std::pair<std::uint32_t, std::uint32_t>, std::size_t>> edges;
+  edges.reserve(3 * s.triangles.size());
+  for (std::size_t t = 0; t < s.triangles.size(); ++t)
+    for (int k = 0; k < 3; ++k) {
+      const std::uint32_t a = s.triangles[t][k], b = s.triangles[t][(k + 1) % 3];
+      edges.push_back({{std::min(a, b), std::max(a, b)}, t});
+    }
+  std::sort(edges.begin(), edges.end());
+  const double min_cos = std::cos(degrees * M_PI / 180.0);
+  for (std::size_t i = 1; i < edges.size(); ++i) {
+    if (edges[i].first != edges[i - 1].first) continue;
+    const Vec3& n = normal[edges[i].second];
+    const Vec3& m = normal[edges[i - 1].second];
+    if (detail::norm(n) > 0 && detail::norm(m) > 0 && detail::dot(n, m) < min_cos) return true;
+  }
+  return false;
+}
+
+/// The median length of the triangles' edges (each edge counted once per triangle).
+double median_edge_length(const TriangleMesh& s) {
+  std::vector<double> lengths;
+  lengths.reserve(3 * s.triangles.size());
+  for (const Tri& t : s.triangles)
+    for (int k = 0; k < 3; ++k)
+      lengths.push_back(detail::norm(detail::sub(s.vertices[t[(k + 1) % 3]], s.vertices[t[k]])));
+  if (lengths.empty()) return 0.0;
+  const auto middle = lengths.begin() + static_cast<std::ptrdiff_t>(lengths.size() / 2);
+  std::nth_element(lengths.begin(), middle, lengths.end());
+  return *middle;
+}
+
 std::size_t vertex_budget(const detail::Mesh3Criteria& criteria, double diagonal) {
   const double per_cell = diagonal / criteria.cell_size;
   const double per_facet = diagonal / criteria.facet_size;
@@ -193,41 +248,63 @@ TetMesh mesh_closed_surface(const TriangleMesh& input, const MeshingOptions& mes
                                  std::to_string(static_cast<long>(kMaxDiagonalPerSize)) +
                                  " of the bounding-box diagonal (" + std::to_string(diagonal) +
                                  "); give larger --facet-size / --cell-size / --facet-distance");
-  criteria.max_vertices = vertex_budget(criteria, diagonal);
-  TetMesh mesh = run_mesh_3_guarded(input, criteria, file);
-  if (mesh.tets.empty())
-    throw InputError(file,
-                     "meshing produced no tetrahedra (is the surface closed and "
-                     "larger than the facet size?)");
+  const double median_edge = median_edge_length(input);
+  const bool sharp = has_sharp_edge(input, kSharpEdgeDegrees);
   // Mesh_3 refines with its manifold option, so the boundary of the refined tets is a closed
   // 2-manifold; sliver perturbation can break that (it moves vertices after refinement: on
   // rotor, homer, couplingdown and cheese it leaves non-manifold vertices or edges), and
-  // exudation alone has not been seen to. So the boundary is checked, and meshing is retried
-  // with exudation only, then with no optimisation; the first valid mesh is returned.
-  std::string defect = boundary_defect(mesh, file);
-  if (defect.empty()) return mesh;
-  std::string defects = "optimised: " + defect;
-  if (criteria.optimize) {
-    struct Retry {
-      const char* name;
-      bool exude;
-    };
-    for (const Retry& retry : {Retry{"exudation only", true}, Retry{"no optimisation", false}}) {
-      detail::Mesh3Criteria fallback = criteria;
-      fallback.perturb = false;
-      fallback.optimize = retry.exude;
-      mesh = run_mesh_3_guarded(input, fallback, file);
-      const std::string retry_defect = boundary_defect(mesh, file);
-      if (retry_defect.empty()) {
-        notes.optimization_used = retry.name;
-        notes.first_defect = defect;
+  // exudation alone has not been seen to. Thin parts can also leave the cells in the complex
+  // with a non-manifold edge or an enclosed void whatever the optimisation (femur.off). So the
+  // boundary is checked, and meshing is retried with exudation only, then with no
+  // optimisation, then the same at kRetrySizeFactors of every size; the first valid mesh is
+  // returned.
+  struct Attempt {
+    const char* name;
+    bool optimize;
+    bool perturb;
+  };
+  std::vector<Attempt> attempts = {{"optimised", criteria.optimize, true}};
+  if (criteria.optimize)
+    attempts.insert(attempts.end(),
+                    {{"exudation only", true, false}, {"no optimisation", false, false}});
+  std::string first_defect;
+  std::string defects;
+  for (const double factor : kRetrySizeFactors) {
+    detail::Mesh3Criteria sized = criteria;
+    sized.facet_size *= factor;
+    sized.cell_size *= factor;
+    sized.facet_distance *= factor;
+    sized.max_vertices = vertex_budget(sized, diagonal);
+    if (sharp && median_edge >= kProtectEdgeFacets * sized.facet_size)
+      sized.sharp_edge_angle = kSharpEdgeDegrees;
+    for (const Attempt& attempt : attempts) {
+      detail::Mesh3Criteria tried = sized;
+      tried.optimize = attempt.optimize;
+      tried.perturb = attempt.perturb;
+      const TetMesh mesh = run_mesh_3_guarded(input, tried, file);
+      if (mesh.tets.empty())
+        throw InputError(file,
+                         "meshing produced no tetrahedra (is the surface closed and "
+                         "larger than the facet size?)");
+      const std::string defect = boundary_defect(mesh, file);
+      if (defect.empty()) {
+        if (!first_defect.empty()) {
+          notes.optimization_used = attempt.name;
+          if (factor != 1.0)
+            notes.optimization_used += ", sizes x" + std::to_string(factor).substr(0, 3);
+          notes.first_defect = first_defect;
+        }
         return mesh;
       }
-      defects += std::string("; ") + retry.name + ": " + retry_defect;
+      if (first_defect.empty()) first_defect = defect;
+      if (factor == 1.0)
+        defects += std::string(defects.empty() ? "" : "; ") + attempt.name + ": " + defect;
     }
   }
   throw InputError(file, "tetrahedralize: the meshed boundary is not a closed 2-manifold (" +
-                             defects + "); thin parts may need a smaller --facet-size");
+                             defects +
+                             "; also at 0.7 and 0.5 of the sizes); thin parts may "
+                             "need a smaller --facet-size");
 }
 
 }  // namespace

@@ -24,6 +24,11 @@ struct Mesh3Criteria {
   /// many vertices (0: no limit). Mesh_3's manifold refinement does not always terminate
   /// (sharp corners without feature protection); the budget turns that into an error.
   std::size_t max_vertices = 0;
+  /// > 0 (polyhedral surfaces only): the surface's sharp edges, those whose two triangles'
+  /// normals differ by more than this many degrees, are protected (CGAL
+  /// Polyhedral_mesh_domain_with_features_3, detect_features; edge size = facet_size), which
+  /// Mesh_3's manifold refinement needs to terminate at sharp corners. 0: no protection.
+  double sharp_edge_angle = 0.0;
 };
 
 /// Thrown by the Mesh_3 calls when refinement reached Mesh3Criteria::max_vertices.

@@ -1,14 +1,21 @@
 // Shape-keeping repairs of a triangle soup before meshing (`--repair fix`): degenerate and
-// duplicate triangles, isolated vertices, orientation (CGAL polygon-soup processing), small
-// holes (CGAL hole filling with fairing, which needs Eigen).
+// duplicate triangles, isolated vertices, orientation (CGAL polygon-soup processing), border
+// stitching, zero-area triangles, small holes (CGAL hole filling with fairing, which needs
+// Eigen) and few self-intersections (CGAL local remeshing).
 
 #define CGAL_EIGEN3_ENABLED 1
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Polygon_mesh_processing/border.h>
+#include <CGAL/Polygon_mesh_processing/measure.h>
 #include <CGAL/Polygon_mesh_processing/orient_polygon_soup.h>
 #include <CGAL/Polygon_mesh_processing/polygon_mesh_to_polygon_soup.h>
 #include <CGAL/Polygon_mesh_processing/polygon_soup_to_polygon_mesh.h>
+#include <CGAL/Polygon_mesh_processing/repair_degeneracies.h>
 #include <CGAL/Polygon_mesh_processing/repair_polygon_soup.h>
+#include <CGAL/Polygon_mesh_processing/repair_self_intersections.h>
+#include <CGAL/Polygon_mesh_processing/self_intersections.h>
+#include <CGAL/Polygon_mesh_processing/shape_predicates.h>
+#include <CGAL/Polygon_mesh_processing/stitch_borders.h>
 #include <CGAL/Polygon_mesh_processing/triangulate_hole.h>
 #include <CGAL/Surface_mesh.h>
 
@@ -16,6 +23,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <exception>
 #include <string>
 #include <utility>
 #include <vector>
@@ -32,17 +40,22 @@ using Polygon = std::array<std::size_t, 3>;
 
 /// Holes with at most this many border edges are filled (docs/cli.md).
 constexpr std::size_t kMaxHoleBorderEdges = 64;
+/// Self-intersections are removed locally only up to this many intersecting pairs of
+/// triangles (docs/cli.md); more is not a local defect.
+constexpr std::size_t kMaxLocalSelfIntersections = 64;
+/// A surface after self-intersection removal must enclose at least this volume over its area
+/// to the power 3/2 (a ball: 0.094; a 1 x 1 x 0.01 plate: 0.0035).
+constexpr double kMinVolumeOverArea = 1e-3;
+/// Self-intersections are not removed when hole filling made more than this share of the area.
+constexpr double kMaxPatchAreaForRemoval = 0.25;
 
-/// Fills every hole of the oriented soup with at most kMaxHoleBorderEdges border edges
-/// (triangulated, refined, faired: CGAL triangulate_refine_and_fair_hole; when fairing fails
-/// the refined patch is kept). Returns the number of holes filled; the soup is rewritten
-/// only when one was.
-std::size_t fill_small_holes(std::vector<Point>& points, std::vector<Polygon>& polygons) {
+using Mesh = CGAL::Surface_mesh<Point>;
+
+/// Fills every hole of `mesh` with at most kMaxHoleBorderEdges border edges (triangulated,
+/// refined, faired: CGAL triangulate_refine_and_fair_hole; when fairing fails the refined
+/// patch is kept). Returns the number of holes filled; adds the patches' area to `patch_area`.
+std::size_t fill_small_holes(Mesh& mesh, double& patch_area) {
   namespace pmp = CGAL::Polygon_mesh_processing;
-  using Mesh = CGAL::Surface_mesh<Point>;
-  if (!pmp::is_polygon_soup_a_polygon_mesh(polygons)) return 0;
-  Mesh mesh;
-  pmp::polygon_soup_to_polygon_mesh(points, polygons, mesh);
   std::vector<Mesh::Halfedge_index> borders;
   pmp::extract_boundary_cycles(mesh, std::back_inserter(borders));
   std::size_t filled = 0;
@@ -58,8 +71,82 @@ std::size_t fill_small_holes(std::vector<Point>& points, std::vector<Polygon>& p
     pmp::triangulate_refine_and_fair_hole(mesh, h, std::back_inserter(patch),
                                           std::back_inserter(added));
     if (!patch.empty()) ++filled;
+    for (const Mesh::Face_index f : patch) patch_area += pmp::face_area(f, mesh);
   }
-  if (filled == 0) return 0;
+  return filled;
+}
+
+std::size_t count_zero_area_faces(const Mesh& mesh) {
+  std::size_t count = 0;
+  for (const Mesh::Face_index f : mesh.faces())
+    if (CGAL::Polygon_mesh_processing::is_degenerate_triangle_face(f, mesh)) ++count;
+  return count;
+}
+
+/// Removes the self-intersections of `mesh` when they are few (at most
+/// kMaxLocalSelfIntersections pairs of triangles): CGAL's local remeshing
+/// (experimental::remove_self_intersections). The result is kept only if no intersection is
+/// left; returns the number of intersecting pairs removed (0: none, too many, or CGAL could
+/// not remove them all, and `mesh` is unchanged).
+std::size_t remove_few_self_intersections(Mesh& mesh) {
+  namespace pmp = CGAL::Polygon_mesh_processing;
+  std::vector<std::pair<Mesh::Face_index, Mesh::Face_index>> pairs;
+  pmp::self_intersections(mesh, std::back_inserter(pairs));
+  if (pairs.empty() || pairs.size() > kMaxLocalSelfIntersections) return 0;
+  Mesh attempt = mesh;
+  try {
+    if (!pmp::experimental::remove_self_intersections(attempt)) return 0;
+  } catch (const std::exception&) {
+    return 0;  // CGAL gave up on this input; the intersections are reported by validation
+  }
+  if (!CGAL::is_closed(attempt) || pmp::does_self_intersect(attempt)) return 0;
+  // A flat sheet whose filled border folded it onto itself (libcgal-demo negative.off) comes
+  // out closed but enclosing next to nothing, on which Mesh_3 never ends: refused.
+  const double area = pmp::area(attempt);
+  if (!(std::abs(pmp::volume(attempt)) >= kMinVolumeOverArea * area * std::sqrt(area))) return 0;
+  attempt.collect_garbage();
+  mesh = std::move(attempt);
+  return pairs.size();
+}
+
+/// The repairs that need the oriented soup as a polygon mesh, in this order: borders stitched
+/// (CGAL stitch_borders: border edges whose ends coincide with another border edge's, as on a
+/// seam whose vertices were duplicated), zero-area triangles removed (CGAL
+/// remove_degenerate_faces, by edge collapses and flips), small holes filled, few
+/// self-intersections removed on a closed surface. Each count goes to `record`; the soup is
+/// rewritten only when something changed.
+template <class Record>
+void repair_as_mesh(std::vector<Point>& points, std::vector<Polygon>& polygons,
+                    const Record& record) {
+  namespace pmp = CGAL::Polygon_mesh_processing;
+  if (polygons.empty() || !pmp::is_polygon_soup_a_polygon_mesh(polygons)) return;
+  Mesh mesh;
+  pmp::polygon_soup_to_polygon_mesh(points, polygons, mesh);
+  bool changed = false;
+  const std::size_t stitched = pmp::stitch_borders(mesh);
+  record("border edges stitched", stitched);
+  changed |= stitched > 0;
+  if (const std::size_t zero_area = count_zero_area_faces(mesh); zero_area > 0) {
+    pmp::remove_degenerate_faces(mesh);
+    mesh.collect_garbage();
+    const std::size_t left = count_zero_area_faces(mesh);
+    record("zero-area triangles removed", zero_area - std::min(left, zero_area));
+    changed = true;
+  }
+  double patch_area = 0.0;
+  const std::size_t filled = fill_small_holes(mesh, patch_area);
+  record("holes filled", filled);
+  changed |= filled > 0;
+  // Self-intersections made by the hole filling of a mostly open surface (a sheet closed onto
+  // itself, libcgal-demo negative.off) are not local defects: removing them gave a lens on
+  // which Mesh_3 never ended. So removal is tried only when the filled patches are under
+  // kMaxPatchAreaForRemoval of the area.
+  if (CGAL::is_closed(mesh) && patch_area <= kMaxPatchAreaForRemoval * pmp::area(mesh)) {
+    const std::size_t removed = remove_few_self_intersections(mesh);
+    record("self-intersecting triangle pairs removed by local remeshing", removed);
+    changed |= removed > 0;
+  }
+  if (!changed) return;
   std::vector<Point> new_points;
   std::vector<std::vector<std::size_t>> new_polygons;
   pmp::polygon_mesh_to_polygon_soup(mesh, new_points, new_polygons);
@@ -67,7 +154,6 @@ std::size_t fill_small_holes(std::vector<Point>& points, std::vector<Polygon>& p
   polygons.clear();
   for (const std::vector<std::size_t>& p : new_polygons)
     if (p.size() == 3) polygons.push_back({p[0], p[1], p[2]});
-  return filled;
 }
 
 /// Keeps the triangles of the edge-connected component of largest area (ties: the component
@@ -159,7 +245,7 @@ std::vector<RepairCount> repair_soup(TriangleMesh& mesh, bool keep_largest) {
     for (std::size_t v : polygon) used[v] = 1;
   record("isolated vertices removed",
          static_cast<std::size_t>(std::count(used.begin(), used.end(), 0)));
-  record("holes filled", fill_small_holes(points, polygons));
+  repair_as_mesh(points, polygons, record);
   if (keep_largest && !polygons.empty())
     record("smaller components removed", keep_largest_component(points, polygons));
   // Vertices no triangle uses any more are dropped (ids renumbered in order).

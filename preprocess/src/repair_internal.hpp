@@ -13,10 +13,13 @@ namespace tetseg::preprocess::detail {
 /// Repairs that keep the shape, in this order: triangles with a repeated corner removed,
 /// duplicate triangles (same three vertices, either orientation) merged, orientation made
 /// consistent (CGAL orient_polygon_soup: triangles flipped, non-manifold vertices
-/// duplicated), small holes filled, with `keep_largest_component` every edge-connected
-/// component but the one of largest area removed, unused vertices dropped. Returns the
-/// repairs made (kind, count; kinds with a zero count are left out). Vertex ids are
-/// renumbered in order of first use.
+/// duplicated), borders stitched where two border edges coincide (CGAL stitch_borders),
+/// zero-area triangles removed (CGAL remove_degenerate_faces), small holes filled, on a
+/// closed surface a few self-intersections removed by local remeshing (CGAL
+/// experimental::remove_self_intersections; kept only when none is left), with
+/// `keep_largest_component` every edge-connected component but the one of largest area
+/// removed, unused vertices dropped. Returns the repairs made (kind, count; kinds with a zero
+/// count are left out). Vertex ids are renumbered in order of first use.
 std::vector<RepairCount> repair_soup(TriangleMesh& mesh, bool keep_largest_component = false);
 
 /// CGAL 3D alpha wrapping of the triangle soup `soup` (any defects; at least one triangle),

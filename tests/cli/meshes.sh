@@ -75,6 +75,14 @@ grep -q '"hausdorff": {"input_to_mesh": ' dup.json || fail "the report lacks the
 sed -e 's/^8 6 0$/8 5 0/' -e '/^4 2 3 7 6$/d' cube.off >holed.off
 expect_exit 0 "tetseg: repaired holed.off: 1 holes filled" -- \
   "$bin/tetseg" build holed.off -o filled.tetseg --clusters single --facet-size 0.25 --no-optimize
+# Two halves of the cube whose 8 seam edges have duplicated vertices (bottom, top and front
+# on vertices 0-7; right, back and left on copies 8-15): the reader merges vertices by exact
+# position, so the seam is closed as read and builds even with --repair none (stitching of
+# borders that stay separate after reading is tested in tests/preprocess/repair_test.cpp).
+{ sed -n '1,10p' cube.off | sed 's/^8 6 0$/16 6 0/'; sed -n '3,10p' cube.off
+  printf '4 0 3 2 1\n4 4 5 6 7\n4 0 1 5 4\n4 9 10 14 13\n4 10 11 15 14\n4 11 8 12 15\n'; } >halves.off
+expect_exit 0 "tetseg: read .* 8 vertices, 12 triangles" -- \
+  "$bin/tetseg" build halves.off -o halves.tetseg --clusters single --repair none
 python3 -c '
 import math
 n = 80

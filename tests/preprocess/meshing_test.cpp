@@ -266,6 +266,21 @@ TEST_CASE("The simplest polygonal solids read from OFF and mesh with default opt
     CHECK(c.lo[0] == Approx(0.0).margin(1e-9));
     CHECK(c.hi[2] == Approx(1.0).margin(1e-9));
   }
+  SECTION("The right-angled corner tetrahedron in libcgal-demo colored_tetra.ply's order.") {
+    // Without protected sharp edges Mesh_3's manifold refinement looped forever on this
+    // vertex and face order (docs/benchmarks.md); the same solid in another order did not.
+    TriangleMesh s;
+    s.vertices = {{0, 0, 0}, {0, 0, 1}, {0, 1, 0}, {1, 0, 0}};
+    s.triangles = {{0, 1, 2}, {0, 3, 1}, {1, 3, 2}, {0, 2, 3}};
+    validate_closed_surface(s, "colored_tetra.ply");
+    const Checked c = check_valid(tetrahedralize(s, MeshingOptions{}, "colored_tetra.ply"));
+    // Protected edges and corners keep the tetrahedron's shape exactly up to rounding.
+    CHECK(c.volume == Approx(1.0 / 6.0).epsilon(0.03));
+    for (int k = 0; k < 3; ++k) {
+      CHECK(c.lo[k] == Approx(0.0).margin(1e-9));
+      CHECK(c.hi[k] == Approx(1.0).margin(1e-9));
+    }
+  }
   std::filesystem::remove_all(dir);
 }
 

@@ -126,6 +126,71 @@ TEST_CASE("Shape-keeping repairs fix small defects and say what they did", "[mes
     CHECK(count_of(notes, "repeated corner") == 1);
     CHECK(count_of(notes, "isolated vertices removed") == 1);
   }
+  SECTION("Two halves of the cube whose seam vertices are duplicated are stitched.") {
+    // Bottom, top and front (triangles 0-5) keep vertices 0-7; right, back and left (6-11)
+    // use copies 8-15 at the same places, so the seam's edges are border edges twice over.
+    TriangleMesh s = cube();
+    for (std::size_t v = 0; v < 8; ++v) s.vertices.push_back(s.vertices[v]);
+    for (std::size_t t = 6; t < 12; ++t)
+      for (std::uint32_t& v : s.triangles[t]) v += 8;
+    // The independent count: edges of the closed cube with one triangle in each half.
+    std::size_t seam = 0;
+    const TriangleMesh whole = cube();
+    for (std::size_t t = 0; t < 6; ++t)
+      for (std::size_t u = 6; u < 12; ++u) {
+        std::size_t shared = 0;
+        for (std::uint32_t a : whole.triangles[t])
+          for (std::uint32_t b : whole.triangles[u]) shared += a == b;
+        seam += shared == 2;
+      }
+    REQUIRE(seam > 0);
+    const TetrahedralizeNotes notes = fixed_and_refused(s, "not closed");
+    CHECK(count_of(notes, "border edges stitched") == seam);
+    CHECK(count_of(notes, "holes filled") == 0);
+  }
+  SECTION("A zero-area triangle on an edge of the cube is removed.") {
+    // The front's triangle (0 1 5) is split at the midpoint 8 of edge 0-1, and the sliver
+    // (0 1 8), whose corners are collinear, closes the surface between it and the bottom.
+    TriangleMesh s = cube();
+    s.vertices.push_back({0.5, 0, 0});
+    s.triangles[4] = {0, 8, 5};
+    s.triangles.push_back({8, 1, 5});
+    s.triangles.push_back({0, 1, 8});
+    const TetrahedralizeNotes notes = fixed_and_refused(s, "zero-area triangle");
+    CHECK(count_of(notes, "zero-area triangles removed") == 1);
+  }
+}
+
+TEST_CASE("Fix removes a local self-intersection by CGAL's local remeshing", "[meshing][repair]") {
+  // A geodesic sphere (720 triangles) with one vertex slid along the surface past its
+  // neighbours: its fan folds over the next triangles, a few intersecting pairs in one place.
+  TriangleMesh s = tetseg::test::icosphere(6);
+  Vec3& p = s.vertices[0];
+  const Vec3 tangent = {-p[1], p[0], 0.0};  // p is not on the z axis
+  const double t = std::hypot(tangent[0], tangent[1]);
+  Vec3 moved;
+  for (int k = 0; k < 3; ++k) moved[k] = p[k] + 0.35 * tangent[k] / t;
+  const double r = std::hypot(moved[0], moved[1], moved[2]);
+  for (int k = 0; k < 3; ++k) p[k] = 1.02 * moved[k] / r;
+  std::size_t pairs = 0;  // what validation of the unrepaired surface reports
+  try {
+    tetrahedralize(s, coarse(MeshingOptions::Repair::kNone), "folded.off");
+    FAIL("the folded sphere was meshed without repair");
+  } catch (const InputError& e) {
+    const std::string message = e.what();
+    const std::string prefix = "surface self-intersects (";
+    REQUIRE(message.find(prefix) != std::string::npos);
+    pairs = std::stoul(message.substr(message.find(prefix) + prefix.size()));
+  }
+  TetrahedralizeNotes notes;
+  const TetMesh m = tetrahedralize(s, coarse(MeshingOptions::Repair::kFix), "folded.off", &notes);
+  validate_tet_mesh(m, extract_surface(m), "repaired");
+  const std::size_t removed = count_of(notes, "self-intersecting triangle pairs removed");
+  CHECK(removed > 0);
+  CHECK(removed == pairs);
+  // The rest of the sphere is kept: the volume of the unit ball within Mesh_3's facet error.
+  CHECK(total_tet_volume(m) == Approx(4.0 * std::acos(-1.0) / 3.0).epsilon(0.05));
+  CHECK(notes.hausdorff_input_to_mesh < 0.1);
 }
 
 TEST_CASE("Fix fills small holes, names what it cannot repair and points to wrap",

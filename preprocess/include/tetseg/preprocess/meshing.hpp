@@ -83,7 +83,8 @@ TetMesh generate_shape(Shape shape, const ShapeOptions& shape_options,
 /// What tetrahedralize did beyond one plain Mesh_3 run (see tetrahedralize).
 struct TetrahedralizeNotes {
   /// "" when the first mesh was valid; else the retry that gave the returned mesh:
-  /// "exudation only" or "no optimisation".
+  /// "exudation only", "no optimisation", or one of those or "optimised" followed by
+  /// ", sizes x0.7" or ", sizes x0.5" (every meshing size scaled by that factor).
   std::string optimization_used;
   std::string first_defect;          ///< the first mesh's boundary defect, when retried
   std::vector<RepairCount> repairs;  ///< repairs of the input (MeshingOptions::repair)
@@ -97,10 +98,10 @@ struct TetrahedralizeNotes {
 /// Tetrahedralises a closed, manifold surface (interior nodes included). With
 /// `meshing.repair == kFix` the surface is first repaired without changing its shape:
 /// triangles with a repeated corner removed, duplicate triangles merged, orientation made
-/// consistent (flips; non-manifold vertices duplicated), unused vertices dropped, holes of at
-/// most 64 border edges filled; the repairs go to `notes->repairs`. Larger holes,
-/// self-intersections, several components and zero-area triangles with three distinct corners
-/// are not repaired: the error then ends by suggesting `--repair wrap`. With kWrap the surface
+/// consistent (flips; non-manifold vertices duplicated), borders stitched, zero-area triangles
+/// collapsed, holes of at most 64 border edges filled, at most 64 self-intersecting pairs
+/// remeshed locally (docs/cli.md); the repairs go to `notes->repairs`. What is left makes
+/// an error that ends by suggesting `--repair wrap`. With kWrap the surface
 /// is replaced by its CGAL alpha wrap (wrap_alpha, wrap_offset), which is closed, manifold and
 /// free of self-intersections for any soup; while that wrap is a thin shell (all over, or half
 /// of it) or does not mesh, alpha is doubled (at most 6 times); an input whose wrap is still a
@@ -113,7 +114,7 @@ struct TetrahedralizeNotes {
 /// vertex position, common in modelled meshes) are accepted. The result is checked like
 /// validate_tet_mesh (closed 2-manifold boundary, ...); when the optimised mesh (sliver
 /// perturbation, then exudation) fails that check, meshing is retried with exudation only,
-/// then without optimisation, and `notes` (if given) says which mesh was returned. Throws
+/// then without optimisation, then at 0.7 and 0.5 of every size; `notes` says which. Throws
 /// InputError (naming `file`; the message starts with the stage, "tetrahedralize: ...") when
 /// the surface is not usable (validate_closed_surface), a meshing size is below 1e-5 of the
 /// bounding-box diagonal, CGAL throws, meshing yields no tets, or every attempt's boundary is
