@@ -21,15 +21,26 @@ struct SurfacePart {
   Surface surface;                       ///< those triangles; sorted surface / interior nodes
 };
 
-/// Splits `surface` (extract_surface(mesh) of a validated mesh) by component, parts ordered by
-/// their smallest triangle id. One part (a copy of `surface`) for a connected mesh.
-std::vector<SurfacePart> split_surface(const TetMesh& mesh, const Surface& surface);
+/// Each node's component (nodes joined through tets), numbered in order of the components'
+/// first surface triangle; kNoPart for a node of no tet.
+struct NodeParts {
+  static constexpr std::uint32_t kNoPart = 0xffffffffu;
+  std::vector<std::uint32_t> part;
+  std::uint32_t count = 0;
+};
+
+/// Splits `surface` (extract_surface(mesh) of a validated mesh) by component (`parts`, as
+/// check_components returned them), parts ordered by their smallest triangle id. One part (a
+/// copy of `surface`) for a connected mesh.
+std::vector<SurfacePart> split_surface(const TetMesh& mesh, const Surface& surface,
+                                       const NodeParts& parts);
 
 /// The checks that make a mesh with several components meaningful, after the surface checks:
 /// each component is bounded by exactly one closed surface (no cavity), and no component lies
 /// inside another one (their volumes would overlap at rest; tested with the winding number of
 /// one surface node of each component). Throws InputError(file, ...) naming the component.
-void check_components(const TetMesh& mesh, const Surface& surface, const std::string& file);
+/// Returns the components found.
+NodeParts check_components(const TetMesh& mesh, const Surface& surface, const std::string& file);
 
 /// Throws InputError(file, ...) when a surface node of one component (triangles labelled
 /// 0..count-1 by `triangle_component`) lies inside the closed, oriented surface of another
