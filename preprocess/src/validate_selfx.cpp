@@ -28,6 +28,10 @@ struct Box {
   double lo[3], hi[3];
 };
 
+Point point(const std::vector<Vec3>& points, std::uint32_t i) {
+  return Point(points[i][0], points[i][1], points[i][2]);
+}
+
 /// Closed boxes, as CGAL's box intersection uses: touching boxes overlap.
 bool overlap(const Box& a, const Box& b) {
   for (int k = 0; k < 3; ++k)
@@ -111,8 +115,8 @@ bool certainly_apart_at_vertex(const Vec3& s, const Vec3& f1, const Vec3& f2, co
 /// of CGAL's Polygon_mesh_processing::internal::do_faces_intersect (CGAL 5.5), with shared
 /// vertices and edges found by vertex id instead of through a halfedge mesh (the same thing on
 /// a closed, edge-manifold, consistently oriented surface).
-bool strictly_intersect(const std::vector<Vec3>& q, const std::vector<Point>& p, const Tri& f,
-                        const Tri& g, const Kernel& kernel) {
+bool strictly_intersect(const std::vector<Vec3>& q, const Tri& f, const Tri& g,
+                        const Kernel& kernel) {
   bool f_shared[3] = {false, false, false};
   int first_f = -1, first_g = -1, shared = 0;
   for (int i = 0; i < 3; ++i)
@@ -135,9 +139,9 @@ bool strictly_intersect(const std::vector<Vec3>& q, const std::vector<Point>& p,
     const std::uint32_t apex_g = g[k];
     const int side = certain_side_sign(q[a], q[b], q[apex_f], q[apex_g]);
     if (side < 0) return false;
-    if (!CGAL::coplanar(p[a], p[b], p[apex_f], p[apex_g])) return false;
-    return side > 0 ||
-           CGAL::coplanar_orientation(p[a], p[b], p[apex_f], p[apex_g]) == CGAL::POSITIVE;
+    if (!CGAL::coplanar(point(q, a), point(q, b), point(q, apex_f), point(q, apex_g))) return false;
+    return side > 0 || CGAL::coplanar_orientation(point(q, a), point(q, b), point(q, apex_f),
+                                                  point(q, apex_g)) == CGAL::POSITIVE;
   }
   // A shared vertex: a floating-point separating plane settles most pairs without CGAL.
   if (shared == 1 &&
@@ -145,12 +149,12 @@ bool strictly_intersect(const std::vector<Vec3>& q, const std::vector<Point>& p,
                                 q[g[(first_g + 1) % 3]], q[g[(first_g + 2) % 3]]))
     return false;
   const auto do_intersect = kernel.do_intersect_3_object();
-  const Triangle tf(p[f[0]], p[f[1]], p[f[2]]);
-  const Triangle tg(p[g[0]], p[g[1]], p[g[2]]);
+  const Triangle tf(point(q, f[0]), point(q, f[1]), point(q, f[2]));
+  const Triangle tg(point(q, g[0]), point(q, g[1]), point(q, g[2]));
   if (shared == 1) {
     // Each triangle against the other's edge opposite the shared vertex.
-    const Segment sf(p[f[(first_f + 1) % 3]], p[f[(first_f + 2) % 3]]);
-    const Segment sg(p[g[(first_g + 1) % 3]], p[g[(first_g + 2) % 3]]);
+    const Segment sf(point(q, f[(first_f + 1) % 3]), point(q, f[(first_f + 2) % 3]));
+    const Segment sg(point(q, g[(first_g + 1) % 3]), point(q, g[(first_g + 2) % 3]));
     return do_intersect(tf, sg) || do_intersect(tg, sf);
   }
   return do_intersect(tf, tg);
@@ -161,9 +165,6 @@ bool strictly_intersect(const std::vector<Vec3>& q, const std::vector<Point>& p,
 std::vector<std::pair<std::size_t, std::size_t>> self_intersecting_pairs(
     const std::vector<Vec3>& points, const std::vector<Tri>& triangles) {
   const Kernel kernel;
-  std::vector<Point> p;
-  p.reserve(points.size());
-  for (const Vec3& v : points) p.emplace_back(v[0], v[1], v[2]);
   const std::uint32_t count = static_cast<std::uint32_t>(triangles.size());
 
   // A degenerate (collinear) triangle is reported paired with itself and left out of the
@@ -173,7 +174,7 @@ std::vector<std::pair<std::size_t, std::size_t>> self_intersecting_pairs(
   items.reserve(count);
   for (std::uint32_t t = 0; t < count; ++t) {
     const Tri& tri = triangles[t];
-    if (CGAL::collinear(p[tri[0]], p[tri[1]], p[tri[2]])) {
+    if (CGAL::collinear(point(points, tri[0]), point(points, tri[1]), point(points, tri[2]))) {
       pairs.emplace_back(t, t);
     } else {
       items.push_back(t);
@@ -226,7 +227,7 @@ std::vector<std::pair<std::size_t, std::size_t>> self_intersecting_pairs(
 #endif
       for (std::int64_t i = 0; i < size; ++i) {
         const auto [f, g] = candidates[static_cast<std::size_t>(i)];
-        if (strictly_intersect(points, p, triangles[f], triangles[g], kernel))
+        if (strictly_intersect(points, triangles[f], triangles[g], kernel))
           found.emplace_back(std::min(f, g), std::max(f, g));
       }
 #if defined(TETSEG_HAVE_OPENMP)
