@@ -24,26 +24,15 @@ UnionFind joined_nodes(std::size_t node_count, const Elements& elements) {
   return sets;
 }
 
-/// Each node's component: nodes joined through every tet (the parent array is prefetched a
-/// few tets ahead: a mesh's node order rarely follows its tets).
-NodeParts node_parts(const TetMesh& mesh, const Surface& surface) {
-  UnionFind sets(static_cast<std::uint32_t>(mesh.nodes.size()));
-  const std::size_t tet_count = mesh.tets.size();
-  for (std::size_t t = 0; t < tet_count; ++t) {
-    constexpr std::size_t kAhead = 8;
-    if (t + kAhead < tet_count)
-      for (std::uint32_t v : mesh.tets[t + kAhead]) sets.prefetch(v);
-    const Tet& tet = mesh.tets[t];
-    for (std::size_t k = 1; k < 4; ++k) sets.unite(tet[0], tet[k]);
-  }
+/// Each node's component from the roots of tet_node_roots, numbered in order of the first
+/// surface triangle.
+NodeParts node_parts(const std::vector<std::uint32_t>& roots, const Surface& surface) {
   NodeParts parts;
-  std::vector<std::uint32_t> part_of_root(mesh.nodes.size(), kUnset);
-  for (const Tri& t : surface.triangles) {
-    const std::uint32_t root = sets.find(t[0]);
-    if (part_of_root[root] == kUnset) part_of_root[root] = parts.count++;
-  }
-  parts.part.resize(mesh.nodes.size());
-  for (std::uint32_t v = 0; v < parts.part.size(); ++v) parts.part[v] = part_of_root[sets.find(v)];
+  std::vector<std::uint32_t> part_of_root(roots.size(), kUnset);
+  for (const Tri& t : surface.triangles)
+    if (part_of_root[roots[t[0]]] == kUnset) part_of_root[roots[t[0]]] = parts.count++;
+  parts.part.resize(roots.size());
+  for (std::uint32_t v = 0; v < parts.part.size(); ++v) parts.part[v] = part_of_root[roots[v]];
   return parts;
 }
 
@@ -57,6 +46,22 @@ double solid_angle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
 }
 
 }  // namespace
+
+std::vector<std::uint32_t> tet_node_roots(const TetMesh& mesh) {
+  UnionFind sets(static_cast<std::uint32_t>(mesh.nodes.size()));
+  const std::size_t tet_count = mesh.tets.size();
+  for (std::size_t t = 0; t < tet_count; ++t) {
+    // The parent array is prefetched a few tets ahead: node order rarely follows the tets.
+    constexpr std::size_t kAhead = 8;
+    if (t + kAhead < tet_count)
+      for (std::uint32_t v : mesh.tets[t + kAhead]) sets.prefetch(v);
+    const Tet& tet = mesh.tets[t];
+    for (std::size_t k = 1; k < 4; ++k) sets.unite(tet[0], tet[k]);
+  }
+  std::vector<std::uint32_t> roots(mesh.nodes.size());
+  for (std::uint32_t v = 0; v < roots.size(); ++v) roots[v] = sets.find(v);
+  return roots;
+}
 
 std::vector<SurfacePart> split_surface(const TetMesh& mesh, const Surface& surface,
                                        const NodeParts& node_parts) {
@@ -86,8 +91,9 @@ std::vector<SurfacePart> split_surface(const TetMesh& mesh, const Surface& surfa
   return parts;
 }
 
-NodeParts check_components(const TetMesh& mesh, const Surface& surface, const std::string& file) {
-  NodeParts parts = node_parts(mesh, surface);
+NodeParts check_components(const TetMesh& mesh, const Surface& surface,
+                           const std::vector<std::uint32_t>& roots, const std::string& file) {
+  NodeParts parts = node_parts(roots, surface);
   const std::uint32_t count = parts.count;
   const std::vector<std::uint32_t>& part = parts.part;
   // Closed surfaces per component: triangles joined through shared nodes (the surface is

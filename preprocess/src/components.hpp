@@ -29,6 +29,10 @@ struct NodeParts {
   std::uint32_t count = 0;
 };
 
+/// Per node, the smallest id of the nodes joined to it through tets (union-find over the
+/// tets). Every tet's node ids must be in range.
+std::vector<std::uint32_t> tet_node_roots(const TetMesh& mesh);
+
 /// Splits `surface` (extract_surface(mesh) of a validated mesh) by component (`parts`, as
 /// check_components returned them), parts ordered by their smallest triangle id. One part (a
 /// copy of `surface`) for a connected mesh.
@@ -39,8 +43,9 @@ std::vector<SurfacePart> split_surface(const TetMesh& mesh, const Surface& surfa
 /// each component is bounded by exactly one closed surface (no cavity), and no component lies
 /// inside another one (their volumes would overlap at rest; tested with the winding number of
 /// one surface node of each component). Throws InputError(file, ...) naming the component.
-/// Returns the components found.
-NodeParts check_components(const TetMesh& mesh, const Surface& surface, const std::string& file);
+/// `roots` are tet_node_roots(mesh). Returns the components found.
+NodeParts check_components(const TetMesh& mesh, const Surface& surface,
+                           const std::vector<std::uint32_t>& roots, const std::string& file);
 
 /// Throws InputError(file, ...) when a surface node of one component (triangles labelled
 /// 0..count-1 by `triangle_component`) lies inside the closed, oriented surface of another

@@ -177,10 +177,16 @@ detail::FaceMatch detail::match_faces(const TetMesh& mesh, bool check_tets) {
   std::vector<std::size_t> block_crowded(block_count, 0);
   std::vector<FaceKey> block_first_crowded(block_count);
   const std::int64_t blocks = static_cast<std::int64_t>(block_count);
+  const bool find_roots = check_tets && match.tets.first_out_of_range == SIZE_MAX;
 #if defined(TETSEG_HAVE_OPENMP)
 #pragma omp parallel
 #endif
   {
+    // The components of validation: one thread finds them, the others start on the blocks.
+#if defined(TETSEG_HAVE_OPENMP)
+#pragma omp single nowait
+#endif
+    if (find_roots) match.node_roots = tet_node_roots(mesh);
     struct Slot {
       std::uint32_t entry;  // index in the block; kEmpty when free
       std::uint32_t count;

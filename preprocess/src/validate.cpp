@@ -256,7 +256,7 @@ detail::NodeParts detail::validate_tet_mesh(const TetMesh& mesh, const Surface& 
   detail::SurfaceCheck options;
   options.allow_components = true;
   check_surface(mesh.nodes, surface.triangles, file, options, nullptr);
-  return detail::check_components(mesh, surface, file);
+  return detail::check_components(mesh, surface, match.node_roots, file);
 }
 
 void validate_closed_surface(const TriangleMesh& mesh, const std::string& file,

@@ -39,12 +39,16 @@ struct FaceMatch {
   /// Whether `tets` was filled (match_faces with check_tets).
   bool tets_checked = false;
   TetChecks tets;
+  /// With check_tets and every node id in range: tet_node_roots (components.hpp), computed
+  /// by one thread while the others match faces.
+  std::vector<std::uint32_t> node_roots;
 };
 
 /// Matches the faces of every tet in O(T): a counting sort into blocks of smallest-node ids,
 /// then a hash table per block. With `check_tets`, the counting pass also fills
 /// FaceMatch::tets (node ranges, node use, degenerate and inverted tets; each tet's nodes are
-/// read once, prefetched a few tets ahead since a mesh's node order rarely follows its tets).
+/// read once, prefetched a few tets ahead since a mesh's node order rarely follows its tets)
+/// and the hashing pass FaceMatch::node_roots.
 /// Any indices (out-of-range ones included); throws std::length_error at 2^30 tets or more.
 /// Uses OpenMP threads when built with them; the result does not depend on their number.
 FaceMatch match_faces(const TetMesh& mesh, bool check_tets);
