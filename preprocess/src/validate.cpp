@@ -4,13 +4,13 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <numeric>
 #include <stdexcept>
 #include <string>
 #include <tuple>
 #include <vector>
 
 #include "components.hpp"
+#include "segment_topology.hpp"
 #include "tetseg/preprocess/surface.hpp"
 #include "validate_internal.hpp"
 #include "vec3_math.hpp"
@@ -18,28 +18,13 @@
 namespace tetseg::preprocess {
 namespace {
 
+using detail::UnionFind;
+
 constexpr double kDegenerateArea = 1e-12;  // |2 area| relative to max edge^2
 
 std::string plural(std::size_t n, const char* one, const char* many) {
   return std::to_string(n) + " " + (n == 1 ? one : many);
 }
-
-struct UnionFind {
-  explicit UnionFind(std::size_t n) : parent(n) { std::iota(parent.begin(), parent.end(), 0u); }
-  std::uint32_t find(std::uint32_t x) {
-    while (parent[x] != x) {
-      parent[x] = parent[parent[x]];
-      x = parent[x];
-    }
-    return x;
-  }
-  void unite(std::uint32_t a, std::uint32_t b) {
-    a = find(a);
-    b = find(b);
-    if (a != b) parent[std::max(a, b)] = std::min(a, b);
-  }
-  std::vector<std::uint32_t> parent;
-};
 
 void check_finite(const std::vector<Vec3>& points, const std::string& file, const char* noun) {
   for (std::size_t i = 0; i < points.size(); ++i)
@@ -112,13 +97,13 @@ void check_surface(const std::vector<Vec3>& points, const std::vector<Tri>& tria
                                edge_name(first_misoriented) + ")");
   // Vertex manifoldness: the triangles around a vertex must form one fan. Corners (t, k) are
   // joined across every manifold edge at both of its end vertices.
-  UnionFind corners(triangles.size() * 3);
+  UnionFind corners(static_cast<std::uint32_t>(triangles.size() * 3));
   auto corner_of = [&](std::uint32_t t, std::uint32_t v) {
     for (std::uint32_t k = 0; k < 3; ++k)
       if (triangles[t][k] == v) return t * 3 + k;
     return t * 3;
   };
-  UnionFind components(triangles.size());
+  UnionFind components(static_cast<std::uint32_t>(triangles.size()));
   for (const auto& [a, b] : pairs) {
     const std::uint32_t ta = half[a].tri;
     const std::uint32_t tb = half[b].tri;
