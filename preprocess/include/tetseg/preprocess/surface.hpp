@@ -31,7 +31,7 @@ Surface extract_surface(const TetMesh& mesh);
 /// Throws InputError(`file`, message) naming the first defect found, e.g. "surface is not
 /// closed (3 border edges, first between vertices 4 and 7)". Cost: the face matching of
 /// extract_surface with the O(T) checks of the tets made in its counting pass, O(B log B)
-/// checks of the B boundary triangles and the self-intersection test (about 1.3 s of CPU for
+/// checks of the B boundary triangles and the self-intersection test (about 1.2 s of CPU for
 /// 4.8 M tets / 104k triangles with the extraction; docs/benchmarks.md, "Scale"). Thread-safe.
 void validate_tet_mesh(const TetMesh& mesh, const Surface& surface, const std::string& file);
 
