@@ -71,8 +71,6 @@ std::vector<SurfacePart> split_surface(const TetMesh& mesh, const Surface& surfa
     SurfacePart whole;
     whole.triangles.resize(surface.triangles.size());
     std::iota(whole.triangles.begin(), whole.triangles.end(), 0u);
-    whole.tets.resize(mesh.tets.size());
-    std::iota(whole.tets.begin(), whole.tets.end(), 0u);
     whole.surface = surface;
     return {whole};
   }

@@ -17,7 +17,8 @@ namespace tetseg::preprocess::detail {
 /// surface, ascending, and its surface and interior nodes.
 struct SurfacePart {
   std::vector<std::uint32_t> triangles;  ///< ids into the whole surface, ascending
-  std::vector<std::uint32_t> tets;       ///< the component's tet ids, ascending
+  std::vector<std::uint32_t> tets;       ///< the component's tet ids, ascending; empty when
+                                         ///< it is the only one (then: every tet)
   Surface surface;                       ///< those triangles; sorted surface / interior nodes
 };
 
@@ -35,7 +36,7 @@ std::vector<std::uint32_t> tet_node_roots(const TetMesh& mesh);
 
 /// Splits `surface` (extract_surface(mesh) of a validated mesh) by component (`parts`, as
 /// check_components returned them), parts ordered by their smallest triangle id. One part (a
-/// copy of `surface`) for a connected mesh.
+/// copy of `surface`, no tet list) for a connected mesh.
 std::vector<SurfacePart> split_surface(const TetMesh& mesh, const Surface& surface,
                                        const NodeParts& parts);
 
