@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <memory>
 #include <stdexcept>
 #include <utility>
 #include <vector>
@@ -156,7 +157,8 @@ detail::FaceMatch detail::match_faces(const TetMesh& mesh, bool check_tets) {
         static_cast<std::uint32_t>(std::find(used.begin(), used.end(), 0) - used.begin());
   }
   for (std::size_t i = 1; i < start.size(); ++i) start[i] += start[i - 1];
-  std::vector<FaceEntry> entries(tets.size() * 4);
+  // Left uninitialised: the scatter's threads write every entry, and so touch its pages first.
+  const std::unique_ptr<FaceEntry[]> entries(new FaceEntry[tets.size() * 4]);
 #if defined(TETSEG_HAVE_OPENMP)
 #pragma omp parallel for schedule(static, 1)
 #endif
@@ -198,7 +200,7 @@ detail::FaceMatch detail::match_faces(const TetMesh& mesh, bool check_tets) {
 #endif
     for (std::int64_t bi = 0; bi < blocks; ++bi) {
       const std::size_t b = static_cast<std::size_t>(bi);
-      const FaceEntry* const first = entries.data() + start[b * parts];
+      const FaceEntry* const first = entries.get() + start[b * parts];
       const std::size_t size = start[(b + 1) * parts] - start[b * parts];
       if (size == 0) continue;
       unsigned bits = 4;
