@@ -25,8 +25,8 @@ Surface extract_surface(const TetMesh& mesh);
 /// closed (border edges counted), edge-manifold, consistently oriented, vertex-manifold (one
 /// fan of triangles per vertex), free of self-intersection at rest (a median-split BVH over
 /// the triangles' boxes, then CGAL's exact predicates on the pairs whose boxes touch: the same
-/// pairs as CGAL's self_intersections, tested); then per component (nodes joined through tets; a mesh
-/// may have several): bounded by exactly one closed surface (no cavity), not inside another
+/// pairs as CGAL's self_intersections, tested); then per component (nodes joined through tets; a
+/// mesh may have several): bounded by exactly one closed surface (no cavity), not inside another
 /// component (docs/segmentation.md, "Several components").
 /// Throws InputError(`file`, message) naming the first defect found, e.g. "surface is not
 /// closed (3 border edges, first between vertices 4 and 7)". Cost: the face matching of
