@@ -13,7 +13,7 @@
 namespace tetseg::preprocess::detail {
 namespace {
 
-constexpr std::uint32_t kUnset = 0xffffffffu;
+constexpr std::uint32_t kUnset = NodeParts::kNoPart;
 
 /// Node sets joined through every triangle (or tet) of `elements`.
 template <typename Elements>
@@ -24,39 +24,44 @@ UnionFind joined_nodes(std::size_t node_count, const Elements& elements) {
   return sets;
 }
 
-/// Per node, the root of its component (nodes joined through every tet).
-std::vector<std::uint32_t> node_roots(const TetMesh& mesh) {
-  UnionFind sets = joined_nodes(mesh.nodes.size(), mesh.tets);
-  std::vector<std::uint32_t> root(mesh.nodes.size());
-  for (std::uint32_t v = 0; v < root.size(); ++v) root[v] = sets.find(v);
-  return root;
-}
-
-/// Per node, its part (numbered in order of the parts' first surface triangle), kUnset for a
-/// node of no part; `count` receives the number of parts.
-std::vector<std::uint32_t> node_parts(const TetMesh& mesh, const Surface& surface,
-                                      std::uint32_t& count) {
-  const std::vector<std::uint32_t> root = node_roots(mesh);
-  std::vector<std::uint32_t> part_of_root(mesh.nodes.size(), kUnset);
-  count = 0;
+/// Each node's component from the roots of tet_node_roots, numbered in order of the first
+/// surface triangle.
+NodeParts node_parts(const std::vector<std::uint32_t>& roots, const Surface& surface) {
+  NodeParts parts;
+  std::vector<std::uint32_t> part_of_root(roots.size(), kUnset);
   for (const Tri& t : surface.triangles)
-    if (part_of_root[root[t[0]]] == kUnset) part_of_root[root[t[0]]] = count++;
-  std::vector<std::uint32_t> part(mesh.nodes.size());
-  for (std::uint32_t v = 0; v < part.size(); ++v) part[v] = part_of_root[root[v]];
-  return part;
+    if (part_of_root[roots[t[0]]] == kUnset) part_of_root[roots[t[0]]] = parts.count++;
+  parts.part.resize(roots.size());
+  for (std::uint32_t v = 0; v < parts.part.size(); ++v) parts.part[v] = part_of_root[roots[v]];
+  return parts;
 }
 
 }  // namespace
 
-std::vector<SurfacePart> split_surface(const TetMesh& mesh, const Surface& surface) {
-  std::uint32_t count = 0;
-  const std::vector<std::uint32_t> part = node_parts(mesh, surface, count);
+std::vector<std::uint32_t> tet_node_roots(const TetMesh& mesh) {
+  UnionFind sets(static_cast<std::uint32_t>(mesh.nodes.size()));
+  const std::size_t tet_count = mesh.tets.size();
+  for (std::size_t t = 0; t < tet_count; ++t) {
+    // The parent array is prefetched a few tets ahead: node order rarely follows the tets.
+    constexpr std::size_t kAhead = 8;
+    if (t + kAhead < tet_count)
+      for (std::uint32_t v : mesh.tets[t + kAhead]) sets.prefetch(v);
+    const Tet& tet = mesh.tets[t];
+    for (std::size_t k = 1; k < 4; ++k) sets.unite(tet[0], tet[k]);
+  }
+  std::vector<std::uint32_t> roots(mesh.nodes.size());
+  for (std::uint32_t v = 0; v < roots.size(); ++v) roots[v] = sets.find(v);
+  return roots;
+}
+
+std::vector<SurfacePart> split_surface(const TetMesh& mesh, const Surface& surface,
+                                       const NodeParts& node_parts) {
+  const std::uint32_t count = node_parts.count;
+  const std::vector<std::uint32_t>& part = node_parts.part;
   if (count <= 1) {
     SurfacePart whole;
     whole.triangles.resize(surface.triangles.size());
     std::iota(whole.triangles.begin(), whole.triangles.end(), 0u);
-    whole.tets.resize(mesh.tets.size());
-    std::iota(whole.tets.begin(), whole.tets.end(), 0u);
     whole.surface = surface;
     return {whole};
   }
@@ -75,9 +80,11 @@ std::vector<SurfacePart> split_surface(const TetMesh& mesh, const Surface& surfa
   return parts;
 }
 
-void check_components(const TetMesh& mesh, const Surface& surface, const std::string& file) {
-  std::uint32_t count = 0;
-  const std::vector<std::uint32_t> part = node_parts(mesh, surface, count);
+NodeParts check_components(const TetMesh& mesh, const Surface& surface,
+                           const std::vector<std::uint32_t>& roots, const std::string& file) {
+  NodeParts parts = node_parts(roots, surface);
+  const std::uint32_t count = parts.count;
+  const std::vector<std::uint32_t>& part = parts.part;
   // Closed surfaces per component: triangles joined through shared nodes (the surface is
   // vertex-manifold here, so this is edge-connectivity).
   UnionFind shell_sets = joined_nodes(mesh.nodes.size(), surface.triangles);
@@ -93,11 +100,12 @@ void check_components(const TetMesh& mesh, const Surface& surface, const std::st
                                  " (node " + std::to_string(first_node[c]) + ") is bounded by " +
                                  std::to_string(shells[c]) +
                                  " closed surfaces: bodies with a cavity are not supported");
-  if (count <= 1) return;
+  if (count <= 1) return parts;
   std::vector<std::uint32_t> triangle_component;
   triangle_component.reserve(surface.triangles.size());
   for (const Tri& t : surface.triangles) triangle_component.push_back(part[t[0]]);
   check_not_nested(mesh.nodes, surface.triangles, triangle_component, count, file);
+  return parts;
 }
 
 void check_not_nested(const std::vector<Vec3>& points, const std::vector<Tri>& triangles,

@@ -17,19 +17,36 @@ namespace tetseg::preprocess::detail {
 /// surface, ascending, and its surface and interior nodes.
 struct SurfacePart {
   std::vector<std::uint32_t> triangles;  ///< ids into the whole surface, ascending
-  std::vector<std::uint32_t> tets;       ///< the component's tet ids, ascending
+  std::vector<std::uint32_t> tets;       ///< the component's tet ids, ascending; empty when
+                                         ///< it is the only one (then: every tet)
   Surface surface;                       ///< those triangles; sorted surface / interior nodes
 };
 
-/// Splits `surface` (extract_surface(mesh) of a validated mesh) by component, parts ordered by
-/// their smallest triangle id. One part (a copy of `surface`) for a connected mesh.
-std::vector<SurfacePart> split_surface(const TetMesh& mesh, const Surface& surface);
+/// Each node's component (nodes joined through tets), numbered in order of the components'
+/// first surface triangle; kNoPart for a node of no tet.
+struct NodeParts {
+  static constexpr std::uint32_t kNoPart = 0xffffffffu;
+  std::vector<std::uint32_t> part;
+  std::uint32_t count = 0;
+};
+
+/// Per node, the smallest id of the nodes joined to it through tets (union-find over the
+/// tets). Every tet's node ids must be in range.
+std::vector<std::uint32_t> tet_node_roots(const TetMesh& mesh);
+
+/// Splits `surface` (extract_surface(mesh) of a validated mesh) by component (`parts`, as
+/// check_components returned them), parts ordered by their smallest triangle id. One part (a
+/// copy of `surface`, no tet list) for a connected mesh.
+std::vector<SurfacePart> split_surface(const TetMesh& mesh, const Surface& surface,
+                                       const NodeParts& parts);
 
 /// The checks that make a mesh with several components meaningful, after the surface checks:
 /// each component is bounded by exactly one closed surface (no cavity), and no component lies
 /// inside another one (their volumes would overlap at rest; tested with the winding number of
 /// one surface node of each component). Throws InputError(file, ...) naming the component.
-void check_components(const TetMesh& mesh, const Surface& surface, const std::string& file);
+/// `roots` are tet_node_roots(mesh). Returns the components found.
+NodeParts check_components(const TetMesh& mesh, const Surface& surface,
+                           const std::vector<std::uint32_t>& roots, const std::string& file);
 
 /// Throws InputError(file, ...) when a surface node of one component (triangles labelled
 /// 0..count-1 by `triangle_component`) lies inside the closed, oriented surface of another

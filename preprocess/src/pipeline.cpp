@@ -17,6 +17,7 @@
 #include "tetseg/format/asset_io.hpp"
 #include "tetseg/preprocess/names.hpp"
 #include "tetseg/preprocess/surface.hpp"
+#include "validate_internal.hpp"
 
 namespace tetseg::preprocess {
 namespace {
@@ -295,8 +296,9 @@ format::Asset build_asset(const TetMesh& mesh, const std::string& source,
 
   std::vector<detail::SurfacePart> parts;  // one per component (docs/segmentation.md)
   const Surface surface = timer.run("surface", [&](std::string& summary) {
-    Surface s = extract_valid_surface(mesh, source);
-    parts = detail::split_surface(mesh, s);
+    detail::NodeParts node_parts;
+    Surface s = detail::extract_valid_surface(mesh, source, node_parts);
+    parts = detail::split_surface(mesh, s, node_parts);
     summary = std::to_string(s.triangles.size()) + " triangles, " +
               std::to_string(s.interior_nodes.size()) + " interior nodes, " +
               std::to_string(parts.size()) + (parts.size() == 1 ? " component" : " components");

@@ -123,22 +123,4 @@ UnionFind::UnionFind(std::uint32_t n) : m_parent(n) {
   for (std::uint32_t i = 0; i < n; ++i) m_parent[i] = i;
 }
 
-std::uint32_t UnionFind::find(std::uint32_t x) {
-  while (m_parent[x] != x) {
-    m_parent[x] = m_parent[m_parent[x]];
-    x = m_parent[x];
-  }
-  return x;
-}
-
-void UnionFind::unite(std::uint32_t a, std::uint32_t b) {
-  a = find(a);
-  b = find(b);
-  if (a == b) return;
-  if (a < b)
-    m_parent[b] = a;
-  else
-    m_parent[a] = b;
-}
-
 }  // namespace tetseg::preprocess::detail

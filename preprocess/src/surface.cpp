@@ -1,7 +1,9 @@
 // Boundary extraction and volumes. No CGAL here.
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
+#include <memory>
 #include <stdexcept>
 #include <utility>
 #include <vector>
@@ -48,6 +50,45 @@ bool same_face(const FaceEntry& x, const FaceEntry& y) {
   return x.low == y.low && x.mid == y.mid && x.high == y.high;
 }
 
+/// The checks of tet t for validate_tet_mesh, added to `checks`: node ids in range (nodes
+/// marked in `used`), then degenerate or inverted. Prefetches the nodes of a tet a few ahead
+/// (below `end`): the nodes of consecutive tets are rarely near each other in memory.
+void check_tet(const TetMesh& mesh, std::size_t t, std::size_t end, std::vector<char>& used,
+               detail::TetChecks& checks) {
+  const std::size_t n = mesh.nodes.size();
+  constexpr std::size_t kAhead = 6;
+#if defined(__GNUC__)
+  if (t + kAhead < end)
+    for (std::uint32_t v : mesh.tets[t + kAhead])
+      if (v < n) __builtin_prefetch(mesh.nodes[v].data());
+#endif
+  const Tet& tet = mesh.tets[t];
+  if (tet[0] >= n || tet[1] >= n || tet[2] >= n || tet[3] >= n) {
+    checks.first_out_of_range = std::min(checks.first_out_of_range, t);
+    return;
+  }
+  for (std::uint32_t v : tet) {
+#if defined(TETSEG_HAVE_OPENMP)
+#pragma omp atomic write
+#endif
+    used[v] = 1;
+  }
+  const Vec3& a = mesh.nodes[tet[0]];
+  const Vec3& b = mesh.nodes[tet[1]];
+  const Vec3& c = mesh.nodes[tet[2]];
+  const Vec3& d = mesh.nodes[tet[3]];
+  const double det = detail::tet_det(a, b, c, d);
+  // sqrt of the largest squared edge: the same double as the largest of the six lengths.
+  const double edge = std::sqrt(
+      std::max({detail::distance2(a, b), detail::distance2(a, c), detail::distance2(a, d),
+                detail::distance2(b, c), detail::distance2(b, d), detail::distance2(c, d)}));
+  if (!(std::abs(det) > detail::kDegenerateTetVolume * edge * edge * edge)) {
+    if (checks.degenerate++ == 0) checks.first_degenerate = t;
+  } else if (det < 0) {
+    if (checks.inverted++ == 0) checks.first_inverted = t;
+  }
+}
+
 int thread_count() {
 #if defined(TETSEG_HAVE_OPENMP)
   return omp_get_max_threads();
@@ -58,11 +99,12 @@ int thread_count() {
 
 }  // namespace
 
-detail::FaceMatch detail::match_faces(const TetMesh& mesh) {
+detail::FaceMatch detail::match_faces(const TetMesh& mesh, bool check_tets) {
   // No comparison sort of the 4 T faces: a counting sort into blocks of 1024 smallest-node ids
   // (one streaming scatter, a write stream per block), then a hash table per block, in cache.
   // Faces whose nodes are all out of range share a last block. Threads split the tets for the
-  // scatter and the blocks for the rest; the result does not depend on their number.
+  // counting (and the tet checks) and the scatter, and the blocks for the rest; the result
+  // does not depend on their number.
   const std::vector<Tet>& tets = mesh.tets;
   if (tets.size() >= (std::size_t{1} << 30))
     throw std::length_error("match_faces: 2^30 tets or more");
@@ -84,16 +126,39 @@ detail::FaceMatch detail::match_faces(const TetMesh& mesh) {
   auto part_begin = [&](std::size_t p) { return tets.size() * p / parts; };
   std::vector<std::size_t> start(block_count * parts + 1, 0);
   const std::int64_t part_count = static_cast<std::int64_t>(parts);
+  std::vector<TetChecks> part_checks(parts);
+  std::vector<char> used(check_tets ? node_count : 0, 0);
 #if defined(TETSEG_HAVE_OPENMP)
 #pragma omp parallel for schedule(static, 1)
 #endif
   for (std::int64_t pi = 0; pi < part_count; ++pi) {
     const std::size_t p = static_cast<std::size_t>(pi);
-    for (std::size_t t = part_begin(p); t < part_begin(p + 1); ++t)
+    const std::size_t end = part_begin(p + 1);
+    TetChecks checks;
+    for (std::size_t t = part_begin(p); t < end; ++t) {
       for (int f = 0; f < 4; ++f) ++start[block_of(entry_of(t, f)) * parts + p + 1];
+      if (check_tets) check_tet(mesh, t, end, used, checks);
+    }
+    part_checks[p] = checks;
+  }
+  FaceMatch match;
+  if (check_tets) {
+    match.tets_checked = true;
+    TetChecks& all = match.tets;
+    for (const TetChecks& c : part_checks) {  // parts ascend by tet
+      all.first_out_of_range = std::min(all.first_out_of_range, c.first_out_of_range);
+      all.degenerate += c.degenerate;
+      all.inverted += c.inverted;
+      all.first_degenerate = std::min(all.first_degenerate, c.first_degenerate);
+      all.first_inverted = std::min(all.first_inverted, c.first_inverted);
+    }
+    all.unused = static_cast<std::size_t>(std::count(used.begin(), used.end(), 0));
+    all.first_unused =
+        static_cast<std::uint32_t>(std::find(used.begin(), used.end(), 0) - used.begin());
   }
   for (std::size_t i = 1; i < start.size(); ++i) start[i] += start[i - 1];
-  std::vector<FaceEntry> entries(tets.size() * 4);
+  // Left uninitialised: the scatter's threads write every entry, and so touch its pages first.
+  const std::unique_ptr<FaceEntry[]> entries(new FaceEntry[tets.size() * 4]);
 #if defined(TETSEG_HAVE_OPENMP)
 #pragma omp parallel for schedule(static, 1)
 #endif
@@ -114,10 +179,16 @@ detail::FaceMatch detail::match_faces(const TetMesh& mesh) {
   std::vector<std::size_t> block_crowded(block_count, 0);
   std::vector<FaceKey> block_first_crowded(block_count);
   const std::int64_t blocks = static_cast<std::int64_t>(block_count);
+  const bool find_roots = check_tets && match.tets.first_out_of_range == SIZE_MAX;
 #if defined(TETSEG_HAVE_OPENMP)
 #pragma omp parallel
 #endif
   {
+    // The components of validation: one thread finds them, the others start on the blocks.
+#if defined(TETSEG_HAVE_OPENMP)
+#pragma omp single nowait
+#endif
+    if (find_roots) match.node_roots = tet_node_roots(mesh);
     struct Slot {
       std::uint32_t entry;  // index in the block; kEmpty when free
       std::uint32_t count;
@@ -129,7 +200,7 @@ detail::FaceMatch detail::match_faces(const TetMesh& mesh) {
 #endif
     for (std::int64_t bi = 0; bi < blocks; ++bi) {
       const std::size_t b = static_cast<std::size_t>(bi);
-      const FaceEntry* const first = entries.data() + start[b * parts];
+      const FaceEntry* const first = entries.get() + start[b * parts];
       const std::size_t size = start[(b + 1) * parts] - start[b * parts];
       if (size == 0) continue;
       unsigned bits = 4;
@@ -155,7 +226,6 @@ detail::FaceMatch detail::match_faces(const TetMesh& mesh) {
     }
   }
 
-  FaceMatch match;
   match.boundary.assign(tets.size(), 0);
   for (std::size_t b = 0; b < block_count; ++b) {
     for (std::uint32_t face : block_boundary[b])
@@ -192,14 +262,20 @@ Surface detail::surface_from_faces(const TetMesh& mesh, const FaceMatch& match) 
 }
 
 Surface extract_surface(const TetMesh& mesh) {
-  return detail::surface_from_faces(mesh, detail::match_faces(mesh));
+  return detail::surface_from_faces(mesh, detail::match_faces(mesh, false));
+}
+
+Surface detail::extract_valid_surface(const TetMesh& mesh, const std::string& file,
+                                      NodeParts& parts) {
+  const FaceMatch match = match_faces(mesh, true);
+  Surface surface = surface_from_faces(mesh, match);
+  parts = validate_tet_mesh(mesh, surface, match, file);
+  return surface;
 }
 
 Surface extract_valid_surface(const TetMesh& mesh, const std::string& file) {
-  const detail::FaceMatch match = detail::match_faces(mesh);
-  Surface surface = detail::surface_from_faces(mesh, match);
-  detail::validate_tet_mesh(mesh, surface, match, file);
-  return surface;
+  detail::NodeParts parts;
+  return detail::extract_valid_surface(mesh, file, parts);
 }
 
 double enclosed_volume(const std::vector<Vec3>& points, const std::vector<Tri>& triangles) {

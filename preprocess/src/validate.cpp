@@ -4,13 +4,14 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <numeric>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <tuple>
 #include <vector>
 
 #include "components.hpp"
+#include "segment_topology.hpp"
 #include "tetseg/preprocess/surface.hpp"
 #include "validate_internal.hpp"
 #include "vec3_math.hpp"
@@ -18,29 +19,13 @@
 namespace tetseg::preprocess {
 namespace {
 
-constexpr double kDegenerateVolume = 1e-12;  // |6 vol| relative to max edge^3
-constexpr double kDegenerateArea = 1e-12;    // |2 area| relative to max edge^2
+using detail::UnionFind;
+
+constexpr double kDegenerateArea = 1e-12;  // |2 area| relative to max edge^2
 
 std::string plural(std::size_t n, const char* one, const char* many) {
   return std::to_string(n) + " " + (n == 1 ? one : many);
 }
-
-struct UnionFind {
-  explicit UnionFind(std::size_t n) : parent(n) { std::iota(parent.begin(), parent.end(), 0u); }
-  std::uint32_t find(std::uint32_t x) {
-    while (parent[x] != x) {
-      parent[x] = parent[parent[x]];
-      x = parent[x];
-    }
-    return x;
-  }
-  void unite(std::uint32_t a, std::uint32_t b) {
-    a = find(a);
-    b = find(b);
-    if (a != b) parent[std::max(a, b)] = std::min(a, b);
-  }
-  std::vector<std::uint32_t> parent;
-};
 
 void check_finite(const std::vector<Vec3>& points, const std::string& file, const char* noun) {
   for (std::size_t i = 0; i < points.size(); ++i)
@@ -113,13 +98,13 @@ void check_surface(const std::vector<Vec3>& points, const std::vector<Tri>& tria
                                edge_name(first_misoriented) + ")");
   // Vertex manifoldness: the triangles around a vertex must form one fan. Corners (t, k) are
   // joined across every manifold edge at both of its end vertices.
-  UnionFind corners(triangles.size() * 3);
+  UnionFind corners(static_cast<std::uint32_t>(triangles.size() * 3));
   auto corner_of = [&](std::uint32_t t, std::uint32_t v) {
     for (std::uint32_t k = 0; k < 3; ++k)
       if (triangles[t][k] == v) return t * 3 + k;
     return t * 3;
   };
-  UnionFind components(triangles.size());
+  UnionFind components(static_cast<std::uint32_t>(triangles.size()));
   for (const auto& [a, b] : pairs) {
     const std::uint32_t ta = half[a].tri;
     const std::uint32_t tb = half[b].tri;
@@ -246,77 +231,35 @@ void check_boundary_panels(const std::vector<Vec3>& points, const std::vector<Tr
 }  // namespace
 
 void validate_tet_mesh(const TetMesh& mesh, const Surface& surface, const std::string& file) {
-  detail::validate_tet_mesh(mesh, surface, detail::match_faces(mesh), file);
+  detail::validate_tet_mesh(mesh, surface, detail::match_faces(mesh, true), file);
 }
 
-void detail::validate_tet_mesh(const TetMesh& mesh, const Surface& surface, const FaceMatch& match,
-                               const std::string& file) {
+detail::NodeParts detail::validate_tet_mesh(const TetMesh& mesh, const Surface& surface,
+                                            const FaceMatch& match, const std::string& file) {
+  if (!match.tets_checked) throw std::logic_error("validate_tet_mesh: faces matched unchecked");
   const std::size_t n = mesh.nodes.size();
   if (mesh.tets.empty()) throw InputError(file, "mesh has no tetrahedra");
   check_finite(mesh.nodes, file, "node");
-  std::vector<char> used(n, 0);
-  std::size_t first_out_of_range = SIZE_MAX;  // tet
-  const std::int64_t tet_count = static_cast<std::int64_t>(mesh.tets.size());
-#if defined(TETSEG_HAVE_OPENMP)
-#pragma omp parallel for schedule(static) reduction(min : first_out_of_range)
-#endif
-  for (std::int64_t i = 0; i < tet_count; ++i)
-    for (std::uint32_t v : mesh.tets[static_cast<std::size_t>(i)]) {
-      if (v >= n) {
-        first_out_of_range = std::min(first_out_of_range, static_cast<std::size_t>(i));
-      } else {
-#if defined(TETSEG_HAVE_OPENMP)
-#pragma omp atomic write
-#endif
-        used[v] = 1;
-      }
-    }
-  if (first_out_of_range != SIZE_MAX)
-    for (std::uint32_t v : mesh.tets[first_out_of_range])
+  // The per-tet checks were made while matching the faces (match_faces).
+  const TetChecks& checks = match.tets;
+  if (checks.first_out_of_range != SIZE_MAX)
+    for (std::uint32_t v : mesh.tets[checks.first_out_of_range])
       if (v >= n)
-        throw InputError(file, "tet " + std::to_string(first_out_of_range) + " refers to node " +
-                                   std::to_string(v) + " out of range (" + std::to_string(n) +
-                                   " nodes)");
-  const std::size_t unused = static_cast<std::size_t>(std::count(used.begin(), used.end(), 0));
-  if (unused > 0)
-    throw InputError(file,
-                     plural(unused, "node is", "nodes are") + " used by no tet, first is node " +
-                         std::to_string(std::find(used.begin(), used.end(), 0) - used.begin()));
-  std::size_t degenerate = 0;
-  std::size_t inverted = 0;
-  std::size_t first_degenerate = SIZE_MAX;
-  std::size_t first_inverted = SIZE_MAX;
-#if defined(TETSEG_HAVE_OPENMP)
-#pragma omp parallel for schedule(static) reduction(+ : degenerate, inverted) \
-    reduction(min : first_degenerate, first_inverted)
-#endif
-  for (std::int64_t i = 0; i < tet_count; ++i) {
-    const std::size_t t = static_cast<std::size_t>(i);
-    const Tet& tet = mesh.tets[t];
-    const Vec3& a = mesh.nodes[tet[0]];
-    const Vec3& b = mesh.nodes[tet[1]];
-    const Vec3& c = mesh.nodes[tet[2]];
-    const Vec3& d = mesh.nodes[tet[3]];
-    const double det = detail::tet_det(a, b, c, d);
-    // sqrt of the largest squared edge: the same double as the largest of the six lengths.
-    const double edge = std::sqrt(
-        std::max({detail::distance2(a, b), detail::distance2(a, c), detail::distance2(a, d),
-                  detail::distance2(b, c), detail::distance2(b, d), detail::distance2(c, d)}));
-    if (!(std::abs(det) > kDegenerateVolume * edge * edge * edge)) {
-      ++degenerate;
-      first_degenerate = std::min(first_degenerate, t);
-    } else if (det < 0) {
-      ++inverted;
-      first_inverted = std::min(first_inverted, t);
-    }
-  }
-  if (degenerate > 0)
-    throw InputError(file, plural(degenerate, "degenerate tet", "degenerate tets") +
-                               " (zero volume), first is tet " + std::to_string(first_degenerate));
-  if (inverted > 0)
-    throw InputError(file, plural(inverted, "inverted tet", "inverted tets") +
+        throw InputError(file, "tet " + std::to_string(checks.first_out_of_range) +
+                                   " refers to node " + std::to_string(v) + " out of range (" +
+                                   std::to_string(n) + " nodes)");
+  if (checks.unused > 0)
+    throw InputError(file, plural(checks.unused, "node is", "nodes are") +
+                               " used by no tet, first is node " +
+                               std::to_string(checks.first_unused));
+  if (checks.degenerate > 0)
+    throw InputError(file, plural(checks.degenerate, "degenerate tet", "degenerate tets") +
+                               " (zero volume), first is tet " +
+                               std::to_string(checks.first_degenerate));
+  if (checks.inverted > 0)
+    throw InputError(file, plural(checks.inverted, "inverted tet", "inverted tets") +
                                " (negative volume), first is tet " +
-                               std::to_string(first_inverted));
+                               std::to_string(checks.first_inverted));
   // Faces shared by more than two tets.
   const std::size_t crowded = match.crowded;
   const std::array<std::uint32_t, 3>& first_crowded = match.first_crowded;
@@ -334,7 +277,7 @@ void detail::validate_tet_mesh(const TetMesh& mesh, const Surface& surface, cons
   options.allow_components = true;
   check_surface(mesh.nodes, surface.triangles, file, options, nullptr);
   check_boundary_panels(mesh.nodes, surface.triangles, file);
-  detail::check_components(mesh, surface, file);
+  return detail::check_components(mesh, surface, match.node_roots, file);
 }
 
 void validate_closed_surface(const TriangleMesh& mesh, const std::string& file,

@@ -180,16 +180,25 @@ py::array_t<double> doubles_array(const std::vector<double>& v) {
 // ---------------------------------------------------------------------------------------
 // build
 
+/// The memory fields of the CLI reports (docs/cli.md): per stage, the process's peak RSS at
+/// its end and how much the stage raised it (StageTimer measures both).
+void add_memory_fields(py::dict& d, const std::vector<StageReport>& stages) {
+  py::dict peak_rss_bytes;
+  py::dict peak_rss_growth_bytes;
+  for (const StageReport& s : stages) {
+    peak_rss_bytes[py::str(s.name)] = s.peak_rss_bytes;
+    peak_rss_growth_bytes[py::str(s.name)] = s.peak_rss_growth_bytes;
+  }
+  d["peak_rss_bytes"] = peak_rss_bytes;
+  d["peak_rss_growth_bytes"] = peak_rss_growth_bytes;
+}
+
 py::dict report_dict(const std::string& source, const BuildReport& report,
                      const format::Asset& asset, std::size_t asset_bytes, double total) {
   py::dict seconds;
-  py::dict peak_rss_bytes;
-  py::dict peak_rss_growth_bytes;
   py::list stages;
   for (const StageReport& s : report.stages) {
     seconds[py::str(s.name)] = s.seconds;
-    peak_rss_bytes[py::str(s.name)] = s.peak_rss_bytes;
-    peak_rss_growth_bytes[py::str(s.name)] = s.peak_rss_growth_bytes;
     stages.append(py::make_tuple(s.name, s.seconds, s.summary));
   }
   seconds["total"] = total;
@@ -238,8 +247,7 @@ py::dict report_dict(const std::string& source, const BuildReport& report,
   d["input"] = source;
   d["asset_bytes"] = asset_bytes;
   d["seconds"] = seconds;
-  d["peak_rss_bytes"] = peak_rss_bytes;
-  d["peak_rss_growth_bytes"] = peak_rss_growth_bytes;
+  add_memory_fields(d, report.stages);
   d["stages"] = stages;
   d["counts"] = counts;
   d["segmentation"] = segmentation;
@@ -399,22 +407,30 @@ py::dict charge(const py::object& mesh, const py::object& source, const std::str
   std::vector<Tri> triangles;
   ChargeResult result;
   std::vector<double> equalized;
+  BuildReport report;  // the stages of `tetseg charge --report`: read (and validate), charge
   {
     py::gil_scoped_release release;
     std::lock_guard<std::mutex> lock(preprocess_mutex());
-    // As `tetseg charge`: a tet mesh's boundary, or a closed surface as given.
-    read_input(in);
-    if (in.is_tet_mesh) {
-      const Surface surface = extract_valid_surface(in.tet_mesh, in.source);
-      points = std::move(in.tet_mesh.nodes);
-      triangles = surface.triangles;
-    } else {
-      validate_closed_surface(in.surface, in.source);
-      points = std::move(in.surface.vertices);
-      triangles = std::move(in.surface.triangles);
-    }
-    result = compute_charge(points, triangles, options, in.source);
-    equalized = equalize(result.density, method, bins);
+    StageTimer timer(report, nullptr);
+    timer.run("read", [&](std::string&) {
+      // As `tetseg charge`: a tet mesh's boundary, or a closed surface as given.
+      read_input(in);
+      if (in.is_tet_mesh) {
+        const Surface surface = extract_valid_surface(in.tet_mesh, in.source);
+        points = std::move(in.tet_mesh.nodes);
+        triangles = surface.triangles;
+      } else {
+        validate_closed_surface(in.surface, in.source);
+        points = std::move(in.surface.vertices);
+        triangles = std::move(in.surface.triangles);
+      }
+      return 0;
+    });
+    timer.run("charge", [&](std::string&) {
+      result = compute_charge(points, triangles, options, in.source);
+      equalized = equalize(result.density, method, bins);
+      return 0;
+    });
   }
   py::dict d;
   d["density"] = doubles_array(result.density);
@@ -431,6 +447,7 @@ py::dict charge(const py::object& mesh, const py::object& source, const std::str
   d["equalization"] = name_of(method);
   d["assembly_seconds"] = result.assembly_seconds;
   d["solve_seconds"] = result.solve_seconds;
+  add_memory_fields(d, report.stages);
   return d;
 }
 

@@ -116,6 +116,27 @@ def test_charge_equals_cli(pp, bin_dir, sphere_mesh, tmp_path):
     assert np.array_equal(again["density"], result["density"])
 
 
+def test_charge_reports_memory_like_cli(pp, bin_dir, sphere_mesh, tmp_path):
+    report_path = tmp_path / "charge.json"
+    run_tool(bin_dir, "tetseg", "charge", sphere_mesh, "-o", tmp_path / "charge.csv",
+             "--report", report_path)
+    with open(report_path) as f:
+        cli = json.load(f)
+    result = pp.charge(sphere_mesh)
+    for key in ("peak_rss_bytes", "peak_rss_growth_bytes"):
+        # The CLI's steps but its last, `write` (the module writes no file).
+        assert list(result[key]) == ["read", "charge"], key
+        assert list(cli[key])[:2] == ["read", "charge"], key
+    peaks = result["peak_rss_bytes"]
+    growths = result["peak_rss_growth_bytes"]
+    # The process peak is positive and never decreases; a stage raises it by at most itself.
+    assert 0 < peaks["read"] <= peaks["charge"]
+    for name in ("read", "charge"):
+        assert 0 <= growths[name] <= peaks[name], name
+        assert isinstance(peaks[name], int) and isinstance(growths[name], int), name
+    assert growths["charge"] <= peaks["charge"] - peaks["read"]
+
+
 def test_on_stage_reports_every_stage(pp, sphere_mesh):
     seen = []
     _, report = pp.build(sphere_mesh, on_stage=lambda *stage: seen.append(stage))

@@ -23,17 +23,18 @@ Surface extract_surface(const TetMesh& mesh);
 /// no degenerate tet (|6 volume| <= 1e-12 x longest edge^3) and no inverted tet (counts and
 /// the first index are reported); no face shared by more than two tets; then the surface:
 /// closed (border edges counted), edge-manifold, consistently oriented, vertex-manifold (one
-/// fan of triangles per vertex), free of self-intersection at rest (CGAL box-intersection
-/// broad phase with exact predicates); no boundary triangle too thin for the charge solver
-/// (area at most 1e-12 x the longest boundary edge^2 or 1e-10 x its own longest edge^2: what
-/// charge would refuse); then per component (nodes joined through tets; a mesh
-/// may have several): bounded by exactly one closed surface (no cavity), not inside another
+/// fan of triangles per vertex), free of self-intersection at rest (a median-split BVH over
+/// the triangles' boxes, then CGAL's exact predicates on the pairs whose boxes touch: the same
+/// pairs as CGAL's self_intersections, tested); no boundary triangle too thin for the charge
+/// solver (area at most 1e-12 x the longest boundary edge^2 or 1e-10 x its own longest edge^2:
+/// what charge would refuse); then per component (nodes joined through tets; a mesh may have
+/// several): bounded by exactly one closed surface (no cavity), not inside another
 /// component (docs/segmentation.md, "Several components").
 /// Throws InputError(`file`, message) naming the first defect found, e.g. "surface is not
 /// closed (3 border edges, first between vertices 4 and 7)". Cost: the face matching of
-/// extract_surface, O(T) checks of the tets, O(B log B) checks of the B boundary triangles
-/// and the self-intersection test (about 1.1 s of CPU for 4.8 M tets / 104k triangles).
-/// Thread-safe.
+/// extract_surface with the O(T) checks of the tets made in its counting pass, O(B log B)
+/// checks of the B boundary triangles and the self-intersection test (about 1.2 s of CPU for
+/// 4.8 M tets / 104k triangles with the extraction; docs/benchmarks.md, "Scale"). Thread-safe.
 void validate_tet_mesh(const TetMesh& mesh, const Surface& surface, const std::string& file);
 
 /// extract_surface then validate_tet_mesh (same result, same InputError), matching the faces
