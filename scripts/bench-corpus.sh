@@ -50,7 +50,7 @@ work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 
 # The meshes, smallest first when --smallest is given, else by name.
-find "$mesh_dir" -maxdepth 1 -type f \( -iname '*.off' -o -iname '*.ply' \) -printf '%s %p\n' |
+find -L "$mesh_dir" -maxdepth 1 -type f \( -iname '*.off' -o -iname '*.ply' \) -printf '%s %p\n' |
   sort -n | { if [ "$smallest" -gt 0 ]; then head -n "$smallest"; else cat; fi; } |
   cut -d' ' -f2- | sort >"$work/list"
 
