@@ -236,6 +236,30 @@ TEST_CASE("Wrap closes holes, open surfaces and self-intersections", "[meshing][
     const double prism = 48 * 0.5 * 0.25 * std::sin(2 * pi / 48) * 2.0;  // the 48-gon prism
     CHECK(total_tet_volume(m) == Approx(prism).epsilon(0.06));
   }
+  SECTION("Two cubes sharing a corner (a non-manifold vertex): fix refuses, wrap joins them.") {
+    TriangleMesh s = cube();
+    const TriangleMesh other = cube();
+    for (std::size_t i = 1; i < other.vertices.size(); ++i) {
+      const Vec3& p = other.vertices[i];
+      s.vertices.push_back({p[0] + 1.0, p[1] + 1.0, p[2] + 1.0});
+    }
+    // The second cube's corner 0 is the first cube's corner 6, (1, 1, 1).
+    const auto shifted = [](std::uint32_t v) { return v == 0 ? 6u : v + 7u; };
+    for (const Tri& t : other.triangles)
+      s.triangles.push_back({shifted(t[0]), shifted(t[1]), shifted(t[2])});
+    // Duplicating the vertex leaves two cubes touching at a point: not an embedded surface.
+    try {
+      tetrahedralize(s, coarse(MeshingOptions::Repair::kFix), "corner.off");
+      FAIL("two cubes touching at a corner were meshed by fix");
+    } catch (const InputError& e) {
+      CHECK_THAT(e.what(), Catch::Contains("self-intersects"));
+      CHECK_THAT(e.what(), Catch::Contains("--repair wrap"));
+    }
+    const TetMesh m = wrapped(s, 0.03, notes);
+    // Two unit cubes; the wrap's bridge at the corner and its offset add little.
+    CHECK(total_tet_volume(m) == Approx(2.0).epsilon(0.05));
+    CHECK(notes.hausdorff_mesh_to_input < 0.05);
+  }
   SECTION("Two interpenetrating spheres: fix refuses, wrap makes their union.") {
     TriangleMesh s = tetseg::test::icosphere(6);
     const TriangleMesh other = tetseg::test::icosphere(6);
