@@ -95,6 +95,17 @@ TetMesh wrapped(const TriangleMesh& s, double alpha, TetrahedralizeNotes& notes)
   return mesh;
 }
 
+/// `s` is refused by `--repair fix`: the error names a self-intersection and points to wrap.
+void refused_by_fix_as_self_intersecting(const TriangleMesh& s) {
+  try {
+    tetrahedralize(s, coarse(MeshingOptions::Repair::kFix), "defect.off");
+    FAIL("a self-intersecting surface was meshed by fix");
+  } catch (const InputError& e) {
+    CHECK_THAT(e.what(), Catch::Contains("surface self-intersects"));
+    CHECK_THAT(e.what(), Catch::Contains("--repair wrap"));
+  }
+}
+
 }  // namespace
 
 TEST_CASE("Shape-keeping repairs fix small defects and say what they did", "[meshing][repair]") {
@@ -248,13 +259,7 @@ TEST_CASE("Wrap closes holes, open surfaces and self-intersections", "[meshing][
     for (const Tri& t : other.triangles)
       s.triangles.push_back({shifted(t[0]), shifted(t[1]), shifted(t[2])});
     // Duplicating the vertex leaves two cubes touching at a point: not an embedded surface.
-    try {
-      tetrahedralize(s, coarse(MeshingOptions::Repair::kFix), "corner.off");
-      FAIL("two cubes touching at a corner were meshed by fix");
-    } catch (const InputError& e) {
-      CHECK_THAT(e.what(), Catch::Contains("self-intersects"));
-      CHECK_THAT(e.what(), Catch::Contains("--repair wrap"));
-    }
+    refused_by_fix_as_self_intersecting(s);
     const TetMesh m = wrapped(s, 0.03, notes);
     // Two unit cubes; the wrap's bridge at the corner and its offset add little.
     CHECK(total_tet_volume(m) == Approx(2.0).epsilon(0.05));
@@ -267,13 +272,7 @@ TEST_CASE("Wrap closes holes, open surfaces and self-intersections", "[meshing][
     for (Vec3 p : other.vertices) s.vertices.push_back({p[0] + 1.0, p[1], p[2]});
     for (const Tri& t : other.triangles)
       s.triangles.push_back({t[0] + base, t[1] + base, t[2] + base});
-    try {
-      tetrahedralize(s, coarse(MeshingOptions::Repair::kFix), "spheres.off");
-      FAIL("two crossing spheres were meshed by fix");
-    } catch (const InputError& e) {
-      CHECK_THAT(e.what(), Catch::Contains("surface self-intersects"));
-      CHECK_THAT(e.what(), Catch::Contains("--repair wrap"));
-    }
+    refused_by_fix_as_self_intersecting(s);
     const TetMesh m = wrapped(s, 0.02, notes);
     // Union of two unit balls 1 apart: 2 (4/3 pi) - pi (4 + 1)(2 - 1)^2 / 12.
     const double pi = std::acos(-1.0);
