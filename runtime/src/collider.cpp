@@ -239,7 +239,7 @@ void Collider::Impl::refit_and_classify() noexcept {
     }
   }
   if (uses_clusters()) {
-    refit_wide();  // collider_traverse.cpp
+    refit_wide();  // collider_wide.cpp
     // A scene body's binary cluster BVHs serve traverse_bodies.
     for (std::uint32_t c = 0; c < cluster_count() && always_refit; ++c) {
       const format::Cluster& cl = asset->clusters[c];
@@ -362,7 +362,7 @@ void Collider::Impl::refit_and_classify() noexcept {
   stats.triangles_positive = count[0];
   stats.triangles_negative = count[1];
   stats.triangles_uncertain = count[2];
-  sign_wide();  // collider_traverse.cpp
+  sign_wide();  // collider_wide.cpp
   stats.classify_ms = ms_since(t_class);
 }
 

@@ -405,7 +405,7 @@ struct Collider::Impl {
     return vmoved[ends[0]] | vmoved[ends[1]];
   }
 
-  // --- collider_traverse.cpp
+  // --- collider_traverse.cpp (traverse_wide, refit_wide and sign_wide: collider_wide.cpp)
   /// Runs the query over all candidates into workers (merged into stats/results); stops early
   /// for kAny. `out`/`out_cap`: optional contact buffer (forces the serial path). Returns
   /// false on stack overflow.
