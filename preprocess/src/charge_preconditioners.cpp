@@ -1,0 +1,687 @@
+// The preconditioners of the charge solver's GMRES (docs/charge.md, "Preconditioner"):
+// block Jacobi over the leaves, the near-field Schwarz of each leaf with its neighbours, and
+// the two-level Schwarz with a point-charge coarse space.
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#if defined(__SSE2__)
+#include <immintrin.h>
+#endif
+
+#include "charge_solvers.hpp"
+
+namespace tetseg::preprocess::charge_detail {
+
+BlockJacobi::BlockJacobi(const PanelSet& panels, const ClusterTree& tree) : m_tree(tree) {
+  const std::size_t leaves = tree.leaves.size();
+  m_offset.resize(leaves + 1, 0);
+  for (std::size_t l = 0; l < leaves; ++l) {
+    const Cluster& c = tree.nodes[static_cast<std::size_t>(tree.leaves[l])];
+    const std::size_t m = c.end - c.begin;
+    m_offset[l + 1] = m_offset[l] + m * m;
+  }
+  m_inverse.resize(m_offset[leaves]);
+#if defined(TETSEG_HAVE_OPENMP)
+#pragma omp parallel for schedule(dynamic, 8)
+#endif
+  for (std::ptrdiff_t ll = 0; ll < static_cast<std::ptrdiff_t>(leaves); ++ll) {
+    const std::size_t l = static_cast<std::size_t>(ll);
+    const Cluster& c = tree.nodes[static_cast<std::size_t>(tree.leaves[l])];
+    const Eigen::Index m = c.end - c.begin;
+    Eigen::MatrixXd block(m, m);
+    for (Eigen::Index a = 0; a < m; ++a) {
+      for (Eigen::Index b = 0; b < m; ++b) {
+        block(a, b) = matrix_entry(panels, tree.order[c.begin + static_cast<std::size_t>(a)],
+                                   tree.order[c.begin + static_cast<std::size_t>(b)]);
+      }
+    }
+    const Eigen::MatrixXd inv = block.partialPivLu().inverse();
+    Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(
+        m_inverse.data() + m_offset[l], m, m) = inv;
+  }
+}
+
+void BlockJacobi::apply(const double* in, double* out) const {
+  const std::size_t leaves = m_tree.leaves.size();
+#if defined(TETSEG_HAVE_OPENMP)
+#pragma omp parallel for schedule(static)
+#endif
+  for (std::ptrdiff_t ll = 0; ll < static_cast<std::ptrdiff_t>(leaves); ++ll) {
+    const std::size_t l = static_cast<std::size_t>(ll);
+    const Cluster& c = m_tree.nodes[static_cast<std::size_t>(m_tree.leaves[l])];
+    const std::size_t m = c.end - c.begin;
+    const double* inv = m_inverse.data() + m_offset[l];
+    for (std::size_t a = 0; a < m; ++a) {
+      double s = 0.0;
+      for (std::size_t b = 0; b < m; ++b) s += inv[a * m + b] * in[m_tree.order[c.begin + b]];
+      out[m_tree.order[c.begin + a]] = s;
+    }
+  }
+}
+
+}  // namespace tetseg::preprocess::charge_detail
+
+namespace tetseg::preprocess::charge_detail {
+
+namespace {
+
+/// Per-thread buffers of the Schwarz setup.
+struct SchwarzScratch {
+  std::vector<float> a, rows, upper, x, y, z, area;
+  std::vector<std::uint32_t> perm, pivot;
+  void resize(std::size_t s, std::size_t ld, std::size_t members) {
+    a.resize(s * ld);
+    rows.resize(members * ld);
+    upper.resize(members * members);
+    for (auto* v : {&x, &y, &z, &area}) v->resize(s);
+    perm.resize(s);
+    pivot.resize(s);
+  }
+};
+
+/// a[u * ld + v] = area[v] / |p_u - p_v| (0 for u == v), single precision; columns s..ld-1
+/// are set to 0. Four entries per step (SSE: exact square root and division).
+void point_charge_matrix(std::size_t s, std::size_t ld, const float* x, const float* y,
+                         const float* z, const float* area, float* a) {
+  for (std::size_t u = 0; u < s; ++u) {
+    float* row = a + u * ld;
+    const float px = x[u], py = y[u], pz = z[u];
+    std::size_t v = 0;
+#if defined(__SSE2__)
+    const __m128 vx = _mm_set1_ps(px), vy = _mm_set1_ps(py), vz = _mm_set1_ps(pz);
+    const __m128 zero = _mm_setzero_ps(), one = _mm_set1_ps(1.0f);
+    for (; v + 4 <= s; v += 4) {
+      const __m128 dx = _mm_sub_ps(vx, _mm_loadu_ps(x + v));
+      const __m128 dy = _mm_sub_ps(vy, _mm_loadu_ps(y + v));
+      const __m128 dz = _mm_sub_ps(vz, _mm_loadu_ps(z + v));
+      const __m128 r2 =
+          _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)), _mm_mul_ps(dz, dz));
+      const __m128 live = _mm_cmpgt_ps(r2, zero);
+      const __m128 safe = _mm_or_ps(_mm_and_ps(live, r2), _mm_andnot_ps(live, one));
+      const __m128 w = _mm_div_ps(_mm_loadu_ps(area + v), _mm_sqrt_ps(safe));
+      _mm_storeu_ps(row + v, _mm_and_ps(live, w));
+    }
+#endif
+    for (; v < s; ++v) {
+      const float dx = px - x[v], dy = py - y[v], dz = pz - z[v];
+      const float r2 = dx * dx + dy * dy + dz * dz;
+      row[v] = r2 > 0.0f ? area[v] / std::sqrt(r2) : 0.0f;
+    }
+    std::fill(row + s, row + ld, 0.0f);
+  }
+}
+
+/// Eight floats, loaded and stored without alignment (GCC vector extension: 256-bit
+/// instructions in the AVX2 clone below, two 128-bit halves otherwise).
+typedef float Floats8 __attribute__((vector_size(32), aligned(4)));
+typedef std::int32_t Ints8 __attribute__((vector_size(32)));
+
+/// dst[j] -= f * src[j] for keep <= j < end, in blocks of eight from keep rounded down to a
+/// multiple of 8 (end is one): the lanes of the first block below `keep` keep their values.
+inline void subtract_scaled(float* dst, const float* src, float f, std::size_t keep,
+                            std::size_t end) {
+  std::size_t j = keep & ~std::size_t{7};
+  if (j < keep && j < end) {
+    const Ints8 lane = {0, 1, 2, 3, 4, 5, 6, 7};
+    Floats8* d = reinterpret_cast<Floats8*>(dst + j);
+    const Floats8 v = *d - f * *reinterpret_cast<const Floats8*>(src + j);
+    *d = lane + static_cast<std::int32_t>(j) >= static_cast<std::int32_t>(keep) ? v : *d;
+    j += 8;
+  }
+  for (; j < end; j += 8) {
+    Floats8* d = reinterpret_cast<Floats8*>(dst + j);
+    *d -= f * *reinterpret_cast<const Floats8*>(src + j);
+  }
+}
+
+/// subtract_scaled on four rows at once (one load of src per block of eight).
+inline void subtract_scaled4(float* const* dst, const float* src, const float* f, std::size_t keep,
+                             std::size_t end) {
+  std::size_t j = keep & ~std::size_t{7};
+  if (j < keep && j < end) {
+    for (int r = 0; r < 4; ++r) subtract_scaled(dst[r], src, f[r], keep, j + 8);
+    j += 8;
+  }
+  for (; j < end; j += 8) {
+    const Floats8 v = *reinterpret_cast<const Floats8*>(src + j);
+    *reinterpret_cast<Floats8*>(dst[0] + j) -= f[0] * v;
+    *reinterpret_cast<Floats8*>(dst[1] + j) -= f[1] * v;
+    *reinterpret_cast<Floats8*>(dst[2] + j) -= f[2] * v;
+    *reinterpret_cast<Floats8*>(dst[3] + j) -= f[3] * v;
+  }
+}
+
+/// Rows s - m .. s - 1 of A^-1 for the dense s x s matrix A (row-major, stride ld, destroyed),
+/// into rows (m x ld, row t = row s - m + t of A^-1); `upper` is scratch of m x m. LU with partial
+/// pivoting, P A = L U, so A^-1 = U^-1 L^-1 P; the last m rows of the upper triangular U^-1 are
+/// zero left of column s - m, so they need only the trailing m x m block of U and the last m rows
+/// of L^-1: about s^3 / 3 + m s^2 / 2 multiply-adds, all row operations (vectorised). Returns false
+/// if a pivot is zero or not finite.
+TETSEG_CHARGE_CLONES bool inverse_rows_of_last(std::size_t s, std::size_t ld, std::size_t m,
+                                               float* a, std::uint32_t* pivot, float* upper,
+                                               float* rows) {
+  for (std::size_t k = 0; k < s; ++k) {
+    std::size_t p = k;
+    float best = std::abs(a[k * ld + k]);
+    for (std::size_t i = k + 1; i < s; ++i) {
+      const float v = std::abs(a[i * ld + k]);
+      if (v > best) {
+        best = v;
+        p = i;
+      }
+    }
+    if (!(best > 0.0f) || !std::isfinite(best)) return false;
+    pivot[k] = static_cast<std::uint32_t>(p);
+    if (p != k) std::swap_ranges(a + k * ld, a + k * ld + s, a + p * ld);
+    const float* rk = a + k * ld;
+    const float inv = 1.0f / rk[k];
+    // Columns s..ld-1 are 0 and stay 0; four rows at a time.
+    std::size_t i = k + 1;
+    for (; i + 4 <= s; i += 4) {
+      float* const ri[4] = {a + i * ld, a + (i + 1) * ld, a + (i + 2) * ld, a + (i + 3) * ld};
+      float l[4];
+      for (int q = 0; q < 4; ++q) l[q] = ri[q][k] = ri[q][k] * inv;
+      subtract_scaled4(ri, rk, l, k + 1, ld);
+    }
+    for (; i < s; ++i) {
+      float* ri = a + i * ld;
+      const float l = ri[k] * inv;
+      ri[k] = l;
+      subtract_scaled(ri, rk, l, k + 1, ld);
+    }
+  }
+  // Y = last m rows of L^-1: row t solves y L = e_{r+t} (L unit lower triangular), from the
+  // right: y_k is final once the rows below k have been subtracted. L is copied with zeros on
+  // and above the diagonal first, so that whole rows can be subtracted.
+  const std::size_t r = s - m;
+  for (std::size_t t = 0; t < m; ++t) {
+    std::copy(a + (r + t) * ld + r, a + (r + t) * ld + s, upper + t * m);
+  }
+  for (std::size_t k = 0; k < s; ++k) {
+    float* row = a + k * ld;
+    std::fill(row + k, row + ld, 0.0f);
+  }
+  for (std::size_t t = 0; t < m; ++t) {
+    float* y = rows + t * ld;
+    std::fill(y, y + ld, 0.0f);
+    y[r + t] = 1.0f;
+    for (std::size_t k = r + t; k > 0; --k) subtract_scaled(y, a + k * ld, y[k], 0, k);
+  }
+  // X = U_mm^-1 Y (U_mm the trailing m x m block of U), back substitution by rows.
+  for (std::size_t t = m; t-- > 0;) {
+    float* x = rows + t * ld;
+    const float* ut = upper + t * m;
+    for (std::size_t v = t + 1; v < m; ++v) {
+      const float f = ut[v];
+      const float* xv = rows + v * ld;
+      subtract_scaled(x, xv, f, 0, s);
+    }
+    const float inv = 1.0f / ut[t];
+    for (std::size_t j = 0; j < s; ++j) x[j] *= inv;
+  }
+  // X P: the row swaps of the factorisation become column swaps, last first.
+  for (std::size_t k = s; k-- > 0;) {
+    if (pivot[k] == k) continue;
+    for (std::size_t t = 0; t < m; ++t) std::swap(rows[t * ld + k], rows[t * ld + pivot[k]]);
+  }
+  return true;
+}
+
+}  // namespace
+
+NearFieldSchwarz::NearFieldSchwarz(const PanelSet& panels, const ClusterTree& tree,
+                                   const NearField& near, std::size_t max_set)
+    : m_tree(tree) {
+  const std::size_t n = panels.size();
+  const std::size_t leaves = tree.leaves.size();
+  // Pass 1: the extended set of every leaf.
+  std::vector<std::vector<std::uint32_t>> sets(leaves);
+#if defined(TETSEG_HAVE_OPENMP)
+#pragma omp parallel
+#endif
+  {
+    std::vector<char> mark(n, 0);
+    std::vector<std::pair<double, std::uint32_t>> extra;
+#if defined(TETSEG_HAVE_OPENMP)
+#pragma omp for schedule(dynamic, 8)
+#endif
+    for (std::ptrdiff_t ll = 0; ll < static_cast<std::ptrdiff_t>(leaves); ++ll) {
+      const std::size_t l = static_cast<std::size_t>(ll);
+      const Cluster& c = tree.nodes[static_cast<std::size_t>(tree.leaves[l])];
+      auto& set = sets[l];
+      for (std::uint32_t k = c.begin; k < c.end; ++k) {
+        set.push_back(tree.order[k]);
+        mark[tree.order[k]] = 1;
+      }
+      extra.clear();
+      for (std::uint32_t k = c.begin; k < c.end; ++k) {
+        const std::size_t i = tree.order[k];
+        for (std::size_t e = near.row_start[i]; e < near.row_start[i + 1]; ++e) {
+          const std::uint32_t j = near.column[e];
+          if (mark[j]) continue;
+          mark[j] = 1;
+          const Vec3& q = panels.centroid[j];
+          const double dx = q[0] - c.center[0], dy = q[1] - c.center[1], dz = q[2] - c.center[2];
+          extra.push_back({dx * dx + dy * dy + dz * dz, j});
+        }
+      }
+      for (const std::uint32_t j : set) mark[j] = 0;
+      for (const auto& e : extra) mark[e.second] = 0;
+      const std::size_t room = max_set > set.size() ? max_set - set.size() : 0;
+      if (extra.size() > room) {
+        std::nth_element(extra.begin(), extra.begin() + static_cast<std::ptrdiff_t>(room),
+                         extra.end());
+        extra.resize(room);
+      }
+      std::sort(extra.begin(), extra.end());
+      for (const auto& e : extra) set.push_back(e.second);
+    }
+  }
+  m_set_start.assign(leaves + 1, 0);
+  m_rows_start.assign(leaves + 1, 0);
+  for (std::size_t l = 0; l < leaves; ++l) {
+    const Cluster& c = tree.nodes[static_cast<std::size_t>(tree.leaves[l])];
+    m_set_start[l + 1] = m_set_start[l] + sets[l].size();
+    m_rows_start[l + 1] = m_rows_start[l] + sets[l].size() * (c.end - c.begin);
+  }
+  m_set.resize(m_set_start[leaves]);
+  m_rows.resize(m_rows_start[leaves]);
+  m_mean_set =
+      static_cast<double>(m_set.size()) / static_cast<double>(std::max<std::size_t>(leaves, 1));
+  // Pass 2: factorise M_SS and keep the members' rows of its inverse. Unknowns (and
+  // equations) in the order [others, members], so that the members' rows of the inverse come
+  // from the last rows of U^-1 (inverse_rows_of_last).
+#if defined(TETSEG_HAVE_OPENMP)
+#pragma omp parallel
+#endif
+  {
+    std::vector<std::int32_t> pos(n, -1);
+    SchwarzScratch scratch;
+#if defined(TETSEG_HAVE_OPENMP)
+#pragma omp for schedule(dynamic, 4)
+#endif
+    for (std::ptrdiff_t ll = 0; ll < static_cast<std::ptrdiff_t>(leaves); ++ll) {
+      const std::size_t l = static_cast<std::size_t>(ll);
+      const Cluster& c = tree.nodes[static_cast<std::size_t>(tree.leaves[l])];
+      const auto& set = sets[l];
+      std::copy(set.begin(), set.end(),
+                m_set.begin() + static_cast<std::ptrdiff_t>(m_set_start[l]));
+      const std::size_t s = set.size();
+      const std::size_t members = c.end - c.begin;
+      const std::size_t others = s - members;
+      const std::size_t ld = (s + 7) & ~std::size_t{7};
+      // perm[u]: the set position of unknown (and equation) u.
+      scratch.resize(s, ld, members);
+      for (std::size_t u = 0; u < s; ++u) {
+        scratch.perm[u] = static_cast<std::uint32_t>(u < others ? members + u : u - others);
+      }
+      // Point charges in single precision about the leaf centre (the preconditioner needs a
+      // few digits), then the analytic near-field entries over them.
+      for (std::size_t u = 0; u < s; ++u) {
+        const std::size_t j = set[scratch.perm[u]];
+        const Vec3& q = panels.centroid[j];
+        scratch.x[u] = static_cast<float>(q[0] - c.center[0]);
+        scratch.y[u] = static_cast<float>(q[1] - c.center[1]);
+        scratch.z[u] = static_cast<float>(q[2] - c.center[2]);
+        scratch.area[u] = static_cast<float>(panels.area[j]);
+        pos[j] = static_cast<std::int32_t>(u);
+      }
+      point_charge_matrix(s, ld, scratch.x.data(), scratch.y.data(), scratch.z.data(),
+                          scratch.area.data(), scratch.a.data());
+      for (std::size_t u = 0; u < s; ++u) {
+        const std::size_t i = set[scratch.perm[u]];
+        float* row = scratch.a.data() + u * ld;
+        for (std::size_t e = near.row_start[i]; e < near.row_start[i + 1]; ++e) {
+          const std::int32_t b = pos[near.column[e]];
+          if (b >= 0) row[b] = static_cast<float>(near.value[e]);
+        }
+      }
+      for (const std::uint32_t j : set) pos[j] = -1;
+      float* rows = m_rows.data() + m_rows_start[l];
+      if (!inverse_rows_of_last(s, ld, members, scratch.a.data(), scratch.pivot.data(),
+                                scratch.upper.data(), scratch.rows.data())) {
+        // Singular block (not seen on valid input): this leaf falls back to Jacobi.
+        std::fill(rows, rows + members * s, 0.0f);
+        for (std::size_t a = 0; a < members; ++a) {
+          rows[a * s + a] = static_cast<float>(1.0 / near.diagonal[set[a]]);
+        }
+        continue;
+      }
+      // Row t of the result belongs to unknown others + t, i.e. member t; its columns are
+      // equations in perm order.
+      for (std::size_t t = 0; t < members; ++t) {
+        const float* from = scratch.rows.data() + t * ld;
+        float* to = rows + t * s;
+        for (std::size_t u = 0; u < s; ++u) to[scratch.perm[u]] = from[u];
+      }
+    }
+  }
+}
+
+void NearFieldSchwarz::apply(const double* in, double* out) const {
+  const std::size_t leaves = m_tree.leaves.size();
+#if defined(TETSEG_HAVE_OPENMP)
+#pragma omp parallel
+#endif
+  {
+    std::vector<double> gathered;
+#if defined(TETSEG_HAVE_OPENMP)
+#pragma omp for schedule(static)
+#endif
+    for (std::ptrdiff_t ll = 0; ll < static_cast<std::ptrdiff_t>(leaves); ++ll) {
+      const std::size_t l = static_cast<std::size_t>(ll);
+      const Cluster& c = m_tree.nodes[static_cast<std::size_t>(m_tree.leaves[l])];
+      const std::size_t s = m_set_start[l + 1] - m_set_start[l];
+      const std::uint32_t* set = m_set.data() + m_set_start[l];
+      gathered.resize(s);
+      for (std::size_t b = 0; b < s; ++b) gathered[b] = in[set[b]];
+      const float* rows = m_rows.data() + m_rows_start[l];
+      for (std::size_t a = 0; a < c.end - c.begin; ++a) {
+        const float* row = rows + a * s;
+        double s0 = 0.0, s1 = 0.0;
+        std::size_t b = 0;
+        for (; b + 2 <= s; b += 2) {
+          s0 += row[b] * gathered[b];
+          s1 += row[b + 1] * gathered[b + 1];
+        }
+        if (b < s) s0 += row[b] * gathered[b];
+        out[set[a]] = s0 + s1;
+      }
+    }
+  }
+}
+
+}  // namespace tetseg::preprocess::charge_detail
+
+namespace tetseg::preprocess::charge_detail {
+
+namespace {
+
+/// Coarse clusters I and J interact through point charges when (rho_I + rho_J) < this times
+/// the distance of their area centroids (docs/charge.md, "Preconditioner").
+constexpr double kCoarseOpening = 0.4;
+
+}  // namespace
+
+struct TwoLevelSchwarz::CoarseLu {
+  Eigen::PartialPivLU<Eigen::MatrixXd> lu;
+};
+
+TwoLevelSchwarz::~TwoLevelSchwarz() = default;
+
+TwoLevelSchwarz::TwoLevelSchwarz(const PanelSet& panels, const ClusterTree& tree,
+                                 const NearField& near, std::size_t max_set, std::size_t max_coarse)
+    : m_local(panels, tree, near, max_set), m_tree(tree), m_n(panels.size()) {
+  const std::size_t n = m_n;
+  // Coarse clusters: the nodes at depth d (or leaves reached before), 2^d <= max_coarse.
+  int depth = 0;
+  while ((std::size_t{2} << depth) <= std::max<std::size_t>(max_coarse, 1)) ++depth;
+  std::vector<std::int32_t> roots;
+  {
+    std::vector<std::pair<std::int32_t, int>> stack = {{0, 0}};
+    while (!stack.empty()) {
+      const auto [id, d] = stack.back();
+      stack.pop_back();
+      const Cluster& c = tree.nodes[static_cast<std::size_t>(id)];
+      if (d == depth || c.left < 0) {
+        roots.push_back(id);
+      } else {
+        stack.push_back({c.right, d + 1});
+        stack.push_back({c.left, d + 1});
+      }
+    }
+  }
+  m_k = roots.size();
+  const std::size_t k = m_k;
+  m_cluster.resize(n);
+  m_begin.resize(k);
+  m_end.resize(k);
+  for (std::size_t J = 0; J < k; ++J) {
+    const Cluster& c = tree.nodes[static_cast<std::size_t>(roots[J])];
+    m_begin[J] = c.begin;
+    m_end[J] = c.end;
+    for (std::uint32_t e = c.begin; e < c.end; ++e) {
+      m_cluster[tree.order[e]] = static_cast<std::uint32_t>(J);
+    }
+  }
+  // Per node: total area, area centroid, and a radius about it that covers the triangles.
+  const std::size_t nodes = tree.nodes.size();
+  std::vector<double> area(nodes), cx(nodes), cy(nodes), cz(nodes), radius(nodes);
+#if defined(TETSEG_HAVE_OPENMP)
+#pragma omp parallel for schedule(dynamic, 16)
+#endif
+  for (std::ptrdiff_t node = 0; node < static_cast<std::ptrdiff_t>(nodes); ++node) {
+    const std::size_t id = static_cast<std::size_t>(node);
+    const Cluster& c = tree.nodes[id];
+    double a = 0.0, x = 0.0, y = 0.0, z = 0.0;
+    for (std::uint32_t e = c.begin; e < c.end; ++e) {
+      const std::uint32_t j = tree.order[e];
+      const double aj = panels.area[j];
+      a += aj;
+      x += aj * panels.centroid[j][0];
+      y += aj * panels.centroid[j][1];
+      z += aj * panels.centroid[j][2];
+    }
+    area[id] = a;
+    cx[id] = x / a;
+    cy[id] = y / a;
+    cz[id] = z / a;
+    double r2 = 0.0;
+    for (std::uint32_t e = c.begin; e < c.end; ++e) {
+      const std::uint32_t j = tree.order[e];
+      const Vec3& q = panels.centroid[j];
+      const double dx = q[0] - cx[id], dy = q[1] - cy[id], dz = q[2] - cz[id];
+      const double h = 0.5 * panels.diameter[j];
+      r2 = std::max(r2, dx * dx + dy * dy + dz * dz + h * h);
+    }
+    radius[id] = std::sqrt(r2);
+  }
+  m_area.resize(k);
+  m_gx.resize(k);
+  m_gy.resize(k);
+  m_gz.resize(k);
+  for (std::size_t J = 0; J < k; ++J) {
+    const std::size_t id = static_cast<std::size_t>(roots[J]);
+    m_area[J] = area[id];
+    m_gx[J] = cx[id];
+    m_gy[J] = cy[id];
+    m_gz[J] = cz[id];
+  }
+  // Far pairs, then the near list of each cluster: the clusters that are not far, and those
+  // holding a near-field column of one of its members.
+  m_far.assign(k * k, 0);
+  for (std::size_t I = 0; I < k; ++I) {
+    const double ri = radius[static_cast<std::size_t>(roots[I])];
+    for (std::size_t J = 0; J < k; ++J) {
+      const double rj = radius[static_cast<std::size_t>(roots[J])];
+      const double dx = m_gx[I] - m_gx[J], dy = m_gy[I] - m_gy[J], dz = m_gz[I] - m_gz[J];
+      const double d2 = dx * dx + dy * dy + dz * dz;
+      if (I != J && (ri + rj) * (ri + rj) < kCoarseOpening * kCoarseOpening * d2) {
+        m_far[I * k + J] = 1;
+      }
+    }
+    for (std::uint32_t e = m_begin[I]; e < m_end[I]; ++e) {
+      const std::size_t i = tree.order[e];
+      for (std::size_t f = near.row_start[i]; f < near.row_start[i + 1]; ++f) {
+        m_far[I * k + m_cluster[near.column[f]]] = 0;
+      }
+    }
+  }
+  m_near_start.assign(k + 1, 0);
+  m_block_start.assign(k + 1, 0);
+  for (std::size_t I = 0; I < k; ++I) {
+    for (std::size_t J = 0; J < k; ++J) {
+      if (!m_far[I * k + J]) m_near.push_back(static_cast<std::uint32_t>(J));
+    }
+    m_near_start[I + 1] = m_near.size();
+    m_block_start[I + 1] =
+        m_block_start[I] + (m_end[I] - m_begin[I]) * (m_near_start[I + 1] - m_near_start[I]);
+  }
+  m_block.assign(m_block_start[k], 0.0f);
+  // Near blocks: Barnes-Hut over each near cluster's subtree (monopoles at area centroids when
+  // the node's radius is below 0.5 times the distance, point charges in leaves otherwise),
+  // plus the analytic near-field corrections.
+  constexpr double kOpening = 0.5;
+#if defined(TETSEG_HAVE_OPENMP)
+#pragma omp parallel
+#endif
+  {
+    std::vector<std::int32_t> stack;
+    std::vector<std::int32_t> slot(k, -1);
+#if defined(TETSEG_HAVE_OPENMP)
+#pragma omp for schedule(dynamic, 1)
+#endif
+    for (std::ptrdiff_t cluster = 0; cluster < static_cast<std::ptrdiff_t>(k); ++cluster) {
+      const std::size_t I = static_cast<std::size_t>(cluster);
+      const std::size_t first = m_near_start[I], count = m_near_start[I + 1] - first;
+      for (std::size_t s = 0; s < count; ++s) slot[m_near[first + s]] = static_cast<int>(s);
+      for (std::uint32_t e = m_begin[I]; e < m_end[I]; ++e) {
+        const std::size_t i = tree.order[e];
+        const Vec3& p = panels.centroid[i];
+        float* row = m_block.data() + m_block_start[I] + (e - m_begin[I]) * count;
+        for (std::size_t s = 0; s < count; ++s) {
+          double sum = 0.0;
+          stack.assign(1, roots[m_near[first + s]]);
+          while (!stack.empty()) {
+            const std::size_t id = static_cast<std::size_t>(stack.back());
+            stack.pop_back();
+            const Cluster& c = tree.nodes[id];
+            const double dx = p[0] - cx[id], dy = p[1] - cy[id], dz = p[2] - cz[id];
+            const double d2 = dx * dx + dy * dy + dz * dz;
+            if (radius[id] * radius[id] < kOpening * kOpening * d2) {
+              sum += area[id] / std::sqrt(d2);
+            } else if (c.left >= 0) {
+              stack.push_back(c.left);
+              stack.push_back(c.right);
+            } else {
+              for (std::uint32_t f = c.begin; f < c.end; ++f) {
+                const std::uint32_t j = tree.order[f];
+                const Vec3& q = panels.centroid[j];
+                const double ex = p[0] - q[0], ey = p[1] - q[1], ez = p[2] - q[2];
+                const double r2 = ex * ex + ey * ey + ez * ez;
+                if (r2 > 0.0) sum += panels.area[j] / std::sqrt(r2);
+              }
+            }
+          }
+          row[s] = static_cast<float>(sum);
+        }
+        for (std::size_t f = near.row_start[i]; f < near.row_start[i + 1]; ++f) {
+          row[slot[m_cluster[near.column[f]]]] += static_cast<float>(near.correction[f]);
+        }
+      }
+      for (std::size_t s = 0; s < count; ++s) slot[m_near[first + s]] = -1;
+    }
+  }
+  // Galerkin coarse matrix C = Z^T (M Z): near entries sum the blocks; far entries sum the
+  // second-order Taylor expansion of A_J / |x - g_J| over I's members, through I's target
+  // moments S0 = |I|, S1 = sum w, S2 = sum w w^T (w = c_i - g_I).
+  Eigen::MatrixXd coarse =
+      Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(k));
+  m_wx.resize(n);
+  m_wy.resize(n);
+  m_wz.resize(n);
+  for (std::size_t I = 0; I < k; ++I) {
+    const std::size_t first = m_near_start[I], count = m_near_start[I + 1] - first;
+    double s0 = 0.0, s1[3] = {0, 0, 0}, s2[3][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
+    for (std::uint32_t e = m_begin[I]; e < m_end[I]; ++e) {
+      const float* row = m_block.data() + m_block_start[I] + (e - m_begin[I]) * count;
+      for (std::size_t s = 0; s < count; ++s) {
+        coarse(static_cast<Eigen::Index>(I), static_cast<Eigen::Index>(m_near[first + s])) +=
+            row[s];
+      }
+      const Vec3& p = panels.centroid[tree.order[e]];
+      const double w[3] = {p[0] - m_gx[I], p[1] - m_gy[I], p[2] - m_gz[I]};
+      m_wx[e] = w[0];
+      m_wy[e] = w[1];
+      m_wz[e] = w[2];
+      s0 += 1.0;
+      for (int a = 0; a < 3; ++a) {
+        s1[a] += w[a];
+        for (int b = 0; b < 3; ++b) s2[a][b] += w[a] * w[b];
+      }
+    }
+    const double trace = s2[0][0] + s2[1][1] + s2[2][2];
+    for (std::size_t J = 0; J < k; ++J) {
+      if (!m_far[I * k + J]) continue;
+      const double rv[3] = {m_gx[I] - m_gx[J], m_gy[I] - m_gy[J], m_gz[I] - m_gz[J]};
+      const double r2 = rv[0] * rv[0] + rv[1] * rv[1] + rv[2] * rv[2];
+      const double inv_r = 1.0 / std::sqrt(r2), inv_r3 = inv_r / r2, inv_r5 = inv_r3 / r2;
+      double rs1 = 0.0, rs2r = 0.0;
+      for (int a = 0; a < 3; ++a) {
+        rs1 += rv[a] * s1[a];
+        for (int b = 0; b < 3; ++b) rs2r += rv[a] * s2[a][b] * rv[b];
+      }
+      coarse(static_cast<Eigen::Index>(I), static_cast<Eigen::Index>(J)) =
+          m_area[J] * (s0 * inv_r - rs1 * inv_r3 + 0.5 * (3.0 * rs2r - r2 * trace) * inv_r5);
+    }
+  }
+  m_lu = std::make_unique<CoarseLu>();
+  m_lu->lu.compute(coarse);
+  m_residual.resize(n);
+}
+
+void TwoLevelSchwarz::apply(const double* in, double* out) const {
+  const std::size_t k = m_k;
+  const auto& order = m_tree.order;
+  Eigen::VectorXd t = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(k));
+  for (std::size_t J = 0; J < k; ++J) {
+    double s = 0.0;
+    for (std::uint32_t e = m_begin[J]; e < m_end[J]; ++e) s += in[order[e]];
+    t[static_cast<Eigen::Index>(J)] = s;
+  }
+  const Eigen::VectorXd u = m_lu->lu.solve(t);
+  double* r = m_residual.data();
+#if defined(TETSEG_HAVE_OPENMP)
+#pragma omp parallel for schedule(dynamic, 4)
+#endif
+  for (std::ptrdiff_t cluster = 0; cluster < static_cast<std::ptrdiff_t>(k); ++cluster) {
+    const std::size_t I = static_cast<std::size_t>(cluster);
+    // Far clusters: Taylor expansion about g_I of sum_J A_J u_J / |x - g_J|, to second order:
+    // value t0 + g.w + w^T H w.
+    double t0 = 0.0, g[3] = {0, 0, 0}, h[6] = {0, 0, 0, 0, 0, 0};  // xx xy xz yy yz zz
+    const std::uint8_t* far = m_far.data() + I * k;
+    for (std::size_t J = 0; J < k; ++J) {
+      if (!far[J]) continue;
+      const double q = m_area[J] * u[static_cast<Eigen::Index>(J)];
+      const double rx = m_gx[I] - m_gx[J], ry = m_gy[I] - m_gy[J], rz = m_gz[I] - m_gz[J];
+      const double r2 = rx * rx + ry * ry + rz * rz;
+      const double inv_r = 1.0 / std::sqrt(r2), q3 = q * inv_r / r2, q5 = 0.5 * q3 / r2;
+      t0 += q * inv_r;
+      g[0] -= q3 * rx;
+      g[1] -= q3 * ry;
+      g[2] -= q3 * rz;
+      h[0] += q5 * (3.0 * rx * rx - r2);
+      h[1] += q5 * 3.0 * rx * ry;
+      h[2] += q5 * 3.0 * rx * rz;
+      h[3] += q5 * (3.0 * ry * ry - r2);
+      h[4] += q5 * 3.0 * ry * rz;
+      h[5] += q5 * (3.0 * rz * rz - r2);
+    }
+    const std::size_t first = m_near_start[I], count = m_near_start[I + 1] - first;
+    double un[512];
+    std::vector<double> un_large;
+    double* uu = un;
+    if (count > 512) {
+      un_large.resize(count);
+      uu = un_large.data();
+    }
+    for (std::size_t s = 0; s < count; ++s) uu[s] = u[static_cast<Eigen::Index>(m_near[first + s])];
+    for (std::uint32_t e = m_begin[I]; e < m_end[I]; ++e) {
+      const double wx = m_wx[e], wy = m_wy[e], wz = m_wz[e];
+      double v = t0 + g[0] * wx + g[1] * wy + g[2] * wz + h[0] * wx * wx + h[3] * wy * wy +
+                 h[5] * wz * wz + 2.0 * (h[1] * wx * wy + h[2] * wx * wz + h[4] * wy * wz);
+      const float* row = m_block.data() + m_block_start[I] + (e - m_begin[I]) * count;
+      for (std::size_t s = 0; s < count; ++s) v += static_cast<double>(row[s]) * uu[s];
+      const std::size_t i = order[e];
+      r[i] = in[i] - v;
+    }
+  }
+  m_local.apply(r, out);
+  for (std::size_t i = 0; i < m_n; ++i) {
+    out[i] += u[static_cast<Eigen::Index>(m_cluster[i])];
+  }
+}
+
+}  // namespace tetseg::preprocess::charge_detail
