@@ -93,7 +93,7 @@ bool Collider::Impl::seam_culled(std::uint32_t t1, std::uint32_t t2) const noexc
 }
 
 template <typename VertexFace, typename EdgeEdge>
-void Collider::Impl::for_each_adjacent_feature_pair(VertexFace&& vertex_face,
+void Collider::Impl::for_each_adjacent_feature_pair(bool across_clusters, VertexFace&& vertex_face,
                                                     EdgeEdge&& edge_edge) const {
   const BodyShape::Data& T = *topo;
   std::vector<std::uint32_t> near, candidates;
@@ -105,6 +105,14 @@ void Collider::Impl::for_each_adjacent_feature_pair(VertexFace&& vertex_face,
                   T.vt_list.begin() + T.vt_offset[i + 1]);
     }
   };
+  // With `across_clusters`, a vertex or edge whose neighbour triangles (its own included) lie
+  // in one cluster is skipped: a pair of its holders that shares a node lies among them.
+  auto one_cluster = [&]() {
+    if (!across_clusters) return false;
+    for (std::uint32_t t : near)
+      if (asset->triangle_cluster[t] != asset->triangle_cluster[near[0]]) return false;
+    return true;
+  };
   auto sort_unique = [](std::vector<std::uint32_t>& v) {
     std::sort(v.begin(), v.end());
     v.erase(std::unique(v.begin(), v.end()), v.end());
@@ -115,6 +123,7 @@ void Collider::Impl::for_each_adjacent_feature_pair(VertexFace&& vertex_face,
     const std::uint32_t p = T.surf_nodes[ip];
     near.clear();
     for (std::uint32_t k = T.vt_offset[ip]; k < T.vt_offset[ip + 1]; ++k) gather_near(T.vt_list[k]);
+    if (one_cluster()) continue;
     sort_unique(near);
     for (std::uint32_t f : near) {
       const auto& F = tris[f];
@@ -127,6 +136,7 @@ void Collider::Impl::for_each_adjacent_feature_pair(VertexFace&& vertex_face,
   for (std::uint32_t e1 = 0; e1 < ne; ++e1) {
     near.clear();
     for (std::uint32_t k = T.et_offset[e1]; k < T.et_offset[e1 + 1]; ++k) gather_near(T.et_list[k]);
+    if (one_cluster()) continue;
     candidates.clear();
     for (std::uint32_t t : near)
       for (std::uint32_t e2 : T.tri_edges[t])
@@ -166,6 +176,7 @@ void Collider::Impl::build_orphan_sets() {
   // Orphans: every holding triangle pair shares a node.
   auto disjoint = [&](std::uint32_t u, std::uint32_t v) { return !share_node(tris[u], tris[v]); };
   for_each_adjacent_feature_pair(
+      false,
       [&](std::uint32_t p, std::uint32_t f) {
         if (!any_vertex_face_holder(p, f, disjoint)) orphan_vf.push_back({p, f});
       },
@@ -184,6 +195,7 @@ void Collider::Impl::build_seam_orphans() {
     return cluster[u] != cluster[v] && !share_node(tris[u], tris[v]);
   };
   for_each_adjacent_feature_pair(
+      true,
       [&](std::uint32_t p, std::uint32_t f) {
         if (any_vertex_face_holder(p, f, cross) && !any_vertex_face_holder(p, f, cross_disjoint))
           seam_vf.push_back({p, f});
