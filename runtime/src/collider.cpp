@@ -137,6 +137,7 @@ void Collider::Impl::construct(std::shared_ptr<const BodyShape> sh, const Collid
   cluster_err.resize(cluster_count());
   skip_adjacent = uses_global_bvh();
   if (skip_adjacent) build_orphan_sets();
+  if (opt.mode == ColliderMode::kRvbc && cluster_count() > 1) build_seam_orphans();
 
   // kBvh topology storage (built from rest positions now when available, else on the first
   // step or rest check, without allocating).

@@ -345,6 +345,11 @@ struct Collider::Impl {
   bool skip_adjacent = false;
   std::vector<std::array<std::uint32_t, 2>> orphan_vf;  // (node, triangle)
   std::vector<std::array<std::uint32_t, 2>> orphan_ee;  // (edge, edge), first < second
+  // rvbc: triangle pairs of two clusters that share a node are culled; the feature pairs that
+  // only such pairs hold across clusters (seam orphans, built at construction) are tested
+  // directly every step (docs/runtime.md, "Across clusters: seam pairs").
+  std::vector<std::array<std::uint32_t, 2>> seam_vf;  // (node, triangle)
+  std::vector<std::array<std::uint32_t, 2>> seam_ee;  // (edge, edge), first < second
   std::vector<Box> nbox;  // per asset BVH node (refit for a scene body: traverse_bodies)
   std::vector<std::uint32_t> nmov;
   // 4-wide cluster BVHs (topo->wide_nodes), this step: children's data, own box, own moving
@@ -411,6 +416,9 @@ struct Collider::Impl {
   /// false on stack overflow.
   bool run_query(Contact* out, std::size_t out_cap) noexcept;
   bool non_culled(std::uint32_t t1, std::uint32_t t2) const noexcept;
+  /// A pair of two clusters sharing a node that non_culled accepted before the seam rule (both
+  /// not still, boxes overlapping): culled only by that rule (rvbc, not the rest check).
+  bool seam_culled(std::uint32_t t1, std::uint32_t t2) const noexcept;
   void process_triangle_pair(Worker& w, std::uint32_t t1, std::uint32_t t2) const noexcept;
   /// process_triangle_pair of a pair known to be non-culled (not in the rest check).
   void process_non_culled_pair(Worker& w, std::uint32_t t1, std::uint32_t t2) const noexcept;
@@ -426,10 +434,27 @@ struct Collider::Impl {
   void sign_wide() noexcept;
   void brute_vertex_faces(Worker& w, std::uint32_t i) const noexcept;
   void brute_edge_edges(Worker& w, std::uint32_t i) const noexcept;
+  /// Calls vertex_face(p, f) for every vertex-face pair (p not in f) and edge_edge(e1, e2)
+  /// for every edge pair (e1 < e2, four distinct nodes) held by some triangle pair that shares
+  /// a node (construction; allocates, may throw). With `across_clusters`, only those where
+  /// such a pair spans two clusters, and maybe some others.
+  template <typename VertexFace, typename EdgeEdge>
+  void for_each_adjacent_feature_pair(bool across_clusters, VertexFace&& vertex_face,
+                                      EdgeEdge&& edge_edge) const;
+  /// holder(t1, t2) is true for some triangle pair holding the feature pair: (t around p, f),
+  /// or (t1 around e1, t2 around e2).
+  template <typename Holder>
+  bool any_vertex_face_holder(std::uint32_t p, std::uint32_t f, Holder&& holder) const noexcept;
+  template <typename Holder>
+  bool any_edge_edge_holder(std::uint32_t e1, std::uint32_t e2, Holder&& holder) const noexcept;
   /// Builds orphan_vf / orphan_ee from the topology (construction; allocates, may throw).
   void build_orphan_sets();
   /// Tests every orphan feature pair (filters, then the elementary test).
   void test_orphans(Worker& w) const noexcept;
+  /// Builds seam_vf / seam_ee from the topology and clusters (construction; may throw).
+  void build_seam_orphans();
+  /// Tests every seam orphan that no non-culled triangle pair holds (filters, elementary test).
+  void test_seam_orphans(Worker& w) const noexcept;
   /// Intra-cluster work of cluster c1 and its pairs with every cluster c2 > c1.
   bool cluster_tasks(Worker& w, std::uint32_t c1, bool count_skips) const noexcept;
   TreeView cluster_view(std::uint32_t c) const noexcept;
@@ -455,6 +480,13 @@ struct Collider::Impl {
   /// Static intersection check of this body at positions x (check_rest_intersection).
   RestCheck rest_check(const double* x, std::size_t value_count) noexcept;
 };
+
+/// Triangles a and b have a node in common.
+inline bool share_node(const format::Triangle& a, const format::Triangle& b) noexcept {
+  for (std::uint32_t n : a)
+    if (n == b[0] || n == b[1] || n == b[2]) return true;
+  return false;
+}
 
 /// Static check of triangle t1 of A against t2 of B (A == B within a body): an edge of one
 /// meeting the other, conservatively; records a witness in `w` and stops it.

@@ -33,12 +33,6 @@ inline Vec3d v3(const double* p) noexcept {
   return {p[0], p[1], p[2]};
 }
 
-inline bool share_node(const format::Triangle& a, const format::Triangle& b) noexcept {
-  for (std::uint32_t n : a)
-    if (n == b[0] || n == b[1] || n == b[2]) return true;
-  return false;
-}
-
 }  // namespace
 
 TreeView Collider::Impl::cluster_view(std::uint32_t c) const noexcept {
@@ -78,18 +72,30 @@ bool Collider::Impl::non_culled(std::uint32_t t1, std::uint32_t t2) const noexce
   if (t1 == t2) return false;
   if (!rest_mode && !tmov[t1] && !tmov[t2]) return false;
   if (!boxes_overlap(tbox[t1], tbox[t2], opt.ccd.min_separation)) return false;
-  if (orientation_mode() && asset->triangle_cluster[t1] == asset->triangle_cluster[t2]) {
-    const std::uint8_t c = tcls[t1];
-    if (c != kUnc && c == tcls[t2]) return false;
+  if (orientation_mode()) {
+    if (asset->triangle_cluster[t1] == asset->triangle_cluster[t2]) {
+      const std::uint8_t c = tcls[t1];
+      return c == kUnc || c != tcls[t2];
+    }
+    // Across clusters: a pair sharing a node is culled (its feature pairs: the seam orphans).
+    return !share_node(tris[t1], tris[t2]);
   }
   if (skip_adjacent && !rest_mode && share_node(tris[t1], tris[t2])) return false;
   return true;
 }
 
-void Collider::Impl::build_orphan_sets() {
+bool Collider::Impl::seam_culled(std::uint32_t t1, std::uint32_t t2) const noexcept {
+  if (!orientation_mode() || asset->triangle_cluster[t1] == asset->triangle_cluster[t2])
+    return false;
+  if (!tmov[t1] && !tmov[t2]) return false;
+  return boxes_overlap(tbox[t1], tbox[t2], opt.ccd.min_separation) &&
+         share_node(tris[t1], tris[t2]);
+}
+
+template <typename VertexFace, typename EdgeEdge>
+void Collider::Impl::for_each_adjacent_feature_pair(bool across_clusters, VertexFace&& vertex_face,
+                                                    EdgeEdge&& edge_edge) const {
   const BodyShape::Data& T = *topo;
-  orphan_vf.clear();
-  orphan_ee.clear();
   std::vector<std::uint32_t> near, candidates;
   // Appends the triangles sharing a node with triangle t (t included).
   auto gather_near = [&](std::uint32_t t) {
@@ -99,32 +105,38 @@ void Collider::Impl::build_orphan_sets() {
                   T.vt_list.begin() + T.vt_offset[i + 1]);
     }
   };
+  // With `across_clusters`, a vertex or edge whose neighbour triangles (its own included) lie
+  // in one cluster is skipped: a pair of its holders that shares a node lies among them.
+  auto one_cluster = [&]() {
+    if (!across_clusters) return false;
+    for (std::uint32_t t : near)
+      if (asset->triangle_cluster[t] != asset->triangle_cluster[near[0]]) return false;
+    return true;
+  };
   auto sort_unique = [](std::vector<std::uint32_t>& v) {
     std::sort(v.begin(), v.end());
     v.erase(std::unique(v.begin(), v.end()), v.end());
   };
-  // Vertex-face (p, F), p not in F: every triangle around p shares a node with F. Such an F
-  // shares a node with a triangle around p, so it is among their neighbours.
+  // Vertex-face (p, F), p not in F, F sharing a node with a triangle around p: F is among
+  // those triangles' neighbours.
   for (std::uint32_t ip = 0; ip < T.surf_nodes.size(); ++ip) {
     const std::uint32_t p = T.surf_nodes[ip];
     near.clear();
     for (std::uint32_t k = T.vt_offset[ip]; k < T.vt_offset[ip + 1]; ++k) gather_near(T.vt_list[k]);
+    if (one_cluster()) continue;
     sort_unique(near);
     for (std::uint32_t f : near) {
       const auto& F = tris[f];
-      if (p == F[0] || p == F[1] || p == F[2]) continue;
-      bool all_adjacent = true;
-      for (std::uint32_t k = T.vt_offset[ip]; k < T.vt_offset[ip + 1] && all_adjacent; ++k)
-        all_adjacent = share_node(tris[T.vt_list[k]], F);
-      if (all_adjacent) orphan_vf.push_back({p, f});
+      if (p != F[0] && p != F[1] && p != F[2]) vertex_face(p, f);
     }
   }
-  // Edge-edge (e1, e2), four distinct nodes: every triangle around e1 shares a node with every
-  // triangle around e2. e2 is an edge of a triangle sharing a node with one around e1.
+  // Edge-edge (e1, e2), e1 < e2, four distinct nodes, a triangle around e2 sharing a node with
+  // one around e1: e2 is an edge of a neighbour of a triangle around e1.
   const std::uint32_t ne = static_cast<std::uint32_t>(T.edges.size());
   for (std::uint32_t e1 = 0; e1 < ne; ++e1) {
     near.clear();
     for (std::uint32_t k = T.et_offset[e1]; k < T.et_offset[e1 + 1]; ++k) gather_near(T.et_list[k]);
+    if (one_cluster()) continue;
     candidates.clear();
     for (std::uint32_t t : near)
       for (std::uint32_t e2 : T.tri_edges[t])
@@ -133,14 +145,65 @@ void Collider::Impl::build_orphan_sets() {
     const auto& E1 = T.edges[e1];
     for (std::uint32_t e2 : candidates) {
       const auto& E2 = T.edges[e2];
-      if (E1[0] == E2[0] || E1[0] == E2[1] || E1[1] == E2[0] || E1[1] == E2[1]) continue;
-      bool all_adjacent = true;
-      for (std::uint32_t k1 = T.et_offset[e1]; k1 < T.et_offset[e1 + 1] && all_adjacent; ++k1)
-        for (std::uint32_t k2 = T.et_offset[e2]; k2 < T.et_offset[e2 + 1] && all_adjacent; ++k2)
-          all_adjacent = share_node(tris[T.et_list[k1]], tris[T.et_list[k2]]);
-      if (all_adjacent) orphan_ee.push_back({e1, e2});
+      if (E1[0] != E2[0] && E1[0] != E2[1] && E1[1] != E2[0] && E1[1] != E2[1]) edge_edge(e1, e2);
     }
   }
+}
+
+template <typename Holder>
+bool Collider::Impl::any_vertex_face_holder(std::uint32_t p, std::uint32_t f,
+                                            Holder&& holder) const noexcept {
+  const std::uint32_t ip = topo->surf_index[p];
+  for (std::uint32_t k = topo->vt_offset[ip]; k < topo->vt_offset[ip + 1]; ++k)
+    if (holder(topo->vt_list[k], f)) return true;
+  return false;
+}
+
+template <typename Holder>
+bool Collider::Impl::any_edge_edge_holder(std::uint32_t e1, std::uint32_t e2,
+                                          Holder&& holder) const noexcept {
+  const auto& off = topo->et_offset;
+  const auto& list = topo->et_list;
+  for (std::uint32_t k1 = off[e1]; k1 < off[e1 + 1]; ++k1)
+    for (std::uint32_t k2 = off[e2]; k2 < off[e2 + 1]; ++k2)
+      if (holder(list[k1], list[k2])) return true;
+  return false;
+}
+
+void Collider::Impl::build_orphan_sets() {
+  orphan_vf.clear();
+  orphan_ee.clear();
+  // Orphans: every holding triangle pair shares a node.
+  auto disjoint = [&](std::uint32_t u, std::uint32_t v) { return !share_node(tris[u], tris[v]); };
+  for_each_adjacent_feature_pair(
+      false,
+      [&](std::uint32_t p, std::uint32_t f) {
+        if (!any_vertex_face_holder(p, f, disjoint)) orphan_vf.push_back({p, f});
+      },
+      [&](std::uint32_t e1, std::uint32_t e2) {
+        if (!any_edge_edge_holder(e1, e2, disjoint)) orphan_ee.push_back({e1, e2});
+      });
+}
+
+void Collider::Impl::build_seam_orphans() {
+  seam_vf.clear();
+  seam_ee.clear();
+  // Seam orphans: some holding pair spans two clusters, and every such pair shares a node.
+  const auto& cluster = asset->triangle_cluster;
+  auto cross = [&](std::uint32_t u, std::uint32_t v) { return cluster[u] != cluster[v]; };
+  auto cross_disjoint = [&](std::uint32_t u, std::uint32_t v) {
+    return cluster[u] != cluster[v] && !share_node(tris[u], tris[v]);
+  };
+  for_each_adjacent_feature_pair(
+      true,
+      [&](std::uint32_t p, std::uint32_t f) {
+        if (any_vertex_face_holder(p, f, cross) && !any_vertex_face_holder(p, f, cross_disjoint))
+          seam_vf.push_back({p, f});
+      },
+      [&](std::uint32_t e1, std::uint32_t e2) {
+        if (any_edge_edge_holder(e1, e2, cross) && !any_edge_edge_holder(e1, e2, cross_disjoint))
+          seam_ee.push_back({e1, e2});
+      });
 }
 
 bool Collider::Impl::orientation_culled(std::uint32_t t1, std::uint32_t t2) const noexcept {
@@ -500,10 +563,12 @@ void Collider::Impl::close_contacts(Worker& w, double toi) noexcept {
       if (!orientation_culled(t1, t2)) continue;
       ++w.stats.closure_pairs;
       const std::uint64_t key = pair_key(t1, t2);
-      // Claimed: tested by the traversal (non-culled), or earlier in this closure.
+      // Claimed: tested by the traversal (non-culled) or by the seam orphans (a seam-culled
+      // holder: docs/runtime.md, "Across clusters"), or earlier in this closure.
       test_features(w, *this, t1, *this, t2, [&](std::uint32_t u, std::uint32_t v) {
-        return non_culled(u, v) || (pair_key(u, v) < key && closure_mark[u] && closure_mark[v] &&
-                                    orientation_culled(u, v));
+        return non_culled(u, v) || seam_culled(u, v) ||
+               (pair_key(u, v) < key && closure_mark[u] && closure_mark[v] &&
+                orientation_culled(u, v));
       });
     }
   }
@@ -640,6 +705,25 @@ void Collider::Impl::test_orphans(Worker& w) const noexcept {
     process_edge_edge(w, *this, orphan_ee[i][0], *this, orphan_ee[i][1]);
 }
 
+void Collider::Impl::test_seam_orphans(Worker& w) const noexcept {
+  // Each is tested here only when no holding triangle pair is non-culled (otherwise the
+  // smallest such pair tests it): exactly once. The cheap rejections of process_* come first.
+  const double ms = opt.ccd.min_separation;
+  auto nc = [&](std::uint32_t u, std::uint32_t v) { return non_culled(u, v); };
+  for (std::size_t i = 0; i < seam_vf.size() && !w.stop; ++i) {
+    const std::uint32_t p = seam_vf[i][0], f = seam_vf[i][1];
+    const std::uint32_t ip = topo->surf_index[p];
+    if (!vmoved[ip] && !tmov[f]) continue;
+    if (!boxes_overlap(vbox[ip], tbox[f], ms)) continue;
+    if (!any_vertex_face_holder(p, f, nc)) process_vertex_face(w, *this, p, *this, f);
+  }
+  for (std::size_t i = 0; i < seam_ee.size() && !w.stop; ++i) {
+    const std::uint32_t e1 = seam_ee[i][0], e2 = seam_ee[i][1];
+    if (!edge_boxes_overlap(*this, e1, *this, e2)) continue;
+    if (!any_edge_edge_holder(e1, e2, nc)) process_edge_edge(w, *this, e1, *this, e2);
+  }
+}
+
 void Collider::Impl::brute_vertex_faces(Worker& w, std::uint32_t i) const noexcept {
   // Vertex i against every triangle not containing it (swept-box overlap checked inside).
   const std::uint32_t p = topo->surf_nodes[i];
@@ -747,6 +831,10 @@ bool Collider::Impl::run_query(Contact* out, std::size_t out_cap) noexcept {
           }
         }
       }
+      // After every traversal: the seam orphans that no non-culled pair holds.
+      bool done = false;
+      for (const Worker& w : workers) done = done || w.stop || w.overflow;
+      if (!rest_mode && !done) test_seam_orphans(w0);
     }
   }
   // Contact closure around the earliest contacts (rvbc, full queries).

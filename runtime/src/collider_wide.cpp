@@ -125,10 +125,13 @@ bool Collider::Impl::traverse_wide(Worker& w, StackItem first, bool orient) cons
   const WideNode* nodes = topo->wide_nodes.data();
   const double ms = opt.ccd.min_separation;
   const bool use_mov = !rest_mode;
+  // Across clusters (a pair of roots) a pair sharing a node is culled too (non_culled's seam
+  // rule; its feature pairs are the seam orphans').
+  const bool seam = !rest_mode && first.b != kNone;
   auto triangle_pair = [&](std::uint32_t t1, std::uint32_t t2) {
     if (rest_mode) {
       process_triangle_pair(w, t1, t2);
-    } else {
+    } else if (!seam || !share_node(tris[t1], tris[t2])) {
       process_non_culled_pair(w, t1, t2);
     }
   };

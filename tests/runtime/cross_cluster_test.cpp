@@ -1,10 +1,14 @@
 // rvbc with many clusters against brute force, in the configurations that would trap culling
 // across clusters (docs/runtime.md, "Across clusters: not adopted"): neighbouring clusters folded
 // onto each other, wedge tips on a cluster boundary, detectors on both sides of a contact, and
-// random smooth deformations of many small clusters. compare_with_brute checks any-collision, the
+// random smooth deformations of many small clusters; and the seam rule (pairs of two clusters
+// sharing a node culled, their feature pairs tested from the seam orphans: "Across clusters:
+// seam pairs") on low-valence bodies in every split into clusters and on scattered clusters.
+// compare_with_brute checks any-collision, the
 // earliest toi and every brute-force contact at the earliest toi
 // (tests/runtime/support/compare.hpp).
 
+#include <algorithm>
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <random>
@@ -225,4 +229,163 @@ TEST_CASE(
       for (int k = 0; k < 3; ++k) f[3 * (scene.surface_nodes + i) + k] = detectors[i][k];
   const SequenceReport rep = compare_with_brute(scene, frames);
   REQUIRE(rep.contact_frames == 1);
+}
+
+namespace {
+
+// Every partition of `n` triangles into at least two clusters (restricted growth strings:
+// cluster ids in order of first use).
+std::vector<std::vector<std::uint32_t>> cluster_splits(std::uint32_t n) {
+  std::vector<std::vector<std::uint32_t>> out;
+  std::vector<std::uint32_t> c(n, 0);
+  while (true) {
+    const std::uint32_t blocks = *std::max_element(c.begin(), c.end()) + 1;
+    if (blocks >= 2) out.push_back(c);
+    // Next string: the last position that can grow does, the rest restart at 0.
+    std::size_t i = n;
+    while (i-- > 1) {
+      const std::uint32_t prefix_max = *std::max_element(c.begin(), c.begin() + i);
+      if (c[i] <= prefix_max) {
+        ++c[i];
+        std::fill(c.begin() + i + 1, c.end(), 0u);
+        break;
+      }
+    }
+    if (i == 0 || i > n) break;
+  }
+  return out;
+}
+
+// A small closed surface and single-step motions of it, each with a first contact.
+struct SeamCase {
+  Surface surface;
+  std::vector<std::vector<P3>> ends;  // end positions of the vertices, one motion each
+};
+
+// A tetrahedron: every two of its triangles share a node, so in any split into clusters every
+// triangle pair across clusters is culled and the feature pairs they hold are seam orphans.
+SeamCase tetrahedron_case() {
+  SeamCase c;
+  c.surface.verts = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0.3, 0.3, 1}};
+  c.surface.tris = {{0, 2, 1}, {0, 1, 3}, {1, 2, 3}, {2, 0, 3}};
+  c.ends = {{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0.25, 0.3, -1}},        // apex through the base
+            {{0, 0, 0}, {1, 0, 0}, {0.1, 1, 0.2}, {0.9, 0.8, -0.6}}};  // edge 2-3 crosses 0-1
+  return c;
+}
+
+// A triangular bipyramid: apexes of valence 3, equator vertices of valence 4; an apex pushed
+// through a face of the other half meets it where every holding pair shares a node.
+SeamCase bipyramid_case() {
+  SeamCase c;
+  Surface& s = c.surface;
+  for (int i = 0; i < 3; ++i)
+    s.verts.push_back({std::cos(2 * M_PI * i / 3), std::sin(2 * M_PI * i / 3), 0.0});
+  s.verts.push_back({0.1, 0.05, 1.0});    // 3: top
+  s.verts.push_back({-0.05, 0.1, -1.0});  // 4: bottom
+  for (std::uint32_t i = 0; i < 3; ++i) {
+    s.tris.push_back({i, (i + 1) % 3, 3});
+    s.tris.push_back({(i + 1) % 3, i, 4});
+  }
+  orient_outward(s);
+  auto moved = [&](std::uint32_t v, const P3& to) {
+    std::vector<P3> e = s.verts;
+    e[v] = to;
+    return e;
+  };
+  c.ends = {moved(3, {0.35, 0.2, -0.9}),   // top through a bottom face
+            moved(4, {-0.3, -0.25, 0.8}),  // bottom through a top face
+            moved(3, {-0.9, 1.2, -0.4})};  // top swung across the equator: its edges cross
+  return c;
+}
+
+}  // namespace
+
+TEST_CASE("Feature pairs held only by triangle pairs of two clusters sharing a node are found",
+          "[collider][rvbc][cross][seam]") {
+  // rvbc culls every triangle pair of two clusters that shares a node and tests the feature
+  // pairs that only such pairs hold across clusters from the seam-orphan list (docs/runtime.md,
+  // "Across clusters: seam pairs"). On these low-valence bodies, in every split into clusters,
+  // with detectors inside or far outside (more triangle pairs within a cluster culled by
+  // orientation), and with every cluster overlap-only: any-collision, the earliest toi and
+  // every contact at it agree with brute force, no contact is reported twice (answer()), and
+  // with overlap-only clusters every contact of the step equals brute force's.
+  const int body = GENERATE(0, 1);
+  const SeamCase c = body == 0 ? tetrahedron_case() : bipyramid_case();
+  const Surface& s = c.surface;
+  const std::uint32_t nv = static_cast<std::uint32_t>(s.verts.size());
+  int contact_steps = 0;
+  for (const auto& split : cluster_splits(static_cast<std::uint32_t>(s.tris.size()))) {
+    const std::uint32_t clusters = *std::max_element(split.begin(), split.end()) + 1;
+    for (const P3 detector : {P3{0.3, 0.25, 0.2}, P3{4.0, -3.0, 2.5}}) {
+      const Scene classified = make_scene(s, split, std::vector<P3>(clusters, detector));
+      for (int overlap_only = 0; overlap_only < 2; ++overlap_only) {
+        const Scene scene =
+            overlap_only ? with_cluster_flags(classified, format::kClusterOverlapOnly) : classified;
+        for (const auto& end : c.ends) {
+          CAPTURE(body, split, detector, overlap_only, end);
+          std::vector<double> x0 = scene.rest, x1 = scene.rest;
+          for (std::uint32_t v = 0; v < nv; ++v)
+            for (int k = 0; k < 3; ++k) x1[3 * v + k] = end[v][k];
+          const SequenceReport rep = compare_with_brute(scene, {x0, x1});
+          REQUIRE(rep.contact_frames == 1);
+          ++contact_steps;
+          if (!overlap_only) continue;
+          Collider rvbc = collider_for(scene, ColliderMode::kRvbc);
+          Collider brute = collider_for(scene, ColliderMode::kBrute);
+          const StepAnswer r = answer(rvbc, x0.data(), x1.data());
+          const StepAnswer b = answer(brute, x0.data(), x1.data());
+          REQUIRE(r.contacts.size() == b.contacts.size());
+          for (std::size_t i = 0; i < b.contacts.size(); ++i) {
+            CAPTURE(describe(b.contacts[i]));
+            CHECK(same_feature(r.contacts[i], b.contacts[i]));
+          }
+        }
+      }
+    }
+  }
+  CHECK(contact_steps > 0);
+}
+
+TEST_CASE("Triangles scattered over many clusters under random deformations agree with brute force",
+          "[collider][rvbc][cross][seam]") {
+  // Every triangle in a random one of 5 clusters: almost every vertex lies on a seam, many
+  // neighbouring pairs span two clusters (culled) and many feature pairs are seam orphans.
+  const unsigned seed = GENERATE(1u, 2u, 3u, 4u);
+  const int shape = GENERATE(0, 1);
+  CAPTURE(seed, shape);
+  const Surface s = shape == 0 ? sphere(1.0, 12, 7) : dumbbell(10, 16);
+  std::mt19937 rng(seed);
+  std::uniform_int_distribution<std::uint32_t> pick(0, 4);
+  std::vector<std::uint32_t> cluster_of(s.tris.size());
+  for (auto& c : cluster_of) c = pick(rng);
+  for (std::uint32_t c = 0; c < 5; ++c) cluster_of[c] = c;  // no cluster empty
+  const Scene scene = make_scene(
+      s, cluster_of,
+      {{0.2, 0.1, 0.0}, {-0.2, 0.1, 0.1}, {0.0, -0.2, -0.1}, {0.1, 0.0, 0.3}, {0.0, 0.1, -0.3}});
+  const Waves waves(seed, 1.0, 4.0);
+  const auto frames = make_frames(scene, 12, waves);
+  const SequenceReport rep = compare_with_brute(scene, frames);
+  CHECK(rep.frames_compared > 0);
+  // With OpenMP (the seam orphans tested after the parallel traversal) the answers and counts
+  // are the serial ones, on the steps compared above.
+  ColliderOptions parallel_options;
+  parallel_options.use_openmp = true;
+  Collider serial = collider_for(scene, ColliderMode::kRvbc);
+  Collider parallel(scene.asset, parallel_options);
+  for (int f = 0; f < rep.frames_compared; ++f) {
+    CAPTURE(f);
+    for (Collider* c : {&serial, &parallel})
+      REQUIRE(c->step(frames[f].data(), frames[f + 1].data()) == ColliderStatus::kOk);
+    CHECK(any_ok(serial) == any_ok(parallel));
+    // Counts after a stopped any-collision query depend on the threads: start the step again.
+    for (Collider* c : {&serial, &parallel})
+      REQUIRE(c->step(frames[f].data(), frames[f + 1].data()) == ColliderStatus::kOk);
+    const EarliestContact es = earliest_ok(serial), ep = earliest_ok(parallel);
+    REQUIRE(es.found == ep.found);
+    if (es.found) CHECK(same_feature(es.contact, ep.contact));
+    CHECK(contacts_ok(serial, nullptr, 0).found == contacts_ok(parallel, nullptr, 0).found);
+    CHECK(serial.stats().feature_pairs == parallel.stats().feature_pairs);
+    CHECK(serial.stats().feature_tests == parallel.stats().feature_tests);
+    CHECK(serial.stats().triangle_pairs == parallel.stats().triangle_pairs);
+  }
 }

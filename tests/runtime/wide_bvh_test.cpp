@@ -33,8 +33,9 @@ Scene without_rest_positions(const Scene& scene) {
 }
 
 // The triangle pairs rvbc must examine in the step x0 -> x1, by brute force over all pairs:
-// not both triangles still, swept boxes overlapping (min_separation 0), and not in one
-// cluster with the same proven class (the collider's classes for this step).
+// not both triangles still, swept boxes overlapping (min_separation 0), not in one cluster
+// with the same proven class (the collider's classes for this step), and not of two clusters
+// sharing a node.
 std::uint64_t non_culled_pairs(const Scene& scene, const Collider& rvbc, const double* x0,
                                const double* x1) {
   const format::Asset& a = scene.asset.data();
@@ -60,10 +61,15 @@ std::uint64_t non_culled_pairs(const Scene& scene, const Collider& rvbc, const d
       for (int k = 0; k < 3; ++k)
         overlap = overlap && box[t1][k] <= box[t2][3 + k] && box[t2][k] <= box[t1][3 + k];
       if (!overlap) continue;
-      const Orientation c = rvbc.triangle_class(t1);
-      if (a.triangle_cluster[t1] == a.triangle_cluster[t2] && c != Orientation::kUncertain &&
-          c == rvbc.triangle_class(t2))
-        continue;
+      if (a.triangle_cluster[t1] != a.triangle_cluster[t2]) {
+        // Across clusters a pair sharing a node is culled (its feature pairs: seam orphans).
+        const auto& n1 = a.triangles[t1];
+        const auto& n2 = a.triangles[t2];
+        if (std::find_first_of(n1.begin(), n1.end(), n2.begin(), n2.end()) != n1.end()) continue;
+      } else {
+        const Orientation c = rvbc.triangle_class(t1);
+        if (c != Orientation::kUncertain && c == rvbc.triangle_class(t2)) continue;
+      }
       ++count;
     }
   }
