@@ -157,10 +157,10 @@ Detector best_detector(const std::vector<Vec3>& nodes, const Surface& surface,
 struct RefinementOptions {
   /// A cluster whose best detector sees a smaller share of its triangles positive at rest is
   /// split; two neighbouring clusters whose union is seen at least this well are merged.
-  double min_visibility = 0.97;
+  double min_visibility = 0.98;
   /// A split is kept only if it removes at least this many non-positive triangles per edge of
   /// the new cut (a longer cut adds more cross-cluster triangle pairs at run time).
-  double gain_per_cut_edge = 1.0;
+  double gain_per_cut_edge = 0.5;
   /// Cost of a triangle not positive from its part's node, in mean edge lengths of cut (the
   /// cut's edges cost length x (0.05 + equalised density) x concavity factor <= 1).
   double invisibility_cost = 1.0;
