@@ -101,7 +101,7 @@ PY
 for s in pawn elephant armadillo dino; do
   refine_row "$s" "charge" --clusters charge
   refine_row "$s" "refined (defaults)" --clusters refined
-  for g in 0.25 0.5 2 4; do refine_row "$s" "gain $g" --clusters refined --refine-gain "$g"; done
-  for v in 0.9 0.95 0.99; do refine_row "$s" "visibility $v" --clusters refined --refine-visibility "$v"; done
+  for g in 0.25 1 2 4; do refine_row "$s" "gain $g" --clusters refined --refine-gain "$g"; done
+  for v in 0.9 0.95 0.97 0.99; do refine_row "$s" "visibility $v" --clusters refined --refine-visibility "$v"; done
   refine_row "$s" "no merge" --clusters refined --refine-merge false
 done
