@@ -323,79 +323,140 @@ ClusterTree build_cluster_tree(const PanelSet& panels, int leaf_size) {
 
 NearField build_near_field(const PanelSet& panels, const ClusterTree& tree) {
   const std::size_t n = panels.size();
-  std::vector<std::vector<std::uint32_t>> cols(n);
-#if defined(TETSEG_HAVE_OPENMP)
-#pragma omp parallel for schedule(dynamic, 64)
-#endif
-  for (std::ptrdiff_t ii = 0; ii < static_cast<std::ptrdiff_t>(n); ++ii) {
-    const std::size_t i = static_cast<std::size_t>(ii);
-    const Vec3& p = panels.centroid[i];
-    std::vector<std::int32_t> stack = {0};
-    auto& row = cols[i];
-    while (!stack.empty()) {
-      const Cluster& c = tree.nodes[static_cast<std::size_t>(stack.back())];
-      stack.pop_back();
-      const double limit = kNearFactor * c.max_diameter;
-      if (box_distance_sq(c, p) > limit * limit) continue;
-      if (c.left >= 0) {
-        stack.push_back(c.right);
-        stack.push_back(c.left);
-        continue;
-      }
-      for (std::uint32_t k = c.begin; k < c.end; ++k) {
-        const std::uint32_t j = tree.order[k];
-        const Vec3& q = panels.centroid[j];
-        const double dx = p[0] - q[0], dy = p[1] - q[1], dz = p[2] - q[2];
-        const double lim = kNearFactor * panels.diameter[j];
-        if (j == i || dx * dx + dy * dy + dz * dz <= lim * lim) row.push_back(j);
-      }
-    }
-    std::sort(row.begin(), row.end());
+  const std::size_t leaf_count = tree.leaves.size();
+  // Sources in tree order (each leaf contiguous) with their squared near-field radius.
+  std::vector<double> sx(n), sy(n), sz(n), slim2(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    const std::uint32_t j = tree.order[k];
+    sx[k] = panels.centroid[j][0];
+    sy[k] = panels.centroid[j][1];
+    sz[k] = panels.centroid[j][2];
+    const double lim = kNearFactor * panels.diameter[j];
+    slim2[k] = lim * lim;
   }
+  // Per target leaf: its members' rows back to back (each sorted), and their lengths.
+  std::vector<std::vector<std::uint32_t>> leaf_columns(leaf_count);
+  std::vector<std::uint32_t> row_length(n);
+  std::vector<TriangleKernel> kernels(n);
   NearField near;
   near.row_start.resize(n + 1, 0);
-  for (std::size_t i = 0; i < n; ++i) near.row_start[i + 1] = near.row_start[i] + cols[i].size();
-  const std::size_t nnz = near.row_start[n];
-  near.column.resize(nnz);
-  near.value.resize(nnz);
-  near.correction.resize(nnz);
   near.diagonal.resize(n);
-  std::vector<TriangleKernel> kernels(n);
+  // One parallel region: a fork and join cost more than a stage at 5k triangles.
 #if defined(TETSEG_HAVE_OPENMP)
-#pragma omp parallel for schedule(static)
+#pragma omp parallel
 #endif
-  for (std::ptrdiff_t jj = 0; jj < static_cast<std::ptrdiff_t>(n); ++jj) {
-    const auto& t = panels.corners[static_cast<std::size_t>(jj)];
-    kernels[static_cast<std::size_t>(jj)] = TriangleKernel(t[0], t[1], t[2]);
-  }
+  {
 #if defined(TETSEG_HAVE_OPENMP)
-#pragma omp parallel for schedule(dynamic, 64)
+#pragma omp for schedule(static) nowait
 #endif
-  for (std::ptrdiff_t ii = 0; ii < static_cast<std::ptrdiff_t>(n); ++ii) {
-    const std::size_t i = static_cast<std::size_t>(ii);
-    const Vec3& p = panels.centroid[i];
-    std::size_t e = near.row_start[i];
-    for (const std::uint32_t j : cols[i]) {
-      const auto& t = panels.corners[j];
-      double value, point = 0.0;
-      if (j == i) {
-        value = triangle_self_potential(t[0], t[1], t[2]);
-        near.diagonal[i] = value;
-      } else {
-        const Vec3& q = panels.centroid[j];
-        const double dx = p[0] - q[0], dy = p[1] - q[1], dz = p[2] - q[2];
-        const double r2 = dx * dx + dy * dy + dz * dz;
-        const double band = kQuadratureFactor * panels.diameter[j];
-        value = r2 > band * band ? triangle_potential_quadrature(t, panels.area[j], p)
-                                 : kernels[j].potential(p);
-        if (r2 > 0.0) point = panels.area[j] / std::sqrt(r2);
-      }
-      near.column[e] = j;
-      near.value[e] = value;
-      near.correction[e] = value - point;
-      ++e;
+    for (std::ptrdiff_t jj = 0; jj < static_cast<std::ptrdiff_t>(n); ++jj) {
+      const auto& t = panels.corners[static_cast<std::size_t>(jj)];
+      kernels[static_cast<std::size_t>(jj)] = TriangleKernel(t[0], t[1], t[2]);
     }
-    std::vector<std::uint32_t>().swap(cols[i]);
+    // Candidate source leaves of a target leaf by a box-to-box test (no member of a pruned
+    // node is within its near-field radius of any member of the target), then the exact
+    // per-pair test of the row rule.
+    std::vector<std::int32_t> stack, candidates;
+#if defined(TETSEG_HAVE_OPENMP)
+#pragma omp for schedule(dynamic, 1)
+#endif
+    for (std::ptrdiff_t ll = 0; ll < static_cast<std::ptrdiff_t>(leaf_count); ++ll) {
+      const Cluster& target = tree.nodes[static_cast<std::size_t>(tree.leaves[ll])];
+      candidates.clear();
+      stack.assign(1, 0);
+      while (!stack.empty()) {
+        const Cluster& c = tree.nodes[static_cast<std::size_t>(stack.back())];
+        const std::int32_t id = stack.back();
+        stack.pop_back();
+        double d2 = 0.0;
+        for (int a = 0; a < 3; ++a) {
+          const double d =
+              std::max({c.box_min[a] - target.box_max[a], target.box_min[a] - c.box_max[a], 0.0});
+          d2 += d * d;
+        }
+        const double limit = kNearFactor * c.max_diameter;
+        if (d2 > limit * limit) continue;
+        if (c.left >= 0) {
+          stack.push_back(c.right);
+          stack.push_back(c.left);
+        } else {
+          candidates.push_back(id);
+        }
+      }
+      auto& columns = leaf_columns[static_cast<std::size_t>(ll)];
+      std::size_t capacity = 0;
+      for (const std::int32_t id : candidates) {
+        const Cluster& c = tree.nodes[static_cast<std::size_t>(id)];
+        capacity += c.end - c.begin;
+      }
+      columns.resize(static_cast<std::size_t>(target.end - target.begin) * capacity);
+      std::size_t used = 0;
+      for (std::uint32_t m = target.begin; m < target.end; ++m) {
+        const std::uint32_t i = tree.order[m];
+        const double px = sx[m], py = sy[m], pz = sz[m];
+        const std::size_t first = used;
+        for (const std::int32_t id : candidates) {
+          const Cluster& c = tree.nodes[static_cast<std::size_t>(id)];
+          for (std::uint32_t k = c.begin; k < c.end; ++k) {
+            const double dx = px - sx[k], dy = py - sy[k], dz = pz - sz[k];
+            const std::uint32_t j = tree.order[k];
+            columns[used] = j;
+            used += (j == i || dx * dx + dy * dy + dz * dz <= slim2[k]) ? 1 : 0;
+          }
+        }
+        std::sort(columns.begin() + static_cast<std::ptrdiff_t>(first),
+                  columns.begin() + static_cast<std::ptrdiff_t>(used));
+        row_length[i] = static_cast<std::uint32_t>(used - first);
+      }
+      columns.resize(used);
+      columns.shrink_to_fit();
+    }
+#if defined(TETSEG_HAVE_OPENMP)
+#pragma omp single
+#endif
+    {
+      for (std::size_t i = 0; i < n; ++i) near.row_start[i + 1] = near.row_start[i] + row_length[i];
+      const std::size_t nnz = near.row_start[n];
+      // Filled below by both threads (no serial zero-fill of about 20 bytes per entry).
+      near.column.resize(nnz);
+      near.value.resize(nnz);
+      near.correction.resize(nnz);
+    }
+#if defined(TETSEG_HAVE_OPENMP)
+#pragma omp for schedule(dynamic, 1)
+#endif
+    for (std::ptrdiff_t ll = 0; ll < static_cast<std::ptrdiff_t>(leaf_count); ++ll) {
+      const Cluster& target = tree.nodes[static_cast<std::size_t>(tree.leaves[ll])];
+      auto& columns = leaf_columns[static_cast<std::size_t>(ll)];
+      std::size_t from = 0;
+      for (std::uint32_t m = target.begin; m < target.end; ++m) {
+        const std::size_t i = tree.order[m];
+        const Vec3& p = panels.centroid[i];
+        std::size_t e = near.row_start[i];
+        for (std::size_t f = 0; f < row_length[i]; ++f, ++e) {
+          const std::uint32_t j = columns[from + f];
+          const auto& t = panels.corners[j];
+          double value, point = 0.0;
+          if (j == i) {
+            value = triangle_self_potential(t[0], t[1], t[2]);
+            near.diagonal[i] = value;
+          } else {
+            const Vec3& q = panels.centroid[j];
+            const double dx = p[0] - q[0], dy = p[1] - q[1], dz = p[2] - q[2];
+            const double r2 = dx * dx + dy * dy + dz * dz;
+            const double band = kQuadratureFactor * panels.diameter[j];
+            value = r2 > band * band ? triangle_potential_quadrature(t, panels.area[j], p)
+                                     : kernels[j].potential(p);
+            if (r2 > 0.0) point = panels.area[j] / std::sqrt(r2);
+          }
+          near.column[e] = j;
+          near.value[e] = value;
+          near.correction[e] = value - point;
+        }
+        from += row_length[i];
+      }
+      std::vector<std::uint32_t>().swap(columns);
+    }
   }
   return near;
 }
