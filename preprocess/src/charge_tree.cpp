@@ -15,17 +15,6 @@
 namespace tetseg::preprocess::charge_detail {
 namespace {
 
-double box_distance_sq(const Cluster& c, const Vec3& p) {
-  double s = 0.0;
-  for (int a = 0; a < 3; ++a) {
-    const double lo = c.box_min[a] - p[a];
-    const double hi = p[a] - c.box_max[a];
-    const double d = std::max({lo, hi, 0.0});
-    s += d * d;
-  }
-  return s;
-}
-
 /// sum over j in [begin, end) of q[j] / |t - p_j|, skipping p_j == t. `inv_scale2` (1 / R^2,
 /// R of the order of the mesh size) keeps r^2 / R^2 inside single-precision range for the
 /// SSE path: 1/r from the single-precision rsqrt estimate (relative error < 4e-4) refined by
@@ -150,42 +139,65 @@ __attribute__((target("avx2,fma"))) void m2l_sums_avx2(std::size_t kc, const std
   }
 }
 
-/// direct_sum with 256-bit vectors: four sources per step, the same rsqrt estimate and two
-/// Newton steps (fused), the same relative error bound.
-__attribute__((target("avx2,fma"))) double direct_sum_avx2(double tx, double ty, double tz,
+/// acc + q / r for four sources (s) and the target (v): rsqrt estimate of r^2 * vs and two
+/// Newton steps; lanes outside `used` take r^2 = 1 (their charge is 0), r^2 = 0 gives 0.
+__attribute__((target("avx2,fma"), always_inline)) inline __m256d direct_step(
+    __m256d vx, __m256d vy, __m256d vz, __m256d vs, __m256d sx, __m256d sy, __m256d sz, __m256d sq,
+    __m256d used, __m256d acc) {
+  const __m256d half = _mm256_set1_pd(0.5), three_halves = _mm256_set1_pd(1.5);
+  const __m256d dx = _mm256_sub_pd(vx, sx);
+  const __m256d dy = _mm256_sub_pd(vy, sy);
+  const __m256d dz = _mm256_sub_pd(vz, sz);
+  __m256d r2 =
+      _mm256_mul_pd(_mm256_fmadd_pd(dz, dz, _mm256_fmadd_pd(dy, dy, _mm256_mul_pd(dx, dx))), vs);
+  r2 = _mm256_blendv_pd(_mm256_set1_pd(1.0), r2, used);
+  const __m256d live = _mm256_cmp_pd(r2, _mm256_setzero_pd(), _CMP_GT_OQ);
+  __m256d y = _mm256_cvtps_pd(_mm_rsqrt_ps(_mm256_cvtpd_ps(r2)));
+  const __m256d hr2 = _mm256_mul_pd(half, r2);
+  y = _mm256_mul_pd(y, _mm256_fnmadd_pd(hr2, _mm256_mul_pd(y, y), three_halves));
+  y = _mm256_mul_pd(y, _mm256_fnmadd_pd(hr2, _mm256_mul_pd(y, y), three_halves));
+  y = _mm256_and_pd(y, live);  // r2 == 0 (the target itself): drop it
+  return _mm256_fmadd_pd(y, sq, acc);
+}
+
+/// The direct sums of one target over all its source leaves (node ids list[0, count)) with
+/// 256-bit vectors: direct_sum's rsqrt estimate and two (fused) Newton steps, the same relative
+/// error bound; one accumulator pair and one reduction per target, and each leaf's last one to
+/// three sources in a masked step (unused lanes: r^2 = 1, charge 0), not scalar square roots.
+__attribute__((target("avx2,fma"))) double direct_row_avx2(double tx, double ty, double tz,
                                                            const double* px, const double* py,
                                                            const double* pz, const double* q,
-                                                           std::uint32_t begin, std::uint32_t end,
-                                                           double inv_scale2) {
+                                                           const Cluster* nodes,
+                                                           const std::int32_t* list,
+                                                           std::size_t count, double inv_scale2) {
   const __m256d vx = _mm256_set1_pd(tx), vy = _mm256_set1_pd(ty), vz = _mm256_set1_pd(tz);
-  const __m256d vs = _mm256_set1_pd(inv_scale2), half = _mm256_set1_pd(0.5),
-                three_halves = _mm256_set1_pd(1.5), zero = _mm256_setzero_pd();
-  __m256d acc = _mm256_setzero_pd();
-  std::uint32_t j = begin;
-  for (; j + 4 <= end; j += 4) {
-    const __m256d dx = _mm256_sub_pd(vx, _mm256_loadu_pd(px + j));
-    const __m256d dy = _mm256_sub_pd(vy, _mm256_loadu_pd(py + j));
-    const __m256d dz = _mm256_sub_pd(vz, _mm256_loadu_pd(pz + j));
-    const __m256d r2 =
-        _mm256_mul_pd(_mm256_fmadd_pd(dz, dz, _mm256_fmadd_pd(dy, dy, _mm256_mul_pd(dx, dx))), vs);
-    const __m256d live = _mm256_cmp_pd(r2, zero, _CMP_GT_OQ);
-    __m256d y = _mm256_cvtps_pd(_mm_rsqrt_ps(_mm256_cvtpd_ps(r2)));
-    const __m256d hr2 = _mm256_mul_pd(half, r2);
-    y = _mm256_mul_pd(y, _mm256_fnmadd_pd(hr2, _mm256_mul_pd(y, y), three_halves));
-    y = _mm256_mul_pd(y, _mm256_fnmadd_pd(hr2, _mm256_mul_pd(y, y), three_halves));
-    y = _mm256_and_pd(y, live);  // r2 == 0 (the target itself): drop it
-    acc = _mm256_fmadd_pd(y, _mm256_loadu_pd(q + j), acc);
+  const __m256d vs = _mm256_set1_pd(inv_scale2);
+  const __m256i lane = _mm256_setr_epi64x(0, 1, 2, 3);
+  __m256d acc0 = _mm256_setzero_pd(), acc1 = _mm256_setzero_pd();
+
+  const __m256d all = _mm256_castsi256_pd(_mm256_set1_epi64x(-1));
+  for (std::size_t d = 0; d < count; ++d) {
+    const Cluster& s = nodes[static_cast<std::size_t>(list[d])];
+    std::uint32_t j = s.begin;
+    for (; j + 8 <= s.end; j += 8) {
+      acc0 = direct_step(vx, vy, vz, vs, _mm256_loadu_pd(px + j), _mm256_loadu_pd(py + j),
+                         _mm256_loadu_pd(pz + j), _mm256_loadu_pd(q + j), all, acc0);
+      acc1 = direct_step(vx, vy, vz, vs, _mm256_loadu_pd(px + j + 4), _mm256_loadu_pd(py + j + 4),
+                         _mm256_loadu_pd(pz + j + 4), _mm256_loadu_pd(q + j + 4), all, acc1);
+    }
+    for (; j < s.end; j += 4) {
+      const __m256i mask =
+          _mm256_cmpgt_epi64(_mm256_set1_epi64x(static_cast<long long>(s.end - j)), lane);
+      acc0 = direct_step(vx, vy, vz, vs, _mm256_maskload_pd(px + j, mask),
+                         _mm256_maskload_pd(py + j, mask), _mm256_maskload_pd(pz + j, mask),
+                         _mm256_maskload_pd(q + j, mask), _mm256_castsi256_pd(mask), acc0);
+    }
   }
+  const __m256d acc = _mm256_add_pd(acc0, acc1);
   const __m128d pair = _mm_add_pd(_mm256_castpd256_pd128(acc), _mm256_extractf128_pd(acc, 1));
   double lanes[2];
   _mm_storeu_pd(lanes, pair);
-  double sum = (lanes[0] + lanes[1]) * std::sqrt(inv_scale2);
-  for (; j < end; ++j) {
-    const double dx = tx - px[j], dy = ty - py[j], dz = tz - pz[j];
-    const double r2 = dx * dx + dy * dy + dz * dz;
-    if (r2 > 0.0) sum += q[j] / std::sqrt(r2);
-  }
-  return sum;
+  return (lanes[0] + lanes[1]) * std::sqrt(inv_scale2);
 }
 
 bool cpu_has_avx2() {
@@ -197,10 +209,9 @@ void m2l_sums_avx2(std::size_t kc, const std::size_t* start, const std::uint16_t
                    const double* inv_fact, double* local) {
   m2l_sums(kc, start, tb, tc, dv, mv, inv_fact, local);
 }
-double direct_sum_avx2(double tx, double ty, double tz, const double* px, const double* py,
-                       const double* pz, const double* q, std::uint32_t begin, std::uint32_t end,
-                       double inv_scale2) {
-  return direct_sum(tx, ty, tz, px, py, pz, q, begin, end, inv_scale2);
+double direct_row_avx2(double, double, double, const double*, const double*, const double*,
+                       const double*, const Cluster*, const std::int32_t*, std::size_t, double) {
+  return 0.0;  // never called: cpu_has_avx2() is false
 }
 bool cpu_has_avx2() {
   return false;
@@ -860,13 +871,20 @@ void TreecodeOperator::apply(const double* x, double* y) const {
         for (std::size_t e = 0; e < kc; ++e) sum += local[e] * mono[e];
         pot[k - target.begin] = sum;
       }
-      for (std::size_t d = m_direct_start[l]; d < m_direct_start[l + 1]; ++d) {
-        const Cluster& s = nodes[static_cast<std::size_t>(m_direct[d])];
+      if (avx2) {
+        const std::int32_t* list = m_direct.data() + m_direct_start[l];
+        const std::size_t count = m_direct_start[l + 1] - m_direct_start[l];
         for (std::uint32_t k = target.begin; k < target.end; ++k) {
-          pot[k - target.begin] += avx2 ? direct_sum_avx2(px[k], py[k], pz[k], px, py, pz, charge,
-                                                          s.begin, s.end, inv_scale2)
-                                        : direct_sum(px[k], py[k], pz[k], px, py, pz, charge,
-                                                     s.begin, s.end, inv_scale2);
+          pot[k - target.begin] += direct_row_avx2(px[k], py[k], pz[k], px, py, pz, charge,
+                                                   nodes.data(), list, count, inv_scale2);
+        }
+      } else {
+        for (std::size_t d = m_direct_start[l]; d < m_direct_start[l + 1]; ++d) {
+          const Cluster& s = nodes[static_cast<std::size_t>(m_direct[d])];
+          for (std::uint32_t k = target.begin; k < target.end; ++k) {
+            pot[k - target.begin] +=
+                direct_sum(px[k], py[k], pz[k], px, py, pz, charge, s.begin, s.end, inv_scale2);
+          }
         }
       }
       // Exact near field of each target: analytic minus the point charge counted above.
