@@ -408,6 +408,15 @@ NearField build_near_field(const PanelSet& panels, const ClusterTree& tree) {
         const std::size_t first = used;
         for (const std::int32_t id : candidates) {
           const Cluster& c = tree.nodes[static_cast<std::size_t>(id)];
+          // The leaf's box is out of reach of this member (the per-row form of the test above).
+          double b2 = 0.0;
+          const double p3[3] = {px, py, pz};
+          for (int a = 0; a < 3; ++a) {
+            const double d = std::max({c.box_min[a] - p3[a], p3[a] - c.box_max[a], 0.0});
+            b2 += d * d;
+          }
+          const double limit = kNearFactor * c.max_diameter;
+          if (b2 > limit * limit) continue;
           for (std::uint32_t k = c.begin; k < c.end; ++k) {
             const double dx = px - sx[k], dy = py - sy[k], dz = pz - sz[k];
             const std::uint32_t j = tree.order[k];
