@@ -31,11 +31,6 @@ struct ClusterTree {
 /// Median splits along the longest box axis until a node has at most `leaf_size` members.
 ClusterTree build_cluster_tree(const PanelSet& panels, int leaf_size);
 
-/// The near field of the collocation matrix in CSR form: for row i, the columns j with
-/// |c_i - c_j| <= kNearFactor * diameter_j (always including j = i) and the entry M_ij
-/// (closed form, or the six-point quadrature beyond kQuadratureFactor diameters: the rule of
-/// matrix_entry), plus `correction` = M_ij minus the point-charge entry A_j / r_ij (M_ii for
-/// j = i). compute_charge's fast path frees `value` once the preconditioner is built.
 /// std::allocator whose value-initialisation leaves scalars uninitialised: vectors that are
 /// filled in parallel right after resize() skip a serial zero-fill (at 5k the near field's
 /// 6 MB cost 3 ms of one thread, mostly first-touch page faults).
@@ -60,6 +55,12 @@ struct UninitializedAllocator : std::allocator<T> {
 template <class T>
 using UninitializedVector = std::vector<T, UninitializedAllocator<T>>;
 
+/// The near field of the collocation matrix in CSR form: for row i, the columns j with
+/// |c_i - c_j| <= kNearFactor * diameter_j (always including j = i) and the entry M_ij
+/// (closed form, or the six-point quadrature beyond kQuadratureFactor diameters: the rule of
+/// matrix_entry), plus `correction` = M_ij minus the point-charge entry A_j / r_ij (M_ii for
+/// j = i). A row's columns are in tree order, not sorted. compute_charge's fast path frees
+/// `value` once the preconditioner is built.
 struct NearField {
   std::vector<std::size_t> row_start;  ///< size n + 1
   UninitializedVector<std::uint32_t> column;
