@@ -783,12 +783,16 @@ void TreecodeOperator::apply(const double* x, double* y) const {
   auto shift = [&](const std::vector<Term>& terms, const std::vector<std::size_t>& start,
                    const double* d_mono, const double* from, double* to) {
     for (std::size_t a = 0; a < kc; ++a) {
-      double acc = 0.0;
-      for (std::size_t e = start[a]; e < start[a + 1]; ++e) {
-        const Term& t = terms[e];
-        acc += t.coef * d_mono[t.c] * from[t.b];
+      double acc0 = 0.0, acc1 = 0.0;  // two chains: the sums are latency-bound
+      std::size_t e = start[a];
+      for (; e + 2 <= start[a + 1]; e += 2) {
+        const Term& t0 = terms[e];
+        const Term& t1 = terms[e + 1];
+        acc0 += t0.coef * d_mono[t0.c] * from[t0.b];
+        acc1 += t1.coef * d_mono[t1.c] * from[t1.b];
       }
-      to[a] += acc;
+      if (e < start[a + 1]) acc0 += terms[e].coef * d_mono[terms[e].c] * from[terms[e].b];
+      to[a] += acc0 + acc1;
     }
   };
 #if defined(TETSEG_HAVE_OPENMP)
@@ -924,9 +928,16 @@ void TreecodeOperator::apply(const double* x, double* y) const {
       for (std::uint32_t k = target.begin; k < target.end; ++k) {
         monomials(px[k] - target.center[0], py[k] - target.center[1], pz[k] - target.center[2],
                   mono.data());
-        double sum = 0.0;
-        for (std::size_t e = 0; e < kc; ++e) sum += local[e] * mono[e];
-        pot[k - target.begin] = sum;
+        double s0 = 0.0, s1 = 0.0, s2 = 0.0, s3 = 0.0;  // four chains
+        std::size_t e = 0;
+        for (; e + 4 <= kc; e += 4) {
+          s0 += local[e] * mono[e];
+          s1 += local[e + 1] * mono[e + 1];
+          s2 += local[e + 2] * mono[e + 2];
+          s3 += local[e + 3] * mono[e + 3];
+        }
+        for (; e < kc; ++e) s0 += local[e] * mono[e];
+        pot[k - target.begin] = (s0 + s1) + (s2 + s3);
       }
       if (avx2) {
         const std::int32_t* list = m_direct.data() + m_direct_start[l];
@@ -947,11 +958,17 @@ void TreecodeOperator::apply(const double* x, double* y) const {
       // Exact near field of each target: analytic minus the point charge counted above.
       for (std::uint32_t k = target.begin; k < target.end; ++k) {
         const std::size_t i = order[k];
-        double sum = pot[k - target.begin];
-        for (std::size_t e = m_near.row_start[i]; e < m_near.row_start[i + 1]; ++e) {
-          sum += m_near.correction[e] * x[m_near.column[e]];
+        const std::size_t end = m_near.row_start[i + 1];
+        double c0 = 0.0, c1 = 0.0, c2 = 0.0, c3 = 0.0;  // four chains
+        std::size_t e = m_near.row_start[i];
+        for (; e + 4 <= end; e += 4) {
+          c0 += m_near.correction[e] * x[m_near.column[e]];
+          c1 += m_near.correction[e + 1] * x[m_near.column[e + 1]];
+          c2 += m_near.correction[e + 2] * x[m_near.column[e + 2]];
+          c3 += m_near.correction[e + 3] * x[m_near.column[e + 3]];
         }
-        y[i] = sum;
+        for (; e < end; ++e) c0 += m_near.correction[e] * x[m_near.column[e]];
+        y[i] = pot[k - target.begin] + ((c0 + c1) + (c2 + c3));
       }
     }
   }
