@@ -174,7 +174,6 @@ __attribute__((target("avx2,fma"))) double direct_row_avx2(double tx, double ty,
   const __m256d vs = _mm256_set1_pd(inv_scale2);
   const __m256i lane = _mm256_setr_epi64x(0, 1, 2, 3);
   __m256d acc0 = _mm256_setzero_pd(), acc1 = _mm256_setzero_pd();
-
   const __m256d all = _mm256_castsi256_pd(_mm256_set1_epi64x(-1));
   for (std::size_t d = 0; d < count; ++d) {
     const Cluster& s = nodes[static_cast<std::size_t>(list[d])];
