@@ -40,7 +40,7 @@ GmresOutcome solve_gmres(std::size_t n, const ApplyFn& apply, const ApplyFn& pre
   // The Hessenberg matrix before the rotations: A M^-1 V_k = V_(k+1) H_k holds to rounding
   // whatever the orthogonality of V, so r - V_(k+1) H_k y is the true residual of the update.
   auto ha = [&](std::size_t i, std::size_t j) -> double& { return arnoldi[i * m + j]; };
-  bool recompute = false;
+  bool recompute = true;  // false after a converging cycle left r = b - A x in place
   // A zero start needs no product for its residual.
   bool zero_start = std::all_of(x.begin(), x.end(), [](double v) { return v == 0.0; });
   for (;;) {
