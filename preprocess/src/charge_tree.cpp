@@ -707,10 +707,16 @@ TreecodeOperator::TreecodeOperator(const PanelSet& panels, const ClusterTree& tr
   }
 
   // Dual-tree traversal: admissible pairs become M2L, leaf pairs direct sums, otherwise the
-  // larger cluster (or the one that is not a leaf) is split.
-  std::vector<std::vector<std::int32_t>> far(node_count), direct(tree.leaves.size());
-  std::vector<std::pair<std::int32_t, std::int32_t>> stack = {{0, 0}};
-  while (!stack.empty()) {
+  // larger cluster (or the one that is not a leaf) is split. A depth-first walk with an
+  // explicit stack, in two phases with the same lists as one serial walk: one thread walks
+  // until the stack holds kWalks pairs; then the pairs left on the stack are walked to the
+  // end in parallel, each into its own record, and the records are read top of the stack
+  // first (the order in which the serial walk would have finished them).
+  using NodePair = std::pair<std::int32_t, std::int32_t>;
+  struct Walk {
+    std::vector<NodePair> far, direct;  // (target node, source node), in walk order
+  };
+  auto step = [&](std::vector<NodePair>& stack, Walk& out) {
     const auto [ti, si] = stack.back();
     stack.pop_back();
     const Cluster& t = tree.nodes[static_cast<std::size_t>(ti)];
@@ -720,12 +726,12 @@ TreecodeOperator::TreecodeOperator(const PanelSet& panels, const ClusterTree& tr
     const double dz = s.center[2] - t.center[2];
     const double dist = std::sqrt(dx * dx + dy * dy + dz * dz);
     if (ti != si && t.radius + s.radius < theta * dist) {
-      far[static_cast<std::size_t>(ti)].push_back(si);
-      continue;
+      out.far.push_back({ti, si});
+      return;
     }
     const bool t_leaf = t.left < 0, s_leaf = s.left < 0;
     if (t_leaf && s_leaf) {
-      direct[static_cast<std::size_t>(m_leaf_of_node[static_cast<std::size_t>(ti)])].push_back(si);
+      out.direct.push_back({ti, si});
     } else if (s_leaf || (!t_leaf && t.radius >= s.radius)) {
       stack.push_back({t.right, si});
       stack.push_back({t.left, si});
@@ -733,11 +739,38 @@ TreecodeOperator::TreecodeOperator(const PanelSet& panels, const ClusterTree& tr
       stack.push_back({ti, s.right});
       stack.push_back({ti, s.left});
     }
+  };
+  constexpr std::size_t kWalks = 64;
+  std::vector<NodePair> stack = {{0, 0}};
+  std::vector<Walk> walks(1);
+  while (!stack.empty() && stack.size() < kWalks) step(stack, walks[0]);
+  const std::size_t parallel_walks = stack.size();
+  walks.resize(1 + parallel_walks);
+#if defined(TETSEG_HAVE_OPENMP)
+#pragma omp parallel for schedule(dynamic, 1)
+#endif
+  for (std::ptrdiff_t ww = 0; ww < static_cast<std::ptrdiff_t>(parallel_walks); ++ww) {
+    const std::size_t w = static_cast<std::size_t>(ww);
+    std::vector<NodePair> own = {stack[parallel_walks - 1 - w]};
+    while (!own.empty()) step(own, walks[1 + w]);
   }
+  // Per-target lists (CSR), each in walk order.
   m_far_start.assign(node_count + 1, 0);
-  for (std::size_t id = 0; id < node_count; ++id) {
-    m_far_start[id + 1] = m_far_start[id] + far[id].size();
-    m_far.insert(m_far.end(), far[id].begin(), far[id].end());
+  std::vector<std::vector<std::int32_t>> direct(tree.leaves.size());
+  for (const Walk& w : walks) {
+    for (const auto& [ti, si] : w.far) ++m_far_start[static_cast<std::size_t>(ti) + 1];
+  }
+  for (std::size_t id = 0; id < node_count; ++id) m_far_start[id + 1] += m_far_start[id];
+  m_far.resize(m_far_start[node_count]);
+  {
+    std::vector<std::size_t> fill(m_far_start.begin(), m_far_start.end() - 1);
+    for (const Walk& w : walks) {
+      for (const auto& [ti, si] : w.far) m_far[fill[static_cast<std::size_t>(ti)]++] = si;
+      for (const auto& [ti, si] : w.direct) {
+        direct[static_cast<std::size_t>(m_leaf_of_node[static_cast<std::size_t>(ti)])].push_back(
+            si);
+      }
+    }
   }
   m_direct_start.assign(tree.leaves.size() + 1, 0);
   double direct_work = 0.0;
@@ -752,10 +785,12 @@ TreecodeOperator::TreecodeOperator(const PanelSet& panels, const ClusterTree& tr
     }
   }
   m_direct_per_target = direct_work / static_cast<double>(m_n);
+  // Every product writes these before reading them: no zero-fill here (its page faults
+  // then fall in the first product, on both threads).
   m_charge.resize(m_n);
-  m_moments.assign(node_count * m_index.size(), 0.0);
-  m_local.assign(node_count * m_index.size(), 0.0);
-  m_scaled.assign(node_count * m_index.size(), 0.0);
+  m_moments.resize(node_count * m_index.size());
+  m_local.resize(node_count * m_index.size());
+  m_scaled.resize(node_count * m_index.size());
 }
 
 void TreecodeOperator::apply(const double* x, double* y) const {

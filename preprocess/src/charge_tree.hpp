@@ -134,10 +134,10 @@ class TreecodeOperator {
   std::vector<std::int32_t> m_top_nodes;              ///< nodes above the subtrees, parents first
   std::vector<std::size_t> m_subtree_start;           ///< per subtree (CSR) into m_subtree_nodes
   std::vector<std::int32_t> m_subtree_nodes;          ///< each subtree's nodes in post-order
-  mutable std::vector<double> m_charge;
-  mutable std::vector<double> m_moments;  ///< nodes x index count
-  mutable std::vector<double> m_local;    ///< nodes x index count
-  mutable std::vector<double> m_scaled;   ///< nodes x index count: M_k (-1)^|k| / k!
+  mutable UninitializedVector<double> m_charge;
+  mutable UninitializedVector<double> m_moments;  ///< nodes x index count
+  mutable UninitializedVector<double> m_local;    ///< nodes x index count
+  mutable UninitializedVector<double> m_scaled;   ///< nodes x index count: M_k (-1)^|k| / k!
 };
 
 }  // namespace tetseg::preprocess::charge_detail
