@@ -154,7 +154,7 @@ ChargeResult compute_charge(const std::vector<Vec3>& points, const std::vector<T
                              : (n < kAutoHighOrderMin ? kAutoTheta : kAutoLargeTheta);
     // The analytic values served the preconditioner; the FMM needs only the corrections
     // (8 bytes per near entry freed: 0.6 GB at 1.3 M triangles).
-    std::vector<double>().swap(near.value);
+    decltype(near.value)().swap(near.value);
     const TreecodeOperator op(panels, tree, near, theta, order);
     result.assembly_seconds = seconds_since(t0);
     progress("assembly", 1.0);

@@ -2,6 +2,10 @@
 
 #include "charge_potential.hpp"
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 #include <algorithm>
 #include <cmath>
 #include <sstream>
@@ -163,10 +167,12 @@ double triangle_potential_quadrature(const std::array<Vec3, 3>& corners, double 
   // Dunavant's degree-4 rule: two orbits of three points (barycentric (1 - 2 b, b, b)).
   constexpr double kB[2] = {0.091576213509771, 0.445948490915965};
   constexpr double kW[2] = {0.109951743655322, 0.223381589678011};
-  double sum = 0.0;
+  // The six squared distances, then their inverse square roots two at a time (the same
+  // correctly rounded operations as one at a time, so the same result, at half the
+  // square roots' and divisions' issue slots), summed in the original order.
+  double r2[6];
   for (int orbit = 0; orbit < 2; ++orbit) {
     const double b = kB[orbit], a = 1.0 - 2.0 * b;
-    double partial = 0.0;
     for (int k = 0; k < 3; ++k) {
       const Vec3& p = corners[static_cast<std::size_t>(k)];
       const Vec3& q = corners[static_cast<std::size_t>((k + 1) % 3)];
@@ -174,8 +180,22 @@ double triangle_potential_quadrature(const std::array<Vec3, 3>& corners, double 
       const double x = a * p[0] + b * (q[0] + s[0]) - r[0];
       const double y = a * p[1] + b * (q[1] + s[1]) - r[1];
       const double z = a * p[2] + b * (q[2] + s[2]) - r[2];
-      partial += 1.0 / std::sqrt(x * x + y * y + z * z);
+      r2[orbit * 3 + k] = x * x + y * y + z * z;
     }
+  }
+  double inv[6];
+#if defined(__SSE2__)
+  const __m128d one = _mm_set1_pd(1.0);
+  for (int k = 0; k < 6; k += 2) {
+    _mm_storeu_pd(inv + k, _mm_div_pd(one, _mm_sqrt_pd(_mm_loadu_pd(r2 + k))));
+  }
+#else
+  for (int k = 0; k < 6; ++k) inv[k] = 1.0 / std::sqrt(r2[k]);
+#endif
+  double sum = 0.0;
+  for (int orbit = 0; orbit < 2; ++orbit) {
+    double partial = 0.0;
+    for (int k = 0; k < 3; ++k) partial += inv[orbit * 3 + k];
     sum += kW[orbit] * partial;
   }
   return area * sum;

@@ -81,34 +81,74 @@ struct SchwarzScratch {
   }
 };
 
+/// One row of point_charge_matrix from column v on: four entries per SSE step, then scalar.
+inline void point_charge_row_tail(std::size_t s, std::size_t v, float px, float py, float pz,
+                                  const float* x, const float* y, const float* z, const float* area,
+                                  float* row) {
+#if defined(__SSE2__)
+  const __m128 vx = _mm_set1_ps(px), vy = _mm_set1_ps(py), vz = _mm_set1_ps(pz);
+  const __m128 zero = _mm_setzero_ps(), one = _mm_set1_ps(1.0f);
+  for (; v + 4 <= s; v += 4) {
+    const __m128 dx = _mm_sub_ps(vx, _mm_loadu_ps(x + v));
+    const __m128 dy = _mm_sub_ps(vy, _mm_loadu_ps(y + v));
+    const __m128 dz = _mm_sub_ps(vz, _mm_loadu_ps(z + v));
+    const __m128 r2 =
+        _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)), _mm_mul_ps(dz, dz));
+    const __m128 live = _mm_cmpgt_ps(r2, zero);
+    const __m128 safe = _mm_or_ps(_mm_and_ps(live, r2), _mm_andnot_ps(live, one));
+    const __m128 w = _mm_div_ps(_mm_loadu_ps(area + v), _mm_sqrt_ps(safe));
+    _mm_storeu_ps(row + v, _mm_and_ps(live, w));
+  }
+#endif
+  for (; v < s; ++v) {
+    const float dx = px - x[v], dy = py - y[v], dz = pz - z[v];
+    const float r2 = dx * dx + dy * dy + dz * dz;
+    row[v] = r2 > 0.0f ? area[v] / std::sqrt(r2) : 0.0f;
+  }
+}
+
+#if defined(__x86_64__) && defined(__GNUC__)
+/// Eight entries per step of one row (AVX, no FMA: the same correctly rounded operations per
+/// entry as the SSE steps), from column 0; returns the first column left over.
+__attribute__((target("avx2"))) std::size_t point_charge_row_avx2(std::size_t s, float px, float py,
+                                                                  float pz, const float* x,
+                                                                  const float* y, const float* z,
+                                                                  const float* area, float* row) {
+  const __m256 vx = _mm256_set1_ps(px), vy = _mm256_set1_ps(py), vz = _mm256_set1_ps(pz);
+  const __m256 zero = _mm256_setzero_ps(), one = _mm256_set1_ps(1.0f);
+  std::size_t v = 0;
+  for (; v + 8 <= s; v += 8) {
+    const __m256 dx = _mm256_sub_ps(vx, _mm256_loadu_ps(x + v));
+    const __m256 dy = _mm256_sub_ps(vy, _mm256_loadu_ps(y + v));
+    const __m256 dz = _mm256_sub_ps(vz, _mm256_loadu_ps(z + v));
+    const __m256 r2 = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(dx, dx), _mm256_mul_ps(dy, dy)),
+                                    _mm256_mul_ps(dz, dz));
+    const __m256 live = _mm256_cmp_ps(r2, zero, _CMP_GT_OQ);
+    const __m256 safe = _mm256_blendv_ps(one, r2, live);
+    const __m256 w = _mm256_div_ps(_mm256_loadu_ps(area + v), _mm256_sqrt_ps(safe));
+    _mm256_storeu_ps(row + v, _mm256_and_ps(live, w));
+  }
+  return v;
+}
+#endif
+
 /// a[u * ld + v] = area[v] / |p_u - p_v| (0 for u == v), single precision; columns s..ld-1
-/// are set to 0. Four entries per step (SSE: exact square root and division).
+/// are set to 0. Exact square root and division (eight entries per AVX step where the CPU has
+/// it, four per SSE step otherwise; the same values either way).
 void point_charge_matrix(std::size_t s, std::size_t ld, const float* x, const float* y,
                          const float* z, const float* area, float* a) {
+#if defined(__x86_64__) && defined(__GNUC__)
+  static const bool avx2 = __builtin_cpu_supports("avx2");
+#else
+  constexpr bool avx2 = false;
+#endif
   for (std::size_t u = 0; u < s; ++u) {
     float* row = a + u * ld;
-    const float px = x[u], py = y[u], pz = z[u];
     std::size_t v = 0;
-#if defined(__SSE2__)
-    const __m128 vx = _mm_set1_ps(px), vy = _mm_set1_ps(py), vz = _mm_set1_ps(pz);
-    const __m128 zero = _mm_setzero_ps(), one = _mm_set1_ps(1.0f);
-    for (; v + 4 <= s; v += 4) {
-      const __m128 dx = _mm_sub_ps(vx, _mm_loadu_ps(x + v));
-      const __m128 dy = _mm_sub_ps(vy, _mm_loadu_ps(y + v));
-      const __m128 dz = _mm_sub_ps(vz, _mm_loadu_ps(z + v));
-      const __m128 r2 =
-          _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)), _mm_mul_ps(dz, dz));
-      const __m128 live = _mm_cmpgt_ps(r2, zero);
-      const __m128 safe = _mm_or_ps(_mm_and_ps(live, r2), _mm_andnot_ps(live, one));
-      const __m128 w = _mm_div_ps(_mm_loadu_ps(area + v), _mm_sqrt_ps(safe));
-      _mm_storeu_ps(row + v, _mm_and_ps(live, w));
-    }
+#if defined(__x86_64__) && defined(__GNUC__)
+    if (avx2) v = point_charge_row_avx2(s, x[u], y[u], z[u], x, y, z, area, row);
 #endif
-    for (; v < s; ++v) {
-      const float dx = px - x[v], dy = py - y[v], dz = pz - z[v];
-      const float r2 = dx * dx + dy * dy + dz * dz;
-      row[v] = r2 > 0.0f ? area[v] / std::sqrt(r2) : 0.0f;
-    }
+    point_charge_row_tail(s, v, x[u], y[u], z[u], x, y, z, area, row);
     std::fill(row + s, row + ld, 0.0f);
   }
 }
@@ -136,20 +176,53 @@ inline void subtract_scaled(float* dst, const float* src, float f, std::size_t k
   }
 }
 
-/// subtract_scaled on four rows at once (one load of src per block of eight).
-inline void subtract_scaled4(float* const* dst, const float* src, const float* f, std::size_t keep,
-                             std::size_t end) {
-  std::size_t j = keep & ~std::size_t{7};
-  if (j < keep && j < end) {
-    for (int r = 0; r < 4; ++r) subtract_scaled(dst[r], src, f[r], keep, j + 8);
-    j += 8;
-  }
-  for (; j < end; j += 8) {
+/// dst[r][j] -= f[r] * src[j] for 0 <= j < end, four rows (blocks of eight; the lanes of the
+/// last block at or above `end` keep their values).
+inline void subtract_scaled_rows4(float* const* dst, const float* src, const float* f,
+                                  std::size_t end) {
+  std::size_t j = 0;
+  for (; j + 8 <= end; j += 8) {
     const Floats8 v = *reinterpret_cast<const Floats8*>(src + j);
     *reinterpret_cast<Floats8*>(dst[0] + j) -= f[0] * v;
     *reinterpret_cast<Floats8*>(dst[1] + j) -= f[1] * v;
     *reinterpret_cast<Floats8*>(dst[2] + j) -= f[2] * v;
     *reinterpret_cast<Floats8*>(dst[3] + j) -= f[3] * v;
+  }
+  for (int q = 0; q < 4; ++q) {
+    for (std::size_t e = j; e < end; ++e) dst[q][e] -= f[q] * src[e];
+  }
+}
+
+/// Four rows at once: dst[r][j] -= sum over q < 4, in order, of dst[r][k0 + q] * u[q][j] for
+/// keep <= j < end (blocks of eight as in subtract_scaled): four rank-1 updates of a panel in
+/// one load and store of each row block.
+inline void subtract_rank4(float* const* dst, const float* const* u, std::size_t k0,
+                           std::size_t keep, std::size_t end) {
+  float f[4][4];
+  for (int r = 0; r < 4; ++r) {
+    for (int q = 0; q < 4; ++q) f[r][q] = dst[r][k0 + static_cast<std::size_t>(q)];
+  }
+  std::size_t j = keep & ~std::size_t{7};
+  if (j < keep && j < end) {
+    for (int r = 0; r < 4; ++r) {
+      for (int q = 0; q < 4; ++q) subtract_scaled(dst[r], u[q], f[r][q], keep, j + 8);
+    }
+    j += 8;
+  }
+  for (; j < end; j += 8) {
+    const Floats8 u0 = *reinterpret_cast<const Floats8*>(u[0] + j);
+    const Floats8 u1 = *reinterpret_cast<const Floats8*>(u[1] + j);
+    const Floats8 u2 = *reinterpret_cast<const Floats8*>(u[2] + j);
+    const Floats8 u3 = *reinterpret_cast<const Floats8*>(u[3] + j);
+    for (int r = 0; r < 4; ++r) {
+      Floats8* d = reinterpret_cast<Floats8*>(dst[r] + j);
+      Floats8 v = *d;
+      v -= f[r][0] * u0;
+      v -= f[r][1] * u1;
+      v -= f[r][2] * u2;
+      v -= f[r][3] * u3;
+      *d = v;
+    }
   }
 }
 
@@ -162,34 +235,54 @@ inline void subtract_scaled4(float* const* dst, const float* src, const float* f
 TETSEG_CHARGE_CLONES bool inverse_rows_of_last(std::size_t s, std::size_t ld, std::size_t m,
                                                float* a, std::uint32_t* pivot, float* upper,
                                                float* rows) {
-  for (std::size_t k = 0; k < s; ++k) {
-    std::size_t p = k;
-    float best = std::abs(a[k * ld + k]);
-    for (std::size_t i = k + 1; i < s; ++i) {
-      const float v = std::abs(a[i * ld + k]);
-      if (v > best) {
-        best = v;
-        p = i;
+  // Right-looking LU in panels of up to four columns: the panel is factorised with its own
+  // columns updated at once, then the panel's U rows and the trailing rows receive the panel's
+  // (up to) four rank-1 updates in one pass over each row (the same operations in the same
+  // order as one update per column, so the same result, with a quarter of the row loads and
+  // stores). Row swaps move whole rows: a row's pending updates come from its own multipliers.
+  constexpr std::size_t kPanel = 4;
+  for (std::size_t k0 = 0; k0 < s; k0 += kPanel) {
+    const std::size_t kb = std::min(kPanel, s - k0), k1 = k0 + kb;
+    for (std::size_t k = k0; k < k1; ++k) {
+      std::size_t p = k;
+      float best = std::abs(a[k * ld + k]);
+      for (std::size_t i = k + 1; i < s; ++i) {
+        const float v = std::abs(a[i * ld + k]);
+        if (v > best) {
+          best = v;
+          p = i;
+        }
+      }
+      if (!(best > 0.0f) || !std::isfinite(best)) return false;
+      pivot[k] = static_cast<std::uint32_t>(p);
+      if (p != k) std::swap_ranges(a + k * ld, a + k * ld + s, a + p * ld);
+      const float* rk = a + k * ld;
+      const float inv = 1.0f / rk[k];
+      for (std::size_t i = k + 1; i < s; ++i) {
+        float* ri = a + i * ld;
+        const float l = ri[k] * inv;
+        ri[k] = l;
+        for (std::size_t c = k + 1; c < k1; ++c) ri[c] -= l * rk[c];
       }
     }
-    if (!(best > 0.0f) || !std::isfinite(best)) return false;
-    pivot[k] = static_cast<std::uint32_t>(p);
-    if (p != k) std::swap_ranges(a + k * ld, a + k * ld + s, a + p * ld);
-    const float* rk = a + k * ld;
-    const float inv = 1.0f / rk[k];
-    // Columns s..ld-1 are 0 and stay 0; four rows at a time.
-    std::size_t i = k + 1;
-    for (; i + 4 <= s; i += 4) {
-      float* const ri[4] = {a + i * ld, a + (i + 1) * ld, a + (i + 2) * ld, a + (i + 3) * ld};
-      float l[4];
-      for (int q = 0; q < 4; ++q) l[q] = ri[q][k] = ri[q][k] * inv;
-      subtract_scaled4(ri, rk, l, k + 1, ld);
+    if (k1 >= s) break;
+    const float* u[kPanel];
+    for (std::size_t q = 0; q < kPanel; ++q) u[q] = a + (k0 + std::min(q, kb - 1)) * ld;
+    // The panel's own U rows right of the panel (row k0 + t needs rows k0 .. k0 + t - 1).
+    for (std::size_t t = 1; t < kb; ++t) {
+      float* rt = a + (k0 + t) * ld;
+      for (std::size_t q = 0; q < t; ++q) subtract_scaled(rt, u[q], rt[k0 + q], k1, ld);
+    }
+    std::size_t i = k1;
+    if (kb == kPanel) {
+      for (; i + 4 <= s; i += 4) {
+        float* const ri[4] = {a + i * ld, a + (i + 1) * ld, a + (i + 2) * ld, a + (i + 3) * ld};
+        subtract_rank4(ri, u, k0, k1, ld);
+      }
     }
     for (; i < s; ++i) {
       float* ri = a + i * ld;
-      const float l = ri[k] * inv;
-      ri[k] = l;
-      subtract_scaled(ri, rk, l, k + 1, ld);
+      for (std::size_t q = 0; q < kb; ++q) subtract_scaled(ri, u[q], ri[k0 + q], k1, ld);
     }
   }
   // Y = last m rows of L^-1: row t solves y L = e_{r+t} (L unit lower triangular), from the
@@ -203,11 +296,25 @@ TETSEG_CHARGE_CLONES bool inverse_rows_of_last(std::size_t s, std::size_t ld, st
     float* row = a + k * ld;
     std::fill(row + k, row + ld, 0.0f);
   }
-  for (std::size_t t = 0; t < m; ++t) {
-    float* y = rows + t * ld;
-    std::fill(y, y + ld, 0.0f);
-    y[r + t] = 1.0f;
-    for (std::size_t k = r + t; k > 0; --k) subtract_scaled(y, a + k * ld, y[k], 0, k);
+  // Four rows at a time (independent chains, one load of each row of L): a row whose start
+  // r + t lies below k has y[k] = 0 there, and subtracting 0 * L_k changes nothing.
+  for (std::size_t t0 = 0; t0 < m; t0 += 4) {
+    const std::size_t tb = std::min<std::size_t>(4, m - t0);
+    float* y[4];
+    for (std::size_t q = 0; q < 4; ++q) y[q] = rows + (t0 + std::min(q, tb - 1)) * ld;
+    for (std::size_t q = 0; q < tb; ++q) {
+      std::fill(y[q], y[q] + ld, 0.0f);
+      y[q][r + t0 + q] = 1.0f;
+    }
+    for (std::size_t k = r + t0 + tb - 1; k > 0; --k) {
+      const float* lk = a + k * ld;
+      if (tb == 4) {
+        const float f[4] = {y[0][k], y[1][k], y[2][k], y[3][k]};
+        subtract_scaled_rows4(y, lk, f, k);
+      } else {
+        for (std::size_t q = 0; q < tb; ++q) subtract_scaled(y[q], lk, y[q][k], 0, k);
+      }
+    }
   }
   // X = U_mm^-1 Y (U_mm the trailing m x m block of U), back substitution by rows.
   for (std::size_t t = m; t-- > 0;) {

@@ -18,13 +18,16 @@ using IterationFn = std::function<void(int iteration, double residual)>;
 
 struct GmresOutcome {
   int iterations = 0;
-  double residual = 0.0;  ///< true relative residual ||b - A x|| / ||b|| at exit
+  double residual = 0.0;  ///< relative residual ||b - A x|| / ||b|| at exit (solve_gmres)
   bool converged = false;
 };
 
 /// Restarted right-preconditioned GMRES(restart) with modified Gram-Schmidt and Givens
 /// rotations; `precondition` applies an approximate inverse. Starts from the given x. Stops when
-/// the relative residual is <= tolerance or after max_iterations matrix products.
+/// the relative residual is <= tolerance or after max_iterations matrix products. The residual
+/// is b - A x recomputed with a product at every restart; when a cycle's estimate says
+/// converged it is r - V_(k+1) H_k y instead (the Arnoldi relation A M^-1 V_k = V_(k+1) H_k,
+/// which holds to rounding however orthogonal V is), which saves one product per solve.
 GmresOutcome solve_gmres(std::size_t n, const ApplyFn& apply, const ApplyFn& precondition,
                          const std::vector<double>& b, std::vector<double>& x, double tolerance,
                          int max_iterations, int restart, const IterationFn& on_iteration);

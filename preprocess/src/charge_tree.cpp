@@ -9,22 +9,11 @@
 #include <immintrin.h>
 #endif
 #if defined(__x86_64__) && defined(__GNUC__)
-#define TETSEG_CHARGE_AVX2 1  // AVX2 + FMA kernels, chosen at run time (cpu_has_avx2)
+#define TETSEG_CHARGE_AVX2 1  // AVX2 + FMA (and AVX-512F) kernels, chosen at run time
 #endif
 
 namespace tetseg::preprocess::charge_detail {
 namespace {
-
-double box_distance_sq(const Cluster& c, const Vec3& p) {
-  double s = 0.0;
-  for (int a = 0; a < 3; ++a) {
-    const double lo = c.box_min[a] - p[a];
-    const double hi = p[a] - c.box_max[a];
-    const double d = std::max({lo, hi, 0.0});
-    s += d * d;
-  }
-  return s;
-}
 
 /// sum over j in [begin, end) of q[j] / |t - p_j|, skipping p_j == t. `inv_scale2` (1 / R^2,
 /// R of the order of the mesh size) keeps r^2 / R^2 inside single-precision range for the
@@ -150,46 +139,108 @@ __attribute__((target("avx2,fma"))) void m2l_sums_avx2(std::size_t kc, const std
   }
 }
 
-/// direct_sum with 256-bit vectors: four sources per step, the same rsqrt estimate and two
-/// Newton steps (fused), the same relative error bound.
-__attribute__((target("avx2,fma"))) double direct_sum_avx2(double tx, double ty, double tz,
+/// acc + q / r for four sources (s) and the target (v): rsqrt estimate of r^2 * vs and two
+/// Newton steps; lanes outside `used` take r^2 = 1 (their charge is 0), r^2 = 0 gives 0.
+__attribute__((target("avx2,fma"), always_inline)) inline __m256d direct_step(
+    __m256d vx, __m256d vy, __m256d vz, __m256d vs, __m256d sx, __m256d sy, __m256d sz, __m256d sq,
+    __m256d used, __m256d acc) {
+  const __m256d half = _mm256_set1_pd(0.5), three_halves = _mm256_set1_pd(1.5);
+  const __m256d dx = _mm256_sub_pd(vx, sx);
+  const __m256d dy = _mm256_sub_pd(vy, sy);
+  const __m256d dz = _mm256_sub_pd(vz, sz);
+  __m256d r2 =
+      _mm256_mul_pd(_mm256_fmadd_pd(dz, dz, _mm256_fmadd_pd(dy, dy, _mm256_mul_pd(dx, dx))), vs);
+  r2 = _mm256_blendv_pd(_mm256_set1_pd(1.0), r2, used);
+  const __m256d live = _mm256_cmp_pd(r2, _mm256_setzero_pd(), _CMP_GT_OQ);
+  __m256d y = _mm256_cvtps_pd(_mm_rsqrt_ps(_mm256_cvtpd_ps(r2)));
+  const __m256d hr2 = _mm256_mul_pd(half, r2);
+  y = _mm256_mul_pd(y, _mm256_fnmadd_pd(hr2, _mm256_mul_pd(y, y), three_halves));
+  y = _mm256_mul_pd(y, _mm256_fnmadd_pd(hr2, _mm256_mul_pd(y, y), three_halves));
+  y = _mm256_and_pd(y, live);  // r2 == 0 (the target itself): drop it
+  return _mm256_fmadd_pd(y, sq, acc);
+}
+
+/// The direct sums of one target over all its source leaves (node ids list[0, count)) with
+/// 256-bit vectors: direct_sum's rsqrt estimate and two (fused) Newton steps, the same relative
+/// error bound; one accumulator pair and one reduction per target, and each leaf's last one to
+/// three sources in a masked step (unused lanes: r^2 = 1, charge 0), not scalar square roots.
+__attribute__((target("avx2,fma"))) double direct_row_avx2(double tx, double ty, double tz,
                                                            const double* px, const double* py,
                                                            const double* pz, const double* q,
-                                                           std::uint32_t begin, std::uint32_t end,
-                                                           double inv_scale2) {
+                                                           const Cluster* nodes,
+                                                           const std::int32_t* list,
+                                                           std::size_t count, double inv_scale2) {
   const __m256d vx = _mm256_set1_pd(tx), vy = _mm256_set1_pd(ty), vz = _mm256_set1_pd(tz);
-  const __m256d vs = _mm256_set1_pd(inv_scale2), half = _mm256_set1_pd(0.5),
-                three_halves = _mm256_set1_pd(1.5), zero = _mm256_setzero_pd();
-  __m256d acc = _mm256_setzero_pd();
-  std::uint32_t j = begin;
-  for (; j + 4 <= end; j += 4) {
-    const __m256d dx = _mm256_sub_pd(vx, _mm256_loadu_pd(px + j));
-    const __m256d dy = _mm256_sub_pd(vy, _mm256_loadu_pd(py + j));
-    const __m256d dz = _mm256_sub_pd(vz, _mm256_loadu_pd(pz + j));
-    const __m256d r2 =
-        _mm256_mul_pd(_mm256_fmadd_pd(dz, dz, _mm256_fmadd_pd(dy, dy, _mm256_mul_pd(dx, dx))), vs);
-    const __m256d live = _mm256_cmp_pd(r2, zero, _CMP_GT_OQ);
-    __m256d y = _mm256_cvtps_pd(_mm_rsqrt_ps(_mm256_cvtpd_ps(r2)));
-    const __m256d hr2 = _mm256_mul_pd(half, r2);
-    y = _mm256_mul_pd(y, _mm256_fnmadd_pd(hr2, _mm256_mul_pd(y, y), three_halves));
-    y = _mm256_mul_pd(y, _mm256_fnmadd_pd(hr2, _mm256_mul_pd(y, y), three_halves));
-    y = _mm256_and_pd(y, live);  // r2 == 0 (the target itself): drop it
-    acc = _mm256_fmadd_pd(y, _mm256_loadu_pd(q + j), acc);
+  const __m256d vs = _mm256_set1_pd(inv_scale2);
+  const __m256i lane = _mm256_setr_epi64x(0, 1, 2, 3);
+  __m256d acc0 = _mm256_setzero_pd(), acc1 = _mm256_setzero_pd();
+  const __m256d all = _mm256_castsi256_pd(_mm256_set1_epi64x(-1));
+  for (std::size_t d = 0; d < count; ++d) {
+    const Cluster& s = nodes[static_cast<std::size_t>(list[d])];
+    std::uint32_t j = s.begin;
+    for (; j + 8 <= s.end; j += 8) {
+      acc0 = direct_step(vx, vy, vz, vs, _mm256_loadu_pd(px + j), _mm256_loadu_pd(py + j),
+                         _mm256_loadu_pd(pz + j), _mm256_loadu_pd(q + j), all, acc0);
+      acc1 = direct_step(vx, vy, vz, vs, _mm256_loadu_pd(px + j + 4), _mm256_loadu_pd(py + j + 4),
+                         _mm256_loadu_pd(pz + j + 4), _mm256_loadu_pd(q + j + 4), all, acc1);
+    }
+    for (; j < s.end; j += 4) {
+      const __m256i mask =
+          _mm256_cmpgt_epi64(_mm256_set1_epi64x(static_cast<long long>(s.end - j)), lane);
+      acc0 = direct_step(vx, vy, vz, vs, _mm256_maskload_pd(px + j, mask),
+                         _mm256_maskload_pd(py + j, mask), _mm256_maskload_pd(pz + j, mask),
+                         _mm256_maskload_pd(q + j, mask), _mm256_castsi256_pd(mask), acc0);
+    }
   }
+  const __m256d acc = _mm256_add_pd(acc0, acc1);
   const __m128d pair = _mm_add_pd(_mm256_castpd256_pd128(acc), _mm256_extractf128_pd(acc, 1));
   double lanes[2];
   _mm_storeu_pd(lanes, pair);
-  double sum = (lanes[0] + lanes[1]) * std::sqrt(inv_scale2);
-  for (; j < end; ++j) {
-    const double dx = tx - px[j], dy = ty - py[j], dz = tz - pz[j];
-    const double r2 = dx * dx + dy * dy + dz * dz;
-    if (r2 > 0.0) sum += q[j] / std::sqrt(r2);
+  return (lanes[0] + lanes[1]) * std::sqrt(inv_scale2);
+}
+
+/// direct_row_avx2 with 512-bit vectors (AVX-512F): eight sources per step, the 14-bit
+/// rsqrt14 estimate in double and two Newton steps (relative error below 1e-15), masked tails.
+__attribute__((target("avx512f"))) double direct_row_avx512(double tx, double ty, double tz,
+                                                            const double* px, const double* py,
+                                                            const double* pz, const double* q,
+                                                            const Cluster* nodes,
+                                                            const std::int32_t* list,
+                                                            std::size_t count, double inv_scale2) {
+  const __m512d vx = _mm512_set1_pd(tx), vy = _mm512_set1_pd(ty), vz = _mm512_set1_pd(tz);
+  const __m512d vs = _mm512_set1_pd(inv_scale2), half = _mm512_set1_pd(0.5),
+                three_halves = _mm512_set1_pd(1.5), zero = _mm512_setzero_pd();
+  __m512d acc = _mm512_setzero_pd();
+  for (std::size_t d = 0; d < count; ++d) {
+    const Cluster& s = nodes[static_cast<std::size_t>(list[d])];
+    for (std::uint32_t j = s.begin; j < s.end; j += 8) {
+      const std::uint32_t left = s.end - j;
+      const __mmask8 used = left >= 8 ? __mmask8(0xff) : __mmask8((1u << left) - 1u);
+      const __m512d dx = _mm512_sub_pd(vx, _mm512_maskz_loadu_pd(used, px + j));
+      const __m512d dy = _mm512_sub_pd(vy, _mm512_maskz_loadu_pd(used, py + j));
+      const __m512d dz = _mm512_sub_pd(vz, _mm512_maskz_loadu_pd(used, pz + j));
+      const __m512d r2 = _mm512_mul_pd(
+          _mm512_fmadd_pd(dz, dz, _mm512_fmadd_pd(dy, dy, _mm512_mul_pd(dx, dx))), vs);
+      const __mmask8 live = _mm512_mask_cmp_pd_mask(used, r2, zero, _CMP_GT_OQ);
+      __m512d y = _mm512_maskz_rsqrt14_pd(0xff, r2);
+      const __m512d hr2 = _mm512_mul_pd(half, r2);
+      y = _mm512_mul_pd(y, _mm512_fnmadd_pd(hr2, _mm512_mul_pd(y, y), three_halves));
+      y = _mm512_mul_pd(y, _mm512_fnmadd_pd(hr2, _mm512_mul_pd(y, y), three_halves));
+      acc = _mm512_mask3_fmadd_pd(y, _mm512_maskz_loadu_pd(live, q + j), acc, live);
+    }
   }
-  return sum;
+  double lanes[8];
+  _mm512_storeu_pd(lanes, acc);
+  return (((lanes[0] + lanes[4]) + (lanes[2] + lanes[6])) +
+          ((lanes[1] + lanes[5]) + (lanes[3] + lanes[7]))) *
+         std::sqrt(inv_scale2);
 }
 
 bool cpu_has_avx2() {
   return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+}
+bool cpu_has_avx512() {
+  return __builtin_cpu_supports("avx512f");
 }
 #else
 void m2l_sums_avx2(std::size_t kc, const std::size_t* start, const std::uint16_t* tb,
@@ -197,10 +248,16 @@ void m2l_sums_avx2(std::size_t kc, const std::size_t* start, const std::uint16_t
                    const double* inv_fact, double* local) {
   m2l_sums(kc, start, tb, tc, dv, mv, inv_fact, local);
 }
-double direct_sum_avx2(double tx, double ty, double tz, const double* px, const double* py,
-                       const double* pz, const double* q, std::uint32_t begin, std::uint32_t end,
-                       double inv_scale2) {
-  return direct_sum(tx, ty, tz, px, py, pz, q, begin, end, inv_scale2);
+double direct_row_avx2(double, double, double, const double*, const double*, const double*,
+                       const double*, const Cluster*, const std::int32_t*, std::size_t, double) {
+  return 0.0;  // never called: cpu_has_avx2() is false
+}
+double direct_row_avx512(double, double, double, const double*, const double*, const double*,
+                         const double*, const Cluster*, const std::int32_t*, std::size_t, double) {
+  return 0.0;  // never called: cpu_has_avx512() is false
+}
+bool cpu_has_avx512() {
+  return false;
 }
 bool cpu_has_avx2() {
   return false;
@@ -323,79 +380,149 @@ ClusterTree build_cluster_tree(const PanelSet& panels, int leaf_size) {
 
 NearField build_near_field(const PanelSet& panels, const ClusterTree& tree) {
   const std::size_t n = panels.size();
-  std::vector<std::vector<std::uint32_t>> cols(n);
-#if defined(TETSEG_HAVE_OPENMP)
-#pragma omp parallel for schedule(dynamic, 64)
-#endif
-  for (std::ptrdiff_t ii = 0; ii < static_cast<std::ptrdiff_t>(n); ++ii) {
-    const std::size_t i = static_cast<std::size_t>(ii);
-    const Vec3& p = panels.centroid[i];
-    std::vector<std::int32_t> stack = {0};
-    auto& row = cols[i];
-    while (!stack.empty()) {
-      const Cluster& c = tree.nodes[static_cast<std::size_t>(stack.back())];
-      stack.pop_back();
-      const double limit = kNearFactor * c.max_diameter;
-      if (box_distance_sq(c, p) > limit * limit) continue;
-      if (c.left >= 0) {
-        stack.push_back(c.right);
-        stack.push_back(c.left);
-        continue;
-      }
-      for (std::uint32_t k = c.begin; k < c.end; ++k) {
-        const std::uint32_t j = tree.order[k];
-        const Vec3& q = panels.centroid[j];
-        const double dx = p[0] - q[0], dy = p[1] - q[1], dz = p[2] - q[2];
-        const double lim = kNearFactor * panels.diameter[j];
-        if (j == i || dx * dx + dy * dy + dz * dz <= lim * lim) row.push_back(j);
-      }
-    }
-    std::sort(row.begin(), row.end());
+  const std::size_t leaf_count = tree.leaves.size();
+  // Sources in tree order (each leaf contiguous) with their squared near-field radius.
+  std::vector<double> sx(n), sy(n), sz(n), slim2(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    const std::uint32_t j = tree.order[k];
+    sx[k] = panels.centroid[j][0];
+    sy[k] = panels.centroid[j][1];
+    sz[k] = panels.centroid[j][2];
+    const double lim = kNearFactor * panels.diameter[j];
+    slim2[k] = lim * lim;
   }
+  // Per target leaf: its members' rows back to back, and their lengths. A row's columns are
+  // in tree order (candidate leaves as the search meets them), not sorted by id: no reader
+  // needs sorted rows, and sorting them was 2 % of a 5k solve.
+  std::vector<std::vector<std::uint32_t>> leaf_columns(leaf_count);
+  std::vector<std::uint32_t> row_length(n);
+  std::vector<TriangleKernel> kernels(n);
   NearField near;
   near.row_start.resize(n + 1, 0);
-  for (std::size_t i = 0; i < n; ++i) near.row_start[i + 1] = near.row_start[i] + cols[i].size();
-  const std::size_t nnz = near.row_start[n];
-  near.column.resize(nnz);
-  near.value.resize(nnz);
-  near.correction.resize(nnz);
   near.diagonal.resize(n);
-  std::vector<TriangleKernel> kernels(n);
+  // One parallel region: a fork and join cost more than a stage at 5k triangles.
 #if defined(TETSEG_HAVE_OPENMP)
-#pragma omp parallel for schedule(static)
+#pragma omp parallel
 #endif
-  for (std::ptrdiff_t jj = 0; jj < static_cast<std::ptrdiff_t>(n); ++jj) {
-    const auto& t = panels.corners[static_cast<std::size_t>(jj)];
-    kernels[static_cast<std::size_t>(jj)] = TriangleKernel(t[0], t[1], t[2]);
-  }
+  {
 #if defined(TETSEG_HAVE_OPENMP)
-#pragma omp parallel for schedule(dynamic, 64)
+#pragma omp for schedule(static) nowait
 #endif
-  for (std::ptrdiff_t ii = 0; ii < static_cast<std::ptrdiff_t>(n); ++ii) {
-    const std::size_t i = static_cast<std::size_t>(ii);
-    const Vec3& p = panels.centroid[i];
-    std::size_t e = near.row_start[i];
-    for (const std::uint32_t j : cols[i]) {
-      const auto& t = panels.corners[j];
-      double value, point = 0.0;
-      if (j == i) {
-        value = triangle_self_potential(t[0], t[1], t[2]);
-        near.diagonal[i] = value;
-      } else {
-        const Vec3& q = panels.centroid[j];
-        const double dx = p[0] - q[0], dy = p[1] - q[1], dz = p[2] - q[2];
-        const double r2 = dx * dx + dy * dy + dz * dz;
-        const double band = kQuadratureFactor * panels.diameter[j];
-        value = r2 > band * band ? triangle_potential_quadrature(t, panels.area[j], p)
-                                 : kernels[j].potential(p);
-        if (r2 > 0.0) point = panels.area[j] / std::sqrt(r2);
-      }
-      near.column[e] = j;
-      near.value[e] = value;
-      near.correction[e] = value - point;
-      ++e;
+    for (std::ptrdiff_t jj = 0; jj < static_cast<std::ptrdiff_t>(n); ++jj) {
+      const auto& t = panels.corners[static_cast<std::size_t>(jj)];
+      kernels[static_cast<std::size_t>(jj)] = TriangleKernel(t[0], t[1], t[2]);
     }
-    std::vector<std::uint32_t>().swap(cols[i]);
+    // Candidate source leaves of a target leaf by a box-to-box test (no member of a pruned
+    // node is within its near-field radius of any member of the target), then the exact
+    // per-pair test of the row rule.
+    std::vector<std::int32_t> stack, candidates;
+#if defined(TETSEG_HAVE_OPENMP)
+#pragma omp for schedule(dynamic, 1)
+#endif
+    for (std::ptrdiff_t ll = 0; ll < static_cast<std::ptrdiff_t>(leaf_count); ++ll) {
+      const Cluster& target = tree.nodes[static_cast<std::size_t>(tree.leaves[ll])];
+      candidates.clear();
+      stack.assign(1, 0);
+      while (!stack.empty()) {
+        const Cluster& c = tree.nodes[static_cast<std::size_t>(stack.back())];
+        const std::int32_t id = stack.back();
+        stack.pop_back();
+        double d2 = 0.0;
+        for (int a = 0; a < 3; ++a) {
+          const double d =
+              std::max({c.box_min[a] - target.box_max[a], target.box_min[a] - c.box_max[a], 0.0});
+          d2 += d * d;
+        }
+        const double limit = kNearFactor * c.max_diameter;
+        if (d2 > limit * limit) continue;
+        if (c.left >= 0) {
+          stack.push_back(c.right);
+          stack.push_back(c.left);
+        } else {
+          candidates.push_back(id);
+        }
+      }
+      auto& columns = leaf_columns[static_cast<std::size_t>(ll)];
+      std::size_t capacity = 0;
+      for (const std::int32_t id : candidates) {
+        const Cluster& c = tree.nodes[static_cast<std::size_t>(id)];
+        capacity += c.end - c.begin;
+      }
+      columns.resize(static_cast<std::size_t>(target.end - target.begin) * capacity);
+      std::size_t used = 0;
+      for (std::uint32_t m = target.begin; m < target.end; ++m) {
+        const std::uint32_t i = tree.order[m];
+        const double px = sx[m], py = sy[m], pz = sz[m];
+        const std::size_t first = used;
+        for (const std::int32_t id : candidates) {
+          const Cluster& c = tree.nodes[static_cast<std::size_t>(id)];
+          // The leaf's box is out of reach of this member (the per-row form of the test above).
+          double b2 = 0.0;
+          const double p3[3] = {px, py, pz};
+          for (int a = 0; a < 3; ++a) {
+            const double d = std::max({c.box_min[a] - p3[a], p3[a] - c.box_max[a], 0.0});
+            b2 += d * d;
+          }
+          const double limit = kNearFactor * c.max_diameter;
+          if (b2 > limit * limit) continue;
+          for (std::uint32_t k = c.begin; k < c.end; ++k) {
+            const double dx = px - sx[k], dy = py - sy[k], dz = pz - sz[k];
+            const std::uint32_t j = tree.order[k];
+            columns[used] = j;
+            used += (j == i || dx * dx + dy * dy + dz * dz <= slim2[k]) ? 1 : 0;
+          }
+        }
+        row_length[i] = static_cast<std::uint32_t>(used - first);
+      }
+      columns.resize(used);
+      columns.shrink_to_fit();
+    }
+#if defined(TETSEG_HAVE_OPENMP)
+#pragma omp single
+#endif
+    {
+      for (std::size_t i = 0; i < n; ++i) near.row_start[i + 1] = near.row_start[i] + row_length[i];
+      const std::size_t nnz = near.row_start[n];
+      // Filled below by both threads (no serial zero-fill of about 20 bytes per entry).
+      near.column.resize(nnz);
+      near.value.resize(nnz);
+      near.correction.resize(nnz);
+    }
+#if defined(TETSEG_HAVE_OPENMP)
+#pragma omp for schedule(dynamic, 1)
+#endif
+    for (std::ptrdiff_t ll = 0; ll < static_cast<std::ptrdiff_t>(leaf_count); ++ll) {
+      const Cluster& target = tree.nodes[static_cast<std::size_t>(tree.leaves[ll])];
+      auto& columns = leaf_columns[static_cast<std::size_t>(ll)];
+      std::size_t from = 0;
+      for (std::uint32_t m = target.begin; m < target.end; ++m) {
+        const std::size_t i = tree.order[m];
+        const Vec3& p = panels.centroid[i];
+        std::size_t e = near.row_start[i];
+        for (std::size_t f = 0; f < row_length[i]; ++f, ++e) {
+          const std::uint32_t j = columns[from + f];
+          const auto& t = panels.corners[j];
+          double value, point = 0.0;
+          if (j == i) {
+            value = triangle_self_potential(t[0], t[1], t[2]);
+            near.diagonal[i] = value;
+          } else {
+            const Vec3& q = panels.centroid[j];
+            const double dx = p[0] - q[0], dy = p[1] - q[1], dz = p[2] - q[2];
+            const double r2 = dx * dx + dy * dy + dz * dz;
+            const double band = kQuadratureFactor * panels.diameter[j];
+            value = r2 > band * band ? triangle_potential_quadrature(t, panels.area[j], p)
+                                     : kernels[j].potential(p);
+            if (r2 > 0.0) point = panels.area[j] / std::sqrt(r2);
+          }
+          near.column[e] = j;
+          near.value[e] = value;
+          near.correction[e] = value - point;
+        }
+        from += row_length[i];
+      }
+      std::vector<std::uint32_t>().swap(columns);
+    }
   }
   return near;
 }
@@ -580,10 +707,16 @@ TreecodeOperator::TreecodeOperator(const PanelSet& panels, const ClusterTree& tr
   }
 
   // Dual-tree traversal: admissible pairs become M2L, leaf pairs direct sums, otherwise the
-  // larger cluster (or the one that is not a leaf) is split.
-  std::vector<std::vector<std::int32_t>> far(node_count), direct(tree.leaves.size());
-  std::vector<std::pair<std::int32_t, std::int32_t>> stack = {{0, 0}};
-  while (!stack.empty()) {
+  // larger cluster (or the one that is not a leaf) is split. A depth-first walk with an
+  // explicit stack, in two phases with the same lists as one serial walk: one thread walks
+  // until the stack holds kWalks pairs; then the pairs left on the stack are walked to the
+  // end in parallel, each into its own record, and the records are read top of the stack
+  // first (the order in which the serial walk would have finished them).
+  using NodePair = std::pair<std::int32_t, std::int32_t>;
+  struct Walk {
+    std::vector<NodePair> far, direct;  // (target node, source node), in walk order
+  };
+  auto step = [&](std::vector<NodePair>& stack, Walk& out) {
     const auto [ti, si] = stack.back();
     stack.pop_back();
     const Cluster& t = tree.nodes[static_cast<std::size_t>(ti)];
@@ -593,12 +726,12 @@ TreecodeOperator::TreecodeOperator(const PanelSet& panels, const ClusterTree& tr
     const double dz = s.center[2] - t.center[2];
     const double dist = std::sqrt(dx * dx + dy * dy + dz * dz);
     if (ti != si && t.radius + s.radius < theta * dist) {
-      far[static_cast<std::size_t>(ti)].push_back(si);
-      continue;
+      out.far.push_back({ti, si});
+      return;
     }
     const bool t_leaf = t.left < 0, s_leaf = s.left < 0;
     if (t_leaf && s_leaf) {
-      direct[static_cast<std::size_t>(m_leaf_of_node[static_cast<std::size_t>(ti)])].push_back(si);
+      out.direct.push_back({ti, si});
     } else if (s_leaf || (!t_leaf && t.radius >= s.radius)) {
       stack.push_back({t.right, si});
       stack.push_back({t.left, si});
@@ -606,11 +739,38 @@ TreecodeOperator::TreecodeOperator(const PanelSet& panels, const ClusterTree& tr
       stack.push_back({ti, s.right});
       stack.push_back({ti, s.left});
     }
+  };
+  constexpr std::size_t kWalks = 64;
+  std::vector<NodePair> stack = {{0, 0}};
+  std::vector<Walk> walks(1);
+  while (!stack.empty() && stack.size() < kWalks) step(stack, walks[0]);
+  const std::size_t parallel_walks = stack.size();
+  walks.resize(1 + parallel_walks);
+#if defined(TETSEG_HAVE_OPENMP)
+#pragma omp parallel for schedule(dynamic, 1)
+#endif
+  for (std::ptrdiff_t ww = 0; ww < static_cast<std::ptrdiff_t>(parallel_walks); ++ww) {
+    const std::size_t w = static_cast<std::size_t>(ww);
+    std::vector<NodePair> own = {stack[parallel_walks - 1 - w]};
+    while (!own.empty()) step(own, walks[1 + w]);
   }
+  // Per-target lists (CSR), each in walk order.
   m_far_start.assign(node_count + 1, 0);
-  for (std::size_t id = 0; id < node_count; ++id) {
-    m_far_start[id + 1] = m_far_start[id] + far[id].size();
-    m_far.insert(m_far.end(), far[id].begin(), far[id].end());
+  std::vector<std::vector<std::int32_t>> direct(tree.leaves.size());
+  for (const Walk& w : walks) {
+    for (const auto& [ti, si] : w.far) ++m_far_start[static_cast<std::size_t>(ti) + 1];
+  }
+  for (std::size_t id = 0; id < node_count; ++id) m_far_start[id + 1] += m_far_start[id];
+  m_far.resize(m_far_start[node_count]);
+  {
+    std::vector<std::size_t> fill(m_far_start.begin(), m_far_start.end() - 1);
+    for (const Walk& w : walks) {
+      for (const auto& [ti, si] : w.far) m_far[fill[static_cast<std::size_t>(ti)]++] = si;
+      for (const auto& [ti, si] : w.direct) {
+        direct[static_cast<std::size_t>(m_leaf_of_node[static_cast<std::size_t>(ti)])].push_back(
+            si);
+      }
+    }
   }
   m_direct_start.assign(tree.leaves.size() + 1, 0);
   double direct_work = 0.0;
@@ -625,10 +785,12 @@ TreecodeOperator::TreecodeOperator(const PanelSet& panels, const ClusterTree& tr
     }
   }
   m_direct_per_target = direct_work / static_cast<double>(m_n);
+  // Every product writes these before reading them: no zero-fill here (its page faults
+  // then fall in the first product, on both threads).
   m_charge.resize(m_n);
-  m_moments.assign(node_count * m_index.size(), 0.0);
-  m_local.assign(node_count * m_index.size(), 0.0);
-  m_scaled.assign(node_count * m_index.size(), 0.0);
+  m_moments.resize(node_count * m_index.size());
+  m_local.resize(node_count * m_index.size());
+  m_scaled.resize(node_count * m_index.size());
 }
 
 void TreecodeOperator::apply(const double* x, double* y) const {
@@ -644,6 +806,7 @@ void TreecodeOperator::apply(const double* x, double* y) const {
   const double root_radius = nodes[0].radius > 0.0 ? nodes[0].radius : 1.0;
   const double inv_scale2 = 1.0 / (root_radius * root_radius);
   static const bool avx2 = cpu_has_avx2();
+  static const bool avx512 = avx2 && cpu_has_avx512();
   // Monomials w^k for |k| <= order, graded order, from k - e_i.
   auto monomials = [&](double wx, double wy, double wz, double* out) {
     out[0] = 1.0;
@@ -654,12 +817,16 @@ void TreecodeOperator::apply(const double* x, double* y) const {
   auto shift = [&](const std::vector<Term>& terms, const std::vector<std::size_t>& start,
                    const double* d_mono, const double* from, double* to) {
     for (std::size_t a = 0; a < kc; ++a) {
-      double acc = 0.0;
-      for (std::size_t e = start[a]; e < start[a + 1]; ++e) {
-        const Term& t = terms[e];
-        acc += t.coef * d_mono[t.c] * from[t.b];
+      double acc0 = 0.0, acc1 = 0.0;  // two chains: the sums are latency-bound
+      std::size_t e = start[a];
+      for (; e + 2 <= start[a + 1]; e += 2) {
+        const Term& t0 = terms[e];
+        const Term& t1 = terms[e + 1];
+        acc0 += t0.coef * d_mono[t0.c] * from[t0.b];
+        acc1 += t1.coef * d_mono[t1.c] * from[t1.b];
       }
-      to[a] += acc;
+      if (e < start[a + 1]) acc0 += terms[e].coef * d_mono[terms[e].c] * from[terms[e].b];
+      to[a] += acc0 + acc1;
     }
   };
 #if defined(TETSEG_HAVE_OPENMP)
@@ -795,27 +962,47 @@ void TreecodeOperator::apply(const double* x, double* y) const {
       for (std::uint32_t k = target.begin; k < target.end; ++k) {
         monomials(px[k] - target.center[0], py[k] - target.center[1], pz[k] - target.center[2],
                   mono.data());
-        double sum = 0.0;
-        for (std::size_t e = 0; e < kc; ++e) sum += local[e] * mono[e];
-        pot[k - target.begin] = sum;
+        double s0 = 0.0, s1 = 0.0, s2 = 0.0, s3 = 0.0;  // four chains
+        std::size_t e = 0;
+        for (; e + 4 <= kc; e += 4) {
+          s0 += local[e] * mono[e];
+          s1 += local[e + 1] * mono[e + 1];
+          s2 += local[e + 2] * mono[e + 2];
+          s3 += local[e + 3] * mono[e + 3];
+        }
+        for (; e < kc; ++e) s0 += local[e] * mono[e];
+        pot[k - target.begin] = (s0 + s1) + (s2 + s3);
       }
-      for (std::size_t d = m_direct_start[l]; d < m_direct_start[l + 1]; ++d) {
-        const Cluster& s = nodes[static_cast<std::size_t>(m_direct[d])];
+      if (avx2) {
+        const std::int32_t* list = m_direct.data() + m_direct_start[l];
+        const std::size_t count = m_direct_start[l + 1] - m_direct_start[l];
         for (std::uint32_t k = target.begin; k < target.end; ++k) {
-          pot[k - target.begin] += avx2 ? direct_sum_avx2(px[k], py[k], pz[k], px, py, pz, charge,
-                                                          s.begin, s.end, inv_scale2)
-                                        : direct_sum(px[k], py[k], pz[k], px, py, pz, charge,
-                                                     s.begin, s.end, inv_scale2);
+          pot[k - target.begin] += (avx512 ? direct_row_avx512 : direct_row_avx2)(
+              px[k], py[k], pz[k], px, py, pz, charge, nodes.data(), list, count, inv_scale2);
+        }
+      } else {
+        for (std::size_t d = m_direct_start[l]; d < m_direct_start[l + 1]; ++d) {
+          const Cluster& s = nodes[static_cast<std::size_t>(m_direct[d])];
+          for (std::uint32_t k = target.begin; k < target.end; ++k) {
+            pot[k - target.begin] +=
+                direct_sum(px[k], py[k], pz[k], px, py, pz, charge, s.begin, s.end, inv_scale2);
+          }
         }
       }
       // Exact near field of each target: analytic minus the point charge counted above.
       for (std::uint32_t k = target.begin; k < target.end; ++k) {
         const std::size_t i = order[k];
-        double sum = pot[k - target.begin];
-        for (std::size_t e = m_near.row_start[i]; e < m_near.row_start[i + 1]; ++e) {
-          sum += m_near.correction[e] * x[m_near.column[e]];
+        const std::size_t end = m_near.row_start[i + 1];
+        double c0 = 0.0, c1 = 0.0, c2 = 0.0, c3 = 0.0;  // four chains
+        std::size_t e = m_near.row_start[i];
+        for (; e + 4 <= end; e += 4) {
+          c0 += m_near.correction[e] * x[m_near.column[e]];
+          c1 += m_near.correction[e + 1] * x[m_near.column[e + 1]];
+          c2 += m_near.correction[e + 2] * x[m_near.column[e + 2]];
+          c3 += m_near.correction[e + 3] * x[m_near.column[e + 3]];
         }
-        y[i] = sum;
+        for (; e < end; ++e) c0 += m_near.correction[e] * x[m_near.column[e]];
+        y[i] = pot[k - target.begin] + ((c0 + c1) + (c2 + c3));
       }
     }
   }
