@@ -70,10 +70,12 @@ expect_exit 2 "clusters" -- "$bin/tetseg" build sphere.mesh -o x.tetseg --cluste
 [ ! -e x.tetseg ] || fail "a usage error left an asset"
 # A sphere's cluster is seen whole: no visibility note.
 if grep -q "note: .* clusters are seen less than" build.txt; then fail "visibility note on a sphere"; fi
-# A character whose thin parts have no interior node: the build names the poorly seen clusters.
+# A character whose thin parts have no interior node: the build names the poorly seen clusters
+# (the paper's segmentation leaves the dino one cluster seen 71 % positive; refinement with
+# the defaults splits it until each is seen at least 85 %).
 if [[ -f "${TETSEG_CGAL_MESH_DIR:-/nonexistent}/dino.off" ]]; then
   expect_exit 0 "tetseg: note: [0-9]* of [0-9]* clusters are seen less than 80% positive" -- \
-    "$bin/tetseg" build "$TETSEG_CGAL_MESH_DIR/dino.off" -o dino.tetseg
+    "$bin/tetseg" build "$TETSEG_CGAL_MESH_DIR/dino.off" -o dino.tetseg --clusters charge
 else
   skip_without_data "CGAL demo mesh dino.off (visibility note)"
 fi
