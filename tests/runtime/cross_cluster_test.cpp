@@ -1,12 +1,11 @@
 // rvbc with many clusters against brute force, in the configurations that would trap culling
-// across clusters (docs/runtime.md, "Across clusters: not adopted"): neighbouring clusters folded
-// onto each other, wedge tips on a cluster boundary, detectors on both sides of a contact, and
-// random smooth deformations of many small clusters; and the seam rule (pairs of two clusters
-// sharing a node culled, their feature pairs tested from the seam orphans: "Across clusters:
-// seam pairs") on low-valence bodies in every split into clusters and on scattered clusters.
-// compare_with_brute checks any-collision, the
-// earliest toi and every brute-force contact at the earliest toi
-// (tests/runtime/support/compare.hpp).
+// across clusters (docs/runtime.md, "Across clusters by orientation: not adopted"): neighbouring
+// clusters folded onto each other, wedge tips on a cluster boundary, detectors on both sides of a
+// contact, and random smooth deformations of many small clusters; and the seam rule (pairs of two
+// clusters sharing a node culled, their feature pairs tested from the seam orphans: "Across
+// clusters: seam pairs") on low-valence bodies in every split into clusters and on scattered
+// clusters. compare_with_brute checks any-collision, the earliest toi and every brute-force contact
+// at the earliest toi (tests/runtime/support/compare.hpp).
 
 #include <algorithm>
 #include <catch2/catch.hpp>
