@@ -500,4 +500,26 @@ void rest_triangle_pair(Worker& w, const Collider::Impl& A, std::uint32_t t1,
 bool traverse_bodies(Worker& w, const Collider::Impl& A, const Collider::Impl& B,
                      bool rest = false) noexcept;
 
+// Member templates of Collider::Impl used by collider_orphans.cpp (construction) and
+// collider_traverse.cpp (the seam orphans' per-step test).
+template <typename Holder>
+inline bool Collider::Impl::any_vertex_face_holder(std::uint32_t p, std::uint32_t f,
+                                                   Holder&& holder) const noexcept {
+  const std::uint32_t ip = topo->surf_index[p];
+  for (std::uint32_t k = topo->vt_offset[ip]; k < topo->vt_offset[ip + 1]; ++k)
+    if (holder(topo->vt_list[k], f)) return true;
+  return false;
+}
+
+template <typename Holder>
+inline bool Collider::Impl::any_edge_edge_holder(std::uint32_t e1, std::uint32_t e2,
+                                                 Holder&& holder) const noexcept {
+  const auto& off = topo->et_offset;
+  const auto& list = topo->et_list;
+  for (std::uint32_t k1 = off[e1]; k1 < off[e1 + 1]; ++k1)
+    for (std::uint32_t k2 = off[e2]; k2 < off[e2 + 1]; ++k2)
+      if (holder(list[k1], list[k2])) return true;
+  return false;
+}
+
 }  // namespace tetseg
