@@ -15,6 +15,7 @@
 #include "body_shape_data.hpp"
 #include "normal_cone.hpp"
 #include "orientation_terms.hpp"
+#include "plane_filter.hpp"
 #include "tetseg/runtime/classify.hpp"
 #include "tetseg/runtime/collider.hpp"
 #include "tetseg/runtime/median_bvh.hpp"
@@ -483,9 +484,7 @@ struct Collider::Impl {
 
 /// Triangles a and b have a node in common.
 inline bool share_node(const format::Triangle& a, const format::Triangle& b) noexcept {
-  for (std::uint32_t n : a)
-    if (n == b[0] || n == b[1] || n == b[2]) return true;
-  return false;
+  return shared_node_mask(a, b) != 0;
 }
 
 /// Static check of triangle t1 of A against t2 of B (A == B within a body): an edge of one
