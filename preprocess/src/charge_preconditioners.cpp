@@ -343,14 +343,17 @@ NearFieldSchwarz::NearFieldSchwarz(const PanelSet& panels, const ClusterTree& tr
     : m_tree(tree) {
   const std::size_t n = panels.size();
   const std::size_t leaves = tree.leaves.size();
-  // Pass 1: the extended set of every leaf.
+  // Pass 1: the extended set of every leaf: its members, then the near-field columns of its
+  // members with the largest coupling score sum over members i of A_i A_j / |c_i - c_j|^3
+  // (the decay of the inverse operator's kernel; docs/charge.md, "Preconditioner").
   std::vector<std::vector<std::uint32_t>> sets(leaves);
 #if defined(TETSEG_HAVE_OPENMP)
 #pragma omp parallel
 #endif
   {
-    std::vector<char> mark(n, 0);
-    std::vector<std::pair<double, std::uint32_t>> extra;
+    // mark[j]: -1 for a member, 1 + its index in `extra` for a candidate, 0 otherwise.
+    std::vector<std::int32_t> mark(n, 0);
+    std::vector<std::pair<double, std::uint32_t>> extra;  // (-score, column)
 #if defined(TETSEG_HAVE_OPENMP)
 #pragma omp for schedule(dynamic, 8)
 #endif
@@ -360,18 +363,27 @@ NearFieldSchwarz::NearFieldSchwarz(const PanelSet& panels, const ClusterTree& tr
       auto& set = sets[l];
       for (std::uint32_t k = c.begin; k < c.end; ++k) {
         set.push_back(tree.order[k]);
-        mark[tree.order[k]] = 1;
+        mark[tree.order[k]] = -1;
       }
       extra.clear();
       for (std::uint32_t k = c.begin; k < c.end; ++k) {
         const std::size_t i = tree.order[k];
+        const Vec3& p = panels.centroid[i];
         for (std::size_t e = near.row_start[i]; e < near.row_start[i + 1]; ++e) {
           const std::uint32_t j = near.column[e];
-          if (mark[j]) continue;
-          mark[j] = 1;
+          if (mark[j] < 0) continue;
           const Vec3& q = panels.centroid[j];
-          const double dx = q[0] - c.center[0], dy = q[1] - c.center[1], dz = q[2] - c.center[2];
-          extra.push_back({dx * dx + dy * dy + dz * dz, j});
+          const double dx = q[0] - p[0], dy = q[1] - p[1], dz = q[2] - p[2];
+          const double r2 = dx * dx + dy * dy + dz * dz;
+          // Coincident centroids (overlapping triangles) couple the most.
+          const double score =
+              r2 > 0.0 ? panels.area[i] * panels.area[j] / (r2 * std::sqrt(r2)) : HUGE_VAL;
+          if (mark[j] == 0) {
+            extra.push_back({-score, j});
+            mark[j] = static_cast<std::int32_t>(extra.size());
+          } else {
+            extra[static_cast<std::size_t>(mark[j] - 1)].first -= score;
+          }
         }
       }
       for (const std::uint32_t j : set) mark[j] = 0;

@@ -46,10 +46,10 @@ class BlockJacobi {
 };
 
 /// Restricted additive Schwarz preconditioner on the exact near field: for each cluster-tree
-/// leaf L, the set S = L plus the near-field columns of L's rows (nearest to the leaf first,
-/// at most `max_set` in all); M_SS (analytic near entries, point charges elsewhere) is
-/// factorised once and the preconditioner returns, on L only, (M_SS^-1 r_S)|_L. Storage:
-/// |L| x |S| doubles per leaf.
+/// leaf L, the set S = L plus the near-field columns j of L's rows with the largest score
+/// sum over members i of A_i A_j / |c_i - c_j|^3 (at most `max_set` in all); M_SS (analytic
+/// near entries, point charges elsewhere) is factorised once and the preconditioner returns,
+/// on L only, (M_SS^-1 r_S)|_L. Storage: |L| x |S| floats per leaf.
 class NearFieldSchwarz {
  public:
   NearFieldSchwarz(const PanelSet& panels, const ClusterTree& tree, const NearField& near,
