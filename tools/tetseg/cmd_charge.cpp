@@ -281,10 +281,10 @@ void add_charge_command(CLI::App& root) {
   cmd->add_option("--max-iterations", args->max_iterations, "Iteration cap")
       ->check(CLI::Range(1, 100000));
   cmd->add_option("--theta", args->theta,
-                  "Fast solver opening parameter, (0, 1) (0: 0.5 below 10k triangles, 0.45 above)")
+                  "Fast solver opening parameter, (0, 1) (0: 0.4 below 10k triangles, 0.45 above)")
       ->check(CLI::Range(0.0, 0.95));
   cmd->add_option("--order", args->order,
-                  "Fast solver expansion order (-1 = 7 below 10k triangles, else 8)")
+                  "Fast solver expansion order (-1 = 6 below 10k triangles, else 8)")
       ->check(CLI::Range(-1, 16));
   cmd->add_option("--equalization,--equalize", args->equalization,
                   "histogram (the paper), rank or log-histogram (alias log)")
