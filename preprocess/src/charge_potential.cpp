@@ -48,28 +48,30 @@ double TriangleKernel::potential(const Vec3& r) const {
   if (!m_valid) return 0.0;
   const double d = dot(m_normal, sub(r, m_corner));
   const double ad = std::abs(d);
+  // Offsets of the corners from r and their lengths: edge i runs from corner i to i + 1.
+  const Vec3 rc[3] = {sub(m_edge[0].start, r), sub(m_edge[1].start, r), sub(m_edge[2].start, r)};
+  const double dist[3] = {norm(rc[0]), norm(rc[1]), norm(rc[2])};
   double sum = 0.0;
-  for (const Edge& e : m_edge) {
+  for (int i = 0; i < 3; ++i) {
     // Edge coordinates of the projection of r: dir and out are orthogonal to the normal, so
     // the offset from r to its projection drops out of the dot products.
-    const Vec3 to_m = sub(e.start, r);
-    const double lm = dot(to_m, e.dir);
+    const Edge& e = m_edge[i];
+    const double lm = dot(rc[i], e.dir);
     const double lp = lm + e.length;
-    const double t = dot(to_m, e.out);
+    const double t = dot(rc[i], e.out);
     if (std::abs(t) < 1e-12 * e.length) continue;  // point on the edge line: the term vanishes
-    const double r0sq = t * t + d * d;
-    const double rp = std::sqrt(lp * lp + r0sq);
-    const double rm = std::sqrt(lm * lm + r0sq);
+    const double rm = dist[i], rp = dist[(i + 1) % 3];
     const double log_term =
         lm < 0.0 ? std::log((rm - lm) / (rp - lp)) : std::log((rp + lp) / (rm + lm));
     sum += t * log_term;
-    if (ad > 0.0) {
-      // atan2(y1, x1) - atan2(y2, x2) with x1, x2 > 0: both angles lie in (-pi/2, pi/2), so
-      // the difference lies in (-pi, pi) and equals the angle of (x1 + i y1) conj(x2 + i y2).
-      const double y1 = t * lp, x1 = r0sq + ad * rp;
-      const double y2 = t * lm, x2 = r0sq + ad * rm;
-      sum -= ad * std::atan2(y1 * x2 - x1 * y2, x1 * x2 + y1 * y2);
-    }
+  }
+  if (ad > 0.0) {
+    // The edges' angle terms add up to the solid angle the triangle subtends at r, taken in
+    // one atan2 (van Oosterom & Strackee 1983) instead of one per edge.
+    const double triple = dot(rc[0], cross(rc[1], rc[2]));
+    const double denominator = dist[0] * dist[1] * dist[2] + dot(rc[0], rc[1]) * dist[2] +
+                               dot(rc[0], rc[2]) * dist[1] + dot(rc[1], rc[2]) * dist[0];
+    sum -= ad * 2.0 * std::atan2(std::abs(triple), denominator);
   }
   return sum;
 }

@@ -106,6 +106,15 @@ TEST_CASE("The closed-form triangle potential matches quadrature", "[charge][pot
     const Vec3 r{0.3, 0.2, 0.5};
     CHECK(triangle_potential(a, b, c, r) == Approx(quadrature(a, b, c, r, 5)).epsilon(1e-7));
   }
+  SECTION("Points off the plane beside the triangle, over a corner and below agree to 1e-7.") {
+    // The angle terms are taken as one solid angle; these check it where the projection of r
+    // falls outside the triangle (some edge terms negative) and on either side of the plane.
+    for (const Vec3 r : {Vec3{1.5, 1.0, 0.4}, Vec3{-0.4, 0.3, 0.25}, Vec3{0.5, -0.6, -0.3},
+                         Vec3{1.0, 0.0, 0.3}, Vec3{0.3, 0.8, -0.05}, Vec3{0.45, 0.3, -0.7}}) {
+      CAPTURE(r[0], r[1], r[2]);
+      CHECK(triangle_potential(a, b, c, r) == Approx(quadrature(a, b, c, r, 7)).epsilon(1e-7));
+    }
+  }
   SECTION("A point just off an edge agrees to 1e-5.") {
     const Vec3 r{0.5, -0.01, 0.02};
     CHECK(triangle_potential(a, b, c, r) == Approx(quadrature(a, b, c, r, 8)).epsilon(1e-5));
