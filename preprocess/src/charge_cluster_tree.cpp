@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <numeric>
 #include <vector>
 
@@ -127,6 +128,10 @@ NearField build_near_field(const PanelSet& panels, const ClusterTree& tree) {
     // node is within its near-field radius of any member of the target), then the exact
     // per-pair test of the row rule.
     std::vector<std::int32_t> stack, candidates;
+    // A leaf's candidate columns, written before they are counted (not zero-filled: at most
+    // members x candidate sources, 14 MB in all at 5k, of which about a tenth is used).
+    std::unique_ptr<std::uint32_t[]> scratch;
+    std::size_t scratch_size = 0;
 #if defined(TETSEG_HAVE_OPENMP)
 #pragma omp for schedule(dynamic, 1)
 #endif
@@ -153,13 +158,17 @@ NearField build_near_field(const PanelSet& panels, const ClusterTree& tree) {
           candidates.push_back(id);
         }
       }
-      auto& columns = leaf_columns[static_cast<std::size_t>(ll)];
       std::size_t capacity = 0;
       for (const std::int32_t id : candidates) {
         const Cluster& c = tree.nodes[static_cast<std::size_t>(id)];
         capacity += c.end - c.begin;
       }
-      columns.resize(static_cast<std::size_t>(target.end - target.begin) * capacity);
+      capacity *= target.end - target.begin;
+      if (capacity > scratch_size) {
+        scratch.reset(new std::uint32_t[capacity]);
+        scratch_size = capacity;
+      }
+      std::uint32_t* columns = scratch.get();
       std::size_t used = 0;
       for (std::uint32_t m = target.begin; m < target.end; ++m) {
         const std::uint32_t i = tree.order[m];
@@ -185,8 +194,7 @@ NearField build_near_field(const PanelSet& panels, const ClusterTree& tree) {
         }
         row_length[i] = static_cast<std::uint32_t>(used - first);
       }
-      columns.resize(used);
-      columns.shrink_to_fit();
+      leaf_columns[static_cast<std::size_t>(ll)].assign(columns, columns + used);
     }
 #if defined(TETSEG_HAVE_OPENMP)
 #pragma omp single
