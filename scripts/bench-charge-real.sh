@@ -18,6 +18,10 @@ fi
 cmake --build "$build" --target tetseg-bench-charge -j 2 >/dev/null
 meshes="$build/bench-data/data/meshes"
 if [ ! -d "$meshes" ]; then
+  if [ ! -f /usr/share/doc/libcgal-dev/data.tar.gz ]; then
+    echo "bench-charge-real: needs the libcgal-demo meshes (apt install libcgal-demo)" >&2
+    exit 1
+  fi
   mkdir -p "$build/bench-data"
   tar xzf /usr/share/doc/libcgal-dev/data.tar.gz -C "$build/bench-data" data/meshes
 fi
