@@ -5,6 +5,7 @@
 #include "charge_tree.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <numeric>
 #if defined(__SSE2__)
@@ -15,6 +16,18 @@
 #endif
 
 namespace tetseg::preprocess::charge_detail {
+
+namespace {
+
+/// The widest FMM kernels apply() may use (set_fmm_vector_width).
+std::atomic<int> g_vector_width{512};
+
+}  // namespace
+
+void set_fmm_vector_width(int bits) {
+  g_vector_width.store(bits, std::memory_order_relaxed);
+}
+
 namespace {
 
 /// sum over j in [begin, end) of q[j] / |t - p_j|, skipping p_j == t. `inv_scale2` (1 / R^2,
@@ -579,8 +592,11 @@ void TreecodeOperator::apply(const double* x, double* y) const {
   const double* pz = m_z.data();
   const double root_radius = nodes[0].radius > 0.0 ? nodes[0].radius : 1.0;
   const double inv_scale2 = 1.0 / (root_radius * root_radius);
-  static const bool avx2 = cpu_has_avx2();
-  static const bool avx512 = avx2 && cpu_has_avx512();
+  static const bool cpu_avx2 = cpu_has_avx2();
+  static const bool cpu_avx512 = cpu_avx2 && cpu_has_avx512();
+  const int width = g_vector_width.load(std::memory_order_relaxed);
+  const bool avx2 = cpu_avx2 && width >= 256;
+  const bool avx512 = cpu_avx512 && width >= 512;
   // Monomials w^k for |k| <= order, graded order, from k - e_i.
   auto monomials = [&](double wx, double wy, double wz, double* out) {
     out[0] = 1.0;
