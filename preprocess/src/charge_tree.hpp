@@ -78,11 +78,6 @@ struct TaylorRecurrence {
   double alpha, beta;  ///< -(2|k| - 1) / |k|, -(|k| - 1) / |k|
 };
 
-/// Caps the vector width of the FMM kernels: 512 (AVX-512F, the default where the CPU has it),
-/// 256 (AVX2 and FMA) or anything lower (SSE2). For tests and benchmarks of the narrower
-/// kernels; the CPU's features still bound it. Not to be changed during a product.
-void set_fmm_vector_width(int bits);
-
 /// y = M x with M's far part (point charges) approximated by a Cartesian Taylor fast
 /// multipole method on the binary cluster tree: moments up to total order `order` (leaves
 /// from their members, parents by exact shifts), a dual-tree traversal that turns every pair

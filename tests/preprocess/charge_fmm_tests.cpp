@@ -6,6 +6,7 @@
 #include <cmath>
 #include <vector>
 
+#include "../../preprocess/src/charge_fmm_kernels.hpp"
 #include "../../preprocess/src/charge_potential.hpp"
 #include "../../preprocess/src/charge_solvers.hpp"
 #include "../../preprocess/src/charge_tree.hpp"
