@@ -31,7 +31,7 @@ namespace {
 struct CaseResult {
   bool ok = false;
   double assembly = 0, solve = 0, residual = 0, capacitance = 0, exact_residual = -1;
-  int iterations = 0;
+  int iterations = 0, relaxed = 0;
   long peak_kb = 0;
   double cpu = 0;  ///< user + system seconds of the child (all threads)
   char solver[16] = {};
@@ -81,7 +81,7 @@ CaseResult run_case(const TriangleMesh& mesh, const ChargeOptions& options, bool
   if (pid == 0) {
     ::close(fds[0]);
     struct Header {
-      int ok, iterations;
+      int ok, iterations, relaxed;
       double assembly, solve, residual, capacitance, cpu, exact_residual;
       char solver[16], error[200];
     } h{};
@@ -91,6 +91,7 @@ CaseResult run_case(const TriangleMesh& mesh, const ChargeOptions& options, bool
       const auto c = preprocess::compute_charge(mesh.vertices, mesh.triangles, options);
       h.ok = 1;
       h.iterations = c.iterations;
+      h.relaxed = c.relaxed_products;
       h.assembly = c.assembly_seconds;
       h.solve = c.solve_seconds;
       h.residual = c.residual;
@@ -113,7 +114,7 @@ CaseResult run_case(const TriangleMesh& mesh, const ChargeOptions& options, bool
   }
   ::close(fds[1]);
   struct {
-    int ok, iterations;
+    int ok, iterations, relaxed;
     double assembly, solve, residual, capacitance, cpu, exact_residual;
     char solver[16], error[200];
   } h{};
@@ -128,6 +129,7 @@ CaseResult run_case(const TriangleMesh& mesh, const ChargeOptions& options, bool
   ::wait4(pid, &status, 0, &usage);
   r.ok = h.ok != 0 && r.density.size() == mesh.triangles.size();
   r.iterations = h.iterations;
+  r.relaxed = h.relaxed;
   r.assembly = h.assembly;
   r.solve = h.solve;
   r.residual = h.residual;
@@ -221,9 +223,10 @@ struct StageClock {
 };
 
 /// `--stages`: wall / CPU seconds of compute_charge's internal stages for the fast solver
-/// with the two-level preconditioner (set cap 128, K = min(2048, N / 64): compute_charge's
-/// defaults), in this process (no fork afterwards).
-void print_stages(const std::string& name, const TriangleMesh& mesh, int order, double theta) {
+/// with the two-level preconditioner (set cap and K = min(2048, N / 64) as compute_charge
+/// chooses them), in this process (no fork afterwards).
+void print_stages(const std::string& name, const TriangleMesh& mesh, int order, double theta,
+                  int schwarz_set) {
   namespace cd = preprocess::charge_detail;
   StageClock clock;
   const cd::PanelSet panels = cd::make_panels(mesh.vertices, mesh.triangles, "");
@@ -232,7 +235,8 @@ void print_stages(const std::string& name, const TriangleMesh& mesh, int order, 
   const cd::NearField near = cd::build_near_field(panels, tree);
   const std::string t_near = clock.lap();
   const std::size_t n = panels.size();
-  const cd::TwoLevelSchwarz pre(panels, tree, near, 128, std::min<std::size_t>(2048, n / 64));
+  const cd::TwoLevelSchwarz pre(panels, tree, near, cd::schwarz_set_for(n, schwarz_set),
+                                std::min<std::size_t>(2048, n / 64));
   const std::string t_pre = clock.lap();
   const cd::TreecodeOperator op(panels, tree, near, theta, order);
   const std::string t_fmm = clock.lap();
@@ -260,6 +264,8 @@ int main(int argc, char** argv) {
   std::size_t exact_max = 25000;
   int order = -1;
   double theta = 0.0;
+  int schwarz_set = 0;
+  bool exact_products = false;
   int leaf_size = ChargeOptions{}.leaf_size;
   app.add_option("--mesh-dir", mesh_dir, "Directory with the CGAL demo meshes");
   app.add_option("--real", real, "Real mesh (OFF) subdivided to the sizes");
@@ -270,6 +276,11 @@ int main(int argc, char** argv) {
                  "near, two), @tolerance (name@auto: automatic) and :order[:theta] of the FMM");
   app.add_option("--order", order, "FMM order of the timed fast runs (default automatic)");
   app.add_option("--leaf-size", leaf_size, "Cluster-tree leaf size of the timed runs");
+  app.add_option("--schwarz-set", schwarz_set,
+                 "Schwarz set cap of the timed runs and --stages (0: automatic)")
+      ->check(CLI::NonNegativeNumber);
+  app.add_flag("--exact-products", exact_products,
+               "Timed fast runs: no relaxed (cheaper) GMRES products");
   app.add_option("--theta", theta, "FMM opening parameter of the timed fast runs (0: automatic)");
   app.add_option("--exact-residual-max", exact_max,
                  "Largest N for the residual against the exact matrix (O(N^2) product)");
@@ -320,7 +331,7 @@ int main(int argc, char** argv) {
         "| mesh | N | panels + tree | near field | two-level setup | FMM lists | one FMM product "
         "| one preconditioner application |\n|---|---|---|---|---|---|---|---|\n");
     for (const Mesh& m : meshes) {
-      print_stages(m.name, m.mesh, order >= 0 ? order : 8, theta > 0.0 ? theta : 0.45);
+      print_stages(m.name, m.mesh, order >= 0 ? order : 8, theta > 0.0 ? theta : 0.45, schwarz_set);
     }
     return 0;
   }
@@ -386,6 +397,8 @@ int main(int argc, char** argv) {
       o.fast_order = order;
       o.fast_theta = theta;
       o.leaf_size = leaf_size;
+      o.schwarz_set = schwarz_set;
+      o.relaxed_products = !exact_products;
       if (colon != std::string::npos) {
         const std::string rest = spec.substr(colon + 1);
         const std::size_t colon2 = rest.find(':');
@@ -420,12 +433,16 @@ int main(int argc, char** argv) {
         vs_ref = pct(e.first) + " / " + pct(e.second);
         vs_ref_abs = pct(rel_error(r.density, ref, true).first);
       }
+      // Iterations, and how many of them took relaxed products.
+      std::string iterations = std::to_string(r.iterations);
+      if (r.relaxed > 0) iterations += " (" + std::to_string(r.relaxed) + " relaxed)";
       std::printf(
-          "| %s | %zu | %s | %.3f | %.3f | %.3f | %.2f | %d | %.1e | %s | %.0f | %s | %s | %s | %s "
+          "| %s | %zu | %s | %.3f | %.3f | %.3f | %.2f | %s | %.1e | %s | %.0f | %s | %s | %s | %s "
           "|\n",
           m.name.c_str(), n, spec.c_str(), r.assembly, r.solve, r.assembly + r.solve, r.cpu,
-          r.iterations, r.residual, exact_res.c_str(), static_cast<double>(r.peak_kb) / 1024.0,
-          analytic.c_str(), vs_ref.c_str(), vs_ref_abs.c_str(), ref_name.c_str());
+          iterations.c_str(), r.residual, exact_res.c_str(),
+          static_cast<double>(r.peak_kb) / 1024.0, analytic.c_str(), vs_ref.c_str(),
+          vs_ref_abs.c_str(), ref_name.c_str());
       std::fflush(stdout);
     }
   }

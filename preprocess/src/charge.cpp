@@ -39,9 +39,20 @@ constexpr int kAutoOrder = 6;
 constexpr int kAutoLargeOrder = 8;
 constexpr double kAutoLargeTheta = 0.45;
 /// Near-field Schwarz: at most this many triangles per leaf problem (the leaf's own and its
-/// nearest near-field neighbours). Measured 64 / 96 / 128 / 160 on the ellipsoid and the
-/// elephant at 5k and 100k (docs/charge.md, "Preconditioner").
+/// most strongly coupled near-field neighbours). Measured 64 / 96 / 128 / 160 on the ellipsoid
+/// and the elephant at 5k and 100k, and 80 / 96 / 128 with relaxed products on 16 CGAL meshes
+/// at two sizes: below 10k triangles 80 takes 15 % less CPU time than 128 for an iteration more
+/// (a relaxed one), from 10k on it saves 4 % for 17 % more iterations (docs/charge.md,
+/// "Preconditioner").
 constexpr std::size_t kSchwarzSet = 128;
+constexpr std::size_t kSmallSchwarzSet = 80;
+/// Relaxed products (docs/charge.md, "Relaxed products"): once GMRES's residual is small, its
+/// products use a second FMM of this order and opening parameter, whose error against the
+/// automatic operators was at most 2.7e-4 of the product on GMRES's vectors at 5k (elephant,
+/// femur, dino) and 4.8e-4 at 20k-327k (ellipsoid, dino); solve_gmres assumes 1e-3.
+constexpr int kRelaxedOrder = 4;
+constexpr double kRelaxedTheta = 0.5;
+constexpr double kRelaxedError = 1e-3;
 /// Two-level: at most this many coarse clusters (dense LU of K x K), each of at least about
 /// kCoarseClusterMin triangles.
 constexpr std::size_t kCoarseMax = 2048;
@@ -65,6 +76,15 @@ std::size_t available_memory() {
 
 }  // namespace
 
+namespace charge_detail {
+
+std::size_t schwarz_set_for(std::size_t n, int requested) {
+  if (requested > 0) return static_cast<std::size_t>(requested);
+  return n < kAutoHighOrderMin ? kSmallSchwarzSet : kSchwarzSet;
+}
+
+}  // namespace charge_detail
+
 ChargeResult compute_charge(const std::vector<Vec3>& points, const std::vector<Tri>& triangles,
                             const ChargeOptions& options, const std::string& file) {
   const auto t0 = Clock::now();
@@ -79,6 +99,9 @@ ChargeResult compute_charge(const std::vector<Vec3>& points, const std::vector<T
   const double tolerance =
       options.tolerance > 0.0 ? options.tolerance
                               : (n < kAutoTightToleranceMin ? kAutoTolerance : kAutoTightTolerance);
+  if (options.schwarz_set < 0) {
+    throw std::invalid_argument("charge schwarz_set must be positive, or 0 for automatic");
+  }
   if (!(options.fast_theta >= 0.0 && options.fast_theta < 1.0)) {
     throw std::invalid_argument("charge fast_theta must lie in (0, 1), or be 0 for automatic");
   }
@@ -120,14 +143,15 @@ ChargeResult compute_charge(const std::vector<Vec3>& points, const std::vector<T
   if (options.preconditioner == ChargePreconditioner::kBlock && solver != ChargeSolver::kDirect) {
     block = std::make_unique<BlockJacobi>(panels, tree);
   }
+  const std::size_t schwarz_set = schwarz_set_for(n, options.schwarz_set);
   if (options.preconditioner == ChargePreconditioner::kNearField &&
       solver != ChargeSolver::kDirect) {
-    schwarz = std::make_unique<NearFieldSchwarz>(panels, tree, near, kSchwarzSet);
+    schwarz = std::make_unique<NearFieldSchwarz>(panels, tree, near, schwarz_set);
   }
   if (options.preconditioner == ChargePreconditioner::kTwoLevel &&
       solver != ChargeSolver::kDirect) {
     const std::size_t k = std::min(kCoarseMax, n / kCoarseClusterMin);
-    two_level = std::make_unique<TwoLevelSchwarz>(panels, tree, near, kSchwarzSet, k);
+    two_level = std::make_unique<TwoLevelSchwarz>(panels, tree, near, schwarz_set, k);
   }
   const ApplyFn precondition = [&](const double* in, double* out) {
     if (block) {
@@ -156,14 +180,24 @@ ChargeResult compute_charge(const std::vector<Vec3>& points, const std::vector<T
     // (8 bytes per near entry freed: 0.6 GB at 1.3 M triangles).
     decltype(near.value)().swap(near.value);
     const TreecodeOperator op(panels, tree, near, theta, order);
+    // The relaxed operator, when it is cheaper than the main one.
+    std::unique_ptr<TreecodeOperator> relaxed_op;
+    RelaxedProduct relaxed;
+    if (options.relaxed_products && order > kRelaxedOrder && theta < kRelaxedTheta) {
+      relaxed_op =
+          std::make_unique<TreecodeOperator>(panels, tree, near, kRelaxedTheta, kRelaxedOrder);
+      relaxed.apply = [&](const double* x, double* out) { relaxed_op->apply(x, out); };
+      relaxed.relative_error = kRelaxedError;
+    }
     result.assembly_seconds = seconds_since(t0);
     progress("assembly", 1.0);
     const auto t1 = Clock::now();
     const GmresOutcome g = solve_gmres(
         n, [&](const double* x, double* out) { op.apply(x, out); }, precondition, b, y, tolerance,
-        options.max_iterations, options.restart, on_iteration);
+        options.max_iterations, options.restart, on_iteration, relaxed);
     result.solve_seconds = seconds_since(t1);
     result.iterations = g.iterations;
+    result.relaxed_products = g.relaxed_products;
     result.residual = g.residual;
     result.converged = g.converged;
   } else {

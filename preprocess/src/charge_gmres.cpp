@@ -21,7 +21,8 @@ double norm2(const std::vector<double>& v) {
 
 GmresOutcome solve_gmres(std::size_t n, const ApplyFn& apply, const ApplyFn& precondition,
                          const std::vector<double>& b, std::vector<double>& x, double tolerance,
-                         int max_iterations, int restart, const IterationFn& on_iteration) {
+                         int max_iterations, int restart, const IterationFn& on_iteration,
+                         const RelaxedProduct& relaxed) {
   GmresOutcome out;
   restart = std::max(restart, 1);
   const double bnorm = norm2(b);
@@ -38,18 +39,24 @@ GmresOutcome solve_gmres(std::size_t n, const ApplyFn& apply, const ApplyFn& pre
   std::vector<double> h((m + 1) * m), arnoldi((m + 1) * m), cs(m), sn(m), g(m + 1), y(m);
   auto hh = [&](std::size_t i, std::size_t j) -> double& { return h[i * m + j]; };
   // The Hessenberg matrix before the rotations: A M^-1 V_k = V_(k+1) H_k holds to rounding
-  // whatever the orthogonality of V, so r - V_(k+1) H_k y is the true residual of the update.
+  // whatever the orthogonality of V, so r - V_(k+1) H_k y is the true residual of the update
+  // (with relaxed products: of the products taken, within the relaxed budget of the true one).
   auto ha = [&](std::size_t i, std::size_t j) -> double& { return arnoldi[i * m + j]; };
   bool recompute = true;  // false after a converging cycle left r = b - A x in place
+  // Relaxed products since r was last exact, as the sum of the residual norms they were taken at.
+  double relaxed_spent = 0.0;
+  const double relaxed_allowance = kRelaxedBudget * tolerance * bnorm;
   // A zero start needs no product for its residual.
   bool zero_start = std::all_of(x.begin(), x.end(), [](double v) { return v == 0.0; });
   for (;;) {
     if (zero_start) {
       r = b;
       zero_start = false;
+      relaxed_spent = 0.0;
     } else if (recompute) {
       apply(x.data(), r.data());
       for (std::size_t i = 0; i < n; ++i) r[i] = b[i] - r[i];
+      relaxed_spent = 0.0;  // r is exact again
     }
     recompute = true;
     const double beta = norm2(r);
@@ -68,7 +75,15 @@ GmresOutcome solve_gmres(std::size_t n, const ApplyFn& apply, const ApplyFn& pre
     bool converging = false;
     for (; k < m && out.iterations < max_iterations; ++k) {
       precondition(basis[k].data(), z.data());
-      apply(z.data(), w.data());
+      // |g[k]|: the residual norm before this step.
+      const double spend = relaxed.relative_error * (relaxed_spent + std::abs(g[k]));
+      if (relaxed.apply && spend <= relaxed_allowance) {
+        relaxed_spent += std::abs(g[k]);
+        relaxed.apply(z.data(), w.data());
+        ++out.relaxed_products;
+      } else {
+        apply(z.data(), w.data());
+      }
       ++out.iterations;
       for (std::size_t j = 0; j <= k; ++j) {
         double d = 0.0;

@@ -18,8 +18,16 @@ using IterationFn = std::function<void(int iteration, double residual)>;
 
 struct GmresOutcome {
   int iterations = 0;
-  double residual = 0.0;  ///< relative residual ||b - A x|| / ||b|| at exit (solve_gmres)
+  int relaxed_products = 0;  ///< iterations whose product was RelaxedProduct::apply
+  double residual = 0.0;     ///< relative residual ||b - A x|| / ||b|| at exit (solve_gmres)
   bool converged = false;
+};
+
+/// A cheaper product for the late iterations of solve_gmres: ||apply(x) - A x|| is assumed at
+/// most relative_error * ||A x||.
+struct RelaxedProduct {
+  ApplyFn apply;
+  double relative_error = 0.0;
 };
 
 /// Restarted right-preconditioned GMRES(restart) with modified Gram-Schmidt and Givens
@@ -28,9 +36,25 @@ struct GmresOutcome {
 /// is b - A x recomputed with a product at every restart; when a cycle's estimate says
 /// converged it is r - V_(k+1) H_k y instead (the Arnoldi relation A M^-1 V_k = V_(k+1) H_k,
 /// which holds to rounding however orthogonal V is), which saves one product per solve.
+///
+/// Relaxed products (inexact Krylov: Bouras & Fraysse 2005, Simoncini & Szyld 2003): a
+/// product's error perturbs the residual by about its size times the residual norm at that
+/// step, so once the residual is small a less accurate product does as well. Step k uses
+/// relaxed.apply while relative_error * (sum of ||r_(j-1)|| over the relaxed steps j <= k)
+/// stays <= kRelaxedBudget * tolerance * ||b||, the sum restarting wherever b - A x is
+/// recomputed (with `apply`); the true residual then exceeds GMRES's by about that budget at
+/// most (docs/charge.md, "Relaxed products").
 GmresOutcome solve_gmres(std::size_t n, const ApplyFn& apply, const ApplyFn& precondition,
                          const std::vector<double>& b, std::vector<double>& x, double tolerance,
-                         int max_iterations, int restart, const IterationFn& on_iteration);
+                         int max_iterations, int restart, const IterationFn& on_iteration,
+                         const RelaxedProduct& relaxed = {});
+
+/// The share of the tolerance that solve_gmres's relaxed products may spend.
+constexpr double kRelaxedBudget = 0.5;
+
+/// The Schwarz set cap compute_charge uses for n triangles: `requested` if positive, else the
+/// automatic one (ChargeOptions::schwarz_set).
+std::size_t schwarz_set_for(std::size_t n, int requested);
 
 /// Block-Jacobi preconditioner: the exact inverse of the collocation matrix restricted to
 /// each leaf of the cluster tree (leaf_size^2 doubles per leaf).

@@ -190,6 +190,7 @@ ChargeResult charge_by_part(const std::vector<Vec3>& nodes, const std::vector<Su
       total.solver += "+" + r.solver;
     }
     total.iterations += r.iterations;
+    total.relaxed_products += r.relaxed_products;
     total.residual = std::max(total.residual, r.residual);
     total.tolerance = std::max(total.tolerance, r.tolerance);
     total.converged = total.converged && r.converged;

@@ -163,6 +163,10 @@ const std::vector<ProvenanceField>& provenance_fields() {
       number<int>(
           "charge.fast_order", always, [](O& o) -> int& { return o.charge.fast_order; }, true, -1),
       number<int>("charge.leaf_size", always, [](O& o) -> int& { return o.charge.leaf_size; }),
+      number<int>(
+          "charge.schwarz_set", always, [](O& o) -> int& { return o.charge.schwarz_set; }, true, 0),
+      flag("charge.relaxed_products", always,
+           [](O& o) -> bool& { return o.charge.relaxed_products; }),
       number<double>("segmentation.alpha", always,
                      [](O& o) -> double& { return o.segmentation.alpha; }),
       number<double>("segmentation.beta_divisor", always,

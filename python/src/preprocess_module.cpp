@@ -259,6 +259,7 @@ py::dict report_dict(const std::string& source, const BuildReport& report,
     charge["tolerance"] = c.tolerance;
     charge["converged"] = c.converged;
     charge["iterations"] = c.iterations;
+    charge["relaxed_products"] = c.relaxed_products;
     charge["residual"] = c.residual;
     charge["capacitance"] = c.capacitance;
     charge["assembly_seconds"] = c.assembly_seconds;
@@ -388,7 +389,7 @@ py::tuple build(const py::object& mesh, const py::object& source, const std::str
 
 py::dict charge(const py::object& mesh, const py::object& source, const std::string& solver,
                 double tolerance, int max_iterations, double theta, int order,
-                const std::string& equalize_name, int bins) {
+                bool relaxed_products, const std::string& equalize_name, int bins) {
   ChargeOptions options;
   options.solver = enum_from_name<ChargeSolver>("solver", solver);
   const Equalization method = enum_from_name<Equalization>("equalize", equalize_name);
@@ -401,6 +402,7 @@ py::dict charge(const py::object& mesh, const py::object& source, const std::str
   options.max_iterations = max_iterations;
   options.fast_theta = theta;
   options.fast_order = order;
+  options.relaxed_products = relaxed_products;
 
   Input in = input_from(mesh, source);
   std::vector<Vec3> points;
@@ -439,6 +441,7 @@ py::dict charge(const py::object& mesh, const py::object& source, const std::str
   d["triangles"] = cells_array(triangles);
   d["solver"] = result.solver;
   d["iterations"] = result.iterations;
+  d["relaxed_products"] = result.relaxed_products;
   d["residual"] = result.residual;
   d["converged"] = result.converged;
   d["tolerance"] = result.tolerance;
@@ -558,14 +561,16 @@ PYBIND11_MODULE(preprocess, m) {
   m.def("charge", &charge, py::arg("mesh"), py::kw_only(), py::arg("source") = py::none(),
         py::arg("solver") = std::string(name_of(c.solver)), py::arg("tolerance") = c.tolerance,
         py::arg("max_iterations") = c.max_iterations, py::arg("theta") = c.fast_theta,
-        py::arg("order") = c.fast_order,
+        py::arg("order") = c.fast_order, py::arg("relaxed_products") = c.relaxed_products,
         py::arg("equalize") = std::string(name_of(Equalization::kHistogram)), py::arg("bins") = 256,
         "Returns a dict. "
         "Relative charge density of a tet mesh's boundary or of a closed surface, as "
         "`tetseg charge` computes it (docs/charge.md). mesh as for build. Returns density and "
         "equalized (per triangle), points and triangles (the surface they refer to), and the "
-        "solver figures (solver, iterations, residual, converged, tolerance, capacitance, "
-        "total_area, equalization, assembly_seconds, solve_seconds).");
+        "solver figures (solver, iterations, relaxed_products, residual, converged, tolerance, "
+        "capacitance, total_area, equalization, assembly_seconds, solve_seconds). "
+        "relaxed_products=False makes every fast-solver product exact to order and theta "
+        "(`tetseg charge --exact-products`).");
 
   const ShapeOptions s;
   m.def("generate", &generate, py::arg("shape"), py::kw_only(), py::arg("size") = s.size,

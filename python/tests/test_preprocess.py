@@ -116,6 +116,22 @@ def test_charge_equals_cli(pp, bin_dir, sphere_mesh, tmp_path):
     assert np.array_equal(again["density"], result["density"])
 
 
+def test_charge_relaxed_products_like_cli(pp, bin_dir, sphere_mesh, tmp_path):
+    # The fast solver relaxes its last products by default; relaxed_products=False is
+    # `tetseg charge --exact-products`, and both stay within the tolerance of each other.
+    relaxed = pp.charge(sphere_mesh, solver="fast")
+    exact = pp.charge(sphere_mesh, solver="fast", relaxed_products=False)
+    assert 0 < relaxed["relaxed_products"] < relaxed["iterations"]
+    assert exact["relaxed_products"] == 0
+    assert relaxed["converged"] and exact["converged"]
+    assert np.allclose(relaxed["density"], exact["density"], rtol=0, atol=1e-3)
+    csv = tmp_path / "exact.csv"
+    run_tool(bin_dir, "tetseg", "charge", sphere_mesh, "-o", csv, "--solver", "fast",
+             "--exact-products")
+    cli = np.loadtxt(csv, delimiter=",", skiprows=1)
+    assert np.allclose(exact["density"], cli[:, 5], rtol=1e-8, atol=0)
+
+
 def test_charge_reports_memory_like_cli(pp, bin_dir, sphere_mesh, tmp_path):
     report_path = tmp_path / "charge.json"
     run_tool(bin_dir, "tetseg", "charge", sphere_mesh, "-o", tmp_path / "charge.csv",

@@ -28,7 +28,8 @@ def build(mesh: _Mesh, *, source: Optional[str] = ..., clusters: str = ...,
           on_stage: Optional[Callable[[str, float, str], Any]] = ...) -> Tuple[bytes, dict]: ...
 def charge(mesh: _Mesh, *, source: Optional[str] = ..., solver: str = ...,
            tolerance: float = ..., max_iterations: int = ..., theta: float = ...,
-           order: int = ..., equalize: str = ..., bins: int = ...) -> dict: ...
+           order: int = ..., relaxed_products: bool = ..., equalize: str = ...,
+           bins: int = ...) -> dict: ...
 def generate(shape: str, *, size: float = ..., radius: float = ...,
              axes: Tuple[float, float, float] = ..., cell_size: float = ...,
              facet_size: float = ..., facet_distance: float = ..., facet_angle: float = ...,

@@ -49,6 +49,7 @@ assert len(rows) == 512 == rep["triangles"], (len(rows), rep["triangles"])
 assert rep["solver"] == sys.argv[3], rep
 for key in ("iterations", "residual", "capacitance", "assembly_seconds", "solve_seconds"):
     assert key in rep, key
+assert 0 <= rep["relaxed_products"] <= rep["iterations"], rep
 # Memory per step: the process peak is positive and never decreases; growth is its increase.
 steps = ["read", "charge", "write"]
 assert list(rep["peak_rss_bytes"]) == steps == list(rep["peak_rss_growth_bytes"]), rep

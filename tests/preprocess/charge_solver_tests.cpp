@@ -246,18 +246,24 @@ TEST_CASE("The two-level preconditioner converges fast on graded real meshes", "
   // set matters: ranking a leaf's near-field columns by their coupling score
   // sum_i A_i A_j / r_ij^3 instead of by distance to the leaf centre took the femur (7798
   // triangles) from 6 to 4 iterations and the dino (7828) from 8 to 5 at the automatic
-  // tolerance (docs/charge.md, "Preconditioner"). Deterministic counts, not a timing test.
-  for (const auto& [name, most] : {std::pair<const char*, int>{"femur", 4}, {"dino", 5}}) {
-    const std::string path = std::string(TETSEG_CGAL_MESH_DIR) + "/" + name + ".off";
+  // tolerance with sets of 128 (docs/charge.md, "Preconditioner"). The automatic sets of 80
+  // below 10k take one more iteration, a relaxed one. Deterministic counts, not a timing test.
+  struct Case {
+    const char* name;
+    int set, most;
+  };
+  for (const Case c : {Case{"femur", 128, 4}, {"dino", 128, 5}, {"femur", 0, 5}, {"dino", 0, 6}}) {
+    const std::string path = std::string(TETSEG_CGAL_MESH_DIR) + "/" + c.name + ".off";
     if (!tetseg::test::have_test_data(path, "libcgal-demo mesh")) return;
     const TriangleMesh m = tetseg::test::read_off(path);
     ChargeOptions o;
     o.solver = ChargeSolver::kFast;
+    o.schwarz_set = c.set;
     const ChargeResult r = compute_charge(m.vertices, m.triangles, o, path);
-    CAPTURE(name, m.triangles.size(), r.iterations, r.residual);
+    CAPTURE(c.name, c.set, m.triangles.size(), r.iterations, r.residual);
     CHECK(r.converged);
     CHECK(r.residual <= r.tolerance);
-    CHECK(r.iterations <= most);
+    CHECK(r.iterations <= c.most);
   }
 }
 

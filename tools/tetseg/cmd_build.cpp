@@ -79,8 +79,8 @@ std::string report_json(const BuildArgs& args, const BuildReport& report,
     const ChargeResult& c = report.charge;
     out << "  \"charge\": {\"solver\": \"" << c.solver << "\", \"tolerance\": " << c.tolerance
         << ", \"converged\": " << (c.converged ? "true" : "false")
-        << ", \"iterations\": " << c.iterations << ", \"residual\": " << c.residual
-        << ", \"capacitance\": " << c.capacitance
+        << ", \"iterations\": " << c.iterations << ", \"relaxed_products\": " << c.relaxed_products
+        << ", \"residual\": " << c.residual << ", \"capacitance\": " << c.capacitance
         << ", \"assembly_seconds\": " << c.assembly_seconds
         << ", \"solve_seconds\": " << c.solve_seconds << "},\n";
   }

@@ -57,6 +57,13 @@ struct ChargeOptions {
   /// error grows with N for a fixed operator error; docs/charge.md).
   int fast_order = -1;
   int leaf_size = 32;  ///< cluster-tree leaf size (fast solver)
+  /// Two-level and near-field preconditioners: at most this many triangles per leaf problem,
+  /// or 0 for automatic: 80 below 10,000 triangles, 128 from there on (docs/charge.md).
+  int schwarz_set = 0;
+  /// Fast solver: once the residual is small, GMRES's products use a cheaper FMM (order 4,
+  /// theta 0.5) within half the tolerance's budget (inexact Krylov; docs/charge.md, "Relaxed
+  /// products"). False: every product at the requested order and theta.
+  bool relaxed_products = true;
   /// Largest dense matrix the solver may store, in bytes; 0 means half of the memory the
   /// operating system reports as available. Explicit direct/gmres requests beyond it fail.
   std::size_t memory_limit_bytes = 0;
@@ -73,6 +80,7 @@ struct ChargeResult {
   double total_area = 0.0;   ///< sum of triangle areas
   std::string solver;        ///< the solver actually used: "direct", "gmres" or "fast"
   int iterations = 0;        ///< matrix products (0 for direct)
+  int relaxed_products = 0;  ///< of those, products by the cheaper FMM (relaxed_products)
   double residual = 0.0;     ///< final relative residual against the solver's operator
   double tolerance = 0.0;    ///< the tolerance used (options.tolerance or the automatic one)
   bool converged = false;    ///< residual <= tolerance (always true for a successful direct)
