@@ -280,6 +280,26 @@ bool cpu_has_avx2() {
 }
 #endif
 
+double direct_leaves(double tx, double ty, double tz, const double* px, const double* py,
+                     const double* pz, const double* q, const Cluster* nodes,
+                     const std::int32_t* list, std::size_t count, double inv_scale2) {
+  static const bool cpu_avx2 = cpu_has_avx2();
+  static const bool cpu_avx512 = cpu_avx2 && cpu_has_avx512();
+  const int width = fmm_vector_width();
+  if (cpu_avx512 && width >= 512) {
+    return direct_row_avx512(tx, ty, tz, px, py, pz, q, nodes, list, count, inv_scale2);
+  }
+  if (cpu_avx2 && width >= 256) {
+    return direct_row_avx2(tx, ty, tz, px, py, pz, q, nodes, list, count, inv_scale2);
+  }
+  double sum = 0.0;
+  for (std::size_t d = 0; d < count; ++d) {
+    const Cluster& s = nodes[static_cast<std::size_t>(list[d])];
+    sum += direct_sum(tx, ty, tz, px, py, pz, q, s.begin, s.end, inv_scale2);
+  }
+  return sum;
+}
+
 /// Four doubles, one per source cluster of an M2L batch (GCC vector extension: one 256-bit
 /// register in the AVX2 clone, two 128-bit halves otherwise).
 typedef double Doubles4 __attribute__((vector_size(32), aligned(8)));

@@ -38,6 +38,12 @@ double direct_row_avx512(double tx, double ty, double tz, const double* px, cons
                          const double* pz, const double* q, const Cluster* nodes,
                          const std::int32_t* list, std::size_t count, double inv_scale2);
 
+/// direct_row with the widest kernel the CPU and set_fmm_vector_width allow (direct_sum per
+/// leaf without AVX2).
+double direct_leaves(double tx, double ty, double tz, const double* px, const double* py,
+                     const double* pz, const double* q, const Cluster* nodes,
+                     const std::int32_t* list, std::size_t count, double inv_scale2);
+
 /// The multipole-to-local sums of one batch of four source clusters into `local` (SSE2, and
 /// with 256-bit fused multiply-adds where the CPU has them).
 void m2l_sums(std::size_t kc, const std::size_t* start, const std::uint16_t* tb,

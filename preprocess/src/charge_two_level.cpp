@@ -10,6 +10,7 @@
 #include <utility>
 #include <vector>
 
+#include "charge_fmm_kernels.hpp"
 #include "charge_solvers.hpp"
 
 namespace tetseg::preprocess::charge_detail {
@@ -138,14 +139,24 @@ TwoLevelSchwarz::TwoLevelSchwarz(const PanelSet& panels, const ClusterTree& tree
   }
   m_block.assign(m_block_start[k], 0.0f);
   // Near blocks: Barnes-Hut over each near cluster's subtree (monopoles at area centroids when
-  // the node's radius is below 0.5 times the distance, point charges in leaves otherwise),
-  // plus the analytic near-field corrections.
+  // the node's radius is below 0.5 times the distance, point charges in leaves otherwise, summed
+  // by the FMM's direct kernels), plus the analytic near-field corrections.
   constexpr double kOpening = 0.5;
+  std::vector<double> sx(n), sy(n), sz(n), sq(n);  // sources in tree order
+  for (std::size_t e = 0; e < n; ++e) {
+    const std::uint32_t j = tree.order[e];
+    sx[e] = panels.centroid[j][0];
+    sy[e] = panels.centroid[j][1];
+    sz[e] = panels.centroid[j][2];
+    sq[e] = panels.area[j];
+  }
+  const double root_radius = tree.nodes[0].radius > 0.0 ? tree.nodes[0].radius : 1.0;
+  const double inv_scale2 = 1.0 / (root_radius * root_radius);
 #if defined(TETSEG_HAVE_OPENMP)
 #pragma omp parallel
 #endif
   {
-    std::vector<std::int32_t> stack;
+    std::vector<std::int32_t> stack, leaves;
     std::vector<std::int32_t> slot(k, -1);
 #if defined(TETSEG_HAVE_OPENMP)
 #pragma omp for schedule(dynamic, 1)
@@ -161,27 +172,25 @@ TwoLevelSchwarz::TwoLevelSchwarz(const PanelSet& panels, const ClusterTree& tree
         for (std::size_t s = 0; s < count; ++s) {
           double sum = 0.0;
           stack.assign(1, roots[m_near[first + s]]);
+          leaves.clear();
           while (!stack.empty()) {
-            const std::size_t id = static_cast<std::size_t>(stack.back());
+            const std::int32_t id = stack.back();
             stack.pop_back();
-            const Cluster& c = tree.nodes[id];
-            const double dx = p[0] - cx[id], dy = p[1] - cy[id], dz = p[2] - cz[id];
+            const Cluster& c = tree.nodes[static_cast<std::size_t>(id)];
+            const std::size_t u = static_cast<std::size_t>(id);
+            const double dx = p[0] - cx[u], dy = p[1] - cy[u], dz = p[2] - cz[u];
             const double d2 = dx * dx + dy * dy + dz * dz;
-            if (radius[id] * radius[id] < kOpening * kOpening * d2) {
-              sum += area[id] / std::sqrt(d2);
+            if (radius[u] * radius[u] < kOpening * kOpening * d2) {
+              sum += area[u] / std::sqrt(d2);
             } else if (c.left >= 0) {
               stack.push_back(c.left);
               stack.push_back(c.right);
             } else {
-              for (std::uint32_t f = c.begin; f < c.end; ++f) {
-                const std::uint32_t j = tree.order[f];
-                const Vec3& q = panels.centroid[j];
-                const double ex = p[0] - q[0], ey = p[1] - q[1], ez = p[2] - q[2];
-                const double r2 = ex * ex + ey * ey + ez * ez;
-                if (r2 > 0.0) sum += panels.area[j] / std::sqrt(r2);
-              }
+              leaves.push_back(id);
             }
           }
+          sum += direct_leaves(p[0], p[1], p[2], sx.data(), sy.data(), sz.data(), sq.data(),
+                               tree.nodes.data(), leaves.data(), leaves.size(), inv_scale2);
           row[s] = static_cast<float>(sum);
         }
         for (std::size_t f = near.row_start[i]; f < near.row_start[i + 1]; ++f) {
