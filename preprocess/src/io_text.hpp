@@ -58,6 +58,15 @@ class Tokenizer {
   std::size_t m_token_line = 1;
 };
 
+/// The vertices and polygons of a plain ASCII OFF file: the keyword "OFF" alone on its line,
+/// the three counts on the next, one vertex of exactly three numbers per line, one face per
+/// line (tokens after its corners, a colour, ignored), '#' comments. Numbers are read as CGAL's
+/// stream reader reads them (std::from_chars, a leading '+' allowed). False, with both
+/// outputs empty, for anything else (other OFF variants, other layouts, a bad number or index,
+/// trailing content): read_triangle_mesh then leaves the file to CGAL's reader.
+bool read_plain_off(const std::string& text, std::vector<Vec3>& points,
+                    std::vector<std::vector<std::size_t>>& polygons);
+
 /// Strict parsers: the whole token must be a number. Return false otherwise.
 bool parse_double(std::string_view token, double& value);
 bool parse_int(std::string_view token, std::int64_t& value);

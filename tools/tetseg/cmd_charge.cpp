@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <charconv>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
@@ -127,12 +128,22 @@ void compact(const Outputs& o, std::vector<preprocess::Vec3>& points,
 
 std::string format_csv(const Outputs& o) {
   std::string s = "triangle,cx,cy,cz,area,density,equalized\n";
-  char line[256];
+  s.reserve(s.size() + 110 * o.triangles.size());
+  // std::to_chars with a precision writes what printf's %.9g writes, several times faster
+  // (1.3 M rows: about 1 s with snprintf).
+  char number[32];
+  auto append = [&](auto value, auto... format) {
+    const auto [end, ec] = std::to_chars(number, number + sizeof number, value, format...);
+    s.append(number, static_cast<std::size_t>(end - number));
+  };
   for (std::size_t j = 0; j < o.triangles.size(); ++j) {
     const auto c = centroid_of(o, j);
-    std::snprintf(line, sizeof line, "%zu,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g\n", j, c[0], c[1], c[2],
-                  area_of(o, j), o.density[j], o.equalized[j]);
-    s += line;
+    append(j);
+    for (const double v : {c[0], c[1], c[2], area_of(o, j), o.density[j], o.equalized[j]}) {
+      s += ',';
+      append(v, std::chars_format::general, 9);
+    }
+    s += '\n';
   }
   return s;
 }
