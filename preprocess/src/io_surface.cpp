@@ -283,11 +283,12 @@ bool read_plain_off(const std::string& text, std::vector<Vec3>& points,
     }
   }
   if (counts[0] == 0 || counts[1] == 0) return false;
-  // check_off_counts has bounded the counts by the file's size.
   const std::size_t vertex_count = static_cast<std::size_t>(counts[0]);
   const std::size_t face_count = static_cast<std::size_t>(counts[1]);
-  points.reserve(vertex_count);
-  polygons.reserve(face_count);
+  // A vertex line takes at least 6 bytes ("0 0 0\n"), a face line 8 ("3 0 1 2\n"): hostile
+  // counts reserve no more than the file could hold.
+  points.reserve(std::min(vertex_count, text.size() / 6));
+  polygons.reserve(std::min(face_count, text.size() / 8));
   for (std::size_t v = 0; v < vertex_count; ++v) {
     Vec3 p;
     if (!tok.next_record(record, line) || record.size() != 3) return give_up();
@@ -345,7 +346,6 @@ struct PositionEqual {
 TriangleMesh read_with_cgal(const std::string& path, const std::string& ext) {
   const std::string text = detail::read_file_text(path);
   if (text.empty()) throw InputError(path, "empty file");
-  if (ext == ".off") check_off_counts(path, text);
   if (ext == ".ply") check_ply_layout(path, text);
   std::vector<Point> points;
   std::vector<Polygon> polygons;
@@ -359,6 +359,7 @@ TriangleMesh read_with_cgal(const std::string& path, const std::string& ext) {
     for (const Vec3& p : plain_points) points.emplace_back(p[0], p[1], p[2]);
     ok = true;
   } else if (ext == ".off") {
+    check_off_counts(path, text);
     ok = CGAL::IO::read_OFF(path, points, polygons, np);
   } else if (ext == ".ply") {
     ok = CGAL::IO::read_PLY(path, points, polygons, np);

@@ -100,6 +100,12 @@ std::string_view Tokenizer::next(const char* what) {
 
 std::vector<std::string_view> Tokenizer::rest_of_line() {
   std::vector<std::string_view> tokens;
+  rest_of_line(tokens);
+  return tokens;
+}
+
+void Tokenizer::rest_of_line(std::vector<std::string_view>& tokens) {
+  tokens.clear();
   for (;;) {
     skip_space(true);
     if (m_pos >= m_text.size()) break;
@@ -116,13 +122,12 @@ std::vector<std::string_view> Tokenizer::rest_of_line() {
     }
     tokens.push_back(m_text.substr(begin, m_pos - begin));
   }
-  return tokens;
 }
 
 bool Tokenizer::next_record(std::vector<std::string_view>& tokens, std::size_t& line) {
   while (!at_end()) {
     line = m_line;
-    tokens = rest_of_line();
+    rest_of_line(tokens);
     if (!tokens.empty()) {
       m_token_line = line;
       return true;

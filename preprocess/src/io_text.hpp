@@ -28,6 +28,8 @@ class Tokenizer {
   std::string_view next_or_end();
   /// Tokens left on the current line (after the last token returned), consumed.
   std::vector<std::string_view> rest_of_line();
+  /// The same into `tokens` (cleared first; its capacity is reused).
+  void rest_of_line(std::vector<std::string_view>& tokens);
   /// Whether only whitespace and comments remain.
   bool at_end();
   /// Line of the last token returned (1-based).
