@@ -90,6 +90,23 @@ ClusterTree build_cluster_tree(const PanelSet& panels, int leaf_size) {
   return tree;
 }
 
+TreeOrderedPanels in_tree_order(const PanelSet& panels, const ClusterTree& tree) {
+  const std::size_t n = panels.size();
+  TreeOrderedPanels out;
+  out.x.resize(n);
+  out.y.resize(n);
+  out.z.resize(n);
+  out.area.resize(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    const std::uint32_t j = tree.order[k];
+    out.x[k] = panels.centroid[j][0];
+    out.y[k] = panels.centroid[j][1];
+    out.z[k] = panels.centroid[j][2];
+    out.area[k] = panels.area[j];
+  }
+  return out;
+}
+
 NearField build_near_field(const PanelSet& panels, const ClusterTree& tree) {
   const std::size_t n = panels.size();
   const std::size_t leaf_count = tree.leaves.size();

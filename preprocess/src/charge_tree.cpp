@@ -112,17 +112,7 @@ TreecodeOperator::TreecodeOperator(const PanelSet& panels, const ClusterTree& tr
     m_moment_scale.push_back(((k[0] + k[1] + k[2]) % 2 ? -1.0 : 1.0) / f);
   }
 
-  m_x.resize(m_n);
-  m_y.resize(m_n);
-  m_z.resize(m_n);
-  m_area.resize(m_n);
-  for (std::size_t k = 0; k < m_n; ++k) {
-    const std::uint32_t j = tree.order[k];
-    m_x[k] = panels.centroid[j][0];
-    m_y[k] = panels.centroid[j][1];
-    m_z[k] = panels.centroid[j][2];
-    m_area[k] = panels.area[j];
-  }
+  m_sources = in_tree_order(panels, tree);
   const std::size_t node_count = tree.nodes.size();
   // Shift terms grouped by their target index a (M2M already is), with start offsets.
   std::stable_sort(m_l2l.begin(), m_l2l.end(),
@@ -285,9 +275,9 @@ void TreecodeOperator::apply(const double* x, double* y) const {
   const std::size_t kc = m_index.size();
   const std::ptrdiff_t node_count = static_cast<std::ptrdiff_t>(nodes.size());
   double* charge = m_charge.data();
-  const double* px = m_x.data();
-  const double* py = m_y.data();
-  const double* pz = m_z.data();
+  const double* px = m_sources.x.data();
+  const double* py = m_sources.y.data();
+  const double* pz = m_sources.z.data();
   const double root_radius = nodes[0].radius > 0.0 ? nodes[0].radius : 1.0;
   const double inv_scale2 = 1.0 / (root_radius * root_radius);
   static const bool cpu_avx2 = cpu_has_avx2();
@@ -332,7 +322,7 @@ void TreecodeOperator::apply(const double* x, double* y) const {
       if (c.left < 0) {
         for (std::uint32_t k = c.begin; k < c.end; ++k) {
           monomials(px[k] - c.center[0], py[k] - c.center[1], pz[k] - c.center[2], mono.data());
-          const double q = m_area[k] * x[order[k]];
+          const double q = m_sources.area[k] * x[order[k]];
           charge[k] = q;
           for (std::size_t e = 0; e < kc; ++e) mom[e] += q * mono[e];
         }

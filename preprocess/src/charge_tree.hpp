@@ -71,6 +71,13 @@ struct NearField {
 
 NearField build_near_field(const PanelSet& panels, const ClusterTree& tree);
 
+/// Panel centroids and areas in tree order (structure of arrays): the layout the direct-sum
+/// kernels read (charge_fmm_kernels.hpp).
+struct TreeOrderedPanels {
+  std::vector<double> x, y, z, area;
+};
+TreeOrderedPanels in_tree_order(const PanelSet& panels, const ClusterTree& tree);
+
 /// One step of the Duan-Krasny recurrence for the Taylor coefficients of 1 / |R + w|: slot k
 /// from its predecessors k - e_i (m1) and k - 2 e_i (m2), or the zero slot when missing.
 struct TaylorRecurrence {
@@ -102,10 +109,10 @@ class TreecodeOperator {
   int m_order;
   const ClusterTree& m_tree;
   const NearField& m_near;
-  std::vector<double> m_x, m_y, m_z, m_area;  ///< sources in tree order
-  std::vector<std::int32_t> m_parent;         ///< per node, -1 for the root
-  std::vector<std::int32_t> m_leaf_of_node;   ///< leaf index or -1
-  std::vector<std::size_t> m_far_start;       ///< per node (CSR): M2L sources
+  TreeOrderedPanels m_sources;
+  std::vector<std::int32_t> m_parent;        ///< per node, -1 for the root
+  std::vector<std::int32_t> m_leaf_of_node;  ///< leaf index or -1
+  std::vector<std::size_t> m_far_start;      ///< per node (CSR): M2L sources
   std::vector<std::int32_t> m_far;
   std::vector<std::size_t> m_direct_start;  ///< per leaf (CSR): source leaves (node ids)
   std::vector<std::int32_t> m_direct;

@@ -142,14 +142,7 @@ TwoLevelSchwarz::TwoLevelSchwarz(const PanelSet& panels, const ClusterTree& tree
   // the node's radius is below 0.5 times the distance, point charges in leaves otherwise, summed
   // by the FMM's direct kernels), plus the analytic near-field corrections.
   constexpr double kOpening = 0.5;
-  std::vector<double> sx(n), sy(n), sz(n), sq(n);  // sources in tree order
-  for (std::size_t e = 0; e < n; ++e) {
-    const std::uint32_t j = tree.order[e];
-    sx[e] = panels.centroid[j][0];
-    sy[e] = panels.centroid[j][1];
-    sz[e] = panels.centroid[j][2];
-    sq[e] = panels.area[j];
-  }
+  const TreeOrderedPanels sources = in_tree_order(panels, tree);
   const double root_radius = tree.nodes[0].radius > 0.0 ? tree.nodes[0].radius : 1.0;
   const double inv_scale2 = 1.0 / (root_radius * root_radius);
 #if defined(TETSEG_HAVE_OPENMP)
@@ -189,8 +182,9 @@ TwoLevelSchwarz::TwoLevelSchwarz(const PanelSet& panels, const ClusterTree& tree
               leaves.push_back(id);
             }
           }
-          sum += direct_leaves(p[0], p[1], p[2], sx.data(), sy.data(), sz.data(), sq.data(),
-                               tree.nodes.data(), leaves.data(), leaves.size(), inv_scale2);
+          sum += direct_leaves(p[0], p[1], p[2], sources.x.data(), sources.y.data(),
+                               sources.z.data(), sources.area.data(), tree.nodes.data(),
+                               leaves.data(), leaves.size(), inv_scale2);
           row[s] = static_cast<float>(sum);
         }
         for (std::size_t f = near.row_start[i]; f < near.row_start[i + 1]; ++f) {

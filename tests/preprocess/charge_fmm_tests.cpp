@@ -48,6 +48,37 @@ tetseg::preprocess::TriangleMesh scaled(tetseg::preprocess::TriangleMesh m, doub
   return m;
 }
 
+/// A nonsymmetric, diagonally weighted 60 x 60 system for the GMRES tests, with its product,
+/// Jacobi preconditioner and true relative residual.
+struct DenseSystem {
+  static constexpr std::size_t n = 60;
+  std::vector<double> a = std::vector<double>(n * n), b = std::vector<double>(n);
+  DenseSystem() {
+    for (std::size_t i = 0; i < n; ++i) {
+      b[i] = 1.0 + 0.5 * std::cos(0.7 * static_cast<double>(i));
+      for (std::size_t j = 0; j < n; ++j) {
+        a[i * n + j] = (i == j ? 4.0 + 0.1 * static_cast<double>(i % 7) : 0.0) +
+                       std::sin(1.3 * static_cast<double>(i) + 0.7 * static_cast<double>(j)) /
+                           (1.0 + std::abs(static_cast<double>(i) - static_cast<double>(j)));
+      }
+    }
+  }
+  void apply(const double* x, double* y) const { dense_apply(a, n, x, y); }
+  void jacobi(const double* x, double* y) const {
+    for (std::size_t i = 0; i < n; ++i) y[i] = x[i] / a[i * n + i];
+  }
+  double true_residual(const std::vector<double>& x) const {
+    std::vector<double> ax(n);
+    apply(x.data(), ax.data());
+    double rr = 0.0, bb = 0.0;
+    for (std::size_t i = 0; i < n; ++i) {
+      rr += (b[i] - ax[i]) * (b[i] - ax[i]);
+      bb += b[i] * b[i];
+    }
+    return std::sqrt(rr / bb);
+  }
+};
+
 }  // namespace
 
 TEST_CASE("The FMM product matches the exact product of the collocation matrix", "[charge]") {
@@ -139,35 +170,16 @@ TEST_CASE("GMRES reports the true residual of the solution it returns", "[charge
   // At exit the residual comes from the Arnoldi relation instead of a product; it must agree
   // with ||b - A x|| / ||b|| recomputed here, from a zero and from a nonzero start, with and
   // without restarts. A: nonsymmetric, diagonally weighted, 60 x 60.
-  const std::size_t n = 60;
-  std::vector<double> a(n * n), b(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    b[i] = 1.0 + 0.5 * std::cos(0.7 * static_cast<double>(i));
-    for (std::size_t j = 0; j < n; ++j) {
-      a[i * n + j] = (i == j ? 4.0 + 0.1 * static_cast<double>(i % 7) : 0.0) +
-                     std::sin(1.3 * static_cast<double>(i) + 0.7 * static_cast<double>(j)) /
-                         (1.0 + std::abs(static_cast<double>(i) - static_cast<double>(j)));
-    }
-  }
-  const ApplyFn apply = [&](const double* x, double* y) { dense_apply(a, n, x, y); };
-  const ApplyFn jacobi = [&](const double* x, double* y) {
-    for (std::size_t i = 0; i < n; ++i) y[i] = x[i] / a[i * n + i];
-  };
-  auto true_residual = [&](const std::vector<double>& x) {
-    std::vector<double> ax(n);
-    dense_apply(a, n, x.data(), ax.data());
-    double rr = 0.0, bb = 0.0;
-    for (std::size_t i = 0; i < n; ++i) {
-      rr += (b[i] - ax[i]) * (b[i] - ax[i]);
-      bb += b[i] * b[i];
-    }
-    return std::sqrt(rr / bb);
-  };
+  const DenseSystem system;
+  const std::size_t n = DenseSystem::n;
+  const ApplyFn apply = [&](const double* x, double* y) { system.apply(x, y); };
+  const ApplyFn jacobi = [&](const double* x, double* y) { system.jacobi(x, y); };
   for (const int restart : {80, 4}) {
     for (const double start : {0.0, 0.3}) {
       std::vector<double> x(n, start);
-      const GmresOutcome g = solve_gmres(n, apply, jacobi, b, x, 1e-9, 200, restart, nullptr);
-      const double truth = true_residual(x);
+      const GmresOutcome g =
+          solve_gmres(n, apply, jacobi, system.b, x, 1e-9, 200, restart, nullptr);
+      const double truth = system.true_residual(x);
       CAPTURE(restart, start, g.iterations, g.residual, truth);
       REQUIRE(g.converged);
       CHECK(truth <= 1e-9);
@@ -182,48 +194,31 @@ TEST_CASE("Relaxed GMRES products keep the true residual within the relaxed budg
   // delta * (sum of those r) <= kRelaxedBudget * tolerance. Here the relaxed product is the
   // exact one with every component scaled by 1 + delta * s_i (|s_i| <= 1), so it keeps its
   // promise ||relaxed(x) - A x|| <= delta ||A x||; the true residual is recomputed.
-  const std::size_t n = 60;
-  std::vector<double> a(n * n), b(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    b[i] = 1.0 + 0.5 * std::cos(0.7 * static_cast<double>(i));
-    for (std::size_t j = 0; j < n; ++j) {
-      a[i * n + j] = (i == j ? 4.0 + 0.1 * static_cast<double>(i % 7) : 0.0) +
-                     std::sin(1.3 * static_cast<double>(i) + 0.7 * static_cast<double>(j)) /
-                         (1.0 + std::abs(static_cast<double>(i) - static_cast<double>(j)));
-    }
-  }
+  const DenseSystem system;
+  const std::size_t n = DenseSystem::n;
+  const std::vector<double>& b = system.b;
   int exact_products = 0, relaxed_calls = 0;
   const ApplyFn apply = [&](const double* x, double* y) {
     ++exact_products;
-    dense_apply(a, n, x, y);
+    system.apply(x, y);
   };
-  const ApplyFn jacobi = [&](const double* x, double* y) {
-    for (std::size_t i = 0; i < n; ++i) y[i] = x[i] / a[i * n + i];
-  };
-  auto true_residual = [&](const std::vector<double>& x) {
-    std::vector<double> ax(n);
-    dense_apply(a, n, x.data(), ax.data());
-    double rr = 0.0, bb = 0.0;
-    for (std::size_t i = 0; i < n; ++i) {
-      rr += (b[i] - ax[i]) * (b[i] - ax[i]);
-      bb += b[i] * b[i];
-    }
-    return std::sqrt(rr / bb);
-  };
+  const ApplyFn jacobi = [&](const double* x, double* y) { system.jacobi(x, y); };
   const double tolerance = 1e-9;
   for (const double delta : {1e-2, 1e-4}) {
     RelaxedProduct relaxed;
     relaxed.relative_error = delta;
     relaxed.apply = [&](const double* x, double* y) {
       ++relaxed_calls;
-      dense_apply(a, n, x, y);
+      system.apply(x, y);
       for (std::size_t i = 0; i < n; ++i) y[i] *= 1.0 + delta * std::sin(2.1 * i + 0.4);
     };
     exact_products = relaxed_calls = 0;
     std::vector<double> x(n, 0.0);
     const GmresOutcome g =
         solve_gmres(n, apply, jacobi, b, x, tolerance, 200, 80, nullptr, relaxed);
-    const double truth = true_residual(x);
+    const double truth = system.true_residual(x);
+    // One product per iteration, of one kind or the other (no restart, zero start).
+    CHECK(exact_products + relaxed_calls == g.iterations);
     std::vector<double> x_exact(n, 0.0);
     const GmresOutcome e = solve_gmres(n, apply, jacobi, b, x_exact, tolerance, 200, 80, nullptr);
     CAPTURE(delta, g.iterations, g.relaxed_products, e.iterations, g.residual, truth);
@@ -243,7 +238,7 @@ TEST_CASE("Relaxed GMRES products keep the true residual within the relaxed budg
   const GmresOutcome g = solve_gmres(n, apply, jacobi, b, x, tolerance, 200, 80, nullptr, useless);
   CHECK(g.converged);
   CHECK(g.relaxed_products == 0);
-  CHECK(true_residual(x) <= tolerance);
+  CHECK(system.true_residual(x) <= tolerance);
 }
 
 TEST_CASE("Relaxed products leave real meshes' charge within the tolerance", "[charge][cgal]") {
