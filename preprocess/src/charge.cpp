@@ -46,13 +46,6 @@ constexpr double kAutoLargeTheta = 0.45;
 /// "Preconditioner").
 constexpr std::size_t kSchwarzSet = 128;
 constexpr std::size_t kSmallSchwarzSet = 80;
-/// Relaxed products (docs/charge.md, "Relaxed products"): once GMRES's residual is small, its
-/// products use a second FMM of this order and opening parameter, whose error against the
-/// automatic operators was at most 2.7e-4 of the product on GMRES's vectors at 5k (elephant,
-/// femur, dino) and 4.8e-4 at 20k-327k (ellipsoid, dino); solve_gmres assumes 1e-3.
-constexpr int kRelaxedOrder = 4;
-constexpr double kRelaxedTheta = 0.5;
-constexpr double kRelaxedError = 1e-3;
 /// Two-level: at most this many coarse clusters (dense LU of K x K), each of at least about
 /// kCoarseClusterMin triangles.
 constexpr std::size_t kCoarseMax = 2048;

@@ -52,6 +52,14 @@ GmresOutcome solve_gmres(std::size_t n, const ApplyFn& apply, const ApplyFn& pre
 /// The share of the tolerance that solve_gmres's relaxed products may spend.
 constexpr double kRelaxedBudget = 0.5;
 
+/// compute_charge's relaxed products (docs/charge.md, "Relaxed products"): a second FMM of
+/// this order and opening parameter, whose error against the automatic operators was at most
+/// 2.7e-4 of the product on GMRES's vectors at 5k (elephant, femur, dino) and 4.8e-4 at
+/// 20k-327k (ellipsoid, dino); it promises kRelaxedError (tested on random-sign vectors).
+constexpr int kRelaxedOrder = 4;
+constexpr double kRelaxedTheta = 0.5;
+constexpr double kRelaxedError = 1e-3;
+
 /// The Schwarz set cap compute_charge uses for n triangles: `requested` if positive, else the
 /// automatic one (ChargeOptions::schwarz_set).
 std::size_t schwarz_set_for(std::size_t n, int requested);
