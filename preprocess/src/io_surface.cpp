@@ -244,14 +244,9 @@ void triangulate_polygon(const std::vector<Point>& points, const Polygon& polygo
 }
 
 /// A whole token as a number, as CGAL's stream reader would read it (a leading '+' allowed);
-/// false for anything else, including values out of range.
+/// false for anything else, including values out of range (detail::parse_double turns those
+/// into inf or 0 instead, where CGAL's reader fails).
 bool plain_number(std::string_view token, double& value) {
-  if (!token.empty() && token.front() == '+') token.remove_prefix(1);
-  const char* end = token.data() + token.size();
-  const auto [ptr, ec] = std::from_chars(token.data(), end, value);
-  return !token.empty() && ec == std::errc() && ptr == end;
-}
-bool plain_index(std::string_view token, std::int64_t& value) {
   if (!token.empty() && token.front() == '+') token.remove_prefix(1);
   const char* end = token.data() + token.size();
   const auto [ptr, ec] = std::from_chars(token.data(), end, value);
@@ -278,7 +273,7 @@ bool read_plain_off(const std::string& text, std::vector<Vec3>& points,
   std::int64_t counts[3];
   if (!tok.next_record(record, line) || record.size() != 3) return false;
   for (int k = 0; k < 3; ++k) {
-    if (!plain_index(record[static_cast<std::size_t>(k)], counts[k]) || counts[k] < 0) {
+    if (!parse_int(record[static_cast<std::size_t>(k)], counts[k]) || counts[k] < 0) {
       return false;
     }
   }
@@ -299,7 +294,7 @@ bool read_plain_off(const std::string& text, std::vector<Vec3>& points,
   }
   for (std::size_t f = 0; f < face_count; ++f) {
     std::int64_t corners = 0;
-    if (!tok.next_record(record, line) || !plain_index(record[0], corners)) return give_up();
+    if (!tok.next_record(record, line) || !parse_int(record[0], corners)) return give_up();
     // Tokens after the corners (a face colour) are ignored, as CGAL's reader does.
     if (corners < 1 || static_cast<std::size_t>(corners) > kMaxPolygonCorners ||
         record.size() < static_cast<std::size_t>(corners) + 1) {
@@ -308,7 +303,7 @@ bool read_plain_off(const std::string& text, std::vector<Vec3>& points,
     std::vector<std::size_t> polygon(static_cast<std::size_t>(corners));
     for (std::size_t k = 0; k < polygon.size(); ++k) {
       std::int64_t index = 0;
-      if (!plain_index(record[k + 1], index) || index < 0 ||
+      if (!parse_int(record[k + 1], index) || index < 0 ||
           static_cast<std::size_t>(index) >= vertex_count) {
         return give_up();
       }
