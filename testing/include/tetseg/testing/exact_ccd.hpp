@@ -73,22 +73,14 @@ inline Poly dot(const QVec& a, const QVec& b) {
 struct OnSegment {
   QVec cross;
   Poly along;
-  Poly common;           // gcd of the cross coordinates: zero when they all vanish identically
-  bool possible = true;  // false when the cross coordinates have no common root at all
 };
 
 inline OnSegment on_segment(const QVec& x, const QVec& y, const QVec& z) {
-  OnSegment s;
-  const QVec xy = minus(x, y), xz = minus(x, z);
-  s.cross = cross(xy, minus(z, y));
-  s.along = dot(xy, xz);
-  s.common = exact::gcd(exact::gcd(s.cross[0], s.cross[1]), s.cross[2]);
-  s.possible = s.common.empty() || exact::degree(s.common) >= 1;
-  return s;
+  const QVec xy = minus(x, y);
+  return {cross(xy, minus(z, y)), dot(xy, minus(x, z))};
 }
 
-inline bool holds_at(OnSegment& s, exact::RealRoot& t) {
-  if (!s.possible) return false;
+inline bool holds_at(const OnSegment& s, exact::RealRoot& t) {
   for (const Poly& c : s.cross)
     if (exact::sign_at(c, t) != 0) return false;
   return exact::sign_at(s.along, t) <= 0;
@@ -113,7 +105,7 @@ struct Clauses {
         }
       if (in) return true;
     }
-    for (OnSegment& s : segments)
+    for (const OnSegment& s : segments)
       if (holds_at(s, t)) return true;
     return false;
   }
@@ -126,12 +118,11 @@ struct Clauses {
       for (const Poly& g : inside)
         if (exact::degree(g) >= 1) c.push_back(g);
     for (const OnSegment& s : segments) {
-      if (!s.possible) continue;
-      if (!s.common.empty()) {
-        c.push_back(s.common);
-      } else if (exact::degree(s.along) >= 1) {
-        c.push_back(s.along);
-      }
+      // The common roots of the cross coordinates; when they all vanish identically (collinear
+      // for the whole step), the roots of `along`.
+      const Poly common = exact::gcd(exact::gcd(s.cross[0], s.cross[1]), s.cross[2]);
+      if (exact::degree(common) >= 1) c.push_back(common);
+      if (common.empty() && exact::degree(s.along) >= 1) c.push_back(s.along);
     }
     return c;
   }
