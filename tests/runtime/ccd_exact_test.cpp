@@ -14,6 +14,7 @@
 #include <catch2/catch.hpp>
 
 #include "support/test_data.hpp"
+#include "tetseg/runtime/ccd.hpp"
 #include "tetseg/testing/ccd_io.hpp"
 #include "tetseg/testing/exact_ccd.hpp"
 
@@ -331,4 +332,89 @@ TEST_CASE("The exact CCD oracle agrees with exact distances on random grid confi
   CHECK(at_start > trials / 50);
   CHECK(touching_samples > trials / 20);
   CHECK(hits - touching_samples > trials / 50);  // contacts only between the samples
+}
+
+namespace {
+
+struct RuntimeCounts {
+  long queries = 0, exact_hits = 0, missed = 0, late = 0, start_missed = 0;
+};
+
+/// The runtime's answer against the exact one: every exact contact reported, never after the
+/// exact first contact time, and a contact at t = 0 reported as such.
+void compare_runtime(const Query& x, bool vertex_face, RuntimeCounts& c) {
+  const ExactCcd e = oracle(x, vertex_face);
+  const tetseg::CcdResult r =
+      vertex_face ? tetseg::vertex_face_ccd(x[0], x[1], x[2], x[3], x[4], x[5], x[6], x[7])
+                  : tetseg::edge_edge_ccd(x[0], x[1], x[2], x[3], x[4], x[5], x[6], x[7]);
+  ++c.queries;
+  if (!e.hit) return;
+  ++c.exact_hits;
+  if (!r.hit()) {
+    ++c.missed;
+    return;
+  }
+  if (r.toi > e.toi_upper) ++c.late;
+  if (e.at_start && r.toi != 0.0) ++c.start_missed;
+}
+
+}  // namespace
+
+TEST_CASE("The runtime's elementary tests never miss an exact contact nor report it late",
+          "[ccd][exact][random]") {
+  RuntimeCounts c;
+  SECTION("Random grid configurations: coplanar, collinear, still and coinciding nodes.") {
+    std::mt19937_64 rng(7);
+    for (int trial = 0; trial < 20000; ++trial)
+      compare_runtime(grid_query(rng, trial % 3 == 0 ? 1 : 2, trial % 5 == 0 ? 0.125 : 1.0),
+                      trial % 2 == 0, c);
+    CHECK(c.exact_hits > 2000);
+  }
+  SECTION("Near-grazing: a node passing within a few ulps of an edge, a corner or a plane.") {
+    std::mt19937_64 rng(11);
+    std::uniform_real_distribution<double> u(-1, 1);
+    std::uniform_int_distribution<int> ulps(-4, 4);
+    for (int trial = 0; trial < 6000; ++trial) {
+      Query x;
+      for (auto& p : x)
+        for (double& k : p) k = u(rng);
+      const bool vertex_face = trial % 2 == 0;
+      // At t = s the moving node (0) sits on a point of the other primitive's closed set (an
+      // edge point, a corner or an inside point), give or take a few ulps.
+      const double s = (trial % 3 == 0) ? 0.0 : (trial % 3 == 1 ? 1.0 : 0.5);
+      const double w = (trial % 4 == 0) ? 0.0 : std::abs(u(rng));
+      Vec3d target;
+      for (int k = 0; k < 3; ++k) {
+        const double y = x[2][k] + s * (x[6][k] - x[2][k]);
+        const double z = x[3][k] + s * (x[7][k] - x[3][k]);
+        target[k] = y + w * (z - y);
+        for (int n = ulps(rng); n != 0; n += n > 0 ? -1 : 1)
+          target[k] = std::nextafter(target[k], n > 0 ? 2.0 : -2.0);
+      }
+      // Node 0 passes through the target at t = s: x0 + s (x1 - x0) = target.
+      for (int k = 0; k < 3; ++k) {
+        if (s == 0.0) x[0][k] = target[k];
+        if (s == 1.0) x[4][k] = target[k];
+        if (s == 0.5) x[4][k] = 2 * target[k] - x[0][k];
+      }
+      compare_runtime(x, vertex_face, c);
+    }
+    CHECK(c.exact_hits > 300);
+  }
+  SECTION("Every reference query: the runtime's time of impact is never after the exact one.") {
+    if (!tetseg::test::have_test_data(kQueries.string(), "CCD reference queries")) return;
+    for (const char* kind : {"vertex-face", "edge-edge"})
+      for (const auto& scene : fs::directory_iterator(kQueries))
+        if (fs::is_directory(scene.path() / kind))
+          for (const auto& e : fs::directory_iterator(scene.path() / kind))
+            if (e.path().extension() == ".csv")
+              for (const auto& q : io::read_query_csv(e.path().string()))
+                compare_runtime(q.points, kind[0] == 'v', c);
+    CHECK(c.queries == 7279);
+    CHECK(c.exact_hits == 435);
+  }
+  CAPTURE(c.queries, c.exact_hits);
+  CHECK(c.missed == 0);
+  CHECK(c.late == 0);
+  CHECK(c.start_missed == 0);
 }
