@@ -18,7 +18,7 @@ TEST_CASE("Radial-view culling finds the first contact of a pressed sphere", "[c
     CAPTURE(clusters);
     const Scene scene = sphere_scene(clusters);
     const auto frames = make_frames(scene, 16, press_poles);
-    const SequenceReport rep = compare_with_brute(scene, frames);
+    const SequenceReport rep = compare_with_oracle(scene, frames);
     REQUIRE(rep.contact_frames == 1);
     CHECK(rep.rvbc_tests < rep.brute_tests);
   }
@@ -29,7 +29,7 @@ TEST_CASE("Radial-view culling finds the bells of a bent dumbbell touching, wedg
   const Scene scene = dumbbell_scene();
   const auto frames = make_frames(
       scene, 16, [](const P3& p, double t) { return bend_about_x(p, t, 2.6, -0.5, 0.5, 0.0); });
-  const SequenceReport rep = compare_with_brute(scene, frames);
+  const SequenceReport rep = compare_with_oracle(scene, frames);
   REQUIRE(rep.contact_frames == 1);
   CHECK(rep.orientation_culled > 0);
   CHECK(rep.rvbc_tests < rep.brute_tests);
@@ -41,7 +41,7 @@ TEST_CASE("Radial-view culling finds the bells of a bent dumbbell touching, wedg
 TEST_CASE("Radial-view culling finds the contacts of a twisted and bent pawn", "[collider][rvbc]") {
   const Scene scene = pawn_scene();
   const auto frames = make_frames(scene, 16, twist_bend);
-  const SequenceReport rep = compare_with_brute(scene, frames);
+  const SequenceReport rep = compare_with_oracle(scene, frames);
   REQUIRE(rep.contact_frames == 1);
   CHECK(rep.orientation_culled > 0);
 }
@@ -54,7 +54,7 @@ TEST_CASE("Radial-view culling matches brute force under random smooth deformati
   const Scene scene = shape == 0 ? sphere_scene(2) : shape == 1 ? dumbbell_scene() : pawn_scene();
   const Waves waves(seed, 0.9);
   const auto frames = make_frames(scene, 12, waves);
-  const SequenceReport rep = compare_with_brute(scene, frames);
+  const SequenceReport rep = compare_with_oracle(scene, frames);
   CHECK(rep.frames_compared > 0);
 }
 
@@ -68,7 +68,7 @@ TEST_CASE("A drooping mushroom rim touching its base agrees with brute force",
   // The rim droops locally onto the conical base: its tip vertex is the first point to reach
   // the base face B.
   const auto frames = make_frames(scene, 16, RimDroop(s, 0.05));
-  const SequenceReport rep = compare_with_brute(scene, frames);
+  const SequenceReport rep = compare_with_oracle(scene, frames);
   REQUIRE(rep.contact_frames == 1);
   REQUIRE_FALSE(rep.first_contacts.empty());
 }
@@ -83,7 +83,7 @@ TEST_CASE("Results do not depend on translation far from the origin or on scale"
   CAPTURE(offset[0], scale);
   const auto frames =
       transformed(base, scale, {offset[0] * scale, offset[1] * scale, offset[2] * scale});
-  const SequenceReport rep = compare_with_brute(scene, frames);
+  const SequenceReport rep = compare_with_oracle(scene, frames);
   CHECK(rep.contact_frames == 1);
 }
 
@@ -124,7 +124,7 @@ TEST_CASE("Rigid motions and zero motion report no contact", "[collider][numeric
     REQUIRE(c.step(frames[0].data(), frames[1].data()) == ColliderStatus::kOk);
     earliest_ok(c);
     CHECK(c.stats().clusters_skipped >= 1);
-    const SequenceReport rep = compare_with_brute(db, frames);
+    const SequenceReport rep = compare_with_oracle(db, frames);
     CHECK(rep.contact_frames == 1);
   }
 }
@@ -135,7 +135,7 @@ TEST_CASE("Near-degenerate motions agree with brute force", "[collider][numerics
     const auto frames = make_frames(scene, 4, [](const P3& p, double t) {
       return P3{p[0] + 1e-12 * t * p[1], p[1], p[2] - 1e-12 * t};
     });
-    const SequenceReport rep = compare_with_brute(scene, frames);
+    const SequenceReport rep = compare_with_oracle(scene, frames);
     CHECK(rep.contact_frames == 0);
   }
   SECTION("Sliding every node tangentially along the sphere gives no contact.") {
@@ -144,7 +144,7 @@ TEST_CASE("Near-degenerate motions agree with brute force", "[collider][numerics
       return P3{p[0] * std::cos(a) - p[1] * std::sin(a), p[0] * std::sin(a) + p[1] * std::cos(a),
                 p[2]};
     });
-    const SequenceReport rep = compare_with_brute(scene, frames);
+    const SequenceReport rep = compare_with_oracle(scene, frames);
     CHECK(rep.contact_frames == 0);
   }
 }
@@ -215,7 +215,7 @@ TEST_CASE("Degenerate chain BVHs as deep as the cluster is large are traversed c
   const Scene split = make_scene(s, cluster_of, {{0, 0, -1.6}, {0, 0, 1.6}}, 2);
   const auto frames = make_frames(
       chain, 12, [](const P3& p, double t) { return bend_about_x(p, t, 2.6, -0.5, 0.5, 0.0); });
-  const SequenceReport rep = compare_with_brute(chain, frames);
+  const SequenceReport rep = compare_with_oracle(chain, frames);
   CHECK(rep.contact_frames == 1);
   // Same contacts as with well-formed BVHs, step by step.
   Collider a(chain.asset), b(split.asset);
@@ -278,7 +278,7 @@ TEST_CASE("Poles meeting head on: every brute-force contact at the earliest toi 
     CAPTURE(clusters);
     const Scene scene = sphere_scene(clusters);
     const auto frames = make_frames(scene, 16, press_poles_head_on);
-    const SequenceReport rep = compare_with_brute(scene, frames);
+    const SequenceReport rep = compare_with_oracle(scene, frames);
     REQUIRE(rep.contact_frames == 1);
     CHECK(rep.first_contacts.size() > 8);
     CHECK(rep.closure_pairs > 0);

@@ -4,8 +4,8 @@
 // contact, and random smooth deformations of many small clusters; and the seam rule (pairs of two
 // clusters sharing a node culled, their feature pairs tested from the seam orphans: "Across
 // clusters: seam pairs") on low-valence bodies in every split into clusters and on scattered
-// clusters. compare_with_brute checks any-collision, the earliest toi and every brute-force contact
-// at the earliest toi (tests/runtime/support/compare.hpp).
+// clusters. compare_with_oracle checks any-collision, the earliest toi and every brute-force
+// contact at the earliest toi (tests/runtime/support/compare.hpp).
 
 #include <algorithm>
 #include <catch2/catch.hpp>
@@ -86,7 +86,7 @@ TEST_CASE("Neighbouring clusters folded onto each other agree with brute force",
   const Scene scene = sector_scene(s, sectors, 0.3, cut_set, slab_z, sectors == 1 ? 0.0 : 0.2);
   const auto frames =
       make_frames(scene, 24, [](const P3& p, double t) { return fold_capsule(p, t, 3.1); });
-  const SequenceReport rep = compare_with_brute(scene, frames);
+  const SequenceReport rep = compare_with_oracle(scene, frames);
   REQUIRE(rep.contact_frames == 1);
 }
 
@@ -103,7 +103,7 @@ TEST_CASE("A wedge tip on a cluster boundary drooping onto another cluster agree
   const RimDroop droop(s, slant);
   const Scene scene = sector_scene(s, sectors, droop.phi, {1.6}, {0.8, 2.1}, 0.45);
   const auto frames = make_frames(scene, 16, droop);
-  const SequenceReport rep = compare_with_brute(scene, frames);
+  const SequenceReport rep = compare_with_oracle(scene, frames);
   REQUIRE(rep.contact_frames == 1);
   REQUIRE_FALSE(rep.first_contacts.empty());
 }
@@ -119,7 +119,7 @@ TEST_CASE("Many small clusters under random smooth deformations agree with brute
                           : sector_scene(s, 3, 0.2, {-1.0, 0.0, 1.0}, {-1.6, -0.5, 0.5, 1.6}, 0.15);
   const Waves waves(seed, 0.9, 4.0);
   const auto frames = make_frames(scene, 12, waves);
-  const SequenceReport rep = compare_with_brute(scene, frames);
+  const SequenceReport rep = compare_with_oracle(scene, frames);
   CHECK(rep.frames_compared > 0);
 }
 
@@ -226,7 +226,7 @@ TEST_CASE(
   for (auto& f : frames)
     for (std::uint32_t i = 0; i < 2; ++i)
       for (int k = 0; k < 3; ++k) f[3 * (scene.surface_nodes + i) + k] = detectors[i][k];
-  const SequenceReport rep = compare_with_brute(scene, frames);
+  const SequenceReport rep = compare_with_oracle(scene, frames);
   REQUIRE(rep.contact_frames == 1);
 }
 
@@ -325,7 +325,7 @@ TEST_CASE("Feature pairs held only by triangle pairs of two clusters sharing a n
           std::vector<double> x0 = scene.rest, x1 = scene.rest;
           for (std::uint32_t v = 0; v < nv; ++v)
             for (int k = 0; k < 3; ++k) x1[3 * v + k] = end[v][k];
-          const SequenceReport rep = compare_with_brute(scene, {x0, x1});
+          const SequenceReport rep = compare_with_oracle(scene, {x0, x1});
           REQUIRE(rep.contact_frames == 1);
           ++contact_steps;
           if (!overlap_only) continue;
@@ -363,7 +363,7 @@ TEST_CASE("Triangles scattered over many clusters under random deformations agre
       {{0.2, 0.1, 0.0}, {-0.2, 0.1, 0.1}, {0.0, -0.2, -0.1}, {0.1, 0.0, 0.3}, {0.0, 0.1, -0.3}});
   const Waves waves(seed, 1.0, 4.0);
   const auto frames = make_frames(scene, 12, waves);
-  const SequenceReport rep = compare_with_brute(scene, frames);
+  const SequenceReport rep = compare_with_oracle(scene, frames);
   CHECK(rep.frames_compared > 0);
   // With OpenMP (the seam orphans tested after the parallel traversal) the answers and counts
   // are the serial ones, on the steps compared above.

@@ -202,7 +202,7 @@ TEST_CASE("Detector points inside tets find the first contacts that brute force 
       CAPTURE(clusters);
       const Scene scene = with_detector_tets(sphere_scene(clusters), 0.05);
       const auto frames = make_frames(scene, 16, press_poles);
-      const SequenceReport rep = compare_with_brute(scene, frames);
+      const SequenceReport rep = compare_with_oracle(scene, frames);
       REQUIRE(rep.contact_frames == 1);
       CHECK(rep.orientation_culled + rep.clusters_skipped > 0);  // the detectors do cull
       CHECK(rep.rvbc_tests < rep.brute_tests);
@@ -212,7 +212,7 @@ TEST_CASE("Detector points inside tets find the first contacts that brute force 
     const Scene scene = with_detector_tets(dumbbell_scene(), 0.1);
     const auto frames = make_frames(
         scene, 16, [](const P3& p, double t) { return bend_about_x(p, t, 2.6, -0.5, 0.5, 0.0); });
-    const SequenceReport rep = compare_with_brute(scene, frames);
+    const SequenceReport rep = compare_with_oracle(scene, frames);
     REQUIRE(rep.contact_frames == 1);
     CHECK(rep.orientation_culled > 0);
   }
@@ -228,7 +228,7 @@ TEST_CASE("Inverted and degenerate detector tets are handled conservatively",
       const Scene scene = with_detector_tets(sphere_scene(clusters), 0.05);
       auto frames = make_frames(scene, 16, press_poles);
       invert_detector_tets(scene, frames, fling);
-      const SequenceReport rep = compare_with_brute(scene, frames);
+      const SequenceReport rep = compare_with_oracle(scene, frames);
       REQUIRE(rep.contact_frames == 1);
     }
     CAPTURE(fling);
@@ -236,7 +236,7 @@ TEST_CASE("Inverted and degenerate detector tets are handled conservatively",
     auto frames = make_frames(
         scene, 16, [](const P3& p, double t) { return bend_about_x(p, t, 2.6, -0.5, 0.5, 0.0); });
     invert_detector_tets(scene, frames, fling);
-    const SequenceReport rep = compare_with_brute(scene, frames);
+    const SequenceReport rep = compare_with_oracle(scene, frames);
     REQUIRE(rep.contact_frames == 1);
   }
   SECTION("A step across the flat moment: the tet is degenerate inside the step.") {
@@ -257,7 +257,7 @@ TEST_CASE("Random smooth deformations with detector points agree with brute forc
     const Scene scene = with_detector_tets(dumbbell_scene(), 0.1, {0.7, 0.1, 0.1, 0.1});
     const Waves waves(seed, 0.35);
     const auto frames = make_frames(scene, 12, waves);
-    compare_with_brute(scene, frames);
+    compare_with_oracle(scene, frames);
   }
 }
 
@@ -321,7 +321,7 @@ TEST_CASE("One overlap-only cluster beside classified ones agrees with brute for
   const Scene scene = load_scene(a, dumbbell_scene().surface_nodes);
   const auto frames = make_frames(
       scene, 16, [](const P3& p, double t) { return bend_about_x(p, t, 2.6, -0.5, 0.5, 0.0); });
-  const SequenceReport rep = compare_with_brute(scene, frames);
+  const SequenceReport rep = compare_with_oracle(scene, frames);
   REQUIRE(rep.contact_frames == 1);
   // The other clusters are still culled by orientation.
   CHECK(rep.orientation_culled + rep.clusters_skipped > 0);

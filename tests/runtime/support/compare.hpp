@@ -1,7 +1,12 @@
 #pragma once
-// Runs a frame sequence through the collider in several modes and compares with brute force
-// (the oracle): same any-collision answer each frame, and every brute-force contact at the
-// earliest time of impact also found. Used by tests/runtime/collider*_test.cpp.
+// Runs a frame sequence through the collider in several modes and compares every mode, brute
+// included, with the scene oracle (tetseg/testing/scene_oracle.hpp: its own feature
+// enumeration and the elementary tests alone, no collider code) and with exact rational truth
+// (exact_scene_oracle.hpp). Per step: the same any-collision answer; every mode contact is an
+// oracle contact with the same toi (subset: nothing invented); every oracle contact at the
+// earliest toi found; bvh and brute find exactly the oracle's contacts; every exact contact is
+// an oracle contact no later than the exact time. Used by tests/runtime/collider*_test.cpp,
+// cross_cluster, wide_bvh and detector_point tests.
 
 #include <algorithm>
 #include <string>
@@ -11,6 +16,8 @@
 
 #include "runtime/support/queries.hpp"
 #include "tetseg/runtime/collider.hpp"
+#include "tetseg/testing/exact_scene_oracle.hpp"
+#include "tetseg/testing/scene_oracle.hpp"
 #include "tetseg/testing/synthetic_scenes.hpp"
 
 namespace tetseg::test {
@@ -71,12 +78,9 @@ struct SequenceReport {
   /// Earliest contacts whose feature pair also lies in an orientation-culled triangle pair
   /// (same cluster, same definite class): the design note's wedge-tip situation, where the
   /// pair must be tested from another, non-culled triangle pair.
-  int wedge_contacts = 0;  // brute contacts at the earliest toi of the first contact frame
+  int wedge_contacts = 0;  // oracle contacts at the earliest toi of the first contact frame
 };
 
-/// Compares rvbc and bvh with brute on every step until (and including) the first step with a
-/// contact: after it the surface may start a step self-intersecting, which voids the culling
-/// guarantee (design note), so later steps are not compared.
 /// Does a triangle pair containing the feature pair of `c` have the same definite class in
 /// the same cluster (i.e. is it culled by orientation in the collider's current step)?
 inline bool in_culled_pair(const Collider& rvbc, const Scene& scene, const Contact& c) {
@@ -104,9 +108,68 @@ inline bool in_culled_pair(const Collider& rvbc, const Scene& scene, const Conta
   return false;
 }
 
-inline SequenceReport compare_with_brute(const Scene& scene,
-                                         const std::vector<std::vector<double>>& frames,
-                                         bool stop_at_first_contact = true) {
+/// The oracle's contacts over the collider's one body (self-collision on), sorted.
+inline std::vector<Contact> oracle_contacts(const Scene& scene, const double* x0,
+                                            const double* x1) {
+  const format::Asset& a = scene.asset.data();
+  return scene_brute_contacts({OracleBody{a.triangles.data(), a.triangles.size(), x0, x1, true}});
+}
+
+/// Every exact contact of the step is an oracle contact at a toi no later than the exact one.
+/// Returns the exact earliest toi rounded up (2 when there is none).
+inline double require_exact_contacts_found(const Scene& scene, const double* x0, const double* x1,
+                                           const std::vector<Contact>& oracle) {
+  const format::Asset& a = scene.asset.data();
+  const std::vector<Contact> exact =
+      scene_exact_contacts({OracleBody{a.triangles.data(), a.triangles.size(), x0, x1, true}});
+  for (const Contact& e : exact) {
+    CAPTURE(describe(e));
+    const auto it = std::find_if(oracle.begin(), oracle.end(),
+                                 [&](const Contact& o) { return same_feature(o, e); });
+    REQUIRE(it != oracle.end());
+    REQUIRE(it->toi <= e.toi);
+    if (e.at_start) REQUIRE(it->at_start);
+  }
+  return exact.empty() ? 2.0 : exact.front().toi;
+}
+
+/// What a mode must report against the oracle's contacts.
+enum class Expect {
+  kAllContacts,       ///< exactly the oracle's contacts (bvh, brute)
+  kEarliestContacts,  ///< every contact at the earliest toi, nothing outside the oracle's (rvbc)
+};
+
+inline void require_matches_oracle(const StepAnswer& m, const std::vector<Contact>& oracle,
+                                   Expect expect) {
+  constexpr double kTol = 1e-9;  // contacts this close to the earliest toi must be found
+  REQUIRE(m.any == !oracle.empty());
+  for (const Contact& c : m.contacts) {  // subset, at the same times
+    CAPTURE(describe(c));
+    const auto it = std::find_if(oracle.begin(), oracle.end(),
+                                 [&](const Contact& o) { return same_feature(o, c); });
+    REQUIRE(it != oracle.end());
+    REQUIRE(c.toi == it->toi);
+    REQUIRE(c.at_start == it->at_start);
+  }
+  if (expect == Expect::kAllContacts) REQUIRE(m.contacts.size() == oracle.size());
+  if (oracle.empty()) return;
+  REQUIRE(m.earliest.found);
+  REQUIRE(m.earliest.contact.toi == oracle.front().toi);
+  for (const Contact& o : oracle) {
+    if (o.toi > oracle.front().toi + kTol) break;
+    CAPTURE(describe(o));
+    REQUIRE(std::any_of(m.contacts.begin(), m.contacts.end(),
+                        [&](const Contact& x) { return same_feature(x, o); }));
+  }
+}
+
+/// Compares brute, bvh and rvbc with the oracle on every step until (and including) the first
+/// step with a contact: after it the surface may start a step self-intersecting, which voids
+/// rvbc's culling guarantee (design note), so later steps are not compared (unless
+/// `stop_at_first_contact` is false).
+inline SequenceReport compare_with_oracle(const Scene& scene,
+                                          const std::vector<std::vector<double>>& frames,
+                                          bool stop_at_first_contact = true) {
   Collider rvbc = collider_for(scene, ColliderMode::kRvbc);
   Collider bvh = collider_for(scene, ColliderMode::kBvh);
   Collider brute = collider_for(scene, ColliderMode::kBrute);
@@ -115,35 +178,38 @@ inline SequenceReport compare_with_brute(const Scene& scene,
   constexpr double kTol = 1e-9;
   for (std::size_t f = 0; f + 1 < frames.size(); ++f) {
     CAPTURE(f);
-    const StepAnswer b = answer(brute, frames[f].data(), frames[f + 1].data());
-    const StepAnswer r = answer(rvbc, frames[f].data(), frames[f + 1].data());
-    const StepAnswer g = answer(bvh, frames[f].data(), frames[f + 1].data());
+    const double* x0 = frames[f].data();
+    const double* x1 = frames[f + 1].data();
+    const std::vector<Contact> oracle = oracle_contacts(scene, x0, x1);
+    const double exact_earliest = require_exact_contacts_found(scene, x0, x1, oracle);
+    const StepAnswer b = answer(brute, x0, x1);
+    const StepAnswer r = answer(rvbc, x0, x1);
+    const StepAnswer g = answer(bvh, x0, x1);
     rep.orientation_culled += rvbc.stats().node_pairs_orientation_culled;
     rep.clusters_skipped += rvbc.stats().clusters_skipped;
     rep.closure_pairs += rvbc.stats().closure_pairs;
     rep.rvbc_tests += rvbc.stats().feature_tests;
     rep.brute_tests += brute.stats().feature_tests;
     ++rep.frames_compared;
-    REQUIRE(r.any == b.any);
-    REQUIRE(g.any == b.any);
-    // bvh has no orientation culling: exactly the brute-force contact set.
-    REQUIRE(g.contacts.size() == b.contacts.size());
-    for (std::size_t i = 0; i < b.contacts.size(); ++i) {
-      CAPTURE(describe(b.contacts[i]));
-      REQUIRE(same_feature(g.contacts[i], b.contacts[i]));
+    {
+      INFO("brute");
+      require_matches_oracle(b, oracle, Expect::kAllContacts);
     }
-    if (!b.any) continue;
+    {
+      INFO("bvh");
+      require_matches_oracle(g, oracle, Expect::kAllContacts);
+    }
+    {
+      INFO("rvbc");
+      require_matches_oracle(r, oracle, Expect::kEarliestContacts);
+    }
+    if (oracle.empty()) continue;
+    REQUIRE(oracle.front().toi <= exact_earliest);  // never later than the exact time
     ++rep.contact_frames;
-    REQUIRE(r.earliest.found);
-    CHECK(r.earliest.contact.toi == Approx(b.earliest.contact.toi).margin(kTol));
-    for (const Contact& c : b.contacts) {
-      if (c.toi > b.earliest.contact.toi + kTol) continue;
-      CAPTURE(describe(c));
-      const bool found = std::any_of(r.contacts.begin(), r.contacts.end(),
-                                     [&](const Contact& x) { return same_feature(x, c); });
-      CHECK(found);
+    for (const Contact& c : oracle) {
+      if (c.toi > oracle.front().toi + kTol) break;
       if (rep.contact_frames == 1) rep.first_contacts.push_back(c);
-      if (found && in_culled_pair(rvbc, scene, c)) ++rep.wedge_contacts;
+      if (in_culled_pair(rvbc, scene, c)) ++rep.wedge_contacts;
     }
     if (stop_at_first_contact) break;
   }

@@ -17,10 +17,12 @@
 /// set is closed, so its first point is 0 or a real root of one of these polynomials (of f
 /// alone unless f vanishes identically); each candidate root is isolated (Sturm) and the
 /// conditions are decided at it exactly (exact_poly.hpp's sign_at). Swept boxes and the
-/// Bernstein signs of f reject most misses before any root is isolated.
+/// the same conditions in outward-rounded interval arithmetic over a subdivision of [0, 1],
+/// then the exact Bernstein signs of f, reject most misses before any root is isolated.
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <optional>
 #include <vector>
 
@@ -155,6 +157,105 @@ inline ExactCcd solve(Clauses& q) {
   return out;
 }
 
+/// A closed interval of doubles, widened outward after every operation: a cheap rigorous
+/// enclosure. A round-to-nearest result r errs by at most half an ulp (2^-1075 when
+/// subnormal); r -/+ (|r| 2^-51 + 2^-1074), itself rounded, moves by at least one ulp past
+/// it (infinities give NaN, which no filter accepts).
+struct Interval {
+  double lo, hi;
+};
+inline double down(double x) {
+  return x - (std::abs(x) * 0x1p-51 + 0x1p-1074);
+}
+inline double up(double x) {
+  return x + (std::abs(x) * 0x1p-51 + 0x1p-1074);
+}
+inline Interval operator+(Interval a, Interval b) {
+  return {down(a.lo + b.lo), up(a.hi + b.hi)};
+}
+inline Interval operator-(Interval a, Interval b) {
+  return {down(a.lo - b.hi), up(a.hi - b.lo)};
+}
+inline Interval operator*(Interval a, Interval b) {
+  const double p[4] = {a.lo * b.lo, a.lo * b.hi, a.hi * b.lo, a.hi * b.hi};
+  return {down(std::min({p[0], p[1], p[2], p[3]})), up(std::max({p[0], p[1], p[2], p[3]}))};
+}
+/// Polynomials in t with interval coefficients, lowest degree first.
+using IPoly = std::vector<Interval>;
+using IQVec = std::array<IPoly, 3>;
+
+inline IPoly operator+(const IPoly& a, const IPoly& b) {
+  IPoly r(std::max(a.size(), b.size()), Interval{0, 0});
+  for (std::size_t i = 0; i < a.size(); ++i) r[i] = r[i] + a[i];
+  for (std::size_t i = 0; i < b.size(); ++i) r[i] = r[i] + b[i];
+  return r;
+}
+inline IPoly operator-(const IPoly& a, const IPoly& b) {
+  IPoly r(std::max(a.size(), b.size()), Interval{0, 0});
+  for (std::size_t i = 0; i < a.size(); ++i) r[i] = r[i] + a[i];
+  for (std::size_t i = 0; i < b.size(); ++i) r[i] = r[i] - b[i];
+  return r;
+}
+inline IPoly operator*(const IPoly& a, const IPoly& b) {
+  IPoly r(a.size() + b.size() - 1, Interval{0, 0});
+  for (std::size_t i = 0; i < a.size(); ++i)
+    for (std::size_t j = 0; j < b.size(); ++j) r[i + j] = r[i + j] + a[i] * b[j];
+  return r;
+}
+inline IQVec operator-(const IQVec& a, const IQVec& b) {
+  return {a[0] - b[0], a[1] - b[1], a[2] - b[2]};
+}
+inline IQVec icross(const IQVec& a, const IQVec& b) {
+  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+}
+inline IPoly idot(const IQVec& a, const IQVec& b) {
+  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+inline IQVec itrajectory(const Vec3d& x0, const Vec3d& x1) {
+  IQVec v;
+  for (int k = 0; k < 3; ++k)
+    v[k] = {Interval{x0[k], x0[k]}, Interval{x1[k], x1[k]} - Interval{x0[k], x0[k]}};
+  return v;
+}
+/// An enclosure of p over t in [lo, hi] (0 <= lo <= hi), by Horner's rule.
+inline Interval enclosure(const IPoly& p, double lo, double hi) {
+  Interval v{0, 0};
+  for (std::size_t i = p.size(); i-- > 0;) v = v * Interval{lo, hi} + p[i];
+  return v;
+}
+
+/// True when the primitives provably never touch: on every piece of a subdivision of [0, 1]
+/// the enclosure of the coplanarity polynomial `f` excludes 0, or one of the `inside`
+/// polynomials (which are all >= 0 wherever the primitives touch) is strictly negative. A
+/// fast rejection, rigorous in floating point; false says nothing.
+inline bool provably_apart(const IPoly& f, const std::vector<IPoly>& inside) {
+  struct Piece {
+    double lo, hi;
+    int depth;
+  };
+  Piece stack[16];
+  int size = 0;
+  stack[size++] = {0.0, 1.0, 0};
+  while (size > 0) {
+    const Piece t = stack[--size];
+    const Interval fv = enclosure(f, t.lo, t.hi);
+    if (fv.lo > 0 || fv.hi < 0) continue;
+    bool outside = false;
+    for (const IPoly& g : inside) {
+      if (enclosure(g, t.lo, t.hi).hi < 0) {
+        outside = true;
+        break;
+      }
+    }
+    if (outside) continue;
+    if (t.depth == 5) return false;
+    const double mid = 0.5 * (t.lo + t.hi);
+    stack[size++] = {mid, t.hi, t.depth + 1};
+    stack[size++] = {t.lo, mid, t.depth + 1};
+  }
+  return true;
+}
+
 inline bool boxes_disjoint(std::initializer_list<const Vec3d*> a,
                            std::initializer_list<const Vec3d*> b) {
   for (int k = 0; k < 3; ++k) {
@@ -174,6 +275,15 @@ inline ExactCcd exact_vertex_face(const Vec3d& p0, const Vec3d& a0, const Vec3d&
                                   const Vec3d& b1, const Vec3d& c1) {
   namespace d = exact_ccd_detail;
   if (d::boxes_disjoint({&p0, &p1}, {&a0, &b0, &c0, &a1, &b1, &c1})) return {};
+  {
+    const d::IQVec p = d::itrajectory(p0, p1), a = d::itrajectory(a0, a1),
+                   b = d::itrajectory(b0, b1), c = d::itrajectory(c0, c1);
+    const d::IQVec ap = a - p, bp = b - p, cp = c - p, n = d::icross(b - a, c - a);
+    if (d::provably_apart(d::idot(ap, d::icross(bp, cp)),
+                          {d::idot(d::icross(bp, cp), n), d::idot(d::icross(cp, ap), n),
+                           d::idot(d::icross(ap, bp), n)}))
+      return {};
+  }
   const d::QVec p = d::trajectory(p0, p1), a = d::trajectory(a0, a1), b = d::trajectory(b0, b1),
                 c = d::trajectory(c0, c1);
   const d::QVec ap = d::minus(a, p), bp = d::minus(b, p), cp = d::minus(c, p);
@@ -194,6 +304,14 @@ inline ExactCcd exact_edge_edge(const Vec3d& a0, const Vec3d& b0, const Vec3d& c
                                 const Vec3d& d1) {
   namespace x = exact_ccd_detail;
   if (x::boxes_disjoint({&a0, &b0, &a1, &b1}, {&c0, &d0, &c1, &d1})) return {};
+  {
+    const x::IQVec a = x::itrajectory(a0, a1), b = x::itrajectory(b0, b1),
+                   c = x::itrajectory(c0, c1), d = x::itrajectory(d0, d1);
+    const x::IQVec e1 = b - a, e2 = d - c, w = c - a, m = x::icross(e1, e2);
+    const x::IPoly mm = x::idot(m, m), s = x::idot(x::icross(w, e2), m),
+                   u = x::idot(x::icross(w, e1), m);
+    if (x::provably_apart(x::idot(e1, x::icross(w, d - a)), {s, mm - s, u, mm - u})) return {};
+  }
   const x::QVec a = x::trajectory(a0, a1), b = x::trajectory(b0, b1), c = x::trajectory(c0, c1),
                 d = x::trajectory(d0, d1);
   const x::QVec e1 = x::minus(b, a), e2 = x::minus(d, c), w = x::minus(c, a);

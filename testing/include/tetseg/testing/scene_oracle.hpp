@@ -1,11 +1,14 @@
 #pragma once
 /// \file
-/// The brute-force truth over a whole scene, independent of the runtime's culling: every
-/// feature pair with four distinct nodes (vertex against triangle, edge against edge, within a
-/// body with self-collision on and across every pair of bodies) through the elementary tests of
-/// ccd.hpp only. Pairs whose four nodes are all still are skipped (the documented scene rule);
-/// a plain sort-and-sweep on swept feature boxes (exact box overlap, nothing else) keeps it
-/// affordable on large scenes. Shared by the runtime tests and `tetseg-bench scene`.
+/// The brute-force truth over a whole scene, sharing nothing with the runtime's narrow phase
+/// (its own feature enumeration; none of the collider's still-pair code, swept feature boxes,
+/// coplanarity or plane filters): every feature pair with four distinct nodes (vertex against
+/// triangle, edge against edge, within a body with self-collision on and across every pair of
+/// bodies) through the elementary tests of ccd.hpp only. Pairs whose four nodes are all still
+/// are skipped (the documented rule of Collider::step and Scene); a plain sort-and-sweep on
+/// swept feature boxes (exact box overlap, nothing else) keeps it affordable on large scenes.
+/// Shared by the runtime tests, `tetseg-bench table`, `check` and `scene`. The elementary
+/// tests themselves are held to exact rational truth by exact_ccd.hpp (tests only).
 /// Also the closed and open boxes used as still obstacles.
 
 #include <algorithm>
@@ -30,9 +33,14 @@ struct OracleBody {
   bool self = true;  ///< test the body against itself
 };
 
-/// All contacts of the step, sorted by `contact_less`, named as the runtime names them
-/// (bodies[0] <= bodies[1] for edge pairs; edges normalised).
-inline std::vector<Contact> scene_brute_contacts(const std::vector<OracleBody>& bodies) {
+/// Calls `vertex_face(vertex_body, p, face_body, triangle_id, face_nodes)` and
+/// `edge_edge(body_ab, a, b, body_cd, c, d)` once for every feature pair of the step that the
+/// oracle tests: four distinct nodes, self pairs only in bodies with `self`, not all four nodes
+/// still, swept boxes overlapping (exact comparisons). Edges are named as the runtime names
+/// them (a < b, c < d, (body, a, b) <= (body, c, d)).
+template <class VertexFace, class EdgeEdge>
+void for_each_feature_pair(const std::vector<OracleBody>& bodies, VertexFace&& vertex_face,
+                           EdgeEdge&& edge_edge) {
   enum Kind : std::uint8_t { kVertex, kEdge, kTriangle };
   struct Item {
     double lo[3], hi[3];
@@ -43,10 +51,6 @@ inline std::vector<Contact> scene_brute_contacts(const std::vector<OracleBody>& 
     bool moving;
   };
   std::vector<Item> items;
-  auto point = [&](std::uint32_t b, std::uint32_t n, bool end) {
-    const double* x = (end ? bodies[b].x1 : bodies[b].x0) + std::size_t(n) * 3;
-    return Vec3d{x[0], x[1], x[2]};
-  };
   auto add_item = [&](std::uint32_t b, Kind kind, std::uint32_t id,
                       std::array<std::uint32_t, 3> nodes, int count) {
     Item it{};
@@ -60,8 +64,9 @@ inline std::vector<Contact> scene_brute_contacts(const std::vector<OracleBody>& 
       it.hi[k] = -INFINITY;
     }
     for (int c = 0; c < count; ++c) {
-      const Vec3d p0 = point(b, nodes[c], false), p1 = point(b, nodes[c], true);
-      if (!(p0 == p1)) it.moving = true;
+      const double* p0 = bodies[b].x0 + std::size_t(nodes[c]) * 3;
+      const double* p1 = bodies[b].x1 + std::size_t(nodes[c]) * 3;
+      if (!(p0[0] == p1[0] && p0[1] == p1[1] && p0[2] == p1[2])) it.moving = true;
       for (int k = 0; k < 3; ++k) {
         it.lo[k] = std::min({it.lo[k], p0[k], p1[k]});
         it.hi[k] = std::max({it.hi[k], p0[k], p1[k]});
@@ -90,6 +95,45 @@ inline std::vector<Contact> scene_brute_contacts(const std::vector<OracleBody>& 
   std::sort(items.begin(), items.end(),
             [](const Item& a, const Item& b) { return a.lo[0] < b.lo[0]; });
 
+  auto vf = [&](const Item& v, const Item& f) {
+    const std::uint32_t p = v.nodes[0];
+    const auto& F = f.nodes;
+    if (v.body == f.body && (p == F[0] || p == F[1] || p == F[2])) return;
+    vertex_face(v.body, p, f.body, f.id, F);
+  };
+  auto ee = [&](const Item* e, const Item* g) {
+    if (e->body > g->body ||
+        (e->body == g->body && std::array<std::uint32_t, 2>{e->nodes[0], e->nodes[1]} >
+                                   std::array<std::uint32_t, 2>{g->nodes[0], g->nodes[1]}))
+      std::swap(e, g);
+    const std::uint32_t a = e->nodes[0], b = e->nodes[1], c = g->nodes[0], d = g->nodes[1];
+    if (e->body == g->body && (a == c || a == d || b == c || b == d)) return;
+    edge_edge(e->body, a, b, g->body, c, d);
+  };
+  for (std::size_t i = 0; i < items.size(); ++i) {
+    const Item& A = items[i];
+    for (std::size_t j = i + 1; j < items.size() && items[j].lo[0] <= A.hi[0]; ++j) {
+      const Item& B = items[j];
+      if (!A.moving && !B.moving) continue;  // all four nodes still
+      if (A.body == B.body && !bodies[A.body].self) continue;
+      if (A.lo[1] > B.hi[1] || B.lo[1] > A.hi[1] || A.lo[2] > B.hi[2] || B.lo[2] > A.hi[2])
+        continue;
+      if (A.kind == kVertex && B.kind == kTriangle) vf(A, B);
+      if (A.kind == kTriangle && B.kind == kVertex) vf(B, A);
+      if (A.kind == kEdge && B.kind == kEdge) ee(&A, &B);
+    }
+  }
+}
+
+/// Position of node `n` of `body` at the start (end = false) or the end of the step.
+inline Vec3d oracle_point(const OracleBody& body, std::uint32_t n, bool end) {
+  const double* x = (end ? body.x1 : body.x0) + std::size_t(n) * 3;
+  return Vec3d{x[0], x[1], x[2]};
+}
+
+/// All contacts of the step through the elementary tests of ccd.hpp, sorted by
+/// `contact_less`, named as the runtime names them.
+inline std::vector<Contact> scene_brute_contacts(const std::vector<OracleBody>& bodies) {
   std::vector<Contact> out;
   auto add = [&](ContactKind kind, std::uint32_t ba, std::uint32_t bb,
                  std::array<std::uint32_t, 4> nodes, std::uint32_t tri, CcdResult r) {
@@ -103,41 +147,24 @@ inline std::vector<Contact> scene_brute_contacts(const std::vector<OracleBody>& 
     c.toi = c.at_start ? 0.0 : r.toi;
     out.push_back(c);
   };
-  auto vertex_face = [&](const Item& v, const Item& f) {
-    const std::uint32_t p = v.nodes[0];
-    const auto& F = f.nodes;
-    if (v.body == f.body && (p == F[0] || p == F[1] || p == F[2])) return;
-    add(ContactKind::kVertexFace, v.body, f.body, {p, F[0], F[1], F[2]}, f.id,
-        vertex_face_ccd(point(v.body, p, false), point(f.body, F[0], false),
-                        point(f.body, F[1], false), point(f.body, F[2], false),
-                        point(v.body, p, true), point(f.body, F[0], true),
-                        point(f.body, F[1], true), point(f.body, F[2], true)));
+  auto at = [&](std::uint32_t b, std::uint32_t n, bool end) {
+    return oracle_point(bodies[b], n, end);
   };
-  auto edge_edge = [&](const Item* e, const Item* g) {
-    if (e->body > g->body ||
-        (e->body == g->body && std::array<std::uint32_t, 2>{e->nodes[0], e->nodes[1]} >
-                                   std::array<std::uint32_t, 2>{g->nodes[0], g->nodes[1]}))
-      std::swap(e, g);
-    const std::uint32_t a = e->nodes[0], b = e->nodes[1], c = g->nodes[0], d = g->nodes[1];
-    if (e->body == g->body && (a == c || a == d || b == c || b == d)) return;
-    add(ContactKind::kEdgeEdge, e->body, g->body, {a, b, c, d}, 0,
-        edge_edge_ccd(point(e->body, a, false), point(e->body, b, false), point(g->body, c, false),
-                      point(g->body, d, false), point(e->body, a, true), point(e->body, b, true),
-                      point(g->body, c, true), point(g->body, d, true)));
-  };
-  for (std::size_t i = 0; i < items.size(); ++i) {
-    const Item& A = items[i];
-    for (std::size_t j = i + 1; j < items.size() && items[j].lo[0] <= A.hi[0]; ++j) {
-      const Item& B = items[j];
-      if (!A.moving && !B.moving) continue;  // all four nodes still
-      if (A.body == B.body && !bodies[A.body].self) continue;
-      if (A.lo[1] > B.hi[1] || B.lo[1] > A.hi[1] || A.lo[2] > B.hi[2] || B.lo[2] > A.hi[2])
-        continue;
-      if (A.kind == kVertex && B.kind == kTriangle) vertex_face(A, B);
-      if (A.kind == kTriangle && B.kind == kVertex) vertex_face(B, A);
-      if (A.kind == kEdge && B.kind == kEdge) edge_edge(&A, &B);
-    }
-  }
+  for_each_feature_pair(
+      bodies,
+      [&](std::uint32_t vb, std::uint32_t p, std::uint32_t fb, std::uint32_t tri,
+          const std::array<std::uint32_t, 3>& F) {
+        add(ContactKind::kVertexFace, vb, fb, {p, F[0], F[1], F[2]}, tri,
+            vertex_face_ccd(at(vb, p, false), at(fb, F[0], false), at(fb, F[1], false),
+                            at(fb, F[2], false), at(vb, p, true), at(fb, F[0], true),
+                            at(fb, F[1], true), at(fb, F[2], true)));
+      },
+      [&](std::uint32_t eb, std::uint32_t a, std::uint32_t b, std::uint32_t gb, std::uint32_t c,
+          std::uint32_t d) {
+        add(ContactKind::kEdgeEdge, eb, gb, {a, b, c, d}, 0,
+            edge_edge_ccd(at(eb, a, false), at(eb, b, false), at(gb, c, false), at(gb, d, false),
+                          at(eb, a, true), at(eb, b, true), at(gb, c, true), at(gb, d, true)));
+      });
   std::sort(out.begin(), out.end(), contact_less);
   return out;
 }
