@@ -1,6 +1,6 @@
 // Normal-cone mode (ColliderMode::kCone): on deforming sequences it reports exactly the
-// contacts brute force finds (the mode only skips patches proven embedded for the whole step),
-// while actually culling node self-tests.
+// contacts the brute-force scene oracle finds (the mode only skips patches proven embedded for the
+// whole step), while actually culling node self-tests.
 
 #include <algorithm>
 #include <cmath>
@@ -21,34 +21,29 @@ struct ConeReport {
   std::uint64_t cone_culled = 0, cone_pairs = 0, bvh_pairs = 0;
 };
 
-/// Steps until (and including) the first contact: cone equals brute (any, earliest, every
-/// contact); later steps may start self-intersecting and are not compared.
+/// Steps until (and including) the first contact: cone finds exactly the oracle's contacts
+/// (compare.hpp: any, earliest, every contact at the same toi, the exact contacts); later steps
+/// may start self-intersecting and are not compared.
 ConeReport compare_cone(const Scene& scene, const std::vector<std::vector<double>>& frames) {
   Collider cone = collider_for(scene, ColliderMode::kCone);
   Collider bvh = collider_for(scene, ColliderMode::kBvh);
-  Collider brute = collider_for(scene, ColliderMode::kBrute);
   REQUIRE(cone.status() == ColliderStatus::kOk);
   ConeReport rep;
   for (std::size_t f = 0; f + 1 < frames.size(); ++f) {
     CAPTURE(f);
-    const StepAnswer b = answer(brute, frames[f].data(), frames[f + 1].data());
-    const StepAnswer c = answer(cone, frames[f].data(), frames[f + 1].data());
-    (void)answer(bvh, frames[f].data(), frames[f + 1].data());
+    const double* x0 = frames[f].data();
+    const double* x1 = frames[f + 1].data();
+    const std::vector<Contact> oracle = oracle_contacts(scene, x0, x1);
+    require_exact_contacts_found(scene, x0, x1, oracle);
+    const StepAnswer c = answer(cone, x0, x1);
+    (void)answer(bvh, x0, x1);
     ++rep.steps;
     rep.cone_culled += cone.stats().node_pairs_orientation_culled;
     rep.cone_pairs += cone.stats().triangle_pairs;
     rep.bvh_pairs += bvh.stats().triangle_pairs;
-    REQUIRE(c.any == b.any);
-    REQUIRE(c.contacts.size() == b.contacts.size());
-    for (std::size_t i = 0; i < b.contacts.size(); ++i) {
-      CAPTURE(describe(b.contacts[i]));
-      REQUIRE(same_feature(c.contacts[i], b.contacts[i]));
-      CHECK(c.contacts[i].toi == b.contacts[i].toi);
-    }
-    if (b.any) {
+    require_matches_oracle(c, oracle, Expect::kAllContacts);
+    if (!oracle.empty()) {
       ++rep.contact_steps;
-      REQUIRE(c.earliest.found);
-      CHECK(c.earliest.contact.toi == b.earliest.contact.toi);
       break;
     }
   }
@@ -130,28 +125,22 @@ TEST_CASE("Whole-surface modes find contacts of feature pairs held only by adjac
   const std::vector<std::vector<double>> ends = {
       {0, 0, 0, 1, 0, 0, 0, 1, 0, 0.25, 0.3, -1},        // apex through the base
       {0, 0, 0, 1, 0, 0, 0.1, 1, 0.2, 0.9, 0.8, -0.6}};  // edge 2-3 crosses edge 0-1
+  std::vector<format::Triangle> triangles;
+  for (int t = 0; t < 4; ++t) triangles.push_back({tris[3 * t], tris[3 * t + 1], tris[3 * t + 2]});
   for (const auto& end : ends) {
-    std::vector<StepAnswer> answers;
+    const OracleBody body{triangles.data(), triangles.size(), start.data(), end.data(), true};
+    const std::vector<Contact> oracle = scene_brute_contacts({body});
+    REQUIRE_FALSE(oracle.empty());
+    require_exact_contacts_found(body, oracle);
     for (ColliderMode mode : {ColliderMode::kBrute, ColliderMode::kBvh, ColliderMode::kCone}) {
+      CAPTURE(to_string(mode));
       ColliderOptions options;
       options.mode = mode;
       Collider collider(shape, options);
       REQUIRE(collider.status() == ColliderStatus::kOk);
-      answers.push_back(answer(collider, start.data(), end.data()));
+      require_matches_oracle(answer(collider, start.data(), end.data()), oracle,
+                             Expect::kAllContacts);
       if (mode != ColliderMode::kBrute) CHECK(collider.stats().triangle_pairs == 0);
-    }
-    const StepAnswer& b = answers[0];
-    REQUIRE(b.any);
-    for (std::size_t m = 1; m < answers.size(); ++m) {
-      const StepAnswer& a = answers[m];
-      CAPTURE(m);
-      REQUIRE(a.contacts.size() == b.contacts.size());
-      for (std::size_t i = 0; i < b.contacts.size(); ++i) {
-        CAPTURE(describe(b.contacts[i]));
-        CHECK(same_feature(a.contacts[i], b.contacts[i]));
-        CHECK(a.contacts[i].toi == b.contacts[i].toi);
-      }
-      CHECK(a.earliest.contact.toi == b.earliest.contact.toi);
     }
   }
 }

@@ -108,20 +108,23 @@ inline bool in_culled_pair(const Collider& rvbc, const Scene& scene, const Conta
   return false;
 }
 
-/// The oracle's contacts over the collider's one body (self-collision on), sorted.
+/// The collider's one body for the oracles (self-collision on) over the step x0 -> x1.
+inline OracleBody oracle_body(const Scene& scene, const double* x0, const double* x1) {
+  const format::Asset& a = scene.asset.data();
+  return OracleBody{a.triangles.data(), a.triangles.size(), x0, x1, true};
+}
+
+/// The oracle's contacts of the step, sorted.
 inline std::vector<Contact> oracle_contacts(const Scene& scene, const double* x0,
                                             const double* x1) {
-  const format::Asset& a = scene.asset.data();
-  return scene_brute_contacts({OracleBody{a.triangles.data(), a.triangles.size(), x0, x1, true}});
+  return scene_brute_contacts({oracle_body(scene, x0, x1)});
 }
 
 /// Every exact contact of the step is an oracle contact at a toi no later than the exact one.
 /// Returns the exact earliest toi rounded up (2 when there is none).
-inline double require_exact_contacts_found(const Scene& scene, const double* x0, const double* x1,
+inline double require_exact_contacts_found(const OracleBody& body,
                                            const std::vector<Contact>& oracle) {
-  const format::Asset& a = scene.asset.data();
-  const std::vector<Contact> exact =
-      scene_exact_contacts({OracleBody{a.triangles.data(), a.triangles.size(), x0, x1, true}});
+  const std::vector<Contact> exact = scene_exact_contacts({body});
   for (const Contact& e : exact) {
     CAPTURE(describe(e));
     const auto it = std::find_if(oracle.begin(), oracle.end(),
@@ -131,6 +134,11 @@ inline double require_exact_contacts_found(const Scene& scene, const double* x0,
     if (e.at_start) REQUIRE(it->at_start);
   }
   return exact.empty() ? 2.0 : exact.front().toi;
+}
+
+inline double require_exact_contacts_found(const Scene& scene, const double* x0, const double* x1,
+                                           const std::vector<Contact>& oracle) {
+  return require_exact_contacts_found(oracle_body(scene, x0, x1), oracle);
 }
 
 /// What a mode must report against the oracle's contacts.
