@@ -667,6 +667,7 @@ bool Collider::Impl::run_query(Contact* out, std::size_t out_cap) noexcept {
   // the serial ones. A caller buffer keeps the serial path (its truncation is order-bound).
   const bool parallel = workers.size() > 1 && out == nullptr && !rest_mode;
   (void)parallel;
+  std::uint32_t team = 1;  // threads that ran the traversal
   if (!stats.nothing_moved || rest_mode) {
     const std::uint32_t nc = cluster_count();
     const std::int64_t nv = static_cast<std::int64_t>(topo->surf_nodes.size());
@@ -680,6 +681,8 @@ bool Collider::Impl::run_query(Contact* out, std::size_t out_cap) noexcept {
 #pragma omp parallel num_threads(static_cast <int>(workers.size()))
         {
           Worker& w = workers[static_cast<std::size_t>(omp_get_thread_num())];
+#pragma omp single
+          team = static_cast<std::uint32_t>(omp_get_num_threads());
 #pragma omp for schedule(dynamic, 16)
           for (std::int64_t i = 0; i < nv; ++i)
             if (!w.stop) brute_vertex_faces(w, static_cast<std::uint32_t>(i));
@@ -701,6 +704,8 @@ bool Collider::Impl::run_query(Contact* out, std::size_t out_cap) noexcept {
 #pragma omp parallel num_threads(static_cast <int>(workers.size()))
         {
           Worker& w = workers[static_cast<std::size_t>(omp_get_thread_num())];
+#pragma omp single
+          team = static_cast<std::uint32_t>(omp_get_num_threads());
 #pragma omp for schedule(dynamic, 1)
           for (std::int64_t c = 0; c < static_cast<std::int64_t>(nc); ++c)
             if (!w.stop && !w.overflow &&
@@ -733,6 +738,7 @@ bool Collider::Impl::run_query(Contact* out, std::size_t out_cap) noexcept {
     }
     if (any_best) close_contacts(w0, earliest);
   }
+  stats.traversal_threads = team;
   // Merge in worker order.
   bool overflow = false, hit = false;
   std::size_t found = 0;

@@ -298,11 +298,14 @@ ColliderStatus Scene::Impl::run(QueryKind kind, Contact* out, std::size_t cap,
     add_counts(pair_stats[pair_index(p.a, p.b)], w.stats);
   };
   const std::int64_t count = static_cast<std::int64_t>(live.size());
+  stats.pair_threads = 1;
 #if defined(TETSEG_HAVE_OPENMP)
   if (workers.size() > 1 && out == nullptr && count > 1) {
 #pragma omp parallel num_threads(static_cast <int>(workers.size()))
     {
       Worker& w = workers[static_cast<std::size_t>(omp_get_thread_num())];
+#pragma omp single
+      stats.pair_threads = static_cast<std::uint32_t>(omp_get_num_threads());
 #pragma omp for schedule(dynamic, 1)
       for (std::int64_t k = 0; k < count; ++k) {
         bool stopped;

@@ -289,10 +289,7 @@ TEST_CASE(
     "2-manifold boundary",
     "[meshing][cgal-data][slow]") {
   const std::string path = std::string(TETSEG_CGAL_MESH_DIR) + "/rotor_small.off";
-  if (!std::filesystem::exists(path)) {
-    WARN("CGAL demo meshes not found; skipping");
-    return;
-  }
+  if (!tetseg::test::have_test_data(path, "CGAL demo mesh rotor_small.off")) return;
   const TriangleMesh s = read_triangle_mesh(path);
   const Checked c = check_valid(tetrahedralize(s, MeshingOptions{}, path));
   CHECK(c.volume == Approx(std::abs(enclosed_volume(s.vertices, s.triangles))).epsilon(0.05));

@@ -156,7 +156,7 @@ TEST_CASE("Refinement respects the cluster bound and the minimum size", "[refine
   CHECK(counts.splits == 0);
 }
 
-TEST_CASE("Two halves of a box merge into one cluster; star-shaped clusters stay", "[refine]") {
+TEST_CASE("Two halves of a box merge into one cluster, and star-shaped clusters stay", "[refine]") {
   const VoxelShape box = make_voxel_shape(4, 2, 2, 1, [](double, double, double) { return true; });
   Segmentation halves;
   halves.cluster_count = 2;

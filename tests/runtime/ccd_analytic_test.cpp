@@ -311,8 +311,9 @@ TEST_CASE("Non-finite input is reported as a contact, never as a proof of separa
   CHECK(tetseg::edge_edge_ccd(z, x, inf, y, z, x, inf, y).hit());
 }
 
-TEST_CASE("An infinite minimum separation reports every pair; negative or NaN means zero.",
-          "[ccd]") {
+TEST_CASE(
+    "An infinite minimum separation reports every pair, and a negative or NaN one means zero.",
+    "[ccd]") {
   const Motion far = point_vs_triangle({5, 5, 5}, {6, 6, 6});
   const Transform identity;
   CcdOptions o;

@@ -72,6 +72,8 @@ TEST_CASE("OpenMP results are identical to serial results", "[collider][openmp]"
       CHECK(ea.contact.toi == eb.contact.toi);
     }
     CHECK(contacts_ok(serial, nullptr, 0).found == contacts_ok(parallel, nullptr, 0).found);
+    CHECK(serial.stats().traversal_threads == 1);
+    REQUIRE(parallel.stats().traversal_threads > 1);  // parallel against serial, not serial twice
     CHECK(serial.stats().triangles_positive == parallel.stats().triangles_positive);
     CHECK(serial.stats().triangles_uncertain == parallel.stats().triangles_uncertain);
     CHECK(serial.stats().feature_tests == parallel.stats().feature_tests);
@@ -103,6 +105,8 @@ TEST_CASE("Parallel brute force equals serial brute force", "[collider][openmp]"
     REQUIRE(ea.found == eb.found);
     if (ea.found) CHECK(ea.contact.nodes == eb.contact.nodes);
     CHECK(contacts_ok(serial, nullptr, 0).found == contacts_ok(parallel, nullptr, 0).found);
+    CHECK(serial.stats().traversal_threads == 1);
+    REQUIRE(parallel.stats().traversal_threads > 1);  // parallel against serial, not serial twice
     CHECK(serial.stats().feature_tests == parallel.stats().feature_tests);
     total += contacts_ok(serial, nullptr, 0).found;
   }

@@ -378,6 +378,7 @@ TEST_CASE("Triangles scattered over many clusters under random deformations agre
     REQUIRE(es.found == ep.found);
     if (es.found) CHECK(same_feature(es.contact, ep.contact));
     CHECK(contacts_ok(serial, nullptr, 0).found == contacts_ok(parallel, nullptr, 0).found);
+    REQUIRE(parallel.stats().traversal_threads > 1);  // parallel against serial, not serial twice
     CHECK(serial.stats().feature_pairs == parallel.stats().feature_pairs);
     CHECK(serial.stats().feature_tests == parallel.stats().feature_tests);
     CHECK(serial.stats().triangle_pairs == parallel.stats().triangle_pairs);

@@ -574,6 +574,7 @@ TEST_CASE("Scene: OpenMP results equal serial results", "[scene][openmp]") {
     REQUIRE(parallel.add_body(b.shape, o) == ColliderStatus::kOk);
   }
   std::size_t total = 0;
+  int parallel_steps = 0;
   for (std::size_t f = 0; f + 1 < global_frames.size(); ++f) {
     const auto& g0 = global_frames[f];
     const auto& g1 = global_frames[f + 1];
@@ -597,6 +598,8 @@ TEST_CASE("Scene: OpenMP results equal serial results", "[scene][openmp]") {
     REQUIRE(serial.contacts(nullptr, 0, rs) == ColliderStatus::kOk);
     REQUIRE(parallel.contacts(nullptr, 0, rp) == ColliderStatus::kOk);
     CHECK(rs.found == rp.found);
+    CHECK(serial.stats().pair_threads == 1);
+    parallel_steps += parallel.stats().pair_threads > 1 ? 1 : 0;
     CHECK(serial.stats().body_pairs_tested == parallel.stats().body_pairs_tested);
     for (std::uint32_t a = 0; a < bodies.size(); ++a)
       for (std::uint32_t b = a + 1; b < bodies.size(); ++b) {
@@ -606,6 +609,7 @@ TEST_CASE("Scene: OpenMP results equal serial results", "[scene][openmp]") {
     total += rs.found;
   }
   CHECK(total > 0);
+  REQUIRE(parallel_steps > 0);  // parallel against serial, not serial twice
 }
 
 TEST_CASE("Scene: random wobbling bodies against the oracle", "[scene][random]") {

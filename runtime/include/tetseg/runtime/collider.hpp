@@ -133,6 +133,9 @@ struct ColliderStats {
   std::uint64_t contacts = 0;                ///< elementary tests that reported contact
   bool nothing_moved = false;
   bool full_traversal = false;  ///< a complete traversal ran this step
+  /// Threads that ran the last traversal: 1 when serial, more when `use_openmp` took the
+  /// parallel path (tests assert it, so "parallel equals serial" never compares serial runs).
+  std::uint32_t traversal_threads = 0;
 };
 
 /// Result of a static intersection check of the surface at one instant.

@@ -62,6 +62,8 @@ struct SceneStats {
   std::uint64_t body_pairs_tested = 0;   ///< pairs traversed BVH against BVH (last full query)
   std::uint64_t body_pairs_skipped = 0;  ///< disabled, both still, or body boxes apart
   std::uint64_t contacts = 0;            ///< elementary tests that reported contact
+  /// Threads that ran the last inter-body traversal (1 when serial; see ColliderStats).
+  std::uint32_t pair_threads = 0;
 };
 
 class Scene {
