@@ -121,7 +121,7 @@ TEST_CASE("Many small clusters under random smooth deformations agree with brute
   const Waves waves(seed, 0.9, 4.0);
   const auto frames = make_frames(scene, 12, waves);
   const SequenceReport rep = compare_with_oracle(scene, frames);
-  CHECK(rep.frames_compared > 0);
+  CHECK(rep.contact_frames == 1);  // the waves do reach a contact
 }
 
 TEST_CASE(
@@ -331,8 +331,7 @@ TEST_CASE("Feature pairs held only by triangle pairs of two clusters sharing a n
           // time, is found.
           Collider rvbc = collider_for(scene, ColliderMode::kRvbc);
           require_matches_oracle(answer(rvbc, x0.data(), x1.data()),
-                                 oracle_contacts(scene, x0.data(), x1.data()),
-                                 Expect::kAllContacts);
+                                 step_truth(scene, x0.data(), x1.data()), Expect::kAllContacts);
         }
       }
     }
@@ -359,7 +358,7 @@ TEST_CASE("Triangles scattered over many clusters under random deformations agre
   const Waves waves(seed, 1.0, 4.0);
   const auto frames = make_frames(scene, 12, waves);
   const SequenceReport rep = compare_with_oracle(scene, frames);
-  CHECK(rep.frames_compared > 0);
+  CHECK(rep.contact_frames == 1);  // the waves do reach a contact
   // With OpenMP (the seam orphans tested after the parallel traversal) the answers and counts
   // are the serial ones, on the steps compared above.
   ColliderOptions parallel_options;
