@@ -88,7 +88,7 @@ def tetseg_run_json(bin_dir, asset, frames, mode, query="all"):
     return json.loads(out)
 
 
-def contacts_while_polled(engine, refusals=20, deadline_s=300.0):
+def contacts_while_polled(engine, refusals=20, deadline_s=60.0):
     """Runs engine.contacts() over and over on a thread while this thread reads engine.stats
     until `refusals` reads were refused (the engine was inside contacts() while this thread
     ran: the GIL is released there). No timing decides the answer: a faster machine only
