@@ -88,30 +88,27 @@ def tetseg_run_json(bin_dir, asset, frames, mode, query="all"):
     return json.loads(out)
 
 
-def contacts_while_polled(engine, refusals=20, deadline_s=60.0):
-    """Runs engine.contacts() over and over on a thread while this thread reads engine.stats
-    until `refusals` reads were refused (the engine was inside contacts() while this thread
-    ran: the GIL is released there). No timing decides the answer: a faster machine only
-    gets there sooner; with the GIL held during the query no read could ever be refused and
-    the deadline (a guard against hanging, far above any real run) ends the wait.
-    Returns (the contact count of the first query, the messages of the refused reads)."""
-    stop, result, refused = threading.Event(), [], []
+def contacts_while_polled(engine):
+    """Runs one engine.contacts() on a thread while this thread reads engine.stats in a loop
+    (no sleep: each read takes microseconds, the query many milliseconds, on any machine).
+    Returns (the contact count, the messages of the RuntimeErrors the reads got): with the GIL
+    released during the query nearly every read meanwhile is refused; with the GIL held this
+    thread cannot run while the query does (only a few reads, around its Python parts)."""
+    started, result, refused = threading.Event(), [], []
+    engine.contacts()  # the first call sizes the result array (numpy may yield the GIL there)
 
     def query():
-        while not stop.is_set():
-            result.append(len(engine.contacts()))
+        started.set()
+        result.append(len(engine.contacts()))
 
     worker = threading.Thread(target=query)
     worker.start()
-    end = time.monotonic() + deadline_s
-    try:
-        while len(refused) < refusals and time.monotonic() < end and worker.is_alive():
-            try:
-                engine.stats
-            except RuntimeError as error:
-                refused.append(str(error))
-    finally:
-        stop.set()
-        worker.join()
+    started.wait()
+    while worker.is_alive():
+        try:
+            engine.stats
+        except RuntimeError as error:
+            refused.append(str(error))
+    worker.join()
     assert result, "contacts() failed on the worker thread"
     return result[0], refused
