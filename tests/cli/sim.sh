@@ -42,7 +42,7 @@ set +e; "$bin/tetseg-bench" check d.tetseg n.tsf > checkn.txt; rc=$?; set -e
 "$bin/tetseg-bench" check d.tetseg c.tsf > /dev/null || fail "bvh-mode frames not clean"
 
 # Recorded queries: the substeps with contact as frame pairs, the main frames unchanged; each
-# pair's end penetrates (brute force finds contacts) and every mode finds the earliest ones.
+# pair's end penetrates (the scene oracle finds contacts) and every mode finds the earliest ones.
 "$sim" d.mesh d.tetseg -o q.tsf --frames 150 "${args[@]}" --json --record-queries q.queries.tsf \
   --record-every 3 > q.json
 cmp a.tsf q.tsf || fail "recording the queries changed the frames"
@@ -53,15 +53,16 @@ n = d["queries_recorded"]
 assert n == (d["substeps_with_contact"] + 2) // 3 and n > 0, d
 assert os.path.getsize("q.queries.tsf") == 24 + 24 * d["nodes"] * 2 * n, d
 PY
-"$bin/tetseg-bench" table d d.tetseg q.queries.tsf --pairs --modes rvbc,bvh,cone --repeat 1 \
-  --json > qt.json || fail "a mode missed a contact on the recorded queries"
+"$bin/tetseg-bench" table d d.tetseg q.queries.tsf --pairs --modes rvbc,bvh,cone,brute \
+  --repeat 1 --json > qt.json || fail "a mode missed a contact on the recorded queries"
 python3 - <<'PY'
 import json
 rows = json.load(open("qt.json"))["rows"]
 brute = [r for r in rows if r["mode"] == "brute"][0]
 assert brute["contacts"] > 0 and brute["compared"] == brute["steps"], brute
-for r in rows:
+for r in rows:  # every mode, brute included, against the scene oracle
     assert r["missed"] == 0 and r["any_mismatch"] == 0 and r["toi_later"] == 0, r
+    assert r["extra"] == 0, r
 PY
 "$sim" d.mesh d.tetseg -o x.tsf --frames 2 --substeps 1 --dt 0.005 --drop 1 \
   --record-queries xq.tsf 2>err.txt && fail "no query to record: must fail"
