@@ -20,7 +20,9 @@
 #include <algorithm>
 #include <cmath>
 
+#include "ccd_bernstein.hpp"
 #include "ccd_interval.hpp"
+#include "ccd_plane.hpp"
 #include "tetseg/runtime/ccd.hpp"
 
 namespace tetseg {
@@ -251,19 +253,74 @@ bool all_finite(const Vec3d* const* points, int count) noexcept {
 /// inside (0,1)): there the other tests cannot exclude anything (their conditions are proven
 /// false), and contact happens exactly where the cubic vanishes. Any subset of the tests is
 /// sound (each is a necessary condition of contact); this one only drops useless work.
-enum class Depth { kFilter, kFull, kCoplanarOnly };
+/// kOpenCondition (exact contact, four points in one plane): below an interval certified with
+/// one inside condition open, that condition alone decides (subdivided, never recomputed).
+/// kCubicFirst (exact contact): below an interval where the coplanarity cubic changes sign,
+/// the subdivided cubic excludes sub-intervals, and a sub-interval it cannot exclude is given
+/// the full check only once the cubic no longer changes sign on it or it is a leaf (the
+/// crossing is isolated first; the inside conditions are then tested once, near it).
+enum class Depth { kFilter, kFull, kCoplanarOnly, kOpenCondition, kCubicFirst };
 
 /// Outcome of one interval: excluded, or open (with `inside` when every inside condition is
 /// proven strictly positive on it, so that its sub-intervals need only kCoplanarOnly).
+/// Exact contact only, a positive certificate: `certified` when a contact certainly exists in
+/// the interval, `contact_at_start` when its start is a contact time.
 struct IntervalOutcome {
   bool excluded = false;
   bool inside = false;
+  bool certified = false;
+  bool contact_at_start = false;
+  /// Certified in the plane with one inside condition open: on sub-intervals, contact happens
+  /// exactly where that condition is >= 0 (the others are proven positive).
+  bool open_condition = false;
 };
 
 /// True when every Bernstein sum is proven strictly positive (the polynomial > 0 on T).
 template <class I, int N>
 bool positive(const Sums<I, N>& raw) noexcept {
   return range_of(raw).lo > 0.0;
+}
+
+/// True when the polynomial is proven to take both signs on T: its values at the ends (the
+/// first and last Bernstein sums) are of strictly opposite signs, so it has a root in T.
+template <class I, int N>
+bool sign_change(const Sums<I, N>& raw) noexcept {
+  return (upper(raw.s[0]) < 0.0 && lower(raw.s[N]) > 0.0) ||
+         (lower(raw.s[0]) > 0.0 && upper(raw.s[N]) < 0.0);
+}
+
+/// Positive certificate of an open interval (exact contact), from the coplanarity cubic f and
+/// the inside conditions g[0..count) (vertex-face: the three edge-plane quartics; edge-edge:
+/// h1..h4), whose joint non-negativity on the plane of the four points means contact (with
+/// the triangle non-degenerate, the edges not parallel: implied below by a proven-positive
+/// condition, as A e_ab = ... and h1 + h2 = h3 + h4 = |n|^2). `in_plane`: the four points stay
+/// in one plane for the whole step (f vanishes identically).
+///  - every condition proven positive on T and f changing sign on T: contact at f's root;
+///  - in the plane, every condition positive on T: every time of T is a contact (its start);
+///  - in the plane, all conditions but one positive on T and that one positive at an end of
+///    T: contact at that end (and `open_condition`, its sums copied to *open_condition).
+template <class I, int N>
+IntervalOutcome certify(const Sums<I, 3>& f, const Sums<I, 4>* const* conditions, bool in_plane,
+                        bool inside, Sums<I, 4>* open_condition) noexcept {
+  IntervalOutcome out{false, inside, false, false};
+  if (inside) {
+    out.contact_at_start = in_plane;
+    out.certified = in_plane || sign_change(f);
+    return out;
+  }
+  if (!in_plane) return out;
+  int open = -1;
+  for (int k = 0; k < N; ++k) {
+    if (positive(*conditions[k])) continue;
+    if (open >= 0) return out;
+    open = k;
+  }
+  const Sums<I, 4>& g = *conditions[open];
+  out.contact_at_start = lower(g.s[0]) > 0.0;
+  out.certified = out.contact_at_start || lower(g.s[4]) > 0.0;
+  out.open_condition = out.certified;
+  if (out.certified && open_condition != nullptr) *open_condition = g;
+  return out;
 }
 
 /// The four points of a query at the ends of the time interval [ta, tb]: x[i][0] at ta,
@@ -282,10 +339,12 @@ struct VertexFaceTest {
   const Vec3d* x0[4];
   const Vec3d* x1[4];
   Separation sep;
+  /// The four points stay in one axis-aligned plane for the whole step.
+  bool in_plane = in_axis_plane(x0, x1);
 
   template <class I>
-  IntervalOutcome check(double ta, double tb, Depth depth,
-                        Sums<I, 3>* coplanarity = nullptr) const noexcept {
+  IntervalOutcome check(double ta, double tb, Depth depth, Sums<I, 3>* coplanarity = nullptr,
+                        Sums<I, 4>* open_condition = nullptr) const noexcept {
     Vec<I> x[4][2];
     positions_at<I>(x0, x1, ta, tb, x);
     if (boxes_disjoint<I>(x, 1, x + 1, 3, sep)) return {true, false};
@@ -317,9 +376,19 @@ struct VertexFaceTest {
       return {true, false};
     const bool inside = positive(e_ab) && positive(e_bc) && positive(e_ca);
     if (!sep.zero()) return {false, inside};
-    return {negative_where_coplanar(e_ab, f) || negative_where_coplanar(e_bc, f) ||
-                negative_where_coplanar(e_ca, f),
-            inside};
+    if (negative_where_coplanar(e_ab, f) || negative_where_coplanar(e_bc, f) ||
+        negative_where_coplanar(e_ca, f))
+      return {true, false};
+    const Sums<I, 4>* const conditions[3] = {&e_ab, &e_bc, &e_ca};
+    return certify<I, 3>(f, conditions, in_plane, inside, open_condition);
+  }
+
+  /// True when p certainly lies in the triangle at t = 0 (at_end false) or t = 1 (true),
+  /// all four points in one axis-aligned plane then.
+  bool contact_at(bool at_end) const noexcept {
+    const Vec3d* const* x = at_end ? x1 : x0;
+    const int axis = shared_axis(x);
+    return axis >= 0 && vertex_strictly_in_triangle_2d(*x[0], *x[1], *x[2], *x[3], axis);
   }
 };
 
@@ -328,10 +397,12 @@ struct EdgeEdgeTest {
   const Vec3d* x0[4];
   const Vec3d* x1[4];
   Separation sep;
+  /// The four points stay in one axis-aligned plane for the whole step.
+  bool in_plane = in_axis_plane(x0, x1);
 
   template <class I>
-  IntervalOutcome check(double ta, double tb, Depth depth,
-                        Sums<I, 3>* coplanarity = nullptr) const noexcept {
+  IntervalOutcome check(double ta, double tb, Depth depth, Sums<I, 3>* coplanarity = nullptr,
+                        Sums<I, 4>* open_condition = nullptr) const noexcept {
     Vec<I> x[4][2];
     positions_at<I>(x0, x1, ta, tb, x);
     if (boxes_disjoint<I>(x, 2, x + 2, 2, sep)) return {true, false};
@@ -404,9 +475,11 @@ struct EdgeEdgeTest {
     // edges touch exactly where the coplanarity cubic vanishes.
     const bool inside = positive(h1) && positive(h2) && positive(h3) && positive(h4);
     if (!sep.zero()) return {false, inside};
-    return {negative_where_coplanar(h1, f) || negative_where_coplanar(h2, f) ||
-                negative_where_coplanar(h3, f) || negative_where_coplanar(h4, f),
-            inside};
+    if (negative_where_coplanar(h1, f) || negative_where_coplanar(h2, f) ||
+        negative_where_coplanar(h3, f) || negative_where_coplanar(h4, f))
+      return {true, false};
+    const Sums<I, 4>* const conditions[4] = {&h1, &h2, &h3, &h4};
+    return certify<I, 4>(f, conditions, in_plane, inside, open_condition);
   }
 
   /// Plane through the edge with direction e (from point o), normal e x (e x (near - o)):
@@ -425,6 +498,14 @@ struct EdgeEdgeTest {
     return mul_down(far_range.hi, far_range.hi) >
            mul_up(sep.delta2, mul_up(e2, cross_norm2_upper(e, near_o)));
   }
+
+  /// True when the edges certainly cross at t = 0 (at_end false) or t = 1 (true), all four
+  /// points in one axis-aligned plane then.
+  bool contact_at(bool at_end) const noexcept {
+    const Vec3d* const* x = at_end ? x1 : x0;
+    const int axis = shared_axis(x);
+    return axis >= 0 && segments_cross_2d(*x[0], *x[1], *x[2], *x[3], axis);
+  }
 };
 
 double clamp_tolerance(double tol) noexcept {
@@ -432,46 +513,49 @@ double clamp_tolerance(double tol) noexcept {
   return min_nan(tol, 1.0);
 }
 
-/// Bernstein coefficients (not sums) of the coplanarity cubic on an interval.
-struct Cubic {
-  Iv b[4];
-};
-
-Cubic cubic_of(const Sums<Iv, 3>& f) noexcept {
-  return {{f.s[0], divide(f.s[1], 3.0), divide(f.s[2], 3.0), f.s[3]}};
+/// Bernstein coefficients of a polynomial of degree 3 or 4 on an interval (the coplanarity
+/// cubic, or an inside condition), from its enclosed sums: the midpoints with the largest
+/// radius as error bound.
+template <int N>
+FloatBernstein float_bernstein(const Sums<Iv, N>& sums) noexcept {
+  static_assert(N == 3 || N == 4, "degrees 3 and 4");
+  constexpr double kBinomial[2][5] = {{1, 3, 3, 1, 0}, {1, 4, 6, 4, 1}};
+  FloatBernstein p{{}, N, 0.0};
+  for (int k = 0; k <= N; ++k) {
+    const Iv b = (k == 0 || k == N) ? sums.s[k] : divide(sums.s[k], kBinomial[N - 3][k]);
+    p.c[k] = b.m;
+    p.err = max_nan(p.err, b.r);
+  }
+  return p;
 }
 
-Iv average(Iv a, Iv b) noexcept {
-  return (a + b) * exact(0.5);
-}
-
-/// De Casteljau at the midpoint: the cubic's coefficients on both halves (rigorous: each
-/// coefficient of a half is an average of averages of the enclosed coefficients).
-void split(const Cubic& c, Cubic& left, Cubic& right) noexcept {
-  const Iv b01 = average(c.b[0], c.b[1]);
-  const Iv b12 = average(c.b[1], c.b[2]);
-  const Iv b23 = average(c.b[2], c.b[3]);
-  const Iv b012 = average(b01, b12);
-  const Iv b123 = average(b12, b23);
-  const Iv mid = average(b012, b123);
-  left = {{c.b[0], b01, b012, mid}};
-  right = {{mid, b123, b23, c.b[3]}};
-}
-
-/// True when the cubic is proven of one sign on its interval.
-bool one_sign(const Cubic& c) noexcept {
-  const Sums<Iv, 3> sums{{c.b[0], c.b[1], c.b[2], c.b[3]}};
-  const Range r = range_of(sums);
+/// True when the coplanarity cubic f, known to vanish at t = 1, is proven nonzero on [0, 1).
+/// f = (1 - t) g with g quadratic; g's Bernstein coefficients on [0, 1] are f's sums
+/// s0, s1 / 2, s2 (from (1 - t) B_i^2 = C(2,i) / C(3,i) B_i^3), so one strict sign of those three
+/// sums makes g, hence f before t = 1, of one sign.
+bool nonzero_before_end(const Sums<Iv, 3>& f) noexcept {
+  const Sums<Iv, 2> g{{f.s[0], f.s[1], f.s[2]}};
+  const Range r = range_of(g);
   return r.lo > 0.0 || r.hi < 0.0;
+}
+
+/// Start of the last leaf of the bisection of [0, 1] down to the tolerance: 1 - 2^-k with
+/// 2^-k the first halving not above tol.
+double last_leaf_start(double tol) noexcept {
+  double width = 1.0;
+  while (width > tol) width *= 0.5;
+  return 1.0 - width;
 }
 
 struct Item {
   double ta, tb;
   /// kFull, or kCoplanarOnly inside an interval with the inside proven. Exact contact only:
-  /// then `cubic` holds the coplanarity cubic's coefficients on [ta, tb], subdivided from the
-  /// interval where the inside was proven, and the test is its sign (no recomputation).
+  /// then `poly` holds the coplanarity cubic's coefficients on [ta, tb], subdivided from the
+  /// interval where the inside was proven, and the test is its sign (no recomputation); or,
+  /// kOpenCondition, the open inside condition of an interval certified in the plane
+  /// (contact exactly where it is >= 0).
   Depth depth;
-  Cubic cubic;
+  FloatBernstein poly;
 };
 
 template <class Test>
@@ -495,43 +579,101 @@ CcdResult run_bisection(const Test& test, const CcdOptions& options) noexcept {
   // primitives graze within rounding of doubles): from then on double-double is tried on
   // every interval doubles cannot exclude, before splitting it.
   bool near_degenerate = false;
+  // A contact certainly exists in an interval examined so far (exact contact only). Every
+  // interval examined later starts before that contact (everything before an examined
+  // interval was proved contact-free), so the first leaf doubles cannot exclude is reported
+  // as it is: the double-double stage would only move toi later, never decide the hit.
+  bool certified = false;
+  auto report = [&](CcdOutcome outcome, double toi) {
+    result.outcome = outcome;
+    result.toi = toi;
+    return result;
+  };
+  // Start certificate: the four points start in one axis-aligned plane where they certainly
+  // touch.
+  if (exact_contact && test.contact_at(false)) {
+    result.intervals = 1;
+    return report(CcdOutcome::kContactAtStart, 0.0);
+  }
   while (top > 0) {
     const Item item = stack[--top];
     ++result.intervals;
-    const bool subdivided = exact_contact && item.depth == Depth::kCoplanarOnly;
+    const double tm = 0.5 * item.ta + 0.5 * item.tb;
+    const bool leaf = item.tb - item.ta <= tol || result.intervals >= max_intervals ||
+                      top + 2 > kStackSize || !(tm > item.ta && tm < item.tb);
     Sums<Iv, 3> f{};
+    Sums<Iv, 4> open{};
     IntervalOutcome outcome{};
-    if (subdivided)
-      outcome = {one_sign(item.cubic), true};
-    else
-      outcome = test.template check<Iv>(item.ta, item.tb, item.depth, &f);
+    bool checked = false;                       // outcome from the interval check on [ta, tb]
+    if (item.depth == Depth::kOpenCondition) {  // certified parent: contact where poly >= 0
+      outcome.excluded = proven_negative(item.poly);
+      outcome.certified = outcome.open_condition = true;
+      outcome.contact_at_start = start_positive(item.poly);
+    } else if (exact_contact && item.depth == Depth::kCoplanarOnly) {  // contact where poly = 0
+      outcome.excluded = proven_positive(item.poly) || proven_negative(item.poly);
+      outcome.inside = true;
+      outcome.certified = proven_sign_change(item.poly);
+    } else if (item.depth == Depth::kCubicFirst &&
+               (proven_positive(item.poly) || proven_negative(item.poly))) {
+      outcome.excluded = true;
+    } else if (item.depth == Depth::kCubicFirst && !leaf && proven_sign_change(item.poly)) {
+      FloatBernstein left{}, right{};
+      split_half(item.poly, left, right);
+      stack[top++] = {tm, item.tb, Depth::kCubicFirst, right};
+      stack[top++] = {item.ta, tm, Depth::kCubicFirst, left};
+      continue;
+    } else {
+      const Depth depth = item.depth == Depth::kCubicFirst ? Depth::kFull : item.depth;
+      outcome = test.template check<Iv>(item.ta, item.tb, depth, &f, &open);
+      checked = true;
+    }
     if (outcome.excluded) continue;
-    if (near_degenerate && test.template check<Dd>(item.ta, item.tb, item.depth).excluded) continue;
-    if (!start_tested) {
+    if (near_degenerate && !certified && checked &&
+        test.template check<Dd>(item.ta, item.tb, Depth::kFull).excluded)
+      continue;
+    if (!start_tested) {  // item is [0, 1] and f its coplanarity cubic
       start_tested = true;
       ++result.intervals;
+      if (outcome.contact_at_start) return report(CcdOutcome::kContactAtStart, 0.0);
       if (!test.template check<Iv>(0.0, 0.0, Depth::kFull).excluded &&
-          !(exact_contact && test.template check<Dd>(0.0, 0.0, Depth::kFull).excluded)) {
-        result.outcome = CcdOutcome::kContactAtStart;
-        result.toi = 0.0;
-        return result;
+          !(exact_contact && test.template check<Dd>(0.0, 0.0, Depth::kFull).excluded))
+        return report(CcdOutcome::kContactAtStart, 0.0);
+      // End certificate: the four points end in one axis-aligned plane where they certainly
+      // touch, so the coplanarity cubic vanishes at t = 1; if it is proven nonzero on [0, 1),
+      // t = 1 is the first contact, reported at the start of the last leaf of the bisection
+      // (what the bisection reports when the rest of the step is excluded).
+      if (exact_contact && test.contact_at(true)) {
+        if (nonzero_before_end(f)) return report(CcdOutcome::kContact, last_leaf_start(tol));
+        certified = true;
       }
     }
-    const double tm = 0.5 * item.ta + 0.5 * item.tb;
-    if (item.tb - item.ta <= tol || result.intervals >= max_intervals || top + 2 > kStackSize ||
-        !(tm > item.ta && tm < item.tb)) {
-      if (exact_contact && !near_degenerate && result.intervals < max_intervals &&
-          test.template check<Dd>(item.ta, item.tb, item.depth).excluded) {
+    // The start of the interval is a contact and everything before it is contact-free.
+    if (outcome.contact_at_start)
+      return report(item.ta == 0.0 ? CcdOutcome::kContactAtStart : CcdOutcome::kContact, item.ta);
+    certified = certified || outcome.certified;
+    if (leaf) {
+      if (exact_contact && !near_degenerate && !certified && result.intervals < max_intervals &&
+          test.template check<Dd>(item.ta, item.tb, Depth::kFull).excluded) {
         near_degenerate = true;
         continue;
       }
-      result.outcome = CcdOutcome::kContact;
-      result.toi = item.ta;
-      return result;
+      return report(CcdOutcome::kContact, item.ta);
     }
-    const Depth child = outcome.inside ? Depth::kCoplanarOnly : Depth::kFull;
-    Cubic left{}, right{};
-    if (exact_contact && outcome.inside) split(subdivided ? item.cubic : cubic_of(f), left, right);
+    // Children, exact contact: the open condition of an interval certified in the plane, the
+    // coplanarity cubic below an interval with the inside proven or where it changes sign,
+    // subdivided; else (and with a minimum separation) the check again.
+    Depth child = Depth::kFull;
+    FloatBernstein left{}, right{};
+    if (outcome.open_condition) {
+      child = Depth::kOpenCondition;
+      split_half(checked ? float_bernstein(open) : item.poly, left, right);
+    } else if (outcome.inside) {
+      child = Depth::kCoplanarOnly;
+      if (exact_contact) split_half(checked ? float_bernstein(f) : item.poly, left, right);
+    } else if (exact_contact && checked && sign_change(f)) {
+      child = Depth::kCubicFirst;
+      split_half(float_bernstein(f), left, right);
+    }
     stack[top++] = {tm, item.tb, child, right};
     stack[top++] = {item.ta, tm, child, left};
   }
