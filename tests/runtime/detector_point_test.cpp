@@ -16,6 +16,7 @@
 #include "tetseg/format/asset.hpp"
 #include "tetseg/runtime/classify.hpp"
 #include "tetseg/runtime/collider.hpp"
+#include "tetseg/testing/exact_poly.hpp"
 #include "tetseg/testing/synthetic_scenes.hpp"
 
 using namespace tetseg;
@@ -23,67 +24,13 @@ using namespace tetseg::test;
 
 namespace {
 
-// ------------------------------------------------------------ exact polynomial arithmetic
-
-using Poly = std::vector<mpq_class>;  // coefficients, lowest degree first
-
-void trim(Poly& p) {
-  while (!p.empty() && p.back() == 0) p.pop_back();
-}
-
-mpq_class eval(const Poly& p, const mpq_class& x) {
-  mpq_class v = 0;
-  for (std::size_t i = p.size(); i-- > 0;) v = v * x + p[i];
-  return v;
-}
-
-Poly remainder(Poly a, const Poly& b) {
-  trim(a);
-  while (a.size() >= b.size() && !a.empty()) {
-    const mpq_class q = a.back() / b.back();
-    const std::size_t shift = a.size() - b.size();
-    for (std::size_t i = 0; i < b.size(); ++i) a[i + shift] -= q * b[i];
-    a.pop_back();  // the leading term cancels exactly
-    trim(a);
-  }
-  return a;
-}
-
-int sign_changes(const std::vector<Poly>& seq, const mpq_class& x) {
-  int changes = 0, last = 0;
-  for (const Poly& p : seq) {
-    const int s = sgn(eval(p, x));
-    if (s == 0) continue;
-    if (last != 0 && s != last) ++changes;
-    last = s;
-  }
-  return changes;
-}
-
-/// True when p(t) > 0 for every t in [0, 1], decided exactly (endpoint signs and a Sturm
-/// sequence counting the distinct roots in (0, 1)).
-bool positive_on_unit_interval(Poly p) {
-  trim(p);
-  if (p.empty()) return false;  // identically zero
-  if (eval(p, 0) <= 0 || eval(p, 1) <= 0) return false;
-  std::vector<Poly> seq{p};
-  Poly d;
-  for (std::size_t i = 1; i < p.size(); ++i) d.push_back(p[i] * static_cast<long>(i));
-  trim(d);
-  if (d.empty()) return true;  // a positive constant
-  seq.push_back(d);
-  while (true) {
-    Poly r = remainder(seq[seq.size() - 2], seq.back());
-    if (r.empty()) break;
-    for (mpq_class& c : r) c = -c;
-    seq.push_back(r);
-  }
-  return sign_changes(seq, 0) - sign_changes(seq, 1) == 0;
-}
+using tetseg::test::exact::negated;
+using tetseg::test::exact::Poly;
+using tetseg::test::exact::positive_on_unit_interval;
 
 using Q3 = std::array<mpq_class, 3>;
 
-Q3 exact(const double* p) {
+Q3 rational(const double* p) {
   return {mpq_class(p[0]), mpq_class(p[1]), mpq_class(p[2])};
 }
 
@@ -96,9 +43,9 @@ mpq_class det3(const Q3& u, const Q3& v, const Q3& w) {
 /// p1[i] (i = o, a, b, c).
 Poly orientation_cubic(const double* const p0[4], const double* const p1[4]) {
   Q3 u0[3], du[3];
-  const Q3 o0 = exact(p0[0]), o1 = exact(p1[0]);
+  const Q3 o0 = rational(p0[0]), o1 = rational(p1[0]);
   for (int i = 0; i < 3; ++i) {
-    const Q3 a0 = exact(p0[i + 1]), a1 = exact(p1[i + 1]);
+    const Q3 a0 = rational(p0[i + 1]), a1 = rational(p1[i + 1]);
     for (int k = 0; k < 3; ++k) {
       u0[i][k] = a0[k] - o0[k];
       du[i][k] = (a1[k] - o1[k]) - u0[i][k];
@@ -108,11 +55,6 @@ Poly orientation_cubic(const double* const p0[4], const double* const p1[4]) {
           det3(du[0], u0[1], u0[2]) + det3(u0[0], du[1], u0[2]) + det3(u0[0], u0[1], du[2]),
           det3(du[0], du[1], u0[2]) + det3(du[0], u0[1], du[2]) + det3(u0[0], du[1], du[2]),
           det3(du[0], du[1], du[2])};
-}
-
-Poly negated(Poly p) {
-  for (mpq_class& c : p) c = -c;
-  return p;
 }
 
 }  // namespace
