@@ -604,7 +604,10 @@ CcdResult run_bisection(const Test& test, const CcdOptions& options) noexcept {
     Sums<Iv, 3> f{};
     Sums<Iv, 4> open{};
     IntervalOutcome outcome{};
-    bool checked = false;                       // outcome from the interval check on [ta, tb]
+    bool checked = false;  // outcome from the interval check on [ta, tb]
+    // The check this interval gets when it is not decided by a subdivided polynomial alone,
+    // and the one the double-double stage repeats.
+    const Depth depth = item.depth == Depth::kCoplanarOnly ? Depth::kCoplanarOnly : Depth::kFull;
     if (item.depth == Depth::kOpenCondition) {  // certified parent: contact where poly >= 0
       outcome.excluded = proven_negative(item.poly);
       outcome.certified = outcome.open_condition = true;
@@ -623,13 +626,11 @@ CcdResult run_bisection(const Test& test, const CcdOptions& options) noexcept {
       stack[top++] = {item.ta, tm, Depth::kCubicFirst, left};
       continue;
     } else {
-      const Depth depth = item.depth == Depth::kCubicFirst ? Depth::kFull : item.depth;
       outcome = test.template check<Iv>(item.ta, item.tb, depth, &f, &open);
       checked = true;
     }
     if (outcome.excluded) continue;
-    if (near_degenerate && !certified && checked &&
-        test.template check<Dd>(item.ta, item.tb, Depth::kFull).excluded)
+    if (near_degenerate && !certified && test.template check<Dd>(item.ta, item.tb, depth).excluded)
       continue;
     if (!start_tested) {  // item is [0, 1] and f its coplanarity cubic
       start_tested = true;
@@ -653,7 +654,7 @@ CcdResult run_bisection(const Test& test, const CcdOptions& options) noexcept {
     certified = certified || outcome.certified;
     if (leaf) {
       if (exact_contact && !near_degenerate && !certified && result.intervals < max_intervals &&
-          test.template check<Dd>(item.ta, item.tb, Depth::kFull).excluded) {
+          test.template check<Dd>(item.ta, item.tb, depth).excluded) {
         near_degenerate = true;
         continue;
       }
