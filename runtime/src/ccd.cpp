@@ -192,6 +192,15 @@ bool below_minus_delta(const Sums<I, N>& raw, const Separation& s, double scale2
   return r.hi < 0.0 && mul_down(r.hi, r.hi) > mul_up(s.delta2, scale2_hi);
 }
 
+/// True when an inside condition g (degree 4) excludes the interval: g below -delta, or (exact
+/// contact) g plus a multiple of the coplanarity cubic f negative, so g < 0 wherever f = 0.
+/// Tested per condition, right after it is computed: the earliest exclusion skips the rest.
+template <class I>
+bool outside(const Sums<I, 4>& g, const Sums<I, 3>& f, const Separation& s,
+             double scale2_hi) noexcept {
+  return below_minus_delta(g, s, scale2_hi) || (s.zero() && negative_where_coplanar(g, f));
+}
+
 /// True when the function is provably > 0 on the interval (beyond delta * sqrt(scale2)).
 template <class I, int N>
 bool above_delta(const Sums<I, N>& raw, const Separation& s, double scale2_hi) noexcept {
@@ -362,23 +371,17 @@ struct VertexFaceTest {
     // Edge planes (through an edge, perpendicular to the triangle): inside needs
     // n . ((b-a) x (p-a)) >= 0 and the two others.
     const Sums<I, 4> e_ab = quadrilinear(n, cross_sums(u, w));
-    if (below_minus_delta(e_ab, sep, sep.zero() ? 0.0 : mul_up(n2, norm2_upper(u))))
-      return {true, false};
+    if (outside(e_ab, f, sep, sep.zero() ? 0.0 : mul_up(n2, norm2_upper(u)))) return {true, false};
     const Slot<I> cb = difference(x[3], x[2]);
     const Slot<I> pb = difference(x[0], x[2]);
     const Sums<I, 4> e_bc = quadrilinear(n, cross_sums(cb, pb));
-    if (below_minus_delta(e_bc, sep, sep.zero() ? 0.0 : mul_up(n2, norm2_upper(cb))))
-      return {true, false};
+    if (outside(e_bc, f, sep, sep.zero() ? 0.0 : mul_up(n2, norm2_upper(cb)))) return {true, false};
     const Slot<I> ac = difference(x[1], x[3]);
     const Slot<I> pc = difference(x[0], x[3]);
     const Sums<I, 4> e_ca = quadrilinear(n, cross_sums(ac, pc));
-    if (below_minus_delta(e_ca, sep, sep.zero() ? 0.0 : mul_up(n2, norm2_upper(ac))))
-      return {true, false};
+    if (outside(e_ca, f, sep, sep.zero() ? 0.0 : mul_up(n2, norm2_upper(ac)))) return {true, false};
     const bool inside = positive(e_ab) && positive(e_bc) && positive(e_ca);
     if (!sep.zero()) return {false, inside};
-    if (negative_where_coplanar(e_ab, f) || negative_where_coplanar(e_bc, f) ||
-        negative_where_coplanar(e_ca, f))
-      return {true, false};
     const Sums<I, 4>* const conditions[3] = {&e_ab, &e_bc, &e_ca};
     return certify<I, 3>(f, conditions, in_plane, inside, open_condition);
   }
@@ -424,19 +427,19 @@ struct EdgeEdgeTest {
     const double dc2 = sep.zero() ? 0.0 : mul_up(n2, norm2_upper(dc));
     const CrossSums<I> left1 = cross_sums(ca, dc);
     const Sums<I, 4> h1 = quadrilinear(left1, n);
-    if (below_minus_delta(h1, sep, dc2)) return {true, false};
+    if (outside(h1, f, sep, dc2)) return {true, false};
     const Slot<I> bc = difference(x[1], x[2]);
     const CrossSums<I> left2 = cross_sums(bc, dc);
     const Sums<I, 4> h2 = quadrilinear(left2, n);
-    if (below_minus_delta(h2, sep, dc2)) return {true, false};
+    if (outside(h2, f, sep, dc2)) return {true, false};
     const double ba2 = sep.zero() ? 0.0 : mul_up(n2, norm2_upper(ba));
     const CrossSums<I> left3 = cross_sums(ca, ba);
     const Sums<I, 4> h3 = quadrilinear(left3, n);
-    if (below_minus_delta(h3, sep, ba2)) return {true, false};
+    if (outside(h3, f, sep, ba2)) return {true, false};
     const Slot<I> da = difference(x[3], x[0]);
     const CrossSums<I> left4 = cross_sums(ba, da);
     const Sums<I, 4> h4 = quadrilinear(left4, n);
-    if (below_minus_delta(h4, sep, ba2)) return {true, false};
+    if (outside(h4, f, sep, ba2)) return {true, false};
 
     // Planes containing one edge and turned towards an endpoint of the other (decide parallel
     // and coplanar edges, where n vanishes): m = (b-a) x ((b-a) x (c-a)) puts c at
@@ -475,9 +478,6 @@ struct EdgeEdgeTest {
     // edges touch exactly where the coplanarity cubic vanishes.
     const bool inside = positive(h1) && positive(h2) && positive(h3) && positive(h4);
     if (!sep.zero()) return {false, inside};
-    if (negative_where_coplanar(h1, f) || negative_where_coplanar(h2, f) ||
-        negative_where_coplanar(h3, f) || negative_where_coplanar(h4, f))
-      return {true, false};
     const Sums<I, 4>* const conditions[4] = {&h1, &h2, &h3, &h4};
     return certify<I, 4>(f, conditions, in_plane, inside, open_condition);
   }
@@ -595,6 +595,18 @@ CcdResult run_bisection(const Test& test, const CcdOptions& options) noexcept {
     result.intervals = 1;
     return report(CcdOutcome::kContactAtStart, 0.0);
   }
+  // End certificate: the four points end in one axis-aligned plane where they certainly
+  // touch, so the coplanarity cubic vanishes at t = 1; if it is proven nonzero on [0, 1),
+  // t = 1 is the first contact (none at t = 0 either), reported at the start of the last leaf
+  // of the bisection (what the bisection reports when the rest of the step is excluded). Only
+  // the cubic is needed: the contact is certain, nothing needs excluding.
+  const bool contact_at_end = exact_contact && test.contact_at(true);
+  if (contact_at_end) {
+    Sums<Iv, 3> f{};
+    result.intervals = 1;
+    test.template check<Iv>(0.0, 1.0, Depth::kFilter, &f);
+    if (nonzero_before_end(f)) return report(CcdOutcome::kContact, last_leaf_start(tol));
+  }
   while (top > 0) {
     const Item item = stack[--top];
     ++result.intervals;
@@ -639,14 +651,7 @@ CcdResult run_bisection(const Test& test, const CcdOptions& options) noexcept {
       if (!test.template check<Iv>(0.0, 0.0, Depth::kFull).excluded &&
           !(exact_contact && test.template check<Dd>(0.0, 0.0, Depth::kFull).excluded))
         return report(CcdOutcome::kContactAtStart, 0.0);
-      // End certificate: the four points end in one axis-aligned plane where they certainly
-      // touch, so the coplanarity cubic vanishes at t = 1; if it is proven nonzero on [0, 1),
-      // t = 1 is the first contact, reported at the start of the last leaf of the bisection
-      // (what the bisection reports when the rest of the step is excluded).
-      if (exact_contact && test.contact_at(true)) {
-        if (nonzero_before_end(f)) return report(CcdOutcome::kContact, last_leaf_start(tol));
-        certified = true;
-      }
+      certified = contact_at_end;  // a contact at t = 1, after every interval examined
     }
     // The start of the interval is a contact and everything before it is contact-free.
     if (outcome.contact_at_start)
