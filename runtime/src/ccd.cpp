@@ -539,6 +539,23 @@ bool nonzero_before_end(const Sums<Iv, 3>& f) noexcept {
   return r.lo > 0.0 || r.hi < 0.0;
 }
 
+/// Time of impact for a crossing certified on [ta, tb] (exact contact: the inside proven on
+/// it, so contact happens exactly where the coplanarity cubic p vanishes, and p of opposite
+/// signs at the ends): a time t, about tol / 2 before p's first root, such that p is proven
+/// nonzero on [ta, t] (its coefficients there, from one de Casteljau step at the estimated
+/// root, are of one sign), rounded down. Everything before ta being contact-free, t is a
+/// lower bound of the first contact. -1 when the proof fails (then the caller bisects).
+double certified_crossing_time(const FloatBernstein& p, double ta, double tb, double tol) noexcept {
+  const double width = tb - ta;
+  const double local_tol = tol / width;
+  const double lambda = root_estimate(p, 0.25 * local_tol) - 0.5 * local_tol;
+  if (!(lambda > 0.0)) return ta;  // the root is within tol of ta
+  const FloatBernstein left = left_part(p, lambda);
+  if (!proven_positive(left) && !proven_negative(left)) return -1.0;
+  const double t = ta + lambda * width;  // two roundings: 2^-51 |t| covers them
+  return max_nan(ta, t - std::fabs(t) * 0x1p-51);
+}
+
 /// Start of the last leaf of the bisection of [0, 1] down to the tolerance: 1 - 2^-k with
 /// 2^-k the first halving not above tol.
 double last_leaf_start(double tol) noexcept {
@@ -657,6 +674,11 @@ CcdResult run_bisection(const Test& test, const CcdOptions& options) noexcept {
     if (outcome.contact_at_start)
       return report(item.ta == 0.0 ? CcdOutcome::kContactAtStart : CcdOutcome::kContact, item.ta);
     certified = certified || outcome.certified;
+    if (exact_contact && outcome.inside && outcome.certified) {
+      const double toi =
+          certified_crossing_time(checked ? float_bernstein(f) : item.poly, item.ta, item.tb, tol);
+      if (toi >= 0.0) return report(CcdOutcome::kContact, toi);
+    }
     if (leaf) {
       if (exact_contact && !near_degenerate && !certified && result.intervals < max_intervals &&
           test.template check<Dd>(item.ta, item.tb, depth).excluded) {

@@ -56,6 +56,68 @@ inline void split_half(const FloatBernstein& p, FloatBernstein& left, FloatBerns
   left.err = right.err = (p.err + charged) * kBoundRoundUp + kBoundFloor;
 }
 
+/// Rounding error charged per level of de Casteljau at a parameter lambda in [0, 1]
+/// (w + lambda (w' - w): the difference, the product and the sum each round once, at most
+/// 5 2^-53 M together); charged 3 2^-52 M. The propagated error does not grow: in exact
+/// arithmetic each new coefficient is a convex combination of the old ones.
+constexpr double kLerpErrorBound = 3 * 0x1p-52;
+
+/// The coefficients on the left part [0, lambda] of the interval (local parameter), with their
+/// error bound. `bound_scale` as for split_half.
+inline FloatBernstein left_part(const FloatBernstein& p, double lambda,
+                                double bound_scale = 1.0) noexcept {
+  const int n = p.degree;
+  FloatBernstein left{{}, n, 0.0};
+  double w[5] = {};
+  for (int i = 0; i <= n; ++i) w[i] = p.c[i];
+  left.c[0] = w[0];
+  for (int r = 1; r <= n; ++r) {
+    for (int i = 0; i + r <= n; ++i) w[i] = w[i] + lambda * (w[i + 1] - w[i]);
+    left.c[r] = w[0];
+  }
+  const double charged = n * kLerpErrorBound * bound_scale * max_magnitude(p);
+  left.err = (p.err + charged) * kBoundRoundUp + kBoundFloor;
+  return left;
+}
+
+/// Estimate (not a proof) of the first root of the polynomial's midpoint coefficients in
+/// [0, 1], when their end values have opposite signs: regula falsi (Illinois) on the power
+/// form, stopped when the bracket is narrower than `width`. Returns the bracket's left end.
+inline double root_estimate(const FloatBernstein& p, double width) noexcept {
+  // Power form a0 + a1 s + ... from the Bernstein form.
+  double a[5] = {};
+  const int n = p.degree;
+  constexpr double kBinomial[5][5] = {
+      {1, 0, 0, 0, 0}, {1, 1, 0, 0, 0}, {1, 2, 1, 0, 0}, {1, 3, 3, 1, 0}, {1, 4, 6, 4, 1}};
+  for (int k = 0; k <= n; ++k) {  // a_k = C(n,k) sum_i (-1)^(k-i) C(k,i) c_i
+    double sum = 0.0;
+    for (int i = 0; i <= k; ++i) sum += ((k - i) % 2 ? -1.0 : 1.0) * kBinomial[k][i] * p.c[i];
+    a[k] = kBinomial[n][k] * sum;
+  }
+  auto value = [&](double s) {
+    double v = a[n];
+    for (int k = n - 1; k >= 0; --k) v = v * s + a[k];
+    return v;
+  };
+  double lo = 0.0, hi = 1.0, f_lo = value(lo), f_hi = value(hi);
+  int side = 0;
+  for (int iteration = 0; iteration < 60 && hi - lo > width; ++iteration) {
+    double s = (lo * f_hi - hi * f_lo) / (f_hi - f_lo);
+    if (!(s > lo && s < hi)) s = 0.5 * (lo + hi);
+    const double f_s = value(s);
+    if ((f_s < 0.0) == (f_lo < 0.0)) {
+      lo = s, f_lo = f_s;
+      if (side == -1) f_hi *= 0.5;
+      side = -1;
+    } else {
+      hi = s, f_hi = f_s;
+      if (side == 1) f_lo *= 0.5;
+      side = 1;
+    }
+  }
+  return lo;
+}
+
 /// Proven signs over the interval (convex hull of the coefficients, each within err). A NaN
 /// coefficient or bound proves nothing (the comparisons are false).
 inline bool proven_positive(const FloatBernstein& p) noexcept {

@@ -138,3 +138,36 @@ TEST_CASE("Float Bernstein halving stays within its error bound; an eighth of it
   CHECK(worst <= 1.0);
   CHECK(worst_scaled > 1.0);  // the charge per level is load-bearing
 }
+
+TEST_CASE("Float de Casteljau at any parameter stays within its bound; an eighth of it does not",
+          "[ccd][filter]") {
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  std::uniform_real_distribution<double> parameter(0.0, 1.0);
+  std::uniform_int_distribution<int> exponent(-20, 20);
+  double worst = 0.0, worst_scaled = 0.0;
+  for (int trial = 0; trial < 200000; ++trial) {
+    const int n = 3 + trial % 2;
+    const double scale = std::ldexp(1.0, exponent(rng));
+    FloatBernstein p{{}, n, 0.0};
+    std::array<mpq_class, 5> w{};
+    for (int i = 0; i <= n; ++i) {
+      p.c[i] = scale * (unit(rng) + (i % 2 == 0 ? 0.5 : -0.25));
+      w[i] = p.c[i];
+    }
+    const double lambda = parameter(rng);
+    // Exact left part on [0, lambda]: de Casteljau in rationals.
+    std::array<mpq_class, 5> exact{};
+    exact[0] = w[0];
+    for (int r = 1; r <= n; ++r) {
+      for (int i = 0; i + r <= n; ++i) w[i] = w[i] + mpq_class(lambda) * (w[i + 1] - w[i]);
+      exact[r] = w[0];
+    }
+    worst = std::max(worst, violation(tetseg::ccd_detail::left_part(p, lambda), exact));
+    worst_scaled =
+        std::max(worst_scaled, violation(tetseg::ccd_detail::left_part(p, lambda, 0.125), exact));
+  }
+  INFO("largest error / bound: " << worst << "; with an eighth of the charge: " << worst_scaled);
+  CHECK(worst <= 1.0);
+  CHECK(worst_scaled > 1.0);  // the charge per level is load-bearing
+}
