@@ -570,7 +570,9 @@ struct Item {
   /// then `poly` holds the coplanarity cubic's coefficients on [ta, tb], subdivided from the
   /// interval where the inside was proven, and the test is its sign (no recomputation); or,
   /// kOpenCondition, the open inside condition of an interval certified in the plane
-  /// (contact exactly where it is >= 0).
+  /// (contact exactly where it is >= 0); or, kCubicFirst, and kFull below an interval checked
+  /// (exact contact), the coplanarity cubic subdivided from it, which excludes the interval
+  /// when of one sign (degree 0: none).
   Depth depth;
   FloatBernstein poly;
 };
@@ -645,7 +647,7 @@ CcdResult run_bisection(const Test& test, const CcdOptions& options) noexcept {
       outcome.excluded = proven_positive(item.poly) || proven_negative(item.poly);
       outcome.inside = true;
       outcome.certified = proven_sign_change(item.poly);
-    } else if (item.depth == Depth::kCubicFirst &&
+    } else if ((item.depth == Depth::kCubicFirst || item.poly.degree == 3) &&
                (proven_positive(item.poly) || proven_negative(item.poly))) {
       outcome.excluded = true;
     } else if (item.depth == Depth::kCubicFirst && !leaf && proven_sign_change(item.poly)) {
@@ -665,7 +667,11 @@ CcdResult run_bisection(const Test& test, const CcdOptions& options) noexcept {
       start_tested = true;
       ++result.intervals;
       if (outcome.contact_at_start) return report(CcdOutcome::kContactAtStart, 0.0);
-      if (!test.template check<Iv>(0.0, 0.0, Depth::kFull).excluded &&
+      // Exact contact at t = 0 needs the coplanarity cubic to vanish there; its first sum is
+      // its value at t = 0: proven nonzero, the start has no contact (the start check would
+      // exclude it on the cubic too).
+      const bool start_excluded = exact_contact && (lower(f.s[0]) > 0.0 || upper(f.s[0]) < 0.0);
+      if (!start_excluded && !test.template check<Iv>(0.0, 0.0, Depth::kFull).excluded &&
           !(exact_contact && test.template check<Dd>(0.0, 0.0, Depth::kFull).excluded))
         return report(CcdOutcome::kContactAtStart, 0.0);
       certified = contact_at_end;  // a contact at t = 1, after every interval examined
@@ -698,8 +704,8 @@ CcdResult run_bisection(const Test& test, const CcdOptions& options) noexcept {
     } else if (outcome.inside) {
       child = Depth::kCoplanarOnly;
       if (exact_contact) split_half(checked ? float_bernstein(f) : item.poly, left, right);
-    } else if (exact_contact && checked && sign_change(f)) {
-      child = Depth::kCubicFirst;
+    } else if (exact_contact && checked) {  // the cubic, subdivided, as a pre-filter
+      child = sign_change(f) ? Depth::kCubicFirst : Depth::kFull;
       split_half(float_bernstein(f), left, right);
     }
     stack[top++] = {tm, item.tb, child, right};
