@@ -386,12 +386,12 @@ struct VertexFaceTest {
     return certify<I, 3>(f, conditions, in_plane, inside, open_condition);
   }
 
-  /// True when p certainly lies in the triangle at t = 0 (at_end false) or t = 1 (true),
-  /// all four points in one axis-aligned plane then.
-  bool contact_at(bool at_end) const noexcept {
+  /// Contact at t = 0 (at_end false) or t = 1 (true) when the four points are then in one
+  /// axis-aligned plane (ccd_plane.hpp); unknown otherwise.
+  PlaneContact contact_at(bool at_end) const noexcept {
     const Vec3d* const* x = at_end ? x1 : x0;
     const int axis = shared_axis(x);
-    return axis >= 0 && vertex_strictly_in_triangle_2d(*x[0], *x[1], *x[2], *x[3], axis);
+    return axis < 0 ? PlaneContact::kUnknown : vertex_triangle_2d(*x[0], *x[1], *x[2], *x[3], axis);
   }
 };
 
@@ -499,12 +499,12 @@ struct EdgeEdgeTest {
            mul_up(sep.delta2, mul_up(e2, cross_norm2_upper(e, near_o)));
   }
 
-  /// True when the edges certainly cross at t = 0 (at_end false) or t = 1 (true), all four
-  /// points in one axis-aligned plane then.
-  bool contact_at(bool at_end) const noexcept {
+  /// Contact at t = 0 (at_end false) or t = 1 (true) when the four points are then in one
+  /// axis-aligned plane (ccd_plane.hpp); unknown otherwise.
+  PlaneContact contact_at(bool at_end) const noexcept {
     const Vec3d* const* x = at_end ? x1 : x0;
     const int axis = shared_axis(x);
-    return axis >= 0 && segments_cross_2d(*x[0], *x[1], *x[2], *x[3], axis);
+    return axis < 0 ? PlaneContact::kUnknown : segments_2d(*x[0], *x[1], *x[2], *x[3], axis);
   }
 };
 
@@ -535,6 +535,13 @@ FloatBernstein float_bernstein(const Sums<Iv, N>& sums) noexcept {
 /// sums makes g, hence f before t = 1, of one sign.
 bool nonzero_before_end(const Sums<Iv, 3>& f) noexcept {
   const Sums<Iv, 2> g{{f.s[0], f.s[1], f.s[2]}};
+  const Range r = range_of(g);
+  return r.lo > 0.0 || r.hi < 0.0;
+}
+
+/// The same when f vanishes at t = 0: f = t g, g's coefficients are s1, s2 / 2, s3.
+bool nonzero_after_start(const Sums<Iv, 3>& f) noexcept {
+  const Sums<Iv, 2> g{{f.s[1], f.s[2], f.s[3]}};
   const Range r = range_of(g);
   return r.lo > 0.0 || r.hi < 0.0;
 }
@@ -608,24 +615,29 @@ CcdResult run_bisection(const Test& test, const CcdOptions& options) noexcept {
     result.toi = toi;
     return result;
   };
-  // Start certificate: the four points start in one axis-aligned plane where they certainly
-  // touch.
-  if (exact_contact && test.contact_at(false)) {
+  // Plane certificates (exact contact): when the four points start (end) in one axis-aligned
+  // plane, contact there is a 2D question (ccd_plane.hpp), and the coplanarity cubic vanishes
+  // there. Touching at t = 0 is kContactAtStart at once. Otherwise, if the cubic has no other
+  // root in [0, 1] (f = (1 - t) g or t g, g of one sign), contact can only happen at that end:
+  // touching at t = 1 is the first contact, reported at the start of the bisection's last
+  // leaf (what the bisection reports when the rest of the step is excluded); apart, there is
+  // none. Only the boxes and the cubic are computed.
+  const PlaneContact at_start = exact_contact ? test.contact_at(false) : PlaneContact::kUnknown;
+  if (at_start == PlaneContact::kTouching) {
     result.intervals = 1;
     return report(CcdOutcome::kContactAtStart, 0.0);
   }
-  // End certificate: the four points end in one axis-aligned plane where they certainly
-  // touch, so the coplanarity cubic vanishes at t = 1; if it is proven nonzero on [0, 1),
-  // t = 1 is the first contact (none at t = 0 either), reported at the start of the last leaf
-  // of the bisection (what the bisection reports when the rest of the step is excluded). Only
-  // the cubic is needed: the contact is certain, nothing needs excluding.
-  const bool contact_at_end = exact_contact && test.contact_at(true);
-  if (contact_at_end) {
+  const PlaneContact at_end = exact_contact ? test.contact_at(true) : PlaneContact::kUnknown;
+  if (at_start != PlaneContact::kUnknown || at_end != PlaneContact::kUnknown) {
     Sums<Iv, 3> f{};
     result.intervals = 1;
-    test.template check<Iv>(0.0, 1.0, Depth::kFilter, &f);
-    if (nonzero_before_end(f)) return report(CcdOutcome::kContact, last_leaf_start(tol));
+    if (test.template check<Iv>(0.0, 1.0, Depth::kFilter, &f).excluded) return result;
+    if (at_end != PlaneContact::kUnknown && nonzero_before_end(f))
+      return at_end == PlaneContact::kTouching ? report(CcdOutcome::kContact, last_leaf_start(tol))
+                                               : result;
+    if (at_start == PlaneContact::kApart && nonzero_after_start(f)) return result;
   }
+  const bool contact_at_end = at_end == PlaneContact::kTouching;
   while (top > 0) {
     const Item item = stack[--top];
     ++result.intervals;

@@ -62,28 +62,43 @@ inline bool in_axis_plane(const Point3* const x0[4], const Point3* const x1[4]) 
   return false;
 }
 
-/// True when vertex p certainly lies strictly inside triangle (a, b, c), all four in the plane
-/// orthogonal to `axis` (the triangle is then non-degenerate).
-inline bool vertex_strictly_in_triangle_2d(const Point3& p, const Point3& a, const Point3& b,
-                                           const Point3& c, int axis) noexcept {
+/// Contact of four points in one axis-aligned plane, as far as the filtered orientations can
+/// tell: certainly touching, certainly apart, or unknown (near a boundary or degenerate).
+enum class PlaneContact { kApart, kTouching, kUnknown };
+
+/// Vertex p and triangle (a, b, c), all in the plane orthogonal to `axis`: touching when p is
+/// certainly strictly inside (three orientations of one sign); apart when the triangle's
+/// orientation is certain and p is certainly strictly outside one of its edges.
+inline PlaneContact vertex_triangle_2d(const Point3& p, const Point3& a, const Point3& b,
+                                       const Point3& c, int axis) noexcept {
   const int i = (axis + 1) % 3;
   const int j = (axis + 2) % 3;
-  const int s = orient2d_sign(a, b, p, i, j);
-  return s != 0 && orient2d_sign(b, c, p, i, j) == s && orient2d_sign(c, a, p, i, j) == s;
+  const int ab = orient2d_sign(a, b, p, i, j);
+  const int bc = orient2d_sign(b, c, p, i, j);
+  const int ca = orient2d_sign(c, a, p, i, j);
+  if (ab != 0 && bc == ab && ca == ab) return PlaneContact::kTouching;
+  const int triangle = orient2d_sign(a, b, c, i, j);
+  if (triangle != 0 && (ab == -triangle || bc == -triangle || ca == -triangle))
+    return PlaneContact::kApart;
+  return PlaneContact::kUnknown;
 }
 
-/// True when segments ab and cd certainly cross at a point interior to both, all four in the
-/// plane orthogonal to `axis`.
-inline bool segments_cross_2d(const Point3& a, const Point3& b, const Point3& c, const Point3& d,
-                              int axis) noexcept {
+/// Segments ab and cd, all in the plane orthogonal to `axis`: touching when they certainly
+/// cross at a point interior to both; apart when one segment certainly lies strictly on one
+/// side of the other's line.
+inline PlaneContact segments_2d(const Point3& a, const Point3& b, const Point3& c, const Point3& d,
+                                int axis) noexcept {
   const int i = (axis + 1) % 3;
   const int j = (axis + 2) % 3;
   const int c_side = orient2d_sign(a, b, c, i, j);
   const int d_side = orient2d_sign(a, b, d, i, j);
-  if (c_side == 0 || d_side != -c_side) return false;
+  if (c_side != 0 && d_side == c_side) return PlaneContact::kApart;
   const int a_side = orient2d_sign(c, d, a, i, j);
   const int b_side = orient2d_sign(c, d, b, i, j);
-  return a_side != 0 && b_side == -a_side;
+  if (a_side != 0 && b_side == a_side) return PlaneContact::kApart;
+  if (c_side != 0 && d_side == -c_side && a_side != 0 && b_side == -a_side)
+    return PlaneContact::kTouching;
+  return PlaneContact::kUnknown;
 }
 
 }  // namespace tetseg::ccd_detail

@@ -184,6 +184,14 @@ TEST_CASE("Contacts in an axis plane are certified at their exact times", "[ccd]
   CHECK(start.toi == 0.0);
   CHECK(start.intervals == 1);
 
+  // Two edges landing on the ground apart (parallel, one unit between them): the end
+  // certificate proves the miss without bisecting.
+  const Vec3d s0{0, 0, 1}, s1{1, 0, 0.5}, r0{0, 1, 1}, r1{1, 1, 0.5};
+  const Vec3d s0_end{0, 0, 0}, s1_end{1, 0, 0}, r0_end{0, 1, 0}, r1_end{1, 1, 0};
+  const CcdResult apart = tetseg::edge_edge_ccd(s0, s1, r0, r1, s0_end, s1_end, r0_end, r1_end);
+  CHECK(!apart.hit());
+  CHECK(apart.intervals == 1);
+
   // The same edges lifted apart by one ulp of height at the start: no certificate applies
   // (not in one plane), and they never touch while one stays above the other.
   const Vec3d g0{0, 1, 0x1p-52}, g1{1, 0, 0x1p-52};
