@@ -113,6 +113,19 @@ CrossSums<I> cross_sums(const Slot<I>& w1, const Slot<I>& w2) noexcept {
            cross(w1.v[1], w2.v[1])}};
 }
 
+/// The 2D cross product of w1 and w2 on the two axes other than `axis` (degree 2).
+template <class I>
+Sums<I, 2> cross2(const Slot<I>& w1, const Slot<I>& w2, int axis) noexcept {
+  auto coord = [](const Vec<I>& v, int k) -> const I& { return k == 0 ? v.x : k == 1 ? v.y : v.z; };
+  const int i = (axis + 1) % 3;
+  const int j = (axis + 2) % 3;
+  auto cross = [&](const Vec<I>& a, const Vec<I>& b) {
+    return coord(a, i) * coord(b, j) - coord(a, j) * coord(b, i);
+  };
+  return {{cross(w1.v[0], w2.v[0]), cross(w1.v[0], w2.v[1]) + cross(w1.v[1], w2.v[0]),
+           cross(w1.v[1], w2.v[1])}};
+}
+
 /// (w1 x w2) . w3 (degree 3), with n = w1 x w2.
 template <class I>
 Sums<I, 3> trilinear(const CrossSums<I>& n, const Slot<I>& w3) noexcept {
@@ -134,6 +147,19 @@ inline double mid(Iv a) noexcept {
 }
 inline double mid(Dd a) noexcept {
   return a.hi + a.lo;
+}
+
+/// True when two of the three polynomials are proven of strictly opposite signs on the whole
+/// interval.
+template <class I>
+bool opposite_signs(const Sums<I, 2>& o1, const Sums<I, 2>& o2, const Sums<I, 2>& o3) noexcept {
+  const Range r[3] = {range_of(o1), range_of(o2), range_of(o3)};
+  bool positive = false, negative = false;
+  for (const Range& x : r) {
+    positive = positive || x.lo > 0.0;
+    negative = negative || x.hi < 0.0;
+  }
+  return positive && negative;
 }
 
 /// True when e + lambda f < 0 on the whole interval for some lambda (e: an inside condition
@@ -348,8 +374,8 @@ struct VertexFaceTest {
   const Vec3d* x0[4];
   const Vec3d* x1[4];
   Separation sep;
-  /// The four points stay in one axis-aligned plane for the whole step.
-  bool in_plane = in_axis_plane(x0, x1);
+  /// The axis orthogonal to a plane the four points stay in for the whole step, or -1.
+  int plane_axis = axis_plane(x0, x1);
 
   template <class I>
   IntervalOutcome check(double ta, double tb, Depth depth, Sums<I, 3>* coplanarity = nullptr,
@@ -368,22 +394,32 @@ struct VertexFaceTest {
     if (away_from_zero(f, sep, n2)) return {true, false};
     if (depth != Depth::kFull) return {false, depth == Depth::kCoplanarOnly};
 
+    const Slot<I> cb = difference(x[3], x[2]);
+    const Slot<I> pb = difference(x[0], x[2]);
+    const Slot<I> ac = difference(x[1], x[3]);
+    const Slot<I> pc = difference(x[0], x[3]);
+    // In an axis-aligned plane for the whole step (exact contact): p is in the closed
+    // triangle only if no two of its 2D orientations against the edges have strictly
+    // opposite signs (inside a proper triangle they share the triangle's sign; on a
+    // degenerate one, a segment or a point, they all vanish). This also excludes the times
+    // when the triangle degenerates, where the edge-plane conditions below all vanish.
+    if (plane_axis >= 0 && sep.zero() &&
+        opposite_signs(cross2(u, w, plane_axis), cross2(cb, pb, plane_axis),
+                       cross2(ac, pc, plane_axis)))
+      return {true, false};
+
     // Edge planes (through an edge, perpendicular to the triangle): inside needs
     // n . ((b-a) x (p-a)) >= 0 and the two others.
     const Sums<I, 4> e_ab = quadrilinear(n, cross_sums(u, w));
     if (outside(e_ab, f, sep, sep.zero() ? 0.0 : mul_up(n2, norm2_upper(u)))) return {true, false};
-    const Slot<I> cb = difference(x[3], x[2]);
-    const Slot<I> pb = difference(x[0], x[2]);
     const Sums<I, 4> e_bc = quadrilinear(n, cross_sums(cb, pb));
     if (outside(e_bc, f, sep, sep.zero() ? 0.0 : mul_up(n2, norm2_upper(cb)))) return {true, false};
-    const Slot<I> ac = difference(x[1], x[3]);
-    const Slot<I> pc = difference(x[0], x[3]);
     const Sums<I, 4> e_ca = quadrilinear(n, cross_sums(ac, pc));
     if (outside(e_ca, f, sep, sep.zero() ? 0.0 : mul_up(n2, norm2_upper(ac)))) return {true, false};
     const bool inside = positive(e_ab) && positive(e_bc) && positive(e_ca);
     if (!sep.zero()) return {false, inside};
     const Sums<I, 4>* const conditions[3] = {&e_ab, &e_bc, &e_ca};
-    return certify<I, 3>(f, conditions, in_plane, inside, open_condition);
+    return certify<I, 3>(f, conditions, plane_axis >= 0, inside, open_condition);
   }
 
   /// Contact at t = 0 (at_end false) or t = 1 (true) when the four points are then in one
@@ -400,8 +436,8 @@ struct EdgeEdgeTest {
   const Vec3d* x0[4];
   const Vec3d* x1[4];
   Separation sep;
-  /// The four points stay in one axis-aligned plane for the whole step.
-  bool in_plane = in_axis_plane(x0, x1);
+  /// The axis orthogonal to a plane the four points stay in for the whole step, or -1.
+  int plane_axis = axis_plane(x0, x1);
 
   template <class I>
   IntervalOutcome check(double ta, double tb, Depth depth, Sums<I, 3>* coplanarity = nullptr,
@@ -479,7 +515,7 @@ struct EdgeEdgeTest {
     const bool inside = positive(h1) && positive(h2) && positive(h3) && positive(h4);
     if (!sep.zero()) return {false, inside};
     const Sums<I, 4>* const conditions[4] = {&h1, &h2, &h3, &h4};
-    return certify<I, 4>(f, conditions, in_plane, inside, open_condition);
+    return certify<I, 4>(f, conditions, plane_axis >= 0, inside, open_condition);
   }
 
   /// Plane through the edge with direction e (from point o), normal e x (e x (near - o)):

@@ -54,12 +54,12 @@ inline int shared_axis(const Point3* const points[4]) noexcept {
   return -1;
 }
 
-/// True when four points moving linearly from x0 to x1 stay in one plane orthogonal to an
-/// axis for the whole step: they share that coordinate at both ends (then at every time).
-inline bool in_axis_plane(const Point3* const x0[4], const Point3* const x1[4]) noexcept {
+/// The axis orthogonal to a plane in which four points moving linearly from x0 to x1 stay for
+/// the whole step (they share that coordinate at both ends, hence at every time), or -1.
+inline int axis_plane(const Point3* const x0[4], const Point3* const x1[4]) noexcept {
   for (int axis = 0; axis < 3; ++axis)
-    if (share_coordinate(x0, axis) && share_coordinate(x1, axis)) return true;
-  return false;
+    if (share_coordinate(x0, axis) && share_coordinate(x1, axis)) return axis;
+  return -1;
 }
 
 /// Contact of four points in one axis-aligned plane, as far as the filtered orientations can

@@ -147,9 +147,10 @@ TEST_CASE("Degenerate simulator contacts: none missed, none late, no false posit
     CHECK(c.missed == 0);
     CHECK(c.late == 0);
     CHECK(c.start_wrong == 0);
-    // Off the near-degenerate families, nothing comes within rounding of a contact.
-    if (f == kEndInPlane || f == kStartInPlane || f == kGenericCrossing || f == kPartlyStill)
-      CHECK(c.false_positives == 0);
+    // Off the grid (exact touching, where double-double leaves may stay undecided), no false
+    // positive: in particular none while sliding in a plane, where the triangle degenerating
+    // to a segment made every edge-plane condition vanish (the 2D orientations decide).
+    if (f != kGrid) CHECK(c.false_positives == 0);
   }
   // Touching at t = 1 in the plane: the end certificate decides almost all without bisecting.
   const Counts& end = counts[kEndInPlane];
