@@ -583,11 +583,12 @@ bool nonzero_after_start(const Sums<Iv, 3>& f) noexcept {
 }
 
 /// Time of impact for a crossing certified on [ta, tb] (exact contact: the inside proven on
-/// it, so contact happens exactly where the coplanarity cubic p vanishes, and p of opposite
-/// signs at the ends): a time t, about tol / 2 before p's first root, such that p is proven
-/// nonzero on [ta, t] (its coefficients there, from one de Casteljau step at the estimated
-/// root, are of one sign), rounded down. Everything before ta being contact-free, t is a
-/// lower bound of the first contact. -1 when the proof fails (then the caller bisects).
+/// it, so contact happens exactly where the coplanarity cubic p vanishes; or in a plane, where
+/// the open inside condition p is >= 0, p negative at ta; p of opposite signs at the ends): a
+/// time t, about tol / 2 before p's first root, such that p is proven nonzero on [ta, t] (its
+/// coefficients there, from one de Casteljau step at the estimated root, are of one sign), rounded
+/// down. Everything before ta being contact-free, t is a lower bound of the first contact. -1 when
+/// the proof fails (then the caller bisects).
 double certified_crossing_time(const FloatBernstein& p, double ta, double tb, double tol) noexcept {
   const double width = tb - ta;
   const double local_tol = tol / width;
@@ -728,10 +729,17 @@ CcdResult run_bisection(const Test& test, const CcdOptions& options) noexcept {
     if (outcome.contact_at_start)
       return report(item.ta == 0.0 ? CcdOutcome::kContactAtStart : CcdOutcome::kContact, item.ta);
     certified = certified || outcome.certified;
-    if (exact_contact && outcome.inside && outcome.certified) {
-      const double toi =
-          certified_crossing_time(checked ? float_bernstein(f) : item.poly, item.ta, item.tb, tol);
-      if (toi >= 0.0) return report(CcdOutcome::kContact, toi);
+    // A certified crossing jumps to its time of impact: of the coplanarity cubic below a
+    // proven inside, or of the open inside condition in a plane (contact where it is >= 0;
+    // it starts negative here, else contact_at_start) when it changes sign on the interval.
+    if (exact_contact && outcome.certified && (outcome.inside || outcome.open_condition)) {
+      const FloatBernstein p = !checked                 ? item.poly
+                               : outcome.open_condition ? float_bernstein(open)
+                                                        : float_bernstein(f);
+      if (outcome.inside || proven_sign_change(p)) {
+        const double toi = certified_crossing_time(p, item.ta, item.tb, tol);
+        if (toi >= 0.0) return report(CcdOutcome::kContact, toi);
+      }
     }
     if (leaf) {
       if (exact_contact && !near_degenerate && !certified && result.intervals < max_intervals &&
