@@ -16,6 +16,10 @@
 // before toi was proved contact-free. Below an interval where every inside condition is
 // proven positive only the coplanarity cubic can decide, so its sub-intervals test the cubic
 // alone, subdivided from that interval's coefficients (exact contact) or recomputed.
+// Exact contact also proves contacts (docs/ccd.md, "Exact contacts at the speed of float"):
+// certificates at an end of the step in an axis-aligned plane (ccd_plane.hpp), on intervals
+// (inside proven and the cubic changing sign; in a plane, the inside conditions), then a jump
+// to the crossing or descents in floating point with rigorous error bounds (ccd_bernstein.hpp).
 
 #include <algorithm>
 #include <cmath>
