@@ -435,6 +435,16 @@ struct Collider::Impl {
   void sign_wide() noexcept;
   void brute_vertex_faces(Worker& w, std::uint32_t i) const noexcept;
   void brute_edge_edges(Worker& w, std::uint32_t i) const noexcept;
+  /// Intra-cluster work of cluster c1 and its pairs with every cluster c2 > c1.
+  bool cluster_tasks(Worker& w, std::uint32_t c1, bool count_skips) const noexcept;
+  TreeView cluster_view(std::uint32_t c) const noexcept;
+  /// Broad-phase trees of this body against other bodies: its cluster BVHs (rvbc) or its
+  /// whole-surface BVH (after a refit).
+  std::uint32_t tree_count() const noexcept;
+  TreeView tree(std::uint32_t i) const noexcept;
+  TreeView global_view() const noexcept;
+
+  // --- collider_orphans.cpp
   /// Calls vertex_face(p, f) for every vertex-face pair (p not in f) and edge_edge(e1, e2)
   /// for every edge pair (e1 < e2, four distinct nodes) held by some triangle pair that shares
   /// a node (construction; allocates, may throw). With `across_clusters`, only those where
@@ -456,16 +466,8 @@ struct Collider::Impl {
   void build_seam_orphans();
   /// Tests every seam orphan that no non-culled triangle pair holds (filters, elementary test).
   void test_seam_orphans(Worker& w) const noexcept;
-  /// Intra-cluster work of cluster c1 and its pairs with every cluster c2 > c1.
-  bool cluster_tasks(Worker& w, std::uint32_t c1, bool count_skips) const noexcept;
-  TreeView cluster_view(std::uint32_t c) const noexcept;
-  /// Broad-phase trees of this body against other bodies: its cluster BVHs (rvbc) or its
-  /// whole-surface BVH (after a refit).
-  std::uint32_t tree_count() const noexcept;
-  TreeView tree(std::uint32_t i) const noexcept;
-  TreeView global_view() const noexcept;
 
-  // --- normal_cone.cpp (kCone)
+  // --- collider_cone.cpp (kCone; the cone maths: normal_cone.hpp)
   ConeData cone;  // kCone, indexed by global BVH node
   void build_cone_topology(ConeData& cd, const ConeTree& tree, std::vector<std::uint32_t>& pos);
   void build_global_cones();
@@ -487,6 +489,25 @@ inline bool share_node(const format::Triangle& a, const format::Triangle& b) noe
   return shared_node_mask(a, b) != 0;
 }
 
+// --- collider_narrow.cpp: one feature pair of body P/A and body F/B (P == F within a body).
+// Swept boxes, the still rule, the coplanarity and plane filters (exact contact only), the
+// elementary test; a contact is recorded in `w`. Options (ccd, timing) are the first body's.
+void process_vertex_face(Worker& w, const Collider::Impl& P, std::uint32_t p,
+                         const Collider::Impl& F, std::uint32_t face) noexcept;
+void process_edge_edge(Worker& w, const Collider::Impl& A, std::uint32_t e1,
+                       const Collider::Impl& B, std::uint32_t e2) noexcept;
+/// Triangle-pair plane filter of triangle t1 of A and t2 of B (plane_filter.hpp): no feature
+/// pair of the two can touch (exact contact only).
+bool plane_separated(Worker& w, const Collider::Impl& A, std::uint32_t t1, const Collider::Impl& B,
+                     std::uint32_t t2) noexcept;
+
+/// Swept boxes of two edges overlap and not all four nodes are still.
+inline bool edge_boxes_overlap(const Collider::Impl& A, std::uint32_t e1, const Collider::Impl& B,
+                               std::uint32_t e2) noexcept {
+  if (!A.edge_moving(e1) && !B.edge_moving(e2)) return false;
+  return boxes_overlap(A.edge_box(e1), B.edge_box(e2), A.opt.ccd.min_separation);
+}
+
 /// Static check of triangle t1 of A against t2 of B (A == B within a body): an edge of one
 /// meeting the other, conservatively; records a witness in `w` and stops it.
 void rest_triangle_pair(Worker& w, const Collider::Impl& A, std::uint32_t t1,
@@ -498,27 +519,5 @@ void rest_triangle_pair(Worker& w, const Collider::Impl& A, std::uint32_t t1,
 /// check instead (rest_triangle_pair; the witness in `w`). False on stack overflow.
 bool traverse_bodies(Worker& w, const Collider::Impl& A, const Collider::Impl& B,
                      bool rest = false) noexcept;
-
-// Member templates of Collider::Impl used by collider_orphans.cpp (construction) and
-// collider_traverse.cpp (the seam orphans' per-step test).
-template <typename Holder>
-inline bool Collider::Impl::any_vertex_face_holder(std::uint32_t p, std::uint32_t f,
-                                                   Holder&& holder) const noexcept {
-  const std::uint32_t ip = topo->surf_index[p];
-  for (std::uint32_t k = topo->vt_offset[ip]; k < topo->vt_offset[ip + 1]; ++k)
-    if (holder(topo->vt_list[k], f)) return true;
-  return false;
-}
-
-template <typename Holder>
-inline bool Collider::Impl::any_edge_edge_holder(std::uint32_t e1, std::uint32_t e2,
-                                                 Holder&& holder) const noexcept {
-  const auto& off = topo->et_offset;
-  const auto& list = topo->et_list;
-  for (std::uint32_t k1 = off[e1]; k1 < off[e1 + 1]; ++k1)
-    for (std::uint32_t k2 = off[e2]; k2 < off[e2 + 1]; ++k2)
-      if (holder(list[k1], list[k2])) return true;
-  return false;
-}
 
 }  // namespace tetseg
