@@ -121,6 +121,7 @@ ColliderStatus Scene::add_body(std::shared_ptr<const BodyShape> shape, const Bod
     co.bvh_leaf_size = s.opt.bvh_leaf_size;
     co.use_openmp = s.opt.use_openmp;
     co.time_tests = s.opt.time_tests;
+    co.include_still_pairs = s.opt.include_still_pairs;
     co.traversal_stack = s.opt.traversal_stack;
     SceneBody body;
     body.core = std::make_unique<Collider::Impl>();
@@ -212,7 +213,8 @@ ColliderStatus Scene::step(const double* x0, const double* x1, std::size_t value
   for (SceneBody& b : s.bodies) {
     Collider::Impl& core = *b.core;
     core.refit_and_classify();
-    b.moved = core.stats.nodes_moved > 0;
+    // Without the still rule every body takes part, moved or not.
+    b.moved = core.stats.nodes_moved > 0 || s.opt.include_still_pairs;
     s.stats.bodies_moved += b.moved ? 1 : 0;
     s.stats.refit_ms += core.stats.refit_ms;
     s.stats.classify_ms += core.stats.classify_ms;

@@ -58,6 +58,14 @@ struct ColliderOptions {
   /// the coplanarity filter is off, but orientation culling (rvbc) still only guarantees
   /// exact contacts: use `kBvh` when every near contact must be found.
   CcdOptions ccd;
+  /// Test still feature pairs too (all four nodes with x0 == x1 bitwise), which the default
+  /// still rule of `step` skips (docs/runtime.md, "Still geometry"): still clusters, still
+  /// node pairs and steps where nothing moved are then traversed like moving ones, and kBvh,
+  /// kCone and kBrute report every contact a brute-force test of all feature pairs reports,
+  /// still pairs included. kRvbc keeps its orientation culling, which presumes a contact-free
+  /// start: a still pair already touching inside one cluster may stay culled (use kBvh when a
+  /// step may start in contact, e.g. a soup frame or a resting pile). Off by default.
+  bool include_still_pairs = false;
   /// Leaf size of the `kBvh` mode's BVH (clamped to [1, 16]).
   std::uint32_t bvh_leaf_size = 4;
   /// Use OpenMP threads inside a step when built with it: refit and classification loops
@@ -167,11 +175,12 @@ class Collider {
   /// units), `value_count` must equal node_count * 3. The collider keeps the pointers: both
   /// arrays must stay valid and unchanged until the next `step` (queries read them).
   /// Refits and classifies (rvbc). Nodes with x0 == x1 (bitwise) are "still".
-  /// Rule for still geometry: a feature pair whose four nodes are all still is never
-  /// tested (it can only touch during the whole step, i.e. at t = 0, which the previous step
-  /// or `check_rest_intersection` reports); so still clusters, pairs of still clusters and
-  /// a step where nothing moved cost no traversal. Rejects NaN/inf
-  /// positions of the nodes it reads (surface and detector nodes; no other node is read).
+  /// Rule for still geometry (default; `ColliderOptions::include_still_pairs` turns it off):
+  /// a feature pair whose four nodes are all still is never tested (it can only touch during the
+  /// whole step, i.e. at t = 0, which the previous step or `check_rest_intersection` reports); so
+  /// still clusters, pairs of still clusters and a step where nothing moved cost no traversal.
+  /// Rejects NaN/inf positions of the nodes it reads (surface and detector nodes; no other node is
+  /// read).
   ColliderStatus step(const double* x0, const double* x1, std::size_t value_count) noexcept;
   /// Same with value_count = node_count * 3 assumed.
   ColliderStatus step(const double* x0, const double* x1) noexcept;

@@ -22,6 +22,9 @@ namespace tetseg {
 struct SceneOptions {
   /// Passed to the elementary tests (as in `ColliderOptions::ccd`).
   CcdOptions ccd;
+  /// As `ColliderOptions::include_still_pairs`, for every body and pair of bodies: still
+  /// feature pairs (still bodies included) are tested too. Off by default (the still rule).
+  bool include_still_pairs = false;
   /// Leaf size of whole-surface BVHs (surface-only bodies, `kBvh` bodies).
   std::uint32_t bvh_leaf_size = 4;
   /// OpenMP threads (when built with it): inside each body's self-collision queries (as
