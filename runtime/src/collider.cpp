@@ -94,9 +94,13 @@ void Collider::Impl::construct(std::shared_ptr<const BodyShape> sh, const Collid
                      16 * (2 * std::size_t(topo->wide_depth) + 2));
   std::size_t threads = 1;
 #if defined(TETSEG_HAVE_OPENMP)
-  if (opt.use_openmp) threads = static_cast<std::size_t>(std::max(1, omp_get_max_threads()));
+  if (opt.use_openmp)
+    threads = opt.threads > 0 ? opt.threads
+                              : static_cast<std::size_t>(std::max(1, omp_get_max_threads()));
 #endif
   workers.resize(threads);
+  // The whole-surface BVH's parallel traversal: some items per thread to balance.
+  if (threads > 1) frontier.reserve(16 * threads + 4);
   const bool plane_cache = opt.mode != ColliderMode::kBrute && opt.ccd.min_separation <= 0;
   for (Worker& w : workers) {
     w.stack.resize(stack_size);
@@ -434,12 +438,13 @@ namespace {
 auto collider_run(Collider::Impl& s) noexcept {
   return [&s](QueryKind kind, Contact* out, std::size_t cap, std::size_t& written) noexcept {
     s.qkind = kind;
-    if (!s.run_query(out, cap)) return ColliderStatus::kOverflow;
+    ContactSink sink{out, out ? cap : 0};
+    if (!s.run_query(out ? &sink : nullptr)) return ColliderStatus::kOverflow;
     if (kind == QueryKind::kAny) {
       s.cache.any_known = true;
       s.cache.any_value = s.query_hit;
     }
-    written = s.out_written;
+    written = sink.written;
     return ColliderStatus::kOk;
   };
 }

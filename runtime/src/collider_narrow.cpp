@@ -3,6 +3,7 @@
 // into a contact; and the triangle-pair plane filter. Deduplication (which triangle pair tests
 // which feature pair) is the traversal's: collider_traverse.cpp.
 
+#include <algorithm>
 #include <chrono>
 
 #include "collider_impl.hpp"
@@ -28,7 +29,33 @@ void Worker::record(const Contact& c) noexcept {
     best = c;
     has_best = true;
   }
-  if (out && out_written < out_cap) out[out_written++] = c;
+  if (sink) sink->add(c);
+}
+
+namespace {
+
+void add_to_heap(ContactSink& s, const Contact& c) noexcept {
+  if (s.written < s.cap) {
+    s.out[s.written++] = c;
+    std::push_heap(s.out, s.out + s.written, contact_less);
+  } else if (s.cap > 0 && contact_less(c, s.out[0])) {
+    std::pop_heap(s.out, s.out + s.cap, contact_less);
+    s.out[s.cap - 1] = c;
+    std::push_heap(s.out, s.out + s.cap, contact_less);
+  }
+}
+
+}  // namespace
+
+void ContactSink::add(const Contact& c) noexcept {
+#if defined(TETSEG_HAVE_OPENMP)
+  if (locked) {
+#pragma omp critical(tetseg_contact_sink)
+    add_to_heap(*this, c);
+    return;
+  }
+#endif
+  add_to_heap(*this, c);
 }
 
 // Feature pairs of a triangle of body A and a triangle of body B (A == B for self-collision):

@@ -215,7 +215,11 @@ void Collider::Impl::close_contacts(Worker& w, double toi) noexcept {
       }
     }
   };
-  for (std::size_t i = 0; i < w.out_written; ++i) add_ring(w.out[i]);
+  // The buffer's contacts of this body (a scene's buffer holds other parts' too).
+  if (w.sink)
+    for (std::size_t i = 0; i < w.sink->written; ++i)
+      if (w.sink->out[i].bodies[0] == body_id && w.sink->out[i].bodies[1] == body_id)
+        add_ring(w.sink->out[i]);
   for (const Worker& other : workers)
     if (other.has_best) add_ring(other.best);
   const std::size_t ring = closure_ring.size();  // contacts found below add no seeds
@@ -321,7 +325,8 @@ bool traverse_bodies(Worker& w, const Collider::Impl& A, const Collider::Impl& B
   return true;
 }
 
-bool Collider::Impl::traverse_self(Worker& w, const TreeView& t) const noexcept {
+bool Collider::Impl::self_item(Worker& w, const TreeView& t, const StackItem& it,
+                               std::size_t& top) const noexcept {
   const double ms = opt.ccd.min_separation;
   // Pair items are tested (not both still, boxes overlap) before they are pushed, so popped
   // pair items are live.
@@ -330,34 +335,76 @@ bool Collider::Impl::traverse_self(Worker& w, const TreeView& t) const noexcept 
     return boxes_overlap(t.box[a], t.box[b], ms);
   };
   auto self_pair = [&](std::uint32_t t1, std::uint32_t t2) { process_triangle_pair(w, t1, t2); };
+  if (it.b == kNone) {
+    const std::uint32_t n = it.a;
+    if (!rest_mode && t.nmov[n] == 0) return true;
+    if (t.cone && cone_self_free(*t.cone, t.cone_base + n)) {
+      ++w.stats.node_pairs_orientation_culled;
+      return true;
+    }
+    const format::BvhNode& nd = t.nodes[n];
+    if (nd.count > 0) {
+      for (std::uint32_t i = 0; i < nd.count && !w.stop; ++i)
+        for (std::uint32_t j = i + 1; j < nd.count && !w.stop; ++j)
+          process_triangle_pair(w, t.leaf_tris[nd.first + i], t.leaf_tris[nd.first + j]);
+      return true;
+    }
+    if (top + 3 > w.stack.size()) return false;
+    if (live_pair(nd.first, nd.second)) w.stack[top++] = {nd.first, nd.second};
+    w.stack[top++] = {nd.second, kNone};
+    w.stack[top++] = {nd.first, kNone};
+    return true;
+  }
+  return descend_pair(w, t, t, it, ms, live_pair, self_pair, top);
+}
+
+bool Collider::Impl::traverse_self(Worker& w, const TreeView& t, StackItem first) const noexcept {
   std::size_t top = 0;
-  w.stack[top++] = {0, kNone};
+  w.stack[top++] = first;
   while (top > 0 && !w.stop) {
     const StackItem it = w.stack[--top];
     ++w.stats.node_pairs_visited;
-    if (it.b == kNone) {
-      const std::uint32_t n = it.a;
-      if (!rest_mode && t.nmov[n] == 0) continue;
-      if (t.cone && cone_self_free(*t.cone, t.cone_base + n)) {
-        ++w.stats.node_pairs_orientation_culled;
-        continue;
-      }
-      const format::BvhNode& nd = t.nodes[n];
-      if (nd.count > 0) {
-        for (std::uint32_t i = 0; i < nd.count && !w.stop; ++i)
-          for (std::uint32_t j = i + 1; j < nd.count && !w.stop; ++j)
-            process_triangle_pair(w, t.leaf_tris[nd.first + i], t.leaf_tris[nd.first + j]);
-        continue;
-      }
-      if (top + 3 > w.stack.size()) return false;
-      if (live_pair(nd.first, nd.second)) w.stack[top++] = {nd.first, nd.second};
-      w.stack[top++] = {nd.second, kNone};
-      w.stack[top++] = {nd.first, kNone};
-      continue;
-    }
-    if (!descend_pair(w, t, t, it, ms, live_pair, self_pair, top)) return false;
+    if (!self_item(w, t, it, top)) return false;
   }
   return true;
+}
+
+bool Collider::Impl::traverse_global_parallel() noexcept {
+  Worker& w0 = workers[0];
+  const TreeView t = global_view();
+  // Breadth first from the root until there are enough items for the workers to balance
+  // (each expansion adds at most 4 items: the frontier's capacity is target + 4).
+  const std::size_t target = frontier.capacity() - 4;
+  frontier.clear();
+  frontier.push_back({0, kNone});
+  std::size_t head = 0;
+  while (head < frontier.size() && frontier.size() - head < target && !w0.stop) {
+    const StackItem it = frontier[head++];
+    ++w0.stats.node_pairs_visited;
+    std::size_t top = 0;
+    if (!self_item(w0, t, it, top)) return false;
+    for (std::size_t k = 0; k < top; ++k) frontier.push_back(w0.stack[k]);
+  }
+  if (w0.stop) return true;
+  const auto first = static_cast<std::int64_t>(head);
+  const auto count = static_cast<std::int64_t>(frontier.size());
+  bool overflow = false;
+#if defined(TETSEG_HAVE_OPENMP)
+#pragma omp parallel num_threads(static_cast <int>(workers.size())) reduction(|| : overflow)
+  {
+    Worker& w = workers[static_cast<std::size_t>(omp_get_thread_num())];
+    if (omp_get_thread_num() == 0)
+      stats.traversal_threads = static_cast<std::uint32_t>(omp_get_num_threads());
+#pragma omp for schedule(dynamic, 1)
+    for (std::int64_t i = first; i < count; ++i)
+      if (!w.stop && !w.overflow && !traverse_self(w, t, frontier[static_cast<std::size_t>(i)]))
+        w.overflow = overflow = true;
+  }
+#else
+  for (std::int64_t i = first; i < count && !w0.stop; ++i)
+    if (!traverse_self(w0, t, frontier[static_cast<std::size_t>(i)])) overflow = true;
+#endif
+  return !overflow;
 }
 
 void Collider::Impl::brute_vertex_faces(Worker& w, std::uint32_t i) const noexcept {
@@ -402,27 +449,33 @@ bool Collider::Impl::cluster_tasks(Worker& w, std::uint32_t c1, bool count_skips
   return true;
 }
 
-bool Collider::Impl::run_query(Contact* out, std::size_t out_cap) noexcept {
+bool Collider::Impl::run_query(ContactSink* sink) noexcept {
   const auto t_start = Clock::now();
   for (Worker& w : workers) {
     w.reset();
     w.qkind = qkind;
+    w.sink = sink;
   }
   Worker& w0 = workers[0];
-  w0.out = out;
-  w0.out_cap = out ? out_cap : 0;
   const bool count_skips = !stats.full_traversal && qkind == QueryKind::kFull && !rest_mode;
-  // Parallel traversal: OpenMP threads take whole tasks (a cluster with its pairs, a brute
-  // force vertex or edge); merged in worker order, so counts and the earliest contact equal
-  // the serial ones. A caller buffer keeps the serial path (its truncation is order-bound).
-  const bool parallel = workers.size() > 1 && out == nullptr && !rest_mode;
-  (void)parallel;
+  // Parallel traversal: OpenMP threads take whole tasks (a cluster with its pairs, a subtree
+  // of the whole-surface BVH, a brute force vertex or edge); merged in worker order, so counts
+  // and the earliest contact equal the serial ones, and a buffer keeps the smallest contacts
+  // whoever finds them (ContactSink).
+  const bool parallel = workers.size() > 1 && !rest_mode;
+  if (parallel && sink) sink->locked = true;
+  stats.traversal_threads = 1;
   if (!stats.nothing_moved || rest_mode) {
     const std::uint32_t nc = cluster_count();
     const std::int64_t nv = static_cast<std::int64_t>(topo->surf_nodes.size());
     const std::int64_t ne = static_cast<std::int64_t>(topo->edges.size());
     if (global_bvh_active()) {
-      if (tri_count > 0 && !traverse_self(w0, global_view())) w0.overflow = true;
+      if (tri_count > 0) {
+        const bool ok = parallel && frontier.capacity() > 4
+                            ? traverse_global_parallel()
+                            : traverse_self(w0, global_view(), {0, kNone});
+        if (!ok) w0.overflow = true;
+      }
       if (skip_adjacent && !rest_mode && !w0.overflow) test_orphans(w0);
     } else if (opt.mode == ColliderMode::kBrute && !rest_mode) {
 #if defined(TETSEG_HAVE_OPENMP)
@@ -430,6 +483,8 @@ bool Collider::Impl::run_query(Contact* out, std::size_t out_cap) noexcept {
 #pragma omp parallel num_threads(static_cast <int>(workers.size()))
         {
           Worker& w = workers[static_cast<std::size_t>(omp_get_thread_num())];
+          if (omp_get_thread_num() == 0)
+            stats.traversal_threads = static_cast<std::uint32_t>(omp_get_num_threads());
 #pragma omp for schedule(dynamic, 16)
           for (std::int64_t i = 0; i < nv; ++i)
             if (!w.stop) brute_vertex_faces(w, static_cast<std::uint32_t>(i));
@@ -451,6 +506,8 @@ bool Collider::Impl::run_query(Contact* out, std::size_t out_cap) noexcept {
 #pragma omp parallel num_threads(static_cast <int>(workers.size()))
         {
           Worker& w = workers[static_cast<std::size_t>(omp_get_thread_num())];
+          if (omp_get_thread_num() == 0)
+            stats.traversal_threads = static_cast<std::uint32_t>(omp_get_num_threads());
 #pragma omp for schedule(dynamic, 1)
           for (std::int64_t c = 0; c < static_cast<std::int64_t>(nc); ++c)
             if (!w.stop && !w.overflow &&
@@ -503,7 +560,6 @@ bool Collider::Impl::run_query(Contact* out, std::size_t out_cap) noexcept {
   stats.traversal_ms += std::max(0.0, total_ms - tests_ms);
   if (overflow) return false;
   query_hit = hit;
-  out_written = w0.out_written;
   if (qkind == QueryKind::kFull && !rest_mode) {
     stats.full_traversal = true;
     cache.set_full(found, has, first);

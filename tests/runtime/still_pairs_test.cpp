@@ -32,7 +32,8 @@ Surface overlapping_floor(int n) {
     const double shift = layer == 0 ? 0.0 : 1.0 / (3.0 * n);
     const auto base = static_cast<std::uint32_t>(s.verts.size());
     for (int j = 0; j <= n; ++j)
-      for (int i = 0; i <= n; ++i) s.verts.push_back({double(i) / n + shift, double(j) / n + shift, 0});
+      for (int i = 0; i <= n; ++i)
+        s.verts.push_back({double(i) / n + shift, double(j) / n + shift, 0});
     auto id = [&](int i, int j) { return base + static_cast<std::uint32_t>(j * (n + 1) + i); };
     for (int j = 0; j < n; ++j)
       for (int i = 0; i < n; ++i) {
@@ -130,8 +131,8 @@ TEST_CASE("include_still_pairs: a Collider reports the still floor's contacts as
     tetseg::Collider collider(shape, options);
     REQUIRE(collider.step(x1.data(), x1.data(), x1.size()) == ColliderStatus::kOk);
     REQUIRE(!collider.stats().nothing_moved);
-    const tetseg::test::OracleBody at_rest{body.tris.data(), body.tris.size(), x1.data(),
-                                           x1.data(), true};
+    const tetseg::test::OracleBody at_rest{body.tris.data(), body.tris.size(), x1.data(), x1.data(),
+                                           true};
     const std::vector<Contact> want = tetseg::test::scene_brute_contacts({at_rest}, true);
     REQUIRE(!want.empty());
     std::vector<Contact> buffer(want.size() + 16);
@@ -160,7 +161,8 @@ TEST_CASE("include_still_pairs: a Scene with a still floor and a still box repor
   const std::vector<Contact> without = tetseg::test::scene_brute_contacts(oracle);
   REQUIRE(with_still.size() > without.size() + 20);
   bool floor_resting = false;  // a still contact between two still bodies
-  for (const Contact& c : with_still) floor_resting = floor_resting || c.bodies == std::array<std::uint32_t, 2>{0, 1};
+  for (const Contact& c : with_still)
+    floor_resting = floor_resting || c.bodies == std::array<std::uint32_t, 2>{0, 1};
   REQUIRE(floor_resting);
 
   for (bool include : {false, true}) {
