@@ -325,8 +325,10 @@ bool traverse_bodies(Worker& w, const Collider::Impl& A, const Collider::Impl& B
   return true;
 }
 
-bool Collider::Impl::self_item(Worker& w, const TreeView& t, const StackItem& it,
-                               std::size_t& top) const noexcept {
+// Inlined into both traversal loops (a call per item cost about 10 % of the bvh traversal's
+// instructions); used in this file only.
+__attribute__((always_inline)) inline bool Collider::Impl::self_item(
+    Worker& w, const TreeView& t, const StackItem& it, std::size_t& top) const noexcept {
   const double ms = opt.ccd.min_separation;
   // Pair items are tested (not both still, boxes overlap) before they are pushed, so popped
   // pair items are live.

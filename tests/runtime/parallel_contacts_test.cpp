@@ -49,10 +49,9 @@ void require_same(const std::vector<Contact>& a, const std::vector<Contact>& b) 
 struct BentDumbbell {
   tetseg::test::Surface surface = tetseg::test::dumbbell(14, 20);
   tetseg::test::Scene scene = tetseg::test::make_axial_scene(surface, {-0.8, 0.8}, {-1.6, 0, 1.6});
-  std::vector<std::vector<double>> frames =
-      tetseg::test::make_frames(scene, 2, [](const P3& p, double t) {
-        return tetseg::test::bend_about_x(p, t, 3.4, -0.5, 0.5, 0.0);
-      });
+  std::vector<std::vector<double>> frames = tetseg::test::make_frames(
+      scene, 2,
+      [](const P3& p, double t) { return tetseg::test::bend_about_x(p, t, 3.4, -0.5, 0.5, 0.0); });
 };
 
 }  // namespace
@@ -72,7 +71,8 @@ TEST_CASE("Collider contacts into a buffer on two threads equal the serial ones,
     parallel_options.threads = 2;
     tetseg::Collider serial(db.scene.asset, serial_options);
     tetseg::Collider parallel(db.scene.asset, parallel_options);
-    for (tetseg::Collider* c : {&serial, &parallel}) REQUIRE(c->step(x0, x1) == ColliderStatus::kOk);
+    for (tetseg::Collider* c : {&serial, &parallel})
+      REQUIRE(c->step(x0, x1) == ColliderStatus::kOk);
 
     ContactsResult rs, rp;
     const std::vector<Contact> all_serial = contacts_of(serial, 100000, rs);
@@ -137,7 +137,8 @@ TEST_CASE("Scene contacts into a buffer on two threads equal the serial ones", "
   const BentDumbbell db;
   auto dumbbell_shape = tetseg::BodyShape::from_asset(db.scene.asset);
   REQUIRE(dumbbell_shape);
-  const tetseg::test::Surface box = tetseg::test::box_surface({-0.5, -0.5, 1.0}, {0.5, 0.5, 1.4}, 3);
+  const tetseg::test::Surface box =
+      tetseg::test::box_surface({-0.5, -0.5, 1.0}, {0.5, 0.5, 1.4}, 3);
   std::vector<std::uint32_t> ids;
   for (const auto& t : box.tris) ids.insert(ids.end(), t.begin(), t.end());
   auto box_shape = tetseg::BodyShape::from_triangles(ids.data(), box.tris.size(),
