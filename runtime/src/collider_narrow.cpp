@@ -135,11 +135,12 @@ bool nodes_off_plane(Worker& w, const Collider::Impl& T, std::uint32_t t, const 
 // Edge-pair plane filter (exact contact only): both nodes of edge e2 of B stay strictly on one
 // side of the plane of a triangle of A around edge e1. e1 lies in that plane at every t of
 // the step, so the edges never touch.
+// `box2`: e2's swept box (B.edge_box(e2)).
 bool edge_off_face_planes(Worker& w, const Collider::Impl& A, std::uint32_t e1,
-                          const Collider::Impl& B, std::uint32_t e2) noexcept {
+                          const Collider::Impl& B, std::uint32_t e2, const Box& box2) noexcept {
   const auto& et_offset = A.topo->et_offset;
   for (std::uint32_t k = et_offset[e1]; k < et_offset[e1 + 1]; ++k)
-    if (nodes_off_plane(w, A, A.topo->et_list[k], B, B.topo->edges[e2].data(), 2, B.edge_box(e2)))
+    if (nodes_off_plane(w, A, A.topo->et_list[k], B, B.topo->edges[e2].data(), 2, box2))
       return true;
   return false;
 }
@@ -199,21 +200,32 @@ void process_vertex_face(Worker& w, const Collider::Impl& P, std::uint32_t p,
 
 void process_edge_edge(Worker& w, const Collider::Impl& A, std::uint32_t e1,
                        const Collider::Impl& B, std::uint32_t e2) noexcept {
-  if (&A == &B && e1 > e2) std::swap(e1, e2);
+  if (!A.edge_moving(e1) && !B.edge_moving(e2)) return;  // all four nodes still
+  process_edge_edge(w, A, e1, A.edge_box(e1), B, e2, B.edge_box(e2));
+}
+
+void process_edge_edge(Worker& w, const Collider::Impl& A, std::uint32_t e1, Box box1,
+                       const Collider::Impl& B, std::uint32_t e2, Box box2) noexcept {
+  if (&A == &B && e1 > e2) {
+    std::swap(e1, e2);
+    std::swap(box1, box2);
+  }
   const std::uint32_t a = A.topo->edges[e1][0], b = A.topo->edges[e1][1];
   const std::uint32_t c = B.topo->edges[e2][0], d = B.topo->edges[e2][1];
   const ColliderOptions& opt = A.opt;
   const double ms = opt.ccd.min_separation;
-  if (!edge_boxes_overlap(A, e1, B, e2)) return;  // also: all four nodes still
+  // As edge_boxes_overlap, from the given boxes.
+  if (!A.edge_moving(e1) && !B.edge_moving(e2)) return;  // all four nodes still
+  if (!boxes_overlap(box1, box2, ms)) return;
   ++w.stats.feature_pairs;
   if (ms <= 0) {
     // det[b-a, d-c, c-a] = det[b-a, d-a, c-a]: orientation of (a; b, d, c), its points in the
     // union of the two edges' swept boxes (static bound).
     const Orientation o =
         orientation_of(A.pos0(a), A.pos0(b), B.pos0(d), B.pos0(c), A.pos1(a), A.pos1(b), B.pos1(d),
-                       B.pos1(c), union_static_err(A.edge_box(e1), B.edge_box(e2)));
-    if (o != Orientation::kUncertain || edge_off_face_planes(w, A, e1, B, e2) ||
-        edge_off_face_planes(w, B, e2, A, e1)) {
+                       B.pos1(c), union_static_err(box1, box2));
+    if (o != Orientation::kUncertain || edge_off_face_planes(w, A, e1, B, e2, box2) ||
+        edge_off_face_planes(w, B, e2, A, e1, box1)) {
       ++w.stats.feature_pairs_filtered;
       return;
     }

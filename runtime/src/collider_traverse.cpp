@@ -138,19 +138,30 @@ void test_features(Worker& w, const Collider::Impl& A, std::uint32_t t1, const C
       if (w.stop) return;
     }
   }
-  // Edge-edge.
+  // Edge-edge. Each edge's swept box is computed once per triangle pair (t2's when a box of
+  // t1's edges first meets t2's box) and read by every check below.
   const auto& EA = A.topo->edges;
   const auto& EB = B.topo->edges;
+  Box box2[3];
+  bool have_box2 = false;
   for (std::uint32_t i = 0; i < 3; ++i) {
     const std::uint32_t e1 = A.topo->tri_edges[t1][i];
+    const Box box1 = A.edge_box(e1);
     // tbox[t2] contains the boxes of t2's edges: one check rejects all three.
-    if (!boxes_overlap(A.edge_box(e1), B.tbox[t2], ms)) continue;
+    if (!boxes_overlap(box1, B.tbox[t2], ms)) continue;
+    if (!have_box2) {
+      for (std::uint32_t j = 0; j < 3; ++j) box2[j] = B.edge_box(B.topo->tri_edges[t2][j]);
+      have_box2 = true;
+    }
+    const bool moving1 = A.edge_moving(e1);
     for (std::uint32_t j = 0; j < 3; ++j) {
       const std::uint32_t e2 = B.topo->tri_edges[t2][j];
       const auto& E1 = EA[e1];
       const auto& E2 = EB[e2];
       if (same && (E1[0] == E2[0] || E1[0] == E2[1] || E1[1] == E2[0] || E1[1] == E2[1])) continue;
-      if (!edge_boxes_overlap(A, e1, B, e2)) continue;
+      // edge_boxes_overlap from the boxes at hand.
+      if (!moving1 && !B.edge_moving(e2)) continue;
+      if (!boxes_overlap(box1, box2[j], ms)) continue;
       bool owner = true;
       const auto& ea_offset = A.topo->et_offset;
       const auto& ea_list = A.topo->et_list;
@@ -162,7 +173,7 @@ void test_features(Worker& w, const Collider::Impl& A, std::uint32_t t1, const C
           if ((!same || u != v) && claimed(u, v)) owner = false;
         }
       }
-      if (owner) process_edge_edge(w, A, e1, B, e2);
+      if (owner) process_edge_edge(w, A, e1, box1, B, e2, box2[j]);
       if (w.stop) return;
     }
   }
