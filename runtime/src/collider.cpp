@@ -99,8 +99,9 @@ void Collider::Impl::construct(std::shared_ptr<const BodyShape> sh, const Collid
                               : static_cast<std::size_t>(std::max(1, omp_get_max_threads()));
 #endif
   workers.resize(threads);
-  // The whole-surface BVH's parallel traversal: some items per thread to balance.
-  if (threads > 1) frontier.reserve(16 * threads + 4);
+  // The whole-surface BVH's parallel traversal: 16 items per thread, with room for the
+  // items expanded on the way (traverse_global_parallel).
+  if (threads > 1) frontier.reserve(64 * threads + 4);
   const bool plane_cache = opt.mode != ColliderMode::kBrute && opt.ccd.min_separation <= 0;
   for (Worker& w : workers) {
     w.stack.resize(stack_size);

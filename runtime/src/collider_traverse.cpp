@@ -385,13 +385,14 @@ bool Collider::Impl::traverse_self(Worker& w, const TreeView& t, StackItem first
 bool Collider::Impl::traverse_global_parallel() noexcept {
   Worker& w0 = workers[0];
   const TreeView t = global_view();
-  // Breadth first from the root until there are enough items for the workers to balance
-  // (each expansion adds at most 4 items: the frontier's capacity is target + 4).
-  const std::size_t target = frontier.capacity() - 4;
+  // Breadth first from the root until there are 16 items per worker to balance, within the
+  // capacity reserved at construction (an expansion adds at most 4 items): no allocation.
+  const std::size_t target = 16 * workers.size();
   frontier.clear();
   frontier.push_back({0, kNone});
   std::size_t head = 0;
-  while (head < frontier.size() && frontier.size() - head < target && !w0.stop) {
+  while (head < frontier.size() && frontier.size() - head < target &&
+         frontier.size() + 4 <= frontier.capacity() && !w0.stop) {
     const StackItem it = frontier[head++];
     ++w0.stats.node_pairs_visited;
     std::size_t top = 0;

@@ -10,6 +10,7 @@
 #include <memory>
 #include <vector>
 
+#include "support/allocation_probe.hpp"
 #include "tetseg/runtime/collider.hpp"
 #include "tetseg/runtime/scene.hpp"
 #include "tetseg/testing/scene_oracle.hpp"
@@ -129,6 +130,31 @@ TEST_CASE("The bvh mode on two threads reports brute force's contacts", "[collid
   REQUIRE(parallel.stats().traversal_threads == 2);
   REQUIRE(truth.size() > 100);
   require_same(got, truth);
+}
+
+TEST_CASE("Steps and queries on two threads allocate nothing, contact buffer included",
+          "[collider][openmp]") {
+  const BentDumbbell db;
+  for (ColliderMode mode : {ColliderMode::kRvbc, ColliderMode::kBvh, ColliderMode::kCone}) {
+    INFO("mode " << tetseg::to_string(mode));
+    tetseg::ColliderOptions options;
+    options.mode = mode;
+    options.use_openmp = true;
+    options.threads = 2;
+    tetseg::Collider collider(db.scene.asset, options);
+    std::vector<Contact> buffer(100000);
+    for (int round = 0; round < 2; ++round) {  // the first step as well as later ones
+      tetseg::test::AllocationProbe probe;
+      REQUIRE(collider.step(db.frames[0].data(), db.frames[1].data()) == ColliderStatus::kOk);
+      ContactsResult r;
+      REQUIRE(collider.contacts(buffer.data(), buffer.size(), r) == ColliderStatus::kOk);
+      REQUIRE(collider.stats().traversal_threads == 2);
+      REQUIRE(r.found > 100);
+      tetseg::EarliestContact e;
+      REQUIRE(collider.earliest_toi(e) == ColliderStatus::kOk);
+      REQUIRE(probe.count() == 0);
+    }
+  }
 }
 
 TEST_CASE("Scene contacts into a buffer on two threads equal the serial ones", "[scene][openmp]") {
