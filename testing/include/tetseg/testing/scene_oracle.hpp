@@ -3,7 +3,8 @@
 /// The brute-force truth over a whole scene, independent of the runtime's culling: every
 /// feature pair with four distinct nodes (vertex against triangle, edge against edge, within a
 /// body with self-collision on and across every pair of bodies) through the elementary tests of
-/// ccd.hpp only. Pairs whose four nodes are all still are skipped (the documented scene rule);
+/// ccd.hpp only. Pairs whose four nodes are all still are skipped (the documented scene rule)
+/// unless `include_still` (the runtime's `include_still_pairs`);
 /// a plain sort-and-sweep on swept feature boxes (exact box overlap, nothing else) keeps it
 /// affordable on large scenes. Shared by the runtime tests and `tetseg-bench scene`.
 /// Also the closed and open boxes used as still obstacles.
@@ -32,7 +33,8 @@ struct OracleBody {
 
 /// All contacts of the step, sorted by `contact_less`, named as the runtime names them
 /// (bodies[0] <= bodies[1] for edge pairs; edges normalised).
-inline std::vector<Contact> scene_brute_contacts(const std::vector<OracleBody>& bodies) {
+inline std::vector<Contact> scene_brute_contacts(const std::vector<OracleBody>& bodies,
+                                                 bool include_still = false) {
   enum Kind : std::uint8_t { kVertex, kEdge, kTriangle };
   struct Item {
     double lo[3], hi[3];
@@ -129,7 +131,7 @@ inline std::vector<Contact> scene_brute_contacts(const std::vector<OracleBody>& 
     const Item& A = items[i];
     for (std::size_t j = i + 1; j < items.size() && items[j].lo[0] <= A.hi[0]; ++j) {
       const Item& B = items[j];
-      if (!A.moving && !B.moving) continue;  // all four nodes still
+      if (!include_still && !A.moving && !B.moving) continue;  // all four nodes still
       if (A.body == B.body && !bodies[A.body].self) continue;
       if (A.lo[1] > B.hi[1] || B.lo[1] > A.hi[1] || A.lo[2] > B.hi[2] || B.lo[2] > A.hi[2])
         continue;
