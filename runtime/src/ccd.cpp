@@ -494,29 +494,35 @@ struct EdgeEdgeTest {
         separated_by_edge_plane(left2, left1, dc, ac))
       return {true, false};
 
-    // End caps (decide parallel edges): both points of one edge beyond the plane through an
-    // endpoint of the other, perpendicular to it.
-    const Slot<I> ab = difference(x[0], x[1]);
-    const Slot<I> cd = difference(x[2], x[3]);
-    const double ab2 = sep.zero() ? 0.0 : norm2_upper(ab);
-    const double cd2 = sep.zero() ? 0.0 : norm2_upper(cd);
-    const Slot<I> bd = difference(x[1], x[3]);
-    // cap at a: (c-a).(a-b) > delta |a-b| and (d-a).(a-b) > delta |a-b|.
-    if (above_delta(bilinear(ca, ab), sep, ab2) && above_delta(bilinear(da, ab), sep, ab2))
-      return {true, false};
-    // cap at b: (c-b).(b-a), (d-b).(b-a), i.e. (b-c).(a-b), (b-d).(a-b).
-    if (above_delta(bilinear(bc, ab), sep, ab2) && above_delta(bilinear(bd, ab), sep, ab2))
-      return {true, false};
-    // cap at c: (a-c).(c-d), (b-c).(c-d).
-    if (above_delta(bilinear(ac, cd), sep, cd2) && above_delta(bilinear(bc, cd), sep, cd2))
-      return {true, false};
-    // cap at d: (a-d).(d-c), (b-d).(d-c), i.e. (d-a).(c-d), (d-b).(c-d).
-    if (above_delta(bilinear(da, cd), sep, cd2) &&
-        above_delta(bilinear(difference(x[3], x[1]), cd), sep, cd2))
-      return {true, false};
     // Both closest-point parameters strictly inside (0,1) on all of T (then |n| > 0): the
     // edges touch exactly where the coplanarity cubic vanishes.
     const bool inside = positive(h1) && positive(h2) && positive(h3) && positive(h4);
+    // End caps (decide parallel edges): both points of one edge beyond the plane through an
+    // endpoint of the other, perpendicular to it. None can hold where `inside` is proven: then
+    // the point q of segment cd closest to line ab (v = h3 / N in (0,1)) projects onto ab at
+    // u = h1 / N in (0,1), (q - a).(b - a) = u |b - a|^2, while the cap at a (b) puts c and d,
+    // so q, strictly before a (beyond b); the same for the caps at c and d. So they are only
+    // evaluated when `inside` is not proven (the outcome is the same, with less work).
+    if (!inside) {
+      const Slot<I> ab = difference(x[0], x[1]);
+      const Slot<I> cd = difference(x[2], x[3]);
+      const double ab2 = sep.zero() ? 0.0 : norm2_upper(ab);
+      const double cd2 = sep.zero() ? 0.0 : norm2_upper(cd);
+      const Slot<I> bd = difference(x[1], x[3]);
+      // cap at a: (c-a).(a-b) > delta |a-b| and (d-a).(a-b) > delta |a-b|.
+      if (above_delta(bilinear(ca, ab), sep, ab2) && above_delta(bilinear(da, ab), sep, ab2))
+        return {true, false};
+      // cap at b: (c-b).(b-a), (d-b).(b-a), i.e. (b-c).(a-b), (b-d).(a-b).
+      if (above_delta(bilinear(bc, ab), sep, ab2) && above_delta(bilinear(bd, ab), sep, ab2))
+        return {true, false};
+      // cap at c: (a-c).(c-d), (b-c).(c-d).
+      if (above_delta(bilinear(ac, cd), sep, cd2) && above_delta(bilinear(bc, cd), sep, cd2))
+        return {true, false};
+      // cap at d: (a-d).(d-c), (b-d).(d-c), i.e. (d-a).(c-d), (d-b).(c-d).
+      if (above_delta(bilinear(da, cd), sep, cd2) &&
+          above_delta(bilinear(difference(x[3], x[1]), cd), sep, cd2))
+        return {true, false};
+    }
     if (!sep.zero()) return {false, inside};
     const Sums<I, 4>* const conditions[4] = {&h1, &h2, &h3, &h4};
     return certify<I, 4>(f, conditions, plane_axis >= 0, inside, open_condition);
