@@ -35,6 +35,7 @@ namespace {
 using namespace ccd_detail;
 
 constexpr int kStackSize = 64;
+
 constexpr double kMinTolerance = 0x1p-50;
 
 template <class I>
@@ -143,6 +144,17 @@ Sums<I, 4> quadrilinear(const CrossSums<I>& l, const CrossSums<I>& r) noexcept {
   return {{dot(l.c[0], r.c[0]), dot(l.c[0], r.c[1]) + dot(l.c[1], r.c[0]),
            dot(l.c[0], r.c[2]) + dot(l.c[1], r.c[1]) + dot(l.c[2], r.c[0]),
            dot(l.c[1], r.c[2]) + dot(l.c[2], r.c[1]), dot(l.c[2], r.c[2])}};
+}
+
+/// range_of(quadrilinear(l, r)).hi < 0 (the same sums, each proven negative), the end sums
+/// (the form's values at the interval ends) first: where they are not negative, as on most
+/// calls, the three middle sums are not computed.
+template <class I>
+bool quadrilinear_negative(const CrossSums<I>& l, const CrossSums<I>& r) noexcept {
+  if (!(upper(dot(l.c[0], r.c[0])) < 0.0) || !(upper(dot(l.c[2], r.c[2])) < 0.0)) return false;
+  return upper(dot(l.c[0], r.c[1]) + dot(l.c[1], r.c[0])) < 0.0 &&
+         upper(dot(l.c[0], r.c[2]) + dot(l.c[1], r.c[1]) + dot(l.c[2], r.c[0])) < 0.0 &&
+         upper(dot(l.c[1], r.c[2]) + dot(l.c[2], r.c[1])) < 0.0;
 }
 
 /// Mid value of an enclosure, as a double.
@@ -534,8 +546,8 @@ struct EdgeEdgeTest {
   template <class I>
   bool separated_by_edge_plane(const CrossSums<I>& far_e, const CrossSums<I>& e_near,
                                const Slot<I>& e, const Slot<I>& near_o) const noexcept {
+    if (sep.zero()) return quadrilinear_negative(far_e, e_near);
     const Sums<I, 4> far_side = quadrilinear(far_e, e_near);
-    if (sep.zero()) return range_of(far_side).hi < 0.0;
     const Range far_range = value_range(far_side);
     if (!(far_range.hi < 0.0)) return false;
     const double e2 = norm2_upper(e);
