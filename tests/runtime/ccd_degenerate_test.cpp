@@ -198,3 +198,49 @@ TEST_CASE("Contacts in an axis plane are certified at their exact times", "[ccd]
   const Vec3d g0{0, 1, 0x1p-52}, g1{1, 0, 0x1p-52};
   CHECK(!tetseg::edge_edge_ccd(e0, e1, g0, g1, e0, e1, g0, g1).hit());
 }
+
+TEST_CASE("Collinear edges sliding along their line: apart is a miss and touching a hit",
+          "[ccd][exact]") {
+  // Four points on one line through the origin (a direction with no zero coordinate: never
+  // in one axis plane, so no plane certificate applies), at integer multiples of it. The
+  // common normal of the edges vanishes, so only the end caps (both points of one edge beyond
+  // an endpoint of the other) prove a miss on the whole step: the points move 8 units along
+  // the line, so the swept boxes overlap and without the caps the miss takes a bisection down
+  // to intervals short enough for the boxes. Against the exact oracle.
+  std::mt19937_64 rng(25);
+  std::uniform_int_distribution<int> coord(1, 5), length(1, 4), shift(-3, 3), gap(1, 3);
+  int misses = 0, touches = 0;
+  for (int i = 0; i < 400; ++i) {
+    const Vec3d dir{double(coord(rng)), -double(coord(rng)), double(coord(rng))};
+    auto at = [&](double s) { return Vec3d{s * dir[0], s * dir[1], s * dir[2]}; };
+    // Edge ab, then edge cd after a gap, at both ends of the step; with `touch`, c ends on b.
+    const bool touch = i % 2 == 1;
+    double s0[4], s1[4];
+    for (double* s : {s0, s1}) {
+      s[0] = shift(rng);
+      s[1] = s[0] + length(rng);
+      s[2] = s[1] + gap(rng);
+      s[3] = s[2] + length(rng);
+    }
+    for (double& s : s1) s += 8;
+    if (touch) {
+      s1[3] += s1[1] - s1[2];
+      s1[2] = s1[1];
+    }
+    const Query q{
+        true,
+        kGrid,
+        {at(s0[0]), at(s0[1]), at(s0[2]), at(s0[3]), at(s1[0]), at(s1[1]), at(s1[2]), at(s1[3])}};
+    const CcdResult r = run(q);
+    const tetseg::test::ExactCcd e = exact(q);
+    INFO("query " << i << ": line (" << dir[0] << ", " << dir[1] << ", " << dir[2] << ")");
+    REQUIRE(e.hit == touch);
+    CHECK(r.hit() == touch);
+    if (touch) CHECK(r.toi <= e.toi_upper);
+    if (!touch) CHECK(r.intervals == 1);  // the caps exclude the whole step at once
+    misses += !r.hit();
+    touches += r.hit();
+  }
+  CHECK(misses == 200);
+  CHECK(touches == 200);
+}
