@@ -8,7 +8,8 @@
 // collider's culling assumes an intersection-free start (docs/runtime.md); the table shows
 // how many steps were compared.
 // Links the runtime only. Timings: each step is run `--repeat` times and the fastest run of
-// the step is kept (robust to the shared cores of a CI machine); the mean is over steps.
+// the step is kept (robust to the shared cores of a CI machine); the mean is over steps (the
+// JSON also has the medians over steps of the total and CPU times).
 // tetseg-bench scene: scene_table.hpp.
 
 #include <time.h>
@@ -68,6 +69,8 @@ struct Row {
   bool timed_tests = false;  ///< elementary tests timed apart (else counted as traversal)
   std::size_t steps = 0;
   double refit = 0, classify = 0, cone = 0, traversal = 0, tests = 0, total = 0, cpu = 0;
+  /// Medians over steps of the kept run's wall and CPU milliseconds (means: total, cpu).
+  double total_median = 0, cpu_median = 0;
   double tri_pairs = 0, feature_tests = 0, contacts = 0, neg_unc = 0;
   std::size_t clusters = 0;
   /// missed: oracle contacts at the step's earliest toi that the mode did not report (must be
@@ -94,6 +97,14 @@ void load_scene(Scene& s, const std::string& asset_path, const std::string& fram
     throw Failure{kExitBadInput, frames_path + ": " + tetseg::to_string(fs) + ": " + why};
   if (s.frames.node_count != s.asset.node_count())
     throw Failure{kExitBadInput, frames_path + ": node count differs from the asset's"};
+}
+
+/// Median of `v` (mean of the two middle values for an even count; 0 when empty).
+double median(std::vector<double> v) {
+  if (v.empty()) return 0;
+  std::sort(v.begin(), v.end());
+  const std::size_t m = v.size() / 2;
+  return v.size() % 2 ? v[m] : 0.5 * (v[m - 1] + v[m]);
 }
 
 /// Which steps are run and what is timed.
@@ -166,6 +177,7 @@ Row run_mode(const Scene& s, tetseg::ColliderMode mode, bool openmp, const Plan&
   row.clusters = s.asset.cluster_count();
   const std::size_t steps = step_count(s.frames, plan);
   row.steps = steps;
+  std::vector<double> step_total, step_cpu;
   for (std::size_t i = 0; i < steps; ++i) {
     const double* x0 = s.frames.frame(step_start(i, plan));
     const double* x1 = s.frames.frame(step_end(i, plan));
@@ -195,6 +207,8 @@ Row run_mode(const Scene& s, tetseg::ColliderMode mode, bool openmp, const Plan&
       throw Failure{kExitFailed, s.name + ": query failed"};
     row.total += best_total;
     row.cpu += best_cpu;
+    step_total.push_back(best_total);
+    step_cpu.push_back(best_cpu);
     row.refit += best_stats.refit_ms;
     row.classify += best_stats.classify_ms;
     row.cone += best_stats.cone_ms;
@@ -237,6 +251,8 @@ Row run_mode(const Scene& s, tetseg::ColliderMode mode, bool openmp, const Plan&
   for (double* v : {&row.refit, &row.classify, &row.cone, &row.traversal, &row.tests, &row.total,
                     &row.cpu, &row.tri_pairs, &row.feature_tests, &row.contacts, &row.neg_unc})
     *v /= n;
+  row.total_median = median(step_total);
+  row.cpu_median = median(step_cpu);
   return row;
 }
 
@@ -303,6 +319,8 @@ int table(const std::vector<std::string>& scene_args, const std::string& mode_li
                 << ", \"traversal_ms\": " << r.traversal
                 << ", \"tests_ms\": " << (r.timed_tests ? fmt("%.17g", r.tests) : "null")
                 << ", \"total_ms\": " << r.total << ", \"total_cpu_ms\": " << r.cpu
+                << ", \"median_total_ms\": " << r.total_median
+                << ", \"median_cpu_ms\": " << r.cpu_median
                 << ", \"triangle_pairs\": " << r.tri_pairs
                 << ", \"feature_tests\": " << r.feature_tests << ", \"contacts\": " << r.contacts
                 << ", \"missed\": " << r.missed << ", \"later_missed\": " << r.later_missed
@@ -421,12 +439,11 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1, 100));
   t->add_option("--query", query,
                 "Timed query after each step: all (contacts into a buffer, default) or earliest "
-                "(earliest_toi, which rvbc traverses in parallel with --openmp); the other runs "
-                "untimed for the comparison")
+                "(earliest_toi); the other runs untimed for the comparison")
       ->check(CLI::IsMember({"all", "earliest"}));
   t->add_flag("--openmp", openmp,
-              "Also run each mode with use_openmp (refit, classification; rvbc's traversal "
-              "with --query earliest)");
+              "Also run each mode with use_openmp (refit, classification and the traversal "
+              "of every query; threads: OMP_NUM_THREADS)");
   t->add_flag("--no-truth", no_truth,
               "Skip the oracle and the comparison (timings only; missed reads 0)");
   t->add_flag("--json", json, "JSON on stdout instead of the Markdown table");

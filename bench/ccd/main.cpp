@@ -161,7 +161,8 @@ io::Mesh load_mesh(const std::string& path) {
 }
 
 int command_frames(const std::string& path0, const std::string& path1, bool json,
-                   const tetseg::CcdOptions& options, soup::BroadPhase broad_phase) {
+                   const tetseg::CcdOptions& options, soup::BroadPhase broad_phase,
+                   soup::StillPairs still_pairs) {
   const io::Mesh m0 = load_mesh(path0);
   const io::Mesh m1 = load_mesh(path1);
   if (m0.vertices.size() != m1.vertices.size())
@@ -169,8 +170,8 @@ int command_frames(const std::string& path0, const std::string& path1, bool json
   if (m0.faces != m1.faces) throw ToolError(kExitBadInput, path1, "faces differ from " + path0);
   soup::FrameStats stats;
   const double cpu_start = thread_cpu_seconds();
-  const auto contacts =
-      soup::find_contacts(m0.vertices, m1.vertices, m0.faces, options, broad_phase, &stats);
+  const auto contacts = soup::find_contacts(m0.vertices, m1.vertices, m0.faces, options,
+                                            broad_phase, &stats, still_pairs);
   const double cpu = thread_cpu_seconds() - cpu_start;
   std::ostringstream out;
   char buf[160];
@@ -305,6 +306,12 @@ int main(int argc, char** argv) {
   frames
       ->add_option("--min-separation", options.min_separation, "Minimum separation (length units)")
       ->check(CLI::NonNegativeNumber);
+  bool skip_still = false;
+  frames->add_flag("--skip-still", skip_still,
+                   "Do not test pairs whose four vertices are still (x0 == x1): the runtime's "
+                   "default rule for simulator steps that start contact-free. Default: every "
+                   "pair touching during the step is reported, still ones included (the "
+                   "frame's exact truth)");
 
   auto* truth =
       app.add_subcommand("truth", "List the true pairs of a scalable-CCD frame (boxes + mma_bool)");
@@ -325,7 +332,8 @@ int main(int argc, char** argv) {
       return command_frames(ply0, ply1, json, options,
                             brute   ? soup::BroadPhase::kBrute
                             : sweep ? soup::BroadPhase::kSweep
-                                    : soup::BroadPhase::kScene);
+                                    : soup::BroadPhase::kScene,
+                            skip_still ? soup::StillPairs::kSkip : soup::StillPairs::kInclude);
     return command_truth(truth_ply, boxes_path, bools_path, kind);
   } catch (const ToolError& e) {
     print_error(kTool, e.file(), e.what());

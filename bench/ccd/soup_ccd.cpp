@@ -32,6 +32,12 @@ bool shares(const std::array<std::uint32_t, 3>& f, std::uint32_t v) {
   return f[0] == v || f[1] == v || f[2] == v;
 }
 
+/// Whether vertex v is still over the step (x0 == x1 bitwise: the runtime's rule).
+bool still(const std::vector<std::array<double, 3>>& x0,
+           const std::vector<std::array<double, 3>>& x1, std::uint32_t v) {
+  return x0[v] == x1[v];
+}
+
 /// Swept box of every vertex over the step, enlarged by the minimum separation (rounded
 /// outwards).
 std::vector<Box> swept_vertex_boxes(const std::vector<std::array<double, 3>>& x0,
@@ -83,7 +89,9 @@ void sort_and_sweep(const std::vector<Box>& boxes, const std::vector<bool>& seco
 std::vector<Contact> sweep_contacts(const std::vector<std::array<double, 3>>& x0,
                                     const std::vector<std::array<double, 3>>& x1,
                                     const std::vector<std::array<std::uint32_t, 3>>& faces,
-                                    const CcdOptions& options, FrameStats* stats) {
+                                    const CcdOptions& options, FrameStats* stats,
+                                    StillPairs still_pairs) {
+  const bool skip_still = still_pairs == StillPairs::kSkip;
   FrameStats local;
   FrameStats& st = stats ? *stats : local;
   const double start = thread_cpu_seconds();
@@ -145,6 +153,9 @@ std::vector<Contact> sweep_contacts(const std::vector<std::array<double, 3>>& x0
     const auto& face = faces[f];
     const Vec3d &p0 = x0[v], &a0 = x0[face[0]], &b0 = x0[face[1]], &c0 = x0[face[2]];
     const Vec3d &p1 = x1[v], &a1 = x1[face[0]], &b1 = x1[face[1]], &c1 = x1[face[2]];
+    if (skip_still && still(x0, x1, v) && still(x0, x1, face[0]) && still(x0, x1, face[1]) &&
+        still(x0, x1, face[2]))
+      continue;
     if (!vertex_face_ccd_filter(p0, a0, b0, c0, p1, a1, b1, c1, options)) continue;
     ++st.tests;
     const CcdResult r = vertex_face_ccd(p0, a0, b0, c0, p1, a1, b1, c1, options);
@@ -155,6 +166,9 @@ std::vector<Contact> sweep_contacts(const std::vector<std::array<double, 3>>& x0
     if (g < e) std::swap(e, g);
     const Vec3d &a0 = x0[e[0]], &b0 = x0[e[1]], &c0 = x0[g[0]], &d0 = x0[g[1]];
     const Vec3d &a1 = x1[e[0]], &b1 = x1[e[1]], &c1 = x1[g[0]], &d1 = x1[g[1]];
+    if (skip_still && still(x0, x1, e[0]) && still(x0, x1, e[1]) && still(x0, x1, g[0]) &&
+        still(x0, x1, g[1]))
+      continue;
     if (!edge_edge_ccd_filter(a0, b0, c0, d0, a1, b1, c1, d1, options)) continue;
     ++st.tests;
     const CcdResult r = edge_edge_ccd(a0, b0, c0, d0, a1, b1, c1, d1, options);
@@ -182,7 +196,8 @@ std::vector<Contact> sweep_contacts(const std::vector<std::array<double, 3>>& x0
 std::vector<Contact> scene_contacts(const std::vector<std::array<double, 3>>& x0,
                                     const std::vector<std::array<double, 3>>& x1,
                                     const std::vector<std::array<std::uint32_t, 3>>& faces,
-                                    const CcdOptions& options, FrameStats* stats) {
+                                    const CcdOptions& options, FrameStats* stats,
+                                    StillPairs still_pairs) {
   const auto nodes = static_cast<std::uint32_t>(x0.size());
   std::vector<std::uint32_t> ids;
   ids.reserve(faces.size() * 3);
@@ -197,6 +212,7 @@ std::vector<Contact> scene_contacts(const std::vector<std::array<double, 3>>& x0
   SceneOptions scene_options;
   scene_options.ccd = options;
   scene_options.time_tests = false;
+  scene_options.include_still_pairs = still_pairs == StillPairs::kInclude;
   Scene scene(scene_options);
   std::uint32_t body = 0;
   if (scene.add_body(shape, BodyOptions{}, &body) != ColliderStatus::kOk ||
@@ -250,9 +266,16 @@ std::vector<Contact> find_contacts(const std::vector<std::array<double, 3>>& x0,
                                    const std::vector<std::array<double, 3>>& x1,
                                    const std::vector<std::array<std::uint32_t, 3>>& faces,
                                    const CcdOptions& options, BroadPhase broad_phase,
-                                   FrameStats* stats) {
-  if (broad_phase == BroadPhase::kScene) return scene_contacts(x0, x1, faces, options, stats);
-  if (broad_phase == BroadPhase::kSweep) return sweep_contacts(x0, x1, faces, options, stats);
+                                   FrameStats* stats, StillPairs still_pairs) {
+  if (broad_phase == BroadPhase::kScene)
+    return scene_contacts(x0, x1, faces, options, stats, still_pairs);
+  if (broad_phase == BroadPhase::kSweep)
+    return sweep_contacts(x0, x1, faces, options, stats, still_pairs);
+  const bool skip_still = still_pairs == StillPairs::kSkip;
+  auto all_still = [&](const std::array<std::uint32_t, 4>& ids) {
+    return skip_still && still(x0, x1, ids[0]) && still(x0, x1, ids[1]) && still(x0, x1, ids[2]) &&
+           still(x0, x1, ids[3]);
+  };
   const std::vector<Box> vertex_boxes = swept_vertex_boxes(x0, x1, options);
   std::vector<Box> face_boxes(faces.size());
   for (std::size_t f = 0; f < faces.size(); ++f)
@@ -299,11 +322,13 @@ std::vector<Contact> find_contacts(const std::vector<std::array<double, 3>>& x0,
   std::vector<Contact> contacts;
   for (const auto& [v, f] : vf_pairs) {
     const auto& face = faces[f];
+    if (all_still({v, face[0], face[1], face[2]})) continue;
     const CcdResult r = vertex_face_ccd(x0[v], x0[face[0]], x0[face[1]], x0[face[2]], x1[v],
                                         x1[face[0]], x1[face[1]], x1[face[2]], options);
     if (r.hit()) contacts.push_back({true, {v, face[0], face[1], face[2]}, r.toi});
   }
   for (const auto& e : ee_pairs) {
+    if (all_still(e)) continue;
     const CcdResult r = edge_edge_ccd(x0[e[0]], x0[e[1]], x0[e[2]], x0[e[3]], x1[e[0]], x1[e[1]],
                                       x1[e[2]], x1[e[3]], options);
     if (r.hit()) contacts.push_back({false, e, r.toi});

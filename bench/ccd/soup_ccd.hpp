@@ -3,9 +3,11 @@
 /// All contacts of a deforming triangle soup over one linear step, through the runtime: the
 /// soup is one surface-only body of a `tetseg::Scene` (median-split BVH over the swept
 /// triangle boxes, self-traversal, feature pairs with four distinct nodes deduplicated exactly,
-/// the runtime's filters and elementary tests; feature pairs whose four vertices do not move
-/// are not tested, docs/runtime.md "Still geometry"). `brute` is an independent reference: all
-/// face pairs with overlapping swept boxes, candidate lists deduplicated, elementary tests.
+/// the runtime's filters and elementary tests). By default still feature pairs (four vertices
+/// with x0 == x1) are tested too, so the result is every touching pair of the frame; with
+/// `StillPairs::kSkip` they are not (the runtime's default rule, docs/runtime.md "Still
+/// geometry"). `brute` is an independent reference: all face pairs with overlapping swept
+/// boxes, candidate lists deduplicated, elementary tests.
 
 #include <array>
 #include <cstdint>
@@ -29,6 +31,12 @@ enum class BroadPhase {
   kBrute,  ///< all face pairs (quadratic; a reference for tests)
 };
 
+/// Which feature pairs whose four vertices are all still (x0 == x1 bitwise) are tested.
+enum class StillPairs {
+  kInclude,  ///< all of them: every pair touching during the step (the frame's exact truth)
+  kSkip,     ///< none (the runtime's still rule: such a pair can only touch at t = 0)
+};
+
 /// Work of one frame. Sort and sweep: candidates (box-overlapping pairs that share no vertex),
 /// thread CPU time of the broad phase and of the pre-filters and elementary tests. Scene: the
 /// body's `ColliderStats` counts. Both: elementary tests run (after the pre-filters).
@@ -49,7 +57,8 @@ std::vector<Contact> find_contacts(const std::vector<std::array<double, 3>>& x0,
                                    const std::vector<std::array<std::uint32_t, 3>>& faces,
                                    const CcdOptions& options,
                                    BroadPhase broad_phase = BroadPhase::kScene,
-                                   FrameStats* stats = nullptr);
+                                   FrameStats* stats = nullptr,
+                                   StillPairs still_pairs = StillPairs::kInclude);
 
 /// CPU time of the calling thread, in seconds.
 double thread_cpu_seconds();

@@ -195,6 +195,8 @@ py::dict options_dict(const ColliderOptions& o) {
   d["use_openmp"] = o.use_openmp;
   d["check_first_step"] = o.check_first_step;
   d["time_tests"] = o.time_tests;
+  d["include_still_pairs"] = o.include_still_pairs;
+  d["threads"] = o.threads;
   return d;
 }
 
@@ -294,7 +296,8 @@ class PyCollider {
 
 ColliderOptions make_options(const std::string& mode, double min_separation, double time_tolerance,
                              std::uint32_t max_intervals, std::uint32_t bvh_leaf_size,
-                             bool use_openmp, bool check_first_step, bool time_tests) {
+                             bool use_openmp, bool check_first_step, bool time_tests,
+                             bool include_still_pairs, std::uint32_t threads) {
   ColliderOptions o;
   if (!parse_collider_mode(mode.c_str(), o.mode))
     throw py::value_error("unknown mode '" + mode + "' (rvbc, bvh, brute, cone)");
@@ -305,6 +308,8 @@ ColliderOptions make_options(const std::string& mode, double min_separation, dou
   o.use_openmp = use_openmp;
   o.check_first_step = check_first_step;
   o.time_tests = time_tests;
+  o.include_still_pairs = include_still_pairs;
+  o.threads = threads;
   return o;
 }
 
@@ -515,13 +520,13 @@ PYBIND11_MODULE(_runtime, m) {
       .def(py::init([](py::object asset, const std::string& mode, double min_separation,
                        double time_tolerance, std::uint32_t max_intervals,
                        std::uint32_t bvh_leaf_size, bool use_openmp, bool check_first_step,
-                       bool time_tests) {
+                       bool time_tests, bool include_still_pairs, std::uint32_t threads) {
              if (!py::isinstance<PyAsset>(asset))
                throw py::type_error("Collider expects a tetseg.Asset (see tetseg.load_asset)");
              return std::make_unique<PyCollider>(
-                 std::move(asset),
-                 make_options(mode, min_separation, time_tolerance, max_intervals, bvh_leaf_size,
-                              use_openmp, check_first_step, time_tests));
+                 std::move(asset), make_options(mode, min_separation, time_tolerance, max_intervals,
+                                                bvh_leaf_size, use_openmp, check_first_step,
+                                                time_tests, include_still_pairs, threads));
            }),
            py::arg("asset"), py::kw_only(), py::arg("mode") = std::string(to_string(defaults.mode)),
            py::arg("min_separation") = defaults.ccd.min_separation,
@@ -531,10 +536,15 @@ PYBIND11_MODULE(_runtime, m) {
            py::arg("use_openmp") = defaults.use_openmp,
            py::arg("check_first_step") = defaults.check_first_step,
            py::arg("time_tests") = defaults.time_tests,
+           py::arg("include_still_pairs") = defaults.include_still_pairs,
+           py::arg("threads") = defaults.threads,
            "Builds a collider (allocates all scratch memory). Options as "
            "tetseg::ColliderOptions (docs/runtime.md): mode is one of MODES; min_separation, "
-           "time_tolerance and max_intervals go to the elementary tests. The collider holds a "
-           "reference to the asset, so it keeps working when the caller drops the Asset.")
+           "time_tolerance and max_intervals go to the elementary tests; include_still_pairs "
+           "also tests feature pairs whose four nodes do not move (skipped by default); threads "
+           "is the OpenMP thread count with use_openmp (0: OpenMP's default). The collider "
+           "holds a reference to the asset, so it keeps working when the caller drops the "
+           "Asset.")
       .def("step", &PyCollider::step, py::arg("x0"), py::arg("x1"),
            "Starts a step from positions x0 (t = 0) to x1 (t = 1): "
            "(node_count, 3) C-contiguous float64 arrays, used in place (not copied) and "

@@ -272,6 +272,8 @@ class PyScene {
     d["use_openmp"] = m_options.use_openmp;
     d["time_tests"] = m_options.time_tests;
     d["traversal_stack"] = m_options.traversal_stack;
+    d["include_still_pairs"] = m_options.include_still_pairs;
+    d["threads"] = m_options.threads;
     return d;
   }
 
@@ -372,7 +374,8 @@ void bind_scene(py::module_& m) {
       "during steps and queries.")
       .def(py::init([](double min_separation, double time_tolerance, std::uint32_t max_intervals,
                        std::uint32_t bvh_leaf_size, bool use_openmp, bool time_tests,
-                       std::uint32_t traversal_stack) {
+                       std::uint32_t traversal_stack, bool include_still_pairs,
+                       std::uint32_t threads) {
              SceneOptions o;
              o.ccd.min_separation = min_separation;
              o.ccd.time_tolerance = time_tolerance;
@@ -381,6 +384,8 @@ void bind_scene(py::module_& m) {
              o.use_openmp = use_openmp;
              o.time_tests = time_tests;
              o.traversal_stack = traversal_stack;
+             o.include_still_pairs = include_still_pairs;
+             o.threads = threads;
              return std::make_unique<PyScene>(o);
            }),
            py::kw_only(), py::arg("min_separation") = defaults.ccd.min_separation,
@@ -389,10 +394,14 @@ void bind_scene(py::module_& m) {
            py::arg("bvh_leaf_size") = defaults.bvh_leaf_size,
            py::arg("use_openmp") = defaults.use_openmp, py::arg("time_tests") = defaults.time_tests,
            py::arg("traversal_stack") = defaults.traversal_stack,
+           py::arg("include_still_pairs") = defaults.include_still_pairs,
+           py::arg("threads") = defaults.threads,
            "An empty scene. Options as tetseg::SceneOptions (docs/runtime.md): min_separation, "
            "time_tolerance and max_intervals go to the elementary tests; traversal_stack 0 "
            "never overflows (small values are for tests: queries then raise ColliderError "
-           "'traversal stack overflow').")
+           "'traversal stack overflow'); include_still_pairs also tests feature pairs whose "
+           "four nodes do not move, still bodies included (skipped by default); threads is the "
+           "OpenMP thread count with use_openmp (0: OpenMP's default).")
       .def("add_body", &PyScene::add_body, py::arg("shape"), py::kw_only(),
            py::arg("mode") = std::string(to_string(BodyOptions{}.mode)), py::arg("still") = false,
            py::arg("self_collision") = true, py::arg("global_offset") = py::none(),

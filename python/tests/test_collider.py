@@ -94,7 +94,8 @@ def test_options_and_stats(dumbbell):
                                use_openmp=True, check_first_step=True, time_tests=False)
     assert collider.options == {"mode": "bvh", "min_separation": 1e-3, "time_tolerance": 1e-6,
                                 "max_intervals": 512, "bvh_leaf_size": 2, "use_openmp": True,
-                                "check_first_step": True, "time_tests": False}
+                                "check_first_step": True, "time_tests": False,
+                                "include_still_pairs": False, "threads": 0}
     collider.step(frames[5], frames[6])
     assert collider.rest_intersection["intersecting"] is False
     collider.any_collision()

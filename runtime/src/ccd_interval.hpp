@@ -6,18 +6,23 @@
 // operations (round-to-nearest assumed, as everywhere in C++ by default). Each operation adds
 // to the radius the propagated radii plus the rounding error of its own midpoint (at most
 // 2^-53 |m|, bounded here by 2^-52 |m|), and the radius sum itself is rounded upwards by a
-// relative factor 1 + 2^-49 (covers the at most 7 roundings of the radius formula) plus the
-// smallest normal double (covers underflow). Non-finite values propagate as NaN/inf and then
-// never prove anything (all comparisons used for decisions are false on NaN).
+// relative factor 1 + 2^-49 (covers the at most 7 roundings of the radius formula) plus an
+// absolute floor kTiny = 2^-500 (covers underflow, which loses at most 2^-1074 per rounding).
+// The floor is far above the smallest normal double on purpose: every radius is then at least
+// 2^-500, so a product of two radii stays a normal double. With the smallest normal double as
+// the floor, exactly degenerate queries (four points in one plane: many quantities exactly 0,
+// radii at the floor) multiplied radii into the subnormal range, where x86 arithmetic takes a
+// microcode assist per operation (such queries ran 3 times slower). The price: quantities
+// below about 1e-150 are not resolved. Non-finite values propagate as NaN/inf and then never
+// prove anything (all comparisons used for decisions are false on NaN).
 
 #include <cmath>
-#include <limits>
 
 namespace tetseg::ccd_detail {
 
 constexpr double kRel = 0x1p-52;
 constexpr double kUp = 1.0 + 0x1p-49;
-constexpr double kTiny = std::numeric_limits<double>::min();
+constexpr double kTiny = 0x1p-500;
 
 struct Iv {
   double m;

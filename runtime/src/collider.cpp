@@ -1,6 +1,6 @@
 // Collider: construction (topology, scratch), step validation, refit and classification,
-// and the public query entry points. Traversal: collider_traverse.cpp; kBvh mode's BVH and
-// the rest-intersection check: collider_bvh.cpp.
+// and the public query entry points. Traversal: collider_traverse.cpp; narrow phase:
+// collider_narrow.cpp; kBvh mode's BVH and the rest-intersection check: collider_bvh.cpp.
 
 #include <algorithm>
 #include <chrono>
@@ -94,9 +94,14 @@ void Collider::Impl::construct(std::shared_ptr<const BodyShape> sh, const Collid
                      16 * (2 * std::size_t(topo->wide_depth) + 2));
   std::size_t threads = 1;
 #if defined(TETSEG_HAVE_OPENMP)
-  if (opt.use_openmp) threads = static_cast<std::size_t>(std::max(1, omp_get_max_threads()));
+  if (opt.use_openmp)
+    threads = opt.threads > 0 ? opt.threads
+                              : static_cast<std::size_t>(std::max(1, omp_get_max_threads()));
 #endif
   workers.resize(threads);
+  // The whole-surface BVH's parallel traversal: 16 items per thread, with room for the
+  // items expanded on the way (traverse_global_parallel).
+  if (threads > 1) frontier.reserve(64 * threads + 4);
   const bool plane_cache = opt.mode != ColliderMode::kBrute && opt.ccd.min_separation <= 0;
   for (Worker& w : workers) {
     w.stack.resize(stack_size);
@@ -198,6 +203,9 @@ void Collider::Impl::refit_and_classify() noexcept {
     Box* vb = vbox.data();
     std::uint8_t* vm = vmoved.data();
     const bool at_rest = rest_mode;
+    // Without the still rule every node counts as moving for the culling (vmoved and all that
+    // follows from it); nodes_moved still counts the nodes that moved.
+    const bool all_live = !rest_mode && opt.include_still_pairs;
 #if defined(TETSEG_HAVE_OPENMP)
 #pragma omp parallel for reduction(+ : moved) if (opt.use_openmp && nv > 4096)
 #endif
@@ -205,7 +213,7 @@ void Collider::Impl::refit_and_classify() noexcept {
       const double* a = p0 + std::size_t(nodes[i]) * 3;
       const double* b = p1 + std::size_t(nodes[i]) * 3;
       const bool m = !at_rest && (a[0] != b[0] || a[1] != b[1] || a[2] != b[2]);
-      vm[i] = m ? 1 : 0;
+      vm[i] = (m || all_live) ? 1 : 0;
       moved += m ? 1 : 0;
       for (int k = 0; k < 3; ++k) {
         vb[i].lo[k] = std::min(a[k], b[k]);
@@ -214,7 +222,7 @@ void Collider::Impl::refit_and_classify() noexcept {
     }
   }
   stats.nodes_moved = moved;
-  stats.nothing_moved = moved == 0 && !rest_mode;
+  stats.nothing_moved = moved == 0 && !rest_mode && !opt.include_still_pairs;
   if (stats.nothing_moved && !always_refit) {
     stats.refit_ms = ms_since(t_refit);
     return;  // every feature pair is still: no test can run this step
@@ -260,7 +268,7 @@ void Collider::Impl::refit_and_classify() noexcept {
   if (stats.nothing_moved) return;  // scene body: boxes only
   if (opt.mode == ColliderMode::kCone && !rest_mode) {
     const auto t_cone = Clock::now();
-    update_cones();  // normal_cone.cpp
+    update_cones();  // collider_cone.cpp
     stats.cone_ms = ms_since(t_cone);
   }
 
@@ -431,12 +439,13 @@ namespace {
 auto collider_run(Collider::Impl& s) noexcept {
   return [&s](QueryKind kind, Contact* out, std::size_t cap, std::size_t& written) noexcept {
     s.qkind = kind;
-    if (!s.run_query(out, cap)) return ColliderStatus::kOverflow;
+    ContactSink sink{out, out ? cap : 0};
+    if (!s.run_query(out ? &sink : nullptr)) return ColliderStatus::kOverflow;
     if (kind == QueryKind::kAny) {
       s.cache.any_known = true;
       s.cache.any_value = s.query_hit;
     }
-    written = s.out_written;
+    written = sink.written;
     return ColliderStatus::kOk;
   };
 }

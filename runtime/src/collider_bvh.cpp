@@ -142,7 +142,7 @@ RestCheck Collider::Impl::rest_check(const double* x, std::size_t value_count) n
   rest_mode = true;
   refit_and_classify();
   qkind = QueryKind::kAny;
-  const bool ok = run_query(nullptr, 0);  // rest mode: serial, worker 0
+  const bool ok = run_query(nullptr);  // rest mode: serial, worker 0
   rest_mode = false;
   have_step = false;
   stats = ColliderStats{};

@@ -183,6 +183,18 @@ struct WholeSurfaceBvh {
   }
 };
 
+/// A caller's contact buffer, shared by every worker of one query: it keeps the `cap`
+/// smallest contacts in `contact_less` order (a max-heap on that order while filling; the
+/// query sorts it at the end), so its content does not depend on which worker finds what, or
+/// when. `written` = min(contacts added, cap). With `locked`, `add` runs under a lock
+/// (workers on several threads); contacts are rare next to tests, so the lock costs little.
+struct ContactSink {
+  Contact* out = nullptr;
+  std::size_t cap = 0, written = 0;
+  bool locked = false;
+  void add(const Contact& c) noexcept;
+};
+
 /// Running state of one traversal thread (index 0 is the serial one). Allocated at
 /// construction: one per OpenMP thread when `use_openmp`, else one.
 struct Worker {
@@ -194,8 +206,7 @@ struct Worker {
   bool has_best = false;
   Contact best;
   double tests_seconds = 0;
-  Contact* out = nullptr;
-  std::size_t out_cap = 0, out_written = 0;
+  ContactSink* sink = nullptr;  // the query's buffer (null: none)
   bool rest_hit = false;
   std::uint32_t rest_a = 0, rest_b = 0;
   QueryKind qkind = QueryKind::kFull;
@@ -207,13 +218,14 @@ struct Worker {
   std::vector<std::uint32_t> plane_base;
   std::vector<FacePlaneStatic> plane;
   std::vector<std::uint64_t> plane_step;
-  /// Counts a contact: stops the traversal for kAny, else keeps the earliest and fills `out`.
+  /// Counts a contact: stops the traversal for kAny, else keeps the earliest and adds it to
+  /// `sink`.
   void record(const Contact& c) noexcept;
   void reset() noexcept {
     stats = ColliderStats{};
     stop = overflow = has_best = rest_hit = false;
-    found = out_written = out_cap = 0;
-    out = nullptr;
+    found = 0;
+    sink = nullptr;
     tests_seconds = 0;
   }
 };
@@ -360,6 +372,9 @@ struct Collider::Impl {
   std::vector<std::uint8_t> wmov, wsign;
   std::vector<orientation_detail::StaticErr> cluster_err;  // per cluster, this step (classify)
   std::vector<Worker> workers;
+  // Items of the whole-surface BVH handed to the workers (traverse_global_parallel; capacity
+  // reserved at construction when there are several workers).
+  std::vector<StackItem> frontier;
   // Contact closure scratch (capacity tri_count, reserved at construction).
   std::vector<std::uint32_t> closure_ring;
   std::vector<std::uint8_t> closure_mark;
@@ -370,8 +385,7 @@ struct Collider::Impl {
 
   // running query (shared, read-only during traversal) and its merged outcome
   QueryKind qkind = QueryKind::kFull;
-  bool query_hit = false;       // kAny: a contact was found
-  std::size_t out_written = 0;  // contacts written to the caller's buffer
+  bool query_hit = false;  // kAny: a contact was found
 
   // --- collider.cpp
   /// Allocates all scratch for `sh` (non-null). Throws on allocation failure.
@@ -413,9 +427,20 @@ struct Collider::Impl {
 
   // --- collider_traverse.cpp (traverse_wide, refit_wide and sign_wide: collider_wide.cpp)
   /// Runs the query over all candidates into workers (merged into stats/results); stops early
-  /// for kAny. `out`/`out_cap`: optional contact buffer (forces the serial path). Returns
-  /// false on stack overflow.
-  bool run_query(Contact* out, std::size_t out_cap) noexcept;
+  /// for kAny. `sink`: optional contact buffer (may be shared with other parts of a scene
+  /// query). Parallel with use_openmp (every mode but the rest check). Returns false on stack
+  /// overflow.
+  bool run_query(ContactSink* sink) noexcept;
+  /// The self traversal of tree `t` from `first` (the root: {0, kNone}). False on overflow.
+  bool traverse_self(Worker& w, const TreeView& t, StackItem first) const noexcept;
+  /// One popped item of the self traversal: leaves are processed, live children pushed on
+  /// w.stack above `top`. False when the stack has no room.
+  bool self_item(Worker& w, const TreeView& t, const StackItem& it,
+                 std::size_t& top) const noexcept;
+  /// The self traversal of the whole-surface BVH on the OpenMP workers: the top of the tree
+  /// is expanded breadth first on worker 0 into `frontier`, whose items the workers then
+  /// traverse (each item once, so counts and contacts are the serial ones).
+  bool traverse_global_parallel() noexcept;
   bool non_culled(std::uint32_t t1, std::uint32_t t2) const noexcept;
   /// A pair of two clusters sharing a node that non_culled accepted before the seam rule (both
   /// not still, boxes overlapping): culled only by that rule (rvbc, not the rest check).
@@ -423,7 +448,6 @@ struct Collider::Impl {
   void process_triangle_pair(Worker& w, std::uint32_t t1, std::uint32_t t2) const noexcept;
   /// process_triangle_pair of a pair known to be non-culled (not in the rest check).
   void process_non_culled_pair(Worker& w, std::uint32_t t1, std::uint32_t t2) const noexcept;
-  bool traverse_self(Worker& w, const TreeView& tree) const noexcept;
   /// Traversal of the 4-wide cluster BVHs from `first` (a self item {node, kNone} or a pair of
   /// child slots); `orient`: cull by the sign bits (within one cluster). False on overflow.
   bool traverse_wide(Worker& w, StackItem first, bool orient) const noexcept;
@@ -435,6 +459,16 @@ struct Collider::Impl {
   void sign_wide() noexcept;
   void brute_vertex_faces(Worker& w, std::uint32_t i) const noexcept;
   void brute_edge_edges(Worker& w, std::uint32_t i) const noexcept;
+  /// Intra-cluster work of cluster c1 and its pairs with every cluster c2 > c1.
+  bool cluster_tasks(Worker& w, std::uint32_t c1, bool count_skips) const noexcept;
+  TreeView cluster_view(std::uint32_t c) const noexcept;
+  /// Broad-phase trees of this body against other bodies: its cluster BVHs (rvbc) or its
+  /// whole-surface BVH (after a refit).
+  std::uint32_t tree_count() const noexcept;
+  TreeView tree(std::uint32_t i) const noexcept;
+  TreeView global_view() const noexcept;
+
+  // --- collider_orphans.cpp
   /// Calls vertex_face(p, f) for every vertex-face pair (p not in f) and edge_edge(e1, e2)
   /// for every edge pair (e1 < e2, four distinct nodes) held by some triangle pair that shares
   /// a node (construction; allocates, may throw). With `across_clusters`, only those where
@@ -456,16 +490,8 @@ struct Collider::Impl {
   void build_seam_orphans();
   /// Tests every seam orphan that no non-culled triangle pair holds (filters, elementary test).
   void test_seam_orphans(Worker& w) const noexcept;
-  /// Intra-cluster work of cluster c1 and its pairs with every cluster c2 > c1.
-  bool cluster_tasks(Worker& w, std::uint32_t c1, bool count_skips) const noexcept;
-  TreeView cluster_view(std::uint32_t c) const noexcept;
-  /// Broad-phase trees of this body against other bodies: its cluster BVHs (rvbc) or its
-  /// whole-surface BVH (after a refit).
-  std::uint32_t tree_count() const noexcept;
-  TreeView tree(std::uint32_t i) const noexcept;
-  TreeView global_view() const noexcept;
 
-  // --- normal_cone.cpp (kCone)
+  // --- collider_cone.cpp (kCone; the cone maths: normal_cone.hpp)
   ConeData cone;  // kCone, indexed by global BVH node
   void build_cone_topology(ConeData& cd, const ConeTree& tree, std::vector<std::uint32_t>& pos);
   void build_global_cones();
@@ -487,6 +513,29 @@ inline bool share_node(const format::Triangle& a, const format::Triangle& b) noe
   return shared_node_mask(a, b) != 0;
 }
 
+// --- collider_narrow.cpp: one feature pair of body P/A and body F/B (P == F within a body).
+// Swept boxes, the still rule, the coplanarity and plane filters (exact contact only), the
+// elementary test; a contact is recorded in `w`. Options (ccd, timing) are the first body's.
+void process_vertex_face(Worker& w, const Collider::Impl& P, std::uint32_t p,
+                         const Collider::Impl& F, std::uint32_t face) noexcept;
+void process_edge_edge(Worker& w, const Collider::Impl& A, std::uint32_t e1,
+                       const Collider::Impl& B, std::uint32_t e2) noexcept;
+/// The same with the edges' swept boxes already at hand (`box1` = A.edge_box(e1), `box2` =
+/// B.edge_box(e2)): the triangle-pair loop computes each edge's box once per pair.
+void process_edge_edge(Worker& w, const Collider::Impl& A, std::uint32_t e1, Box box1,
+                       const Collider::Impl& B, std::uint32_t e2, Box box2) noexcept;
+/// Triangle-pair plane filter of triangle t1 of A and t2 of B (plane_filter.hpp): no feature
+/// pair of the two can touch (exact contact only).
+bool plane_separated(Worker& w, const Collider::Impl& A, std::uint32_t t1, const Collider::Impl& B,
+                     std::uint32_t t2) noexcept;
+
+/// Swept boxes of two edges overlap and not all four nodes are still.
+inline bool edge_boxes_overlap(const Collider::Impl& A, std::uint32_t e1, const Collider::Impl& B,
+                               std::uint32_t e2) noexcept {
+  if (!A.edge_moving(e1) && !B.edge_moving(e2)) return false;
+  return boxes_overlap(A.edge_box(e1), B.edge_box(e2), A.opt.ccd.min_separation);
+}
+
 /// Static check of triangle t1 of A against t2 of B (A == B within a body): an edge of one
 /// meeting the other, conservatively; records a witness in `w` and stops it.
 void rest_triangle_pair(Worker& w, const Collider::Impl& A, std::uint32_t t1,
@@ -498,27 +547,5 @@ void rest_triangle_pair(Worker& w, const Collider::Impl& A, std::uint32_t t1,
 /// check instead (rest_triangle_pair; the witness in `w`). False on stack overflow.
 bool traverse_bodies(Worker& w, const Collider::Impl& A, const Collider::Impl& B,
                      bool rest = false) noexcept;
-
-// Member templates of Collider::Impl used by collider_orphans.cpp (construction) and
-// collider_traverse.cpp (the seam orphans' per-step test).
-template <typename Holder>
-inline bool Collider::Impl::any_vertex_face_holder(std::uint32_t p, std::uint32_t f,
-                                                   Holder&& holder) const noexcept {
-  const std::uint32_t ip = topo->surf_index[p];
-  for (std::uint32_t k = topo->vt_offset[ip]; k < topo->vt_offset[ip + 1]; ++k)
-    if (holder(topo->vt_list[k], f)) return true;
-  return false;
-}
-
-template <typename Holder>
-inline bool Collider::Impl::any_edge_edge_holder(std::uint32_t e1, std::uint32_t e2,
-                                                 Holder&& holder) const noexcept {
-  const auto& off = topo->et_offset;
-  const auto& list = topo->et_list;
-  for (std::uint32_t k1 = off[e1]; k1 < off[e1 + 1]; ++k1)
-    for (std::uint32_t k2 = off[e2]; k2 < off[e2 + 1]; ++k2)
-      if (holder(list[k1], list[k2])) return true;
-  return false;
-}
 
 }  // namespace tetseg

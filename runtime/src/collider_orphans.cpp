@@ -1,8 +1,7 @@
 // Collider construction: the feature pairs that only triangle pairs sharing a node hold, listed
 // once from the topology: the orphan sets of the whole-surface modes (docs/runtime.md,
 // "Adjacent triangle pairs: orphan sets") and rvbc's seam orphans ("Across clusters: seam
-// pairs"). Their per-step tests are in collider_traverse.cpp (test_orphans,
-// test_seam_orphans).
+// pairs"); and their tests every step (test_orphans, test_seam_orphans).
 
 #include <algorithm>
 #include <vector>
@@ -10,6 +9,26 @@
 #include "collider_impl.hpp"
 
 namespace tetseg {
+
+template <typename Holder>
+inline bool Collider::Impl::any_vertex_face_holder(std::uint32_t p, std::uint32_t f,
+                                                   Holder&& holder) const noexcept {
+  const std::uint32_t ip = topo->surf_index[p];
+  for (std::uint32_t k = topo->vt_offset[ip]; k < topo->vt_offset[ip + 1]; ++k)
+    if (holder(topo->vt_list[k], f)) return true;
+  return false;
+}
+
+template <typename Holder>
+inline bool Collider::Impl::any_edge_edge_holder(std::uint32_t e1, std::uint32_t e2,
+                                                 Holder&& holder) const noexcept {
+  const auto& off = topo->et_offset;
+  const auto& list = topo->et_list;
+  for (std::uint32_t k1 = off[e1]; k1 < off[e1 + 1]; ++k1)
+    for (std::uint32_t k2 = off[e2]; k2 < off[e2 + 1]; ++k2)
+      if (holder(list[k1], list[k2])) return true;
+  return false;
+}
 
 template <typename VertexFace, typename EdgeEdge>
 void Collider::Impl::for_each_adjacent_feature_pair(bool across_clusters, VertexFace&& vertex_face,
@@ -103,6 +122,32 @@ void Collider::Impl::build_seam_orphans() {
         if (any_edge_edge_holder(e1, e2, cross) && !any_edge_edge_holder(e1, e2, cross_disjoint))
           seam_ee.push_back({e1, e2});
       });
+}
+
+void Collider::Impl::test_orphans(Worker& w) const noexcept {
+  for (std::size_t i = 0; i < orphan_vf.size() && !w.stop; ++i)
+    process_vertex_face(w, *this, orphan_vf[i][0], *this, orphan_vf[i][1]);
+  for (std::size_t i = 0; i < orphan_ee.size() && !w.stop; ++i)
+    process_edge_edge(w, *this, orphan_ee[i][0], *this, orphan_ee[i][1]);
+}
+
+void Collider::Impl::test_seam_orphans(Worker& w) const noexcept {
+  // Each is tested here only when no holding triangle pair is non-culled (otherwise the
+  // smallest such pair tests it): exactly once. The cheap rejections of process_* come first.
+  const double ms = opt.ccd.min_separation;
+  auto nc = [&](std::uint32_t u, std::uint32_t v) { return non_culled(u, v); };
+  for (std::size_t i = 0; i < seam_vf.size() && !w.stop; ++i) {
+    const std::uint32_t p = seam_vf[i][0], f = seam_vf[i][1];
+    const std::uint32_t ip = topo->surf_index[p];
+    if (!vmoved[ip] && !tmov[f]) continue;
+    if (!boxes_overlap(vbox[ip], tbox[f], ms)) continue;
+    if (!any_vertex_face_holder(p, f, nc)) process_vertex_face(w, *this, p, *this, f);
+  }
+  for (std::size_t i = 0; i < seam_ee.size() && !w.stop; ++i) {
+    const std::uint32_t e1 = seam_ee[i][0], e2 = seam_ee[i][1];
+    if (!edge_boxes_overlap(*this, e1, *this, e2)) continue;
+    if (!any_edge_edge_holder(e1, e2, nc)) process_edge_edge(w, *this, e1, *this, e2);
+  }
 }
 
 }  // namespace tetseg

@@ -1,6 +1,7 @@
 // Collider traversal: candidate triangle pairs (rvbc per-cluster BVHs with orientation
-// culling, kBvh global BVH, kBrute all feature pairs), feature-pair deduplication, the
-// cheap filters and the elementary tests (the 4-wide cluster traversal: collider_wide.cpp).
+// culling, kBvh global BVH, kBrute all feature pairs) and feature-pair deduplication (the
+// 4-wide cluster traversal: collider_wide.cpp; one feature pair's filters and elementary
+// test: collider_narrow.cpp; the orphan sets' tests: collider_orphans.cpp).
 //
 // Deduplication is exact and needs no marks: a feature pair is tested only from the
 // non-culled triangle pair with the smallest (min id, max id) key among all non-culled
@@ -27,10 +28,6 @@ constexpr std::uint8_t kUnc = static_cast<std::uint8_t>(Orientation::kUncertain)
 
 inline std::uint64_t pair_key(std::uint32_t a, std::uint32_t b) noexcept {
   return a < b ? (std::uint64_t(a) << 32) | b : (std::uint64_t(b) << 32) | a;
-}
-
-inline Vec3d v3(const double* p) noexcept {
-  return {p[0], p[1], p[2]};
 }
 
 }  // namespace
@@ -101,227 +98,6 @@ bool Collider::Impl::orientation_culled(std::uint32_t t1, std::uint32_t t2) cons
   return boxes_overlap(tbox[t1], tbox[t2], opt.ccd.min_separation);
 }
 
-void Worker::record(const Contact& c) noexcept {
-  ++stats.contacts;
-  if (qkind == QueryKind::kAny) {
-    stop = true;
-    return;
-  }
-  ++found;
-  if (!has_best || contact_less(c, best)) {
-    best = c;
-    has_best = true;
-  }
-  if (out && out_written < out_cap) out[out_written++] = c;
-}
-
-// ------------------------------------------------- the one feature-pair path
-// Feature pairs of a triangle of body A and a triangle of body B (A == B for self-collision):
-// swept-box checks, the coplanarity filter, the elementary test, the contact. Options (ccd,
-// timing) are A's; a scene gives all its bodies the same.
-
-namespace {
-
-// The plane of triangle t of `body` for this step (FacePlaneStatic::of its nodes).
-FacePlaneStatic plane_of(const Collider::Impl& body, std::uint32_t t) noexcept {
-  const auto& f = body.tris[t];
-  return FacePlaneStatic::of(body.pos0(f[0]), body.pos0(f[1]), body.pos0(f[2]), body.pos1(f[0]),
-                             body.pos1(f[1]), body.pos1(f[2]));
-}
-
-// Plane of triangle t of `body` for this step: from w's per-step cache when w caches that
-// body (its own collider's, or any body's for a scene worker; computed there at first use),
-// else null (FaceSides computes it). Same values either way (the same operations in the same
-// order).
-inline const FacePlaneStatic* face_plane(Worker& w, const Collider::Impl& body,
-                                         std::uint32_t t) noexcept {
-  std::size_t i = t;
-  if (w.plane_owner != &body) {
-    if (body.body_id >= w.plane_base.size()) return nullptr;
-    i += w.plane_base[body.body_id];
-  }
-  if (w.plane_step[i] != body.step_serial) {
-    w.plane[i] = plane_of(body, t);
-    w.plane_step[i] = body.step_serial;
-  }
-  return &w.plane[i];
-}
-
-// StaticErr::of the extents of the union of boxes a and b (box_union's values: the smaller
-// lower bound, the larger upper bound, per axis).
-inline orientation_detail::StaticErr union_static_err(const Box& a, const Box& b) noexcept {
-#if defined(__SSE2__)
-  // min(b, a) and max(b, a) lane by lane pick as box_union's comparisons do.
-  const __m128d lo = _mm_min_pd(_mm_loadu_pd(b.lo), _mm_loadu_pd(a.lo));
-  const __m128d hi = _mm_max_pd(_mm_loadu_pd(b.hi), _mm_loadu_pd(a.hi));
-  double xy[2];
-  _mm_storeu_pd(xy, _mm_sub_pd(hi, lo));
-  const double z_lo = b.lo[2] < a.lo[2] ? b.lo[2] : a.lo[2];
-  const double z_hi = b.hi[2] > a.hi[2] ? b.hi[2] : a.hi[2];
-  const double extent[3] = {xy[0], xy[1], z_hi - z_lo};
-#else
-  Box u = a;
-  box_union(u, b);
-  const double extent[3] = {u.hi[0] - u.lo[0], u.hi[1] - u.lo[1], u.hi[2] - u.lo[2]};
-#endif
-  return orientation_detail::StaticErr::of(extent);
-}
-
-// The `count` nodes of body O stay strictly on one side of the plane of triangle t of body T
-// for the whole step, each side proven by the error-bounded orientation cubic. `box` holds the
-// nodes at both ends of the step (with t's swept box: the static error bound).
-bool nodes_off_plane(Worker& w, const Collider::Impl& T, std::uint32_t t, const Collider::Impl& O,
-                     const std::uint32_t* nodes, int count, const Box& box) noexcept {
-  // A node of the triangle itself has a zero cubic, never a proven side: the answer is false
-  // (as the cubics would give it, found without them).
-  const auto& tn = T.tris[t];
-  if (&T == &O)
-    for (int i = 0; i < count; ++i)
-      if (nodes[i] == tn[0] || nodes[i] == tn[1] || nodes[i] == tn[2]) return false;
-  const orientation_detail::StaticErr err = union_static_err(T.tbox[t], box);
-  const MovingTriangle face{tn, T.x0, T.x1, face_plane(w, T, t)};
-  FaceSides sides(face, &err);
-  Orientation side = Orientation::kUncertain;
-  for (int i = 0; i < count; ++i) {
-    const Orientation o = sides.of(O.pos0(nodes[i]), O.pos1(nodes[i]));
-    if (o == Orientation::kUncertain || (i > 0 && o != side)) return false;
-    side = o;
-  }
-  return true;
-}
-
-// Edge-pair plane filter (exact contact only): both nodes of edge e2 of B stay strictly on one
-// side of the plane of a triangle of A around edge e1. e1 lies in that plane at every t of
-// the step, so the edges never touch.
-bool edge_off_face_planes(Worker& w, const Collider::Impl& A, std::uint32_t e1,
-                          const Collider::Impl& B, std::uint32_t e2) noexcept {
-  const auto& et_offset = A.topo->et_offset;
-  for (std::uint32_t k = et_offset[e1]; k < et_offset[e1 + 1]; ++k)
-    if (nodes_off_plane(w, A, A.topo->et_list[k], B, B.topo->edges[e2].data(), 2, B.edge_box(e2)))
-      return true;
-  return false;
-}
-
-// Vertex-face plane filter (exact contact only): the three nodes of face `face` of F stay
-// strictly on one side of the plane of a triangle of P around node p. p lies in that plane at
-// every t of the step, so it never touches the face.
-bool face_off_vertex_planes(Worker& w, const Collider::Impl& P, std::uint32_t p,
-                            const Collider::Impl& F, std::uint32_t face) noexcept {
-  const std::uint32_t ip = P.topo->surf_index[p];
-  const auto& vt_offset = P.topo->vt_offset;
-  for (std::uint32_t k = vt_offset[ip]; k < vt_offset[ip + 1]; ++k)
-    if (nodes_off_plane(w, P, P.topo->vt_list[k], F, F.tris[face].data(), 3, F.tbox[face]))
-      return true;
-  return false;
-}
-
-}  // namespace
-
-void process_vertex_face(Worker& w, const Collider::Impl& P, std::uint32_t p,
-                         const Collider::Impl& F, std::uint32_t face) noexcept {
-  const auto& f = F.tris[face];
-  const std::uint32_t ip = P.topo->surf_index[p];
-  if (!P.vmoved[ip] && !F.tmov[face]) return;  // still feature pair: only t = 0 contact possible
-  const ColliderOptions& opt = P.opt;
-  const double ms = opt.ccd.min_separation;
-  if (!boxes_overlap(P.vbox[ip], F.tbox[face], ms)) return;
-  ++w.stats.feature_pairs;
-  if (ms <= 0) {
-    // Coplanarity cubic det[b-a, c-a, p-a] with a proven strict sign: never coplanar. Its
-    // points lie in the union of the vertex's and the face's swept boxes (static bound).
-    const Orientation o = orientation_of(F.pos0(f[0]), F.pos0(f[1]), F.pos0(f[2]), P.pos0(p),
-                                         F.pos1(f[0]), F.pos1(f[1]), F.pos1(f[2]), P.pos1(p),
-                                         union_static_err(P.vbox[ip], F.tbox[face]));
-    if (o != Orientation::kUncertain || face_off_vertex_planes(w, P, p, F, face)) {
-      ++w.stats.feature_pairs_filtered;
-      return;
-    }
-  }
-  ++w.stats.feature_tests;
-  Clock::time_point t0;
-  if (opt.time_tests) t0 = Clock::now();
-  const CcdResult r =
-      vertex_face_ccd(v3(P.pos0(p)), v3(F.pos0(f[0])), v3(F.pos0(f[1])), v3(F.pos0(f[2])),
-                      v3(P.pos1(p)), v3(F.pos1(f[0])), v3(F.pos1(f[1])), v3(F.pos1(f[2])), opt.ccd);
-  if (opt.time_tests) w.tests_seconds += std::chrono::duration<double>(Clock::now() - t0).count();
-  if (!r.hit()) return;
-  Contact c;
-  c.kind = ContactKind::kVertexFace;
-  c.bodies = {P.body_id, F.body_id};
-  c.nodes = {p, f[0], f[1], f[2]};
-  c.triangle = face;
-  c.at_start = r.outcome == CcdOutcome::kContactAtStart;
-  c.toi = c.at_start ? 0.0 : r.toi;
-  w.record(c);
-}
-
-// Swept boxes of two edges overlap and not all four nodes are still.
-inline bool edge_boxes_overlap(const Collider::Impl& A, std::uint32_t e1, const Collider::Impl& B,
-                               std::uint32_t e2) noexcept {
-  if (!A.edge_moving(e1) && !B.edge_moving(e2)) return false;
-  return boxes_overlap(A.edge_box(e1), B.edge_box(e2), A.opt.ccd.min_separation);
-}
-
-void process_edge_edge(Worker& w, const Collider::Impl& A, std::uint32_t e1,
-                       const Collider::Impl& B, std::uint32_t e2) noexcept {
-  if (&A == &B && e1 > e2) std::swap(e1, e2);
-  const std::uint32_t a = A.topo->edges[e1][0], b = A.topo->edges[e1][1];
-  const std::uint32_t c = B.topo->edges[e2][0], d = B.topo->edges[e2][1];
-  const ColliderOptions& opt = A.opt;
-  const double ms = opt.ccd.min_separation;
-  if (!edge_boxes_overlap(A, e1, B, e2)) return;  // also: all four nodes still
-  ++w.stats.feature_pairs;
-  if (ms <= 0) {
-    // det[b-a, d-c, c-a] = det[b-a, d-a, c-a]: orientation of (a; b, d, c), its points in the
-    // union of the two edges' swept boxes (static bound).
-    const Orientation o =
-        orientation_of(A.pos0(a), A.pos0(b), B.pos0(d), B.pos0(c), A.pos1(a), A.pos1(b), B.pos1(d),
-                       B.pos1(c), union_static_err(A.edge_box(e1), B.edge_box(e2)));
-    if (o != Orientation::kUncertain || edge_off_face_planes(w, A, e1, B, e2) ||
-        edge_off_face_planes(w, B, e2, A, e1)) {
-      ++w.stats.feature_pairs_filtered;
-      return;
-    }
-  }
-  ++w.stats.feature_tests;
-  Clock::time_point t0;
-  if (opt.time_tests) t0 = Clock::now();
-  const CcdResult r =
-      edge_edge_ccd(v3(A.pos0(a)), v3(A.pos0(b)), v3(B.pos0(c)), v3(B.pos0(d)), v3(A.pos1(a)),
-                    v3(A.pos1(b)), v3(B.pos1(c)), v3(B.pos1(d)), opt.ccd);
-  if (opt.time_tests) w.tests_seconds += std::chrono::duration<double>(Clock::now() - t0).count();
-  if (!r.hit()) return;
-  Contact k;
-  k.kind = ContactKind::kEdgeEdge;
-  k.bodies = {A.body_id, B.body_id};
-  // Edges sorted (a<b, c<d); within one body e1 < e2 in sorted edge order.
-  k.nodes = {a, b, c, d};
-  k.triangle = 0;
-  k.at_start = r.outcome == CcdOutcome::kContactAtStart;
-  k.toi = k.at_start ? 0.0 : r.toi;
-  w.record(k);
-}
-
-// Triangle-pair plane filter of triangle t1 of A and t2 of B (plane_filter.hpp; exact
-// contact only; docs/runtime.md, "Triangle-pair plane filter").
-// Each triangle's plane comes from w's per-step cache when w caches its body (face_plane),
-// else is computed per pair. Same answer either way.
-bool plane_separated(Worker& w, const Collider::Impl& A, std::uint32_t t1, const Collider::Impl& B,
-                     std::uint32_t t2) noexcept {
-  const bool same = &A == &B;
-  // Both triangles lie in the union of their swept boxes: its extents bound every coordinate
-  // difference of the cubics (the static error bound).
-  const orientation_detail::StaticErr err = union_static_err(A.tbox[t1], B.tbox[t2]);
-  const auto& n1 = A.tris[t1];
-  const auto& n2 = B.tris[t2];
-  const MovingTriangle m1{n1, A.x0, A.x1, face_plane(w, A, t1)};
-  if (nodes_strictly_on_one_side(m1, MovingTriangle{n2, B.x0, B.x1},
-                                 same ? shared_node_mask(n2, n1) : 0, &err))
-    return true;  // plane_separated
-  const MovingTriangle m2{n2, B.x0, B.x1, face_plane(w, B, t2)};
-  return nodes_strictly_on_one_side(m2, m1, same ? shared_node_mask(n1, n2) : 0, &err);
-}
-
 // Tests the feature pairs of triangle t1 of A and t2 of B (t1 != t2 within one body):
 // vertex-face both ways and edge-edge, features with four distinct nodes, that no other
 // triangle pair claims: `claimed(u, v)` (u of A, v of B) is true when the pair (u, v) tests a
@@ -362,19 +138,30 @@ void test_features(Worker& w, const Collider::Impl& A, std::uint32_t t1, const C
       if (w.stop) return;
     }
   }
-  // Edge-edge.
+  // Edge-edge. Each edge's swept box is computed once per triangle pair (t2's when a box of
+  // t1's edges first meets t2's box) and read by every check below.
   const auto& EA = A.topo->edges;
   const auto& EB = B.topo->edges;
+  Box box2[3];
+  bool have_box2 = false;
   for (std::uint32_t i = 0; i < 3; ++i) {
     const std::uint32_t e1 = A.topo->tri_edges[t1][i];
+    const Box box1 = A.edge_box(e1);
     // tbox[t2] contains the boxes of t2's edges: one check rejects all three.
-    if (!boxes_overlap(A.edge_box(e1), B.tbox[t2], ms)) continue;
+    if (!boxes_overlap(box1, B.tbox[t2], ms)) continue;
+    if (!have_box2) {
+      for (std::uint32_t j = 0; j < 3; ++j) box2[j] = B.edge_box(B.topo->tri_edges[t2][j]);
+      have_box2 = true;
+    }
+    const bool moving1 = A.edge_moving(e1);
     for (std::uint32_t j = 0; j < 3; ++j) {
       const std::uint32_t e2 = B.topo->tri_edges[t2][j];
       const auto& E1 = EA[e1];
       const auto& E2 = EB[e2];
       if (same && (E1[0] == E2[0] || E1[0] == E2[1] || E1[1] == E2[0] || E1[1] == E2[1])) continue;
-      if (!edge_boxes_overlap(A, e1, B, e2)) continue;
+      // edge_boxes_overlap from the boxes at hand.
+      if (!moving1 && !B.edge_moving(e2)) continue;
+      if (!boxes_overlap(box1, box2[j], ms)) continue;
       bool owner = true;
       const auto& ea_offset = A.topo->et_offset;
       const auto& ea_list = A.topo->et_list;
@@ -386,7 +173,7 @@ void test_features(Worker& w, const Collider::Impl& A, std::uint32_t t1, const C
           if ((!same || u != v) && claimed(u, v)) owner = false;
         }
       }
-      if (owner) process_edge_edge(w, A, e1, B, e2);
+      if (owner) process_edge_edge(w, A, e1, box1, B, e2, box2[j]);
       if (w.stop) return;
     }
   }
@@ -439,7 +226,11 @@ void Collider::Impl::close_contacts(Worker& w, double toi) noexcept {
       }
     }
   };
-  for (std::size_t i = 0; i < w.out_written; ++i) add_ring(w.out[i]);
+  // The buffer's contacts of this body (a scene's buffer holds other parts' too).
+  if (w.sink)
+    for (std::size_t i = 0; i < w.sink->written; ++i)
+      if (w.sink->out[i].bodies[0] == body_id && w.sink->out[i].bodies[1] == body_id)
+        add_ring(w.sink->out[i]);
   for (const Worker& other : workers)
     if (other.has_best) add_ring(other.best);
   const std::size_t ring = closure_ring.size();  // contacts found below add no seeds
@@ -545,7 +336,10 @@ bool traverse_bodies(Worker& w, const Collider::Impl& A, const Collider::Impl& B
   return true;
 }
 
-bool Collider::Impl::traverse_self(Worker& w, const TreeView& t) const noexcept {
+// Inlined into both traversal loops (a call per item cost about 10 % of the bvh traversal's
+// instructions); used in this file only.
+__attribute__((always_inline)) inline bool Collider::Impl::self_item(
+    Worker& w, const TreeView& t, const StackItem& it, std::size_t& top) const noexcept {
   const double ms = opt.ccd.min_separation;
   // Pair items are tested (not both still, boxes overlap) before they are pushed, so popped
   // pair items are live.
@@ -554,60 +348,77 @@ bool Collider::Impl::traverse_self(Worker& w, const TreeView& t) const noexcept 
     return boxes_overlap(t.box[a], t.box[b], ms);
   };
   auto self_pair = [&](std::uint32_t t1, std::uint32_t t2) { process_triangle_pair(w, t1, t2); };
+  if (it.b == kNone) {
+    const std::uint32_t n = it.a;
+    if (!rest_mode && t.nmov[n] == 0) return true;
+    if (t.cone && cone_self_free(*t.cone, t.cone_base + n)) {
+      ++w.stats.node_pairs_orientation_culled;
+      return true;
+    }
+    const format::BvhNode& nd = t.nodes[n];
+    if (nd.count > 0) {
+      for (std::uint32_t i = 0; i < nd.count && !w.stop; ++i)
+        for (std::uint32_t j = i + 1; j < nd.count && !w.stop; ++j)
+          process_triangle_pair(w, t.leaf_tris[nd.first + i], t.leaf_tris[nd.first + j]);
+      return true;
+    }
+    if (top + 3 > w.stack.size()) return false;
+    if (live_pair(nd.first, nd.second)) w.stack[top++] = {nd.first, nd.second};
+    w.stack[top++] = {nd.second, kNone};
+    w.stack[top++] = {nd.first, kNone};
+    return true;
+  }
+  return descend_pair(w, t, t, it, ms, live_pair, self_pair, top);
+}
+
+bool Collider::Impl::traverse_self(Worker& w, const TreeView& t, StackItem first) const noexcept {
   std::size_t top = 0;
-  w.stack[top++] = {0, kNone};
+  w.stack[top++] = first;
   while (top > 0 && !w.stop) {
     const StackItem it = w.stack[--top];
     ++w.stats.node_pairs_visited;
-    if (it.b == kNone) {
-      const std::uint32_t n = it.a;
-      if (!rest_mode && t.nmov[n] == 0) continue;
-      if (t.cone && cone_self_free(*t.cone, t.cone_base + n)) {
-        ++w.stats.node_pairs_orientation_culled;
-        continue;
-      }
-      const format::BvhNode& nd = t.nodes[n];
-      if (nd.count > 0) {
-        for (std::uint32_t i = 0; i < nd.count && !w.stop; ++i)
-          for (std::uint32_t j = i + 1; j < nd.count && !w.stop; ++j)
-            process_triangle_pair(w, t.leaf_tris[nd.first + i], t.leaf_tris[nd.first + j]);
-        continue;
-      }
-      if (top + 3 > w.stack.size()) return false;
-      if (live_pair(nd.first, nd.second)) w.stack[top++] = {nd.first, nd.second};
-      w.stack[top++] = {nd.second, kNone};
-      w.stack[top++] = {nd.first, kNone};
-      continue;
-    }
-    if (!descend_pair(w, t, t, it, ms, live_pair, self_pair, top)) return false;
+    if (!self_item(w, t, it, top)) return false;
   }
   return true;
 }
 
-void Collider::Impl::test_orphans(Worker& w) const noexcept {
-  for (std::size_t i = 0; i < orphan_vf.size() && !w.stop; ++i)
-    process_vertex_face(w, *this, orphan_vf[i][0], *this, orphan_vf[i][1]);
-  for (std::size_t i = 0; i < orphan_ee.size() && !w.stop; ++i)
-    process_edge_edge(w, *this, orphan_ee[i][0], *this, orphan_ee[i][1]);
-}
-
-void Collider::Impl::test_seam_orphans(Worker& w) const noexcept {
-  // Each is tested here only when no holding triangle pair is non-culled (otherwise the
-  // smallest such pair tests it): exactly once. The cheap rejections of process_* come first.
-  const double ms = opt.ccd.min_separation;
-  auto nc = [&](std::uint32_t u, std::uint32_t v) { return non_culled(u, v); };
-  for (std::size_t i = 0; i < seam_vf.size() && !w.stop; ++i) {
-    const std::uint32_t p = seam_vf[i][0], f = seam_vf[i][1];
-    const std::uint32_t ip = topo->surf_index[p];
-    if (!vmoved[ip] && !tmov[f]) continue;
-    if (!boxes_overlap(vbox[ip], tbox[f], ms)) continue;
-    if (!any_vertex_face_holder(p, f, nc)) process_vertex_face(w, *this, p, *this, f);
+bool Collider::Impl::traverse_global_parallel() noexcept {
+  Worker& w0 = workers[0];
+  const TreeView t = global_view();
+  // Breadth first from the root until there are 16 items per worker to balance, within the
+  // capacity reserved at construction (an expansion adds at most 4 items): no allocation.
+  const std::size_t target = 16 * workers.size();
+  frontier.clear();
+  frontier.push_back({0, kNone});
+  std::size_t head = 0;
+  while (head < frontier.size() && frontier.size() - head < target &&
+         frontier.size() + 4 <= frontier.capacity() && !w0.stop) {
+    const StackItem it = frontier[head++];
+    ++w0.stats.node_pairs_visited;
+    std::size_t top = 0;
+    if (!self_item(w0, t, it, top)) return false;
+    for (std::size_t k = 0; k < top; ++k) frontier.push_back(w0.stack[k]);
   }
-  for (std::size_t i = 0; i < seam_ee.size() && !w.stop; ++i) {
-    const std::uint32_t e1 = seam_ee[i][0], e2 = seam_ee[i][1];
-    if (!edge_boxes_overlap(*this, e1, *this, e2)) continue;
-    if (!any_edge_edge_holder(e1, e2, nc)) process_edge_edge(w, *this, e1, *this, e2);
+  if (w0.stop) return true;
+  const auto first = static_cast<std::int64_t>(head);
+  const auto count = static_cast<std::int64_t>(frontier.size());
+  bool overflow = false;
+#if defined(TETSEG_HAVE_OPENMP)
+#pragma omp parallel num_threads(static_cast <int>(workers.size())) reduction(|| : overflow)
+  {
+    Worker& w = workers[static_cast<std::size_t>(omp_get_thread_num())];
+    if (omp_get_thread_num() == 0)
+      stats.traversal_threads = static_cast<std::uint32_t>(omp_get_num_threads());
+#pragma omp for schedule(dynamic, 1)
+    for (std::int64_t i = first; i < count; ++i)
+      if (!w.stop && !w.overflow && !traverse_self(w, t, frontier[static_cast<std::size_t>(i)]))
+        w.overflow = overflow = true;
   }
+#else
+  for (std::int64_t i = first; i < count && !w0.stop; ++i)
+    if (!traverse_self(w0, t, frontier[static_cast<std::size_t>(i)])) overflow = true;
+#endif
+  return !overflow;
 }
 
 void Collider::Impl::brute_vertex_faces(Worker& w, std::uint32_t i) const noexcept {
@@ -652,28 +463,33 @@ bool Collider::Impl::cluster_tasks(Worker& w, std::uint32_t c1, bool count_skips
   return true;
 }
 
-bool Collider::Impl::run_query(Contact* out, std::size_t out_cap) noexcept {
+bool Collider::Impl::run_query(ContactSink* sink) noexcept {
   const auto t_start = Clock::now();
   for (Worker& w : workers) {
     w.reset();
     w.qkind = qkind;
+    w.sink = sink;
   }
   Worker& w0 = workers[0];
-  w0.out = out;
-  w0.out_cap = out ? out_cap : 0;
   const bool count_skips = !stats.full_traversal && qkind == QueryKind::kFull && !rest_mode;
-  // Parallel traversal: OpenMP threads take whole tasks (a cluster with its pairs, a brute
-  // force vertex or edge); merged in worker order, so counts and the earliest contact equal
-  // the serial ones. A caller buffer keeps the serial path (its truncation is order-bound).
-  const bool parallel = workers.size() > 1 && out == nullptr && !rest_mode;
-  (void)parallel;
-  std::uint32_t team = 1;  // threads that ran the traversal
+  // Parallel traversal: OpenMP threads take whole tasks (a cluster with its pairs, a subtree
+  // of the whole-surface BVH, a brute force vertex or edge); merged in worker order, so counts
+  // and the earliest contact equal the serial ones, and a buffer keeps the smallest contacts
+  // whoever finds them (ContactSink).
+  const bool parallel = workers.size() > 1 && !rest_mode;
+  if (parallel && sink) sink->locked = true;
+  stats.traversal_threads = 1;
   if (!stats.nothing_moved || rest_mode) {
     const std::uint32_t nc = cluster_count();
     const std::int64_t nv = static_cast<std::int64_t>(topo->surf_nodes.size());
     const std::int64_t ne = static_cast<std::int64_t>(topo->edges.size());
     if (global_bvh_active()) {
-      if (tri_count > 0 && !traverse_self(w0, global_view())) w0.overflow = true;
+      if (tri_count > 0) {
+        const bool ok = parallel && frontier.capacity() > 4
+                            ? traverse_global_parallel()
+                            : traverse_self(w0, global_view(), {0, kNone});
+        if (!ok) w0.overflow = true;
+      }
       if (skip_adjacent && !rest_mode && !w0.overflow) test_orphans(w0);
     } else if (opt.mode == ColliderMode::kBrute && !rest_mode) {
 #if defined(TETSEG_HAVE_OPENMP)
@@ -681,8 +497,8 @@ bool Collider::Impl::run_query(Contact* out, std::size_t out_cap) noexcept {
 #pragma omp parallel num_threads(static_cast <int>(workers.size()))
         {
           Worker& w = workers[static_cast<std::size_t>(omp_get_thread_num())];
-#pragma omp single
-          team = static_cast<std::uint32_t>(omp_get_num_threads());
+          if (omp_get_thread_num() == 0)
+            stats.traversal_threads = static_cast<std::uint32_t>(omp_get_num_threads());
 #pragma omp for schedule(dynamic, 16)
           for (std::int64_t i = 0; i < nv; ++i)
             if (!w.stop) brute_vertex_faces(w, static_cast<std::uint32_t>(i));
@@ -704,8 +520,8 @@ bool Collider::Impl::run_query(Contact* out, std::size_t out_cap) noexcept {
 #pragma omp parallel num_threads(static_cast <int>(workers.size()))
         {
           Worker& w = workers[static_cast<std::size_t>(omp_get_thread_num())];
-#pragma omp single
-          team = static_cast<std::uint32_t>(omp_get_num_threads());
+          if (omp_get_thread_num() == 0)
+            stats.traversal_threads = static_cast<std::uint32_t>(omp_get_num_threads());
 #pragma omp for schedule(dynamic, 1)
           for (std::int64_t c = 0; c < static_cast<std::int64_t>(nc); ++c)
             if (!w.stop && !w.overflow &&
@@ -738,7 +554,6 @@ bool Collider::Impl::run_query(Contact* out, std::size_t out_cap) noexcept {
     }
     if (any_best) close_contacts(w0, earliest);
   }
-  stats.traversal_threads = team;
   // Merge in worker order.
   bool overflow = false, hit = false;
   std::size_t found = 0;
@@ -759,7 +574,6 @@ bool Collider::Impl::run_query(Contact* out, std::size_t out_cap) noexcept {
   stats.traversal_ms += std::max(0.0, total_ms - tests_ms);
   if (overflow) return false;
   query_hit = hit;
-  out_written = w0.out_written;
   if (qkind == QueryKind::kFull && !rest_mode) {
     stats.full_traversal = true;
     cache.set_full(found, has, first);

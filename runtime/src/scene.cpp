@@ -40,7 +40,7 @@ struct Scene::Impl {
   struct PairOutcome {
     std::uint32_t a = 0, b = 0;
     bool ran = false, overflow = false, hit = false, has_best = false;
-    std::size_t found = 0, written = 0;
+    std::size_t found = 0;
     std::uint64_t contacts = 0;
     Contact best;
   };
@@ -94,7 +94,9 @@ Scene::Scene(const SceneOptions& options) noexcept {
     m_impl->opt = options;
     std::size_t threads = 1;
 #if defined(TETSEG_HAVE_OPENMP)
-    if (options.use_openmp) threads = static_cast<std::size_t>(std::max(1, omp_get_max_threads()));
+    if (options.use_openmp)
+      threads = options.threads > 0 ? options.threads
+                                    : static_cast<std::size_t>(std::max(1, omp_get_max_threads()));
 #endif
     m_impl->workers.resize(threads);
     for (Worker& w : m_impl->workers)
@@ -120,7 +122,9 @@ ColliderStatus Scene::add_body(std::shared_ptr<const BodyShape> shape, const Bod
     co.ccd = s.opt.ccd;
     co.bvh_leaf_size = s.opt.bvh_leaf_size;
     co.use_openmp = s.opt.use_openmp;
+    co.threads = s.opt.threads;
     co.time_tests = s.opt.time_tests;
+    co.include_still_pairs = s.opt.include_still_pairs;
     co.traversal_stack = s.opt.traversal_stack;
     SceneBody body;
     body.core = std::make_unique<Collider::Impl>();
@@ -212,7 +216,8 @@ ColliderStatus Scene::step(const double* x0, const double* x1, std::size_t value
   for (SceneBody& b : s.bodies) {
     Collider::Impl& core = *b.core;
     core.refit_and_classify();
-    b.moved = core.stats.nodes_moved > 0;
+    // Without the still rule every body takes part, moved or not.
+    b.moved = core.stats.nodes_moved > 0 || s.opt.include_still_pairs;
     s.stats.bodies_moved += b.moved ? 1 : 0;
     s.stats.refit_ms += core.stats.refit_ms;
     s.stats.classify_ms += core.stats.classify_ms;
@@ -223,13 +228,16 @@ ColliderStatus Scene::step(const double* x0, const double* x1, std::size_t value
 }
 
 // Runs one query over the scene: self queries of the bodies, then the enabled pairs of bodies
-// in order (a, b) with a < b (ordered by b, then a). `out`/`cap`: optional buffer, filled in
-// that order. Pairs run on OpenMP threads when enabled and there is no buffer; outcomes are
-// merged in pair order, so every answer and count equals the serial one. A kAny query answers
+// in order (a, b) with a < b (ordered by b, then a). `out`/`cap`: optional buffer shared by
+// all parts (ContactSink: it keeps the smallest contacts, whoever finds them). Pairs run on
+// OpenMP threads when enabled; outcomes are merged in pair order, so every answer and count
+// equals the serial one. A kAny query answers
 // "hit" when any part finds a contact, and kOverflow only when none does and a part overflowed.
 ColliderStatus Scene::Impl::run(QueryKind kind, Contact* out, std::size_t cap,
                                 std::size_t& written) noexcept {
   written = 0;
+  // One buffer for every part of the query: it keeps the smallest contacts of all of them.
+  ContactSink sink{out, out ? cap : 0};
   std::size_t found = 0;
   bool has = false, overflow = false;
   Contact first;
@@ -239,7 +247,7 @@ ColliderStatus Scene::Impl::run(QueryKind kind, Contact* out, std::size_t cap,
     Collider::Impl& core = *b.core;
     core.qkind = kind;
     const std::uint64_t contacts_before = core.stats.contacts;
-    const bool ok = core.run_query(out ? out + written : nullptr, out ? cap - written : 0);
+    const bool ok = core.run_query(out ? &sink : nullptr);
     stats.contacts += core.stats.contacts - contacts_before;
     if (!ok) {
       if (kind == QueryKind::kFull) return ColliderStatus::kOverflow;
@@ -255,7 +263,6 @@ ColliderStatus Scene::Impl::run(QueryKind kind, Contact* out, std::size_t cap,
       continue;
     }
     found += core.cache.full_found;
-    written += core.out_written;
     keep_earliest(has, first, core.cache.has_best, core.cache.best);
   }
   stats.self_ms += ms_since(t_self);
@@ -282,16 +289,14 @@ ColliderStatus Scene::Impl::run(QueryKind kind, Contact* out, std::size_t cap,
     }
   }
   bool stop = false;  // kAny: a pair found a contact (read racily: only saves work)
-  auto run_pair = [&](Worker& w, PairOutcome& p, Contact* pair_out, std::size_t pair_cap) {
+  auto run_pair = [&](Worker& w, PairOutcome& p) {
     w.reset();
     w.qkind = kind;
-    w.out = pair_out;
-    w.out_cap = pair_out ? pair_cap : 0;
+    w.sink = out ? &sink : nullptr;
     p.overflow = !traverse_bodies(w, *bodies[p.a].core, *bodies[p.b].core);
     p.ran = true;
     p.hit = w.stop;
     p.found = w.found;
-    p.written = w.out_written;
     p.has_best = w.has_best;
     p.best = w.best;
     p.contacts = w.stats.contacts;
@@ -300,7 +305,8 @@ ColliderStatus Scene::Impl::run(QueryKind kind, Contact* out, std::size_t cap,
   const std::int64_t count = static_cast<std::int64_t>(live.size());
   stats.pair_threads = 1;
 #if defined(TETSEG_HAVE_OPENMP)
-  if (workers.size() > 1 && out == nullptr && count > 1) {
+  if (workers.size() > 1 && count > 1) {
+    sink.locked = true;
 #pragma omp parallel num_threads(static_cast <int>(workers.size()))
     {
       Worker& w = workers[static_cast<std::size_t>(omp_get_thread_num())];
@@ -312,7 +318,7 @@ ColliderStatus Scene::Impl::run(QueryKind kind, Contact* out, std::size_t cap,
 #pragma omp atomic read
         stopped = stop;
         if (stopped) continue;
-        run_pair(w, live[static_cast<std::size_t>(k)], nullptr, 0);
+        run_pair(w, live[static_cast<std::size_t>(k)]);
         if (kind == QueryKind::kAny && live[static_cast<std::size_t>(k)].hit) {
 #pragma omp atomic write
           stop = true;
@@ -323,8 +329,7 @@ ColliderStatus Scene::Impl::run(QueryKind kind, Contact* out, std::size_t cap,
 #endif
   {
     for (PairOutcome& p : live) {
-      run_pair(workers[0], p, out ? out + written : nullptr, out ? cap - written : 0);
-      written += p.written;
+      run_pair(workers[0], p);
       if (p.overflow && kind == QueryKind::kFull) break;
       if (p.hit && kind == QueryKind::kAny) break;
     }
@@ -352,6 +357,7 @@ ColliderStatus Scene::Impl::run(QueryKind kind, Contact* out, std::size_t cap,
     stats.body_pairs_skipped = skipped;
     cache.set_full(found, has, first);
   }
+  written = sink.written;
   return ColliderStatus::kOk;
 }
 

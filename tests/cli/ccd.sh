@@ -37,6 +37,26 @@ grep -q '"vertices": 6, "faces": 2' "$work/soup.json" || fail "frames JSON heade
 grep -q '{"kind": "vf", "vertex": 3, "face": \[0, 1, 2\], "toi": 0.4999' "$work/soup.json" ||
   fail "frames JSON contact: $(cat "$work/soup.json")"
 
+# Still geometry: two still triangles crossing in one plane beside the falling vertex. By
+# default every touching pair is reported, still ones included (as brute force and sort and
+# sweep report them); --skip-still keeps the runtime's still rule (only the falling vertex).
+printf 'ply\nformat ascii 1.0\nelement vertex 12\nproperty double x\nproperty double y\nproperty double z\nelement face 4\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n0.25 0.25 0.5\n2 2 1\n2 3 1\n10 10 5\n11 10 5\n10 11 5\n10.25 10.25 5\n11.25 10.25 5\n10.25 11.25 5\n3 0 1 2\n3 3 4 5\n3 6 7 8\n3 9 10 11\n' > "$work/s0.ply"
+sed 's/^0.25 0.25 0.5$/0.25 0.25 -0.5/' "$work/s0.ply" > "$work/s1.ply"
+for broad in "" --brute --sweep; do
+  "$tool" frames "$work/s0.ply" "$work/s1.ply" $broad 2>/dev/null > "$work/still_all"
+  "$tool" frames "$work/s0.ply" "$work/s1.ply" $broad --skip-still 2>/dev/null > "$work/still_skip"
+  grep -q '^vf 9 6 7 8 0$' "$work/still_all" || fail "still floor ($broad): vertex 9 in face 6 7 8 not reported: $(cat "$work/still_all")"
+  [ "$(grep -c ' 0$' "$work/still_all")" -ge 3 ] || fail "still floor ($broad): too few still contacts: $(cat "$work/still_all")"
+  # Vertices 6..11 are the still ones: --skip-still lists exactly the other contacts.
+  awk '!($2 >= 6 && $3 >= 6 && $4 >= 6 && $5 >= 6)' "$work/still_all" > "$work/moving_only"
+  [ -s "$work/moving_only" ] || fail "still floor ($broad): the falling vertex's contacts missing"
+  cmp -s "$work/still_skip" "$work/moving_only" ||
+    fail "still floor ($broad) --skip-still: $(cat "$work/still_skip")"
+  [ -z "$broad" ] && cp "$work/still_all" "$work/still_scene"
+  cmp -s "$work/still_all" "$work/still_scene" || fail "still floor: $broad differs from the runtime scene"
+done
+echo "still floor: $(wc -l < "$work/still_scene") contacts by default, $(wc -l < "$work/still_skip") with --skip-still"
+
 # The BVH finds the same contacts as all face pairs, on a random soup: 150 separate small
 # triangles and a strip of 100 triangles sharing vertices, moving randomly.
 awk -v out0="$work/r0.ply" -v out1="$work/r1.ply" 'BEGIN {

@@ -58,14 +58,27 @@ struct ColliderOptions {
   /// the coplanarity filter is off, but orientation culling (rvbc) still only guarantees
   /// exact contacts: use `kBvh` when every near contact must be found.
   CcdOptions ccd;
+  /// Test still feature pairs too (all four nodes with x0 == x1 bitwise), which the default
+  /// still rule of `step` skips (docs/runtime.md, "Still geometry"): still clusters, still
+  /// node pairs and steps where nothing moved are then traversed like moving ones, and kBvh,
+  /// kCone and kBrute report every contact a brute-force test of all feature pairs reports,
+  /// still pairs included. kRvbc keeps its orientation culling, which presumes a contact-free
+  /// start: a still pair already touching inside one cluster may stay culled (use kBvh when a
+  /// step may start in contact, e.g. a soup frame or a resting pile). Off by default.
+  bool include_still_pairs = false;
   /// Leaf size of the `kBvh` mode's BVH (clamped to [1, 16]).
   std::uint32_t bvh_leaf_size = 4;
   /// Use OpenMP threads inside a step when built with it: refit and classification loops
-  /// (large meshes), and the traversal of `any_collision`, `earliest_toi` and
-  /// `contacts(nullptr, 0)` in rvbc and brute modes (whole clusters / features per task).
-  /// Results are identical to serial (merged in a fixed order); a contact buffer and the bvh
-  /// mode traverse serially. Scratch per thread is allocated at construction. Off by default.
+  /// (large meshes), and the traversal of every query (`any_collision`, `earliest_toi`,
+  /// `contacts` with or without a buffer) in rvbc (whole clusters per task), bvh and cone
+  /// (subtrees of the whole-surface BVH per task) and brute modes (features per task).
+  /// Results are identical to serial, contact buffers included (merged in a fixed order; a
+  /// buffer keeps the smallest contacts, whichever thread finds them: `contacts`). Scratch per
+  /// thread is allocated at construction. Off by default.
   bool use_openmp = false;
+  /// Threads with `use_openmp`: 0 (default) takes OpenMP's default (`omp_get_max_threads`,
+  /// OMP_NUM_THREADS); ignored without OpenMP.
+  std::uint32_t threads = 0;
   /// Run `check_rest_intersection` on the start positions of the first step (cost: one
   /// overlap-only traversal with static triangle tests). Result in `rest_intersection()`.
   bool check_first_step = false;
@@ -133,8 +146,8 @@ struct ColliderStats {
   std::uint64_t contacts = 0;                ///< elementary tests that reported contact
   bool nothing_moved = false;
   bool full_traversal = false;  ///< a complete traversal ran this step
-  /// Threads that ran the last traversal: 1 when serial, more when `use_openmp` took the
-  /// parallel path (tests assert it, so "parallel equals serial" never compares serial runs).
+  /// Threads that ran the last query's traversal: 1 on the serial path, the OpenMP team size
+  /// on a parallel one (use_openmp).
   std::uint32_t traversal_threads = 0;
 };
 
@@ -170,11 +183,12 @@ class Collider {
   /// units), `value_count` must equal node_count * 3. The collider keeps the pointers: both
   /// arrays must stay valid and unchanged until the next `step` (queries read them).
   /// Refits and classifies (rvbc). Nodes with x0 == x1 (bitwise) are "still".
-  /// Rule for still geometry: a feature pair whose four nodes are all still is never
-  /// tested (it can only touch during the whole step, i.e. at t = 0, which the previous step
-  /// or `check_rest_intersection` reports); so still clusters, pairs of still clusters and
-  /// a step where nothing moved cost no traversal. Rejects NaN/inf
-  /// positions of the nodes it reads (surface and detector nodes; no other node is read).
+  /// Rule for still geometry (default; `ColliderOptions::include_still_pairs` turns it off):
+  /// a feature pair whose four nodes are all still is never tested (it can only touch during the
+  /// whole step, i.e. at t = 0, which the previous step or `check_rest_intersection` reports); so
+  /// still clusters, pairs of still clusters and a step where nothing moved cost no traversal.
+  /// Rejects NaN/inf positions of the nodes it reads (surface and detector nodes; no other node is
+  /// read).
   ColliderStatus step(const double* x0, const double* x1, std::size_t value_count) noexcept;
   /// Same with value_count = node_count * 3 assumed.
   ColliderStatus step(const double* x0, const double* x1) noexcept;
@@ -187,10 +201,13 @@ class Collider {
   /// The earliest contact of the step (deterministic: smallest in `contact_less`).
   /// Runs a full traversal once per step; later queries reuse it.
   [[nodiscard]] ColliderStatus earliest_toi(EarliestContact& out) noexcept;
-  /// All contacts of the step: the first `capacity` found are written to `buffer`
-  /// (caller-owned; may be null when capacity is 0), then the written part is sorted with
-  /// `contact_less`. `out.found` counts all of them, so truncation is visible. Runs a
-  /// traversal each call (the list is not stored).
+  /// All contacts of the step into a caller-owned buffer, without allocating: `out.found`
+  /// counts all of them and `out.written` = min(found, capacity) are written, sorted with
+  /// `contact_less`. When truncated (`out.truncated()`), the buffer holds the `capacity`
+  /// smallest contacts in that order (the earliest ones), so the answer does not depend on the
+  /// traversal order or the threads: grow the buffer to `out.found` and call again for all.
+  /// `buffer` may be null when capacity is 0 (counting only). Runs a traversal each call with
+  /// a buffer (the list is not stored); a count-only call after a full traversal reuses it.
   [[nodiscard]] ColliderStatus contacts(Contact* buffer, std::size_t capacity,
                                         ContactsResult& out) noexcept;
 

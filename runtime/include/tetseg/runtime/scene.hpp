@@ -22,13 +22,19 @@ namespace tetseg {
 struct SceneOptions {
   /// Passed to the elementary tests (as in `ColliderOptions::ccd`).
   CcdOptions ccd;
+  /// As `ColliderOptions::include_still_pairs`, for every body and pair of bodies: still
+  /// feature pairs (still bodies included) are tested too. Off by default (the still rule).
+  bool include_still_pairs = false;
   /// Leaf size of whole-surface BVHs (surface-only bodies, `kBvh` bodies).
   std::uint32_t bvh_leaf_size = 4;
   /// OpenMP threads (when built with it): inside each body's self-collision queries (as
-  /// `ColliderOptions::use_openmp`), and over the pairs of bodies of queries without a contact
-  /// buffer (one pair per task, a worker with its own stack per thread, outcomes merged in
-  /// pair order). Results and counts are identical to serial ones. Off by default.
+  /// `ColliderOptions::use_openmp`), and over the pairs of bodies (one pair per task, a worker
+  /// with its own stack per thread, outcomes merged in pair order; a contact buffer is shared
+  /// by all parts and keeps the smallest contacts, as `Collider::contacts`). Results and counts
+  /// are identical to serial ones. Off by default.
   bool use_openmp = false;
+  /// As `ColliderOptions::threads` (0: OpenMP's default).
+  std::uint32_t threads = 0;
   /// As `ColliderOptions::time_tests` (off by default).
   bool time_tests = false;
   /// Traversal stack capacity in node pairs (0: never overflows). Small values are for tests.

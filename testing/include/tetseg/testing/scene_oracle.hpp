@@ -5,7 +5,8 @@
 /// coplanarity or plane filters): every feature pair with four distinct nodes (vertex against
 /// triangle, edge against edge, within a body with self-collision on and across every pair of
 /// bodies) through the elementary tests of ccd.hpp only. Pairs whose four nodes are all still
-/// are skipped (the documented rule of Collider::step and Scene); a plain sort-and-sweep on
+/// are skipped (the documented rule of Collider::step and Scene) unless `include_still` (the
+/// runtime's `include_still_pairs`); a plain sort-and-sweep on
 /// swept feature boxes (exact box overlap, nothing else) keeps it affordable on large scenes.
 /// Shared by the runtime tests, `tetseg-bench table`, `check` and `scene`. The elementary
 /// tests themselves are held to exact rational truth by exact_ccd.hpp (tests only).
@@ -36,11 +37,11 @@ struct OracleBody {
 /// Calls `vertex_face(vertex_body, p, face_body, triangle_id, face_nodes)` and
 /// `edge_edge(body_ab, a, b, body_cd, c, d)` once for every feature pair of the step that the
 /// oracle tests: four distinct nodes, self pairs only in bodies with `self`, not all four nodes
-/// still, swept boxes overlapping (exact comparisons). Edges are named as the runtime names
+/// still (unless `include_still`), swept boxes overlapping (exact comparisons). Edges are named as the runtime names
 /// them (a < b, c < d, (body, a, b) <= (body, c, d)).
 template <class VertexFace, class EdgeEdge>
 void for_each_feature_pair(const std::vector<OracleBody>& bodies, VertexFace&& vertex_face,
-                           EdgeEdge&& edge_edge) {
+                           EdgeEdge&& edge_edge, bool include_still = false) {
   enum Kind : std::uint8_t { kVertex, kEdge, kTriangle };
   struct Item {
     double lo[3], hi[3];
@@ -114,7 +115,7 @@ void for_each_feature_pair(const std::vector<OracleBody>& bodies, VertexFace&& v
     const Item& A = items[i];
     for (std::size_t j = i + 1; j < items.size() && items[j].lo[0] <= A.hi[0]; ++j) {
       const Item& B = items[j];
-      if (!A.moving && !B.moving) continue;  // all four nodes still
+      if (!include_still && !A.moving && !B.moving) continue;  // all four nodes still
       if (A.body == B.body && !bodies[A.body].self) continue;
       if (A.lo[1] > B.hi[1] || B.lo[1] > A.hi[1] || A.lo[2] > B.hi[2] || B.lo[2] > A.hi[2])
         continue;
@@ -133,7 +134,8 @@ inline Vec3d oracle_point(const OracleBody& body, std::uint32_t n, bool end) {
 
 /// All contacts of the step through the elementary tests of ccd.hpp, sorted by
 /// `contact_less`, named as the runtime names them.
-inline std::vector<Contact> scene_brute_contacts(const std::vector<OracleBody>& bodies) {
+inline std::vector<Contact> scene_brute_contacts(const std::vector<OracleBody>& bodies,
+                                                 bool include_still = false) {
   std::vector<Contact> out;
   auto add = [&](ContactKind kind, std::uint32_t ba, std::uint32_t bb,
                  std::array<std::uint32_t, 4> nodes, std::uint32_t tri, CcdResult r) {
@@ -164,7 +166,8 @@ inline std::vector<Contact> scene_brute_contacts(const std::vector<OracleBody>& 
         add(ContactKind::kEdgeEdge, eb, gb, {a, b, c, d}, 0,
             edge_edge_ccd(at(eb, a, false), at(eb, b, false), at(gb, c, false), at(gb, d, false),
                           at(eb, a, true), at(eb, b, true), at(gb, c, true), at(gb, d, true)));
-      });
+      },
+      include_still);
   std::sort(out.begin(), out.end(), contact_less);
   return out;
 }

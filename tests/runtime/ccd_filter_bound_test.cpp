@@ -1,0 +1,173 @@
+// The floating-point fast paths of the elementary CCD tests against exact rational arithmetic
+// (GMP): the filtered 2D orientation of the plane certificates (runtime/src/ccd_plane.hpp) and
+// the float Bernstein subdivision with its running error bound (runtime/src/ccd_bernstein.hpp).
+// Each must never claim what exact arithmetic contradicts, and each bound is load-bearing:
+// scaled down (an eighth of it), the same inputs produce wrong claims.
+
+#include <array>
+#include <cmath>
+#include <random>
+
+#include <gmpxx.h>
+#include <catch2/catch.hpp>
+
+#include "../../runtime/src/ccd_bernstein.hpp"
+#include "../../runtime/src/ccd_plane.hpp"
+
+namespace {
+
+using tetseg::ccd_detail::FloatBernstein;
+using tetseg::ccd_detail::orient2d_sign;
+using tetseg::ccd_detail::Point3;
+
+/// Exact sign of (a - c) x (b - c) on the axes (0, 1).
+int exact_orient2d(const Point3& a, const Point3& b, const Point3& c) {
+  const mpq_class acx = mpq_class(a[0]) - c[0], bcx = mpq_class(b[0]) - c[0];
+  const mpq_class acy = mpq_class(a[1]) - c[1], bcy = mpq_class(b[1]) - c[1];
+  return sgn(mpq_class(acx * bcy - acy * bcx));
+}
+
+/// Nearly collinear triples: c on the line through a and b, rounded, then nudged by a few
+/// ulps; coordinates over many magnitudes, offsets far from the origin. These are the inputs
+/// whose rounding errors come closest to the bound.
+struct NearCollinear {
+  std::mt19937_64 rng{20261128};
+  std::uniform_real_distribution<double> unit{-1.0, 1.0};
+  std::uniform_int_distribution<int> exponent{-30, 30};
+  std::uniform_int_distribution<int> ulps{-4, 4};
+  std::array<Point3, 3> next() {
+    const double scale = std::ldexp(1.0, exponent(rng));
+    const double offset = unit(rng) < 0.0 ? 0.0 : scale * std::ldexp(1.0, exponent(rng) / 3 + 10);
+    const Point3 a{offset + scale * unit(rng), offset + scale * unit(rng), 0.0};
+    const Point3 b{offset + scale * unit(rng), offset + scale * unit(rng), 0.0};
+    const double s = 4.0 * unit(rng);
+    Point3 c{a[0] + s * (b[0] - a[0]), a[1] + s * (b[1] - a[1]), 0.0};
+    for (int k = 0; k < 2; ++k)
+      for (int n = ulps(rng); n != 0; n += n > 0 ? -1 : 1)
+        c[k] = std::nextafter(c[k], n > 0 ? INFINITY : -INFINITY);
+    return {a, b, c};
+  }
+};
+
+}  // namespace
+
+TEST_CASE("The filtered 2D orientation never claims a wrong sign, and an eighth of its bound does",
+          "[ccd][filter]") {
+  NearCollinear gen;
+  int decided = 0, wrong = 0, wrong_scaled = 0;
+  for (int i = 0; i < 400000; ++i) {
+    const auto [a, b, c] = gen.next();
+    const int exact = exact_orient2d(a, b, c);
+    const int s = orient2d_sign(a, b, c, 0, 1);
+    if (s != 0) {
+      ++decided;
+      if (s != exact) ++wrong;
+    }
+    const int scaled = orient2d_sign(a, b, c, 0, 1, 0.125);
+    if (scaled != 0 && scaled != exact) ++wrong_scaled;
+  }
+  INFO(decided << " decided, " << wrong << " wrong; with an eighth of the bound " << wrong_scaled
+               << " wrong");
+  CHECK(wrong == 0);
+  CHECK(decided > 100000);  // the filter decides most of these near-collinear triples
+  CHECK(wrong_scaled > 0);  // the bound is load-bearing
+}
+
+namespace {
+
+/// Exact de Casteljau halving of rational coefficients.
+void exact_split(const std::array<mpq_class, 5>& c, int n, std::array<mpq_class, 5>& left,
+                 std::array<mpq_class, 5>& right) {
+  std::array<mpq_class, 5> w = c;
+  left[0] = w[0];
+  right[n] = w[n];
+  for (int r = 1; r <= n; ++r) {
+    for (int i = 0; i + r <= n; ++i) w[i] = (w[i] + w[i + 1]) / 2;
+    left[r] = w[0];
+    right[n - r] = w[n - r];
+  }
+}
+
+/// Largest |computed - exact| over the coefficients, as a multiple of the claimed bound err;
+/// > 1 means the bound was violated.
+double violation(const FloatBernstein& p, const std::array<mpq_class, 5>& exact) {
+  double worst = 0.0;
+  for (int i = 0; i <= p.degree; ++i) {
+    const mpq_class diff = abs(mpq_class(p.c[i]) - exact[i]);
+    worst = std::max(worst, diff.get_d() / p.err);
+  }
+  return worst;
+}
+
+}  // namespace
+
+TEST_CASE("Float Bernstein halving stays within its error bound, and an eighth of it does not",
+          "[ccd][filter]") {
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  std::uniform_int_distribution<int> exponent(-20, 20);
+  std::uniform_int_distribution<int> side(0, 1);
+  double worst = 0.0, worst_scaled = 0.0;
+  for (int trial = 0; trial < 20000; ++trial) {
+    const int n = 3 + trial % 2;
+    const double scale = std::ldexp(1.0, exponent(rng));
+    FloatBernstein p{{}, n, 0.0}, q{{}, n, 0.0};
+    std::array<mpq_class, 5> exact{}, exact_q{};
+    for (int i = 0; i <= n; ++i) {
+      p.c[i] = q.c[i] = scale * (unit(rng) + (i % 2 == 0 ? 0.5 : -0.25));
+      exact[i] = exact_q[i] = p.c[i];
+    }
+    // Up to 40 halvings down one random path, each checked against exact arithmetic.
+    for (int level = 0; level < 40; ++level) {
+      FloatBernstein left{}, right{}, left_q{}, right_q{};
+      std::array<mpq_class, 5> exact_left, exact_right, exact_left_q, exact_right_q;
+      tetseg::ccd_detail::split_half(p, left, right);
+      tetseg::ccd_detail::split_half(q, left_q, right_q, 0.125);
+      exact_split(exact, n, exact_left, exact_right);
+      exact_split(exact_q, n, exact_left_q, exact_right_q);
+      const bool go_left = side(rng) == 0;
+      p = go_left ? left : right;
+      q = go_left ? left_q : right_q;
+      exact = go_left ? exact_left : exact_right;
+      exact_q = go_left ? exact_left_q : exact_right_q;
+      worst = std::max(worst, violation(p, exact));
+      worst_scaled = std::max(worst_scaled, violation(q, exact_q));
+    }
+  }
+  INFO("largest error / bound: " << worst << "; with an eighth of the charge: " << worst_scaled);
+  CHECK(worst <= 1.0);
+  CHECK(worst_scaled > 1.0);  // the charge per level is load-bearing
+}
+
+TEST_CASE("Float de Casteljau at any parameter stays within its bound, and an eighth of it does not",
+          "[ccd][filter]") {
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  std::uniform_real_distribution<double> parameter(0.0, 1.0);
+  std::uniform_int_distribution<int> exponent(-20, 20);
+  double worst = 0.0, worst_scaled = 0.0;
+  for (int trial = 0; trial < 200000; ++trial) {
+    const int n = 3 + trial % 2;
+    const double scale = std::ldexp(1.0, exponent(rng));
+    FloatBernstein p{{}, n, 0.0};
+    std::array<mpq_class, 5> w{};
+    for (int i = 0; i <= n; ++i) {
+      p.c[i] = scale * (unit(rng) + (i % 2 == 0 ? 0.5 : -0.25));
+      w[i] = p.c[i];
+    }
+    const double lambda = parameter(rng);
+    // Exact left part on [0, lambda]: de Casteljau in rationals.
+    std::array<mpq_class, 5> exact{};
+    exact[0] = w[0];
+    for (int r = 1; r <= n; ++r) {
+      for (int i = 0; i + r <= n; ++i) w[i] = w[i] + mpq_class(lambda) * (w[i + 1] - w[i]);
+      exact[r] = w[0];
+    }
+    worst = std::max(worst, violation(tetseg::ccd_detail::left_part(p, lambda), exact));
+    worst_scaled =
+        std::max(worst_scaled, violation(tetseg::ccd_detail::left_part(p, lambda, 0.125), exact));
+  }
+  INFO("largest error / bound: " << worst << "; with an eighth of the charge: " << worst_scaled);
+  CHECK(worst <= 1.0);
+  CHECK(worst_scaled > 1.0);  // the charge per level is load-bearing
+}
