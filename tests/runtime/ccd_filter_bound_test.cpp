@@ -139,8 +139,9 @@ TEST_CASE("Float Bernstein halving stays within its error bound, and an eighth o
   CHECK(worst_scaled > 1.0);  // the charge per level is load-bearing
 }
 
-TEST_CASE("Float de Casteljau at any parameter stays within its bound, and an eighth of it does not",
-          "[ccd][filter]") {
+TEST_CASE(
+    "Float de Casteljau at any parameter stays within its bound, and an eighth of it does not",
+    "[ccd][filter]") {
   std::mt19937_64 rng(11);
   std::uniform_real_distribution<double> unit(-1.0, 1.0);
   std::uniform_real_distribution<double> parameter(0.0, 1.0);

@@ -37,8 +37,8 @@ struct OracleBody {
 /// Calls `vertex_face(vertex_body, p, face_body, triangle_id, face_nodes)` and
 /// `edge_edge(body_ab, a, b, body_cd, c, d)` once for every feature pair of the step that the
 /// oracle tests: four distinct nodes, self pairs only in bodies with `self`, not all four nodes
-/// still (unless `include_still`), swept boxes overlapping (exact comparisons). Edges are named as the runtime names
-/// them (a < b, c < d, (body, a, b) <= (body, c, d)).
+/// still (unless `include_still`), swept boxes overlapping (exact comparisons). Edges are named as
+/// the runtime names them (a < b, c < d, (body, a, b) <= (body, c, d)).
 template <class VertexFace, class EdgeEdge>
 void for_each_feature_pair(const std::vector<OracleBody>& bodies, VertexFace&& vertex_face,
                            EdgeEdge&& edge_edge, bool include_still = false) {
