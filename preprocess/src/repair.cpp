@@ -28,8 +28,8 @@
 #include <utility>
 #include <vector>
 
+#include "mesh_topology.hpp"
 #include "repair_internal.hpp"
-#include "segment_topology.hpp"
 
 namespace tetseg::preprocess::detail {
 namespace {
