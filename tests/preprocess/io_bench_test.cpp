@@ -14,7 +14,7 @@
 #include <numeric>
 #include <random>
 
-#include "preprocess/grid_mesh.hpp"
+#include "preprocess/support/grid_mesh.hpp"
 #include "tetseg/preprocess/io.hpp"
 #include "tetseg/preprocess/meshing.hpp"
 #include "tetseg/preprocess/surface.hpp"
