@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Reading and writing at a million triangles (docs/benchmarks.md, "Reading a 1.3 M-triangle
+# Reading and writing at a million triangles (docs/benchmarks-history.md, "Reading a 1.3 M-triangle
 # OFF"): writes a torus of 1,310,720 triangles as plain ASCII OFF (70 MB, in the scratch
 # directory), then runs `tetseg charge` on it with one GMRES iteration (the charge is not the
 # point here) for each tetseg binary given, twice, alternating, and prints the reading stage

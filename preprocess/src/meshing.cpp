@@ -331,7 +331,7 @@ std::pair<double, double> area_and_volume(const TriangleMesh& s) {
 ///   a volume of about offset x area; a solid's is far more);
 /// - at least kThinShare of kThinProbes vertices (every k-th) are on a thin part: the point
 ///   kThinProbeDepth x offset inside along the vertex normal is outside the wrap (generalised
-///   winding number below 1/2). On libcgal-demo (docs/benchmarks.md, "Real meshes") the
+///   winding number below 1/2). On libcgal-demo (docs/benchmarks-history.md, "Real meshes") the
 ///   wraps of closed solids have shares 0-0.09; cube-ouvert's partly entered wrap (alpha
 ///   0.16), which the volume test lets through, 0.61. Wraps of open surfaces that Mesh_3 did
 ///   mesh reach 0.66, so no threshold is exact: three of them now take one more doubling.
