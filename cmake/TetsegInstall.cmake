@@ -18,7 +18,8 @@ write_basic_package_version_file(${PROJECT_BINARY_DIR}/tetsegConfigVersion.cmake
 install(FILES ${PROJECT_BINARY_DIR}/tetsegConfig.cmake ${PROJECT_BINARY_DIR}/tetsegConfigVersion.cmake
               ${PROJECT_SOURCE_DIR}/cmake/TetsegAsset.cmake
         DESTINATION ${TETSEG_CMAKE_DIR})
-foreach(tool tetseg tetseg-dump tetseg-ccd tetseg-run tetseg-render)
+# What users run in a pipeline (tools/); the benchmark drivers of bench/ are not installed.
+foreach(tool tetseg tetseg-dump tetseg-render tetseg-frames tetseg-run)
   if(TARGET ${tool})
     install(TARGETS ${tool} RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
   endif()

@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Benchmark of the elementary CCD tests (docs/benchmarks.md, "Elementary CCD tests"): builds
+# Benchmark of the elementary CCD tests (docs/benchmarks.md, "Elementary CCD"; history:
+# docs/benchmarks-history.md, "Elementary CCD tests"): builds
 # tetseg-ccd in Release and runs it on the reference queries (conservative runtime test and the
 # non-conservative fast-cubic baseline), then on whole scalable-CCD frames.
 # Usage: scripts/bench-ccd.sh [build-dir]   (default build-bench-ccd; data from ../shared)

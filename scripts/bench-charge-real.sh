@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The charge solver at its defaults (`auto` at the automatic tolerance) on real CGAL demo
-# surfaces, each as given and 1-to-4 subdivided (docs/benchmarks.md, "Charge on real
-# meshes"): per mesh and size the iterations, GMRES residual, residual against the exact
+# surfaces, each as given and 1-to-4 subdivided (docs/benchmarks.md, "Charge density
+# (offline)"; history: docs/benchmarks-history.md, "Charge on real meshes"): per mesh and size the iterations, GMRES residual, residual against the exact
 # matrix (up to 12k triangles), solve and total seconds (wall) and CPU seconds. Iteration
 # counts are deterministic; the times are one run each. About 2 minutes on 2 cores.
 # Usage: scripts/bench-charge-real.sh [build-dir] [mesh names]

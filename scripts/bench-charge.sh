@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Benchmark of the charge-density solvers (docs/benchmarks.md, "Charge density"): builds
+# Benchmark of the charge-density solvers (docs/benchmarks.md, "Charge density (offline)";
+# history: docs/benchmarks-history.md, "Charge density"): builds
 # tetseg-bench-charge in Release and prints, for ~1k, 5k, 20k and 100k triangles (ellipsoid
 # 1:0.6:0.3 and the CGAL demo elephant, 1-to-4 subdivided), each solver's assembly and solve
 # time, CPU seconds, iterations, residual (against its own operator and, up to 25k triangles,

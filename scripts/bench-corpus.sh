@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Corpus benchmark (docs/benchmarks.md, "Real meshes"): runs `tetseg build` over every OFF/PLY
+# Corpus benchmark (docs/benchmarks.md, "Preprocessing"; history: docs/benchmarks-history.md,
+# "Real meshes"): runs `tetseg build` over every OFF/PLY
 # surface of a folder, once per repair mode, with a time limit per mesh, and prints per mesh
 # the exit code, the failing stage and message, the repairs, the Hausdorff distance, the
 # surface triangles, clusters and wall time, then totals per mode.

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Reading and writing at a million triangles (docs/benchmarks.md, "Reading a 1.3 M-triangle
+# Reading and writing at a million triangles (docs/benchmarks-history.md, "Reading a 1.3 M-triangle
 # OFF"): writes a torus of 1,310,720 triangles as plain ASCII OFF (70 MB, in the scratch
 # directory), then runs `tetseg charge` on it with one GMRES iteration (the charge is not the
 # point here) for each tetseg binary given, twice, alternating, and prints the reading stage
@@ -40,8 +40,11 @@ for round in 1 2; do
     start=$(date +%s.%N)
     "$bin" charge "$off" -o "$scratch/out.csv" --max-iterations 1 2>"$scratch/log.txt"
     end=$(date +%s.%N)
-    read_s=$(sed -n 's/^tetseg: reading .* \.\.\. \([0-9.]*\) s.*/\1/p' "$scratch/log.txt")
-    charge_s=$(sed -n 's/^tetseg: charge \.\.\. \([0-9.]*\) s.*/\1/p' "$scratch/log.txt")
+    # Stage lines: "tetseg: read   0.12 s  ..." (since issue 27), "tetseg: reading x ... 0.12 s" before.
+    read_s=$(sed -n -e 's/^tetseg: reading .* \.\.\. \([0-9.]*\) s.*/\1/p' \
+      -e 's/^tetseg: read  *\([0-9.]*\) s .*/\1/p' "$scratch/log.txt")
+    charge_s=$(sed -n -e 's/^tetseg: charge \.\.\. \([0-9.]*\) s.*/\1/p' \
+      -e 's/^tetseg: charge  *\([0-9.]*\) s .*/\1/p' "$scratch/log.txt")
     awk -v b="$bin" -v r="$read_s" -v c="$charge_s" -v s="$start" -v e="$end" \
       'BEGIN { printf "| %s | %s | %s | %.2f |\n", b, r, c, e - s }'
   done

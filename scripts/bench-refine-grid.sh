@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The refinement-defaults grid of docs/benchmarks.md ("Refinement defaults after the seam
+# The refinement-defaults grid of docs/benchmarks-history.md ("Refinement defaults after the seam
 # rule"): for each scene, assets built with --refine-gain G x --refine-visibility V, then one
 # `tetseg-bench table` over all of them on the scene's frames (rvbc, single thread, timings
 # only, fastest of 3 runs per step), twice. Prints "scene variant:clusters/pairs/cpu-ms ...".

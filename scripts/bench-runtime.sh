@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Per-frame stage times of the collider modes (docs/benchmarks.md, "Runtime per-frame"):
+# Per-frame stage times of the collider modes (docs/benchmarks-history.md, "Runtime per-frame"):
 # builds tetseg-run and tetseg-scene (Release), generates deforming scenes and runs
 # `tetseg-run --json` in rvbc, bvh and brute modes, then prints a Markdown table of the mean
 # per-step times (refit, classify, traversal, elementary tests, total) and feature tests.

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Regenerates the "Table I", "cluster refinement", "refinement parameters" and "segmentation
-# parameters" tables of docs/benchmarks.md.
+# parameters" tables of docs/benchmarks-history.md (the current figures: docs/benchmarks.md).
 #
 #   scripts/bench-table.sh [BUILD_DIR] [SCENE_DIR]    (defaults: ./build, BUILD_DIR/scenes)
 #

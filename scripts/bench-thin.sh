@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Thin and multi-part bodies (docs/benchmarks.md, "Thin and multi-part bodies (issue 13)"):
+# Thin and multi-part bodies (docs/benchmarks.md, "Scenes of several bodies"; history:
+# docs/benchmarks-history.md, "Thin and multi-part bodies (issue 13)"):
 # makes the thin scenes (TETSEG_SCENES=thin scripts/make-scenes.sh), then prints per shape the
 # build figures (time, components, clusters, detectors inside tets, overlap-only clusters) and
 # the scene table of `tetseg-bench scene` (per-step time by stage, contacts, missed contacts

@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Generates the benchmark scenes of docs/benchmarks.md ("Table I", "Cluster refinement"): pawn,
+# Generates the benchmark scenes of docs/benchmarks.md ("Self-collision per frame") and of
+# docs/benchmarks-history.md ("Table I", "Cluster refinement"): pawn,
 # dumbbell, and the libcgal-demo elephant, armadillo and dino, each an asset (default options)
 # plus a tetseg-sim frame sequence of a soft drop onto the ground, and the same mesh's assets
 # with the other cluster methods (NAME-charge.tetseg, NAME-single.tetseg); then the scenes with

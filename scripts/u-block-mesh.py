@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-# A large non-convex tet mesh for build-cost measurements (docs/benchmarks.md, "Detector
+# A large non-convex tet mesh for build-cost measurements (docs/benchmarks-history.md, "Detector
 # points inside tets"): N = 88 gives 1,049,742 tets.
 # U-shaped block of Kuhn-triangulated cubes (a non-convex solid no single point sees whole),
 # written as Medit .mesh: scripts/u-block-mesh.py N out.mesh  (N x N/3 x N cubes minus the slot).

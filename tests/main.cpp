@@ -1,5 +1,5 @@
 // Catch2 main shared by the test tiers. A run in which a test case lacked its data
-// (support/test_data.hpp) and nothing failed exits with kSkipExitCode, so that ctest, which
+// (tetseg/testing/test_data.hpp) and nothing failed exits with kSkipExitCode, so that ctest, which
 // runs one test case per process, reports that test case as skipped rather than passed.
 // A test case that ran no assertion at all fails the run (every ctest entry asserts
 // something): the default reporter is the console one that also records, when each test
@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "support/test_data.hpp"
+#include "tetseg/testing/test_data.hpp"
 
 namespace {
 

@@ -37,22 +37,35 @@ struct Tally {
   long false_negatives = 0;
   long false_positives = 0;
   double seconds = 0;
+  std::vector<double> query_us;  ///< each query timed alone (second pass), for the quantiles
   void add(const Tally& o) {
     queries += o.queries;
     positives += o.positives;
     false_negatives += o.false_negatives;
     false_positives += o.false_positives;
     seconds += o.seconds;
+    query_us.insert(query_us.end(), o.query_us.begin(), o.query_us.end());
   }
   double mean_us() const { return queries ? seconds * 1e6 / static_cast<double>(queries) : 0.0; }
+  /// The q-quantile (0.5: median) of the per-query times: the sorted time at rank
+  /// round(q (n - 1)); 0 without queries.
+  double quantile_us(double q) const {
+    if (query_us.empty()) return 0.0;
+    std::vector<double> sorted = query_us;
+    const auto rank = static_cast<std::size_t>(q * static_cast<double>(sorted.size() - 1) + 0.5);
+    std::nth_element(sorted.begin(), sorted.begin() + rank, sorted.end());
+    return sorted[rank];
+  }
 };
 
 std::string tally_json(const Tally& t) {
   char buf[256];
   std::snprintf(buf, sizeof buf,
                 "{\"queries\": %ld, \"positives\": %ld, \"false_negatives\": %ld, "
-                "\"false_positives\": %ld, \"mean_us\": %.3f}",
-                t.queries, t.positives, t.false_negatives, t.false_positives, t.mean_us());
+                "\"false_positives\": %ld, \"mean_us\": %.3f, \"median_us\": %.3f, "
+                "\"p90_us\": %.3f}",
+                t.queries, t.positives, t.false_negatives, t.false_positives, t.mean_us(),
+                t.quantile_us(0.5), t.quantile_us(0.9));
   return buf;
 }
 
@@ -68,6 +81,19 @@ bool run_query(const io::Query& q, bool vertex_face, bool fast, const tetseg::Cc
              ? tetseg::vertex_face_ccd(x[0], x[1], x[2], x[3], x[4], x[5], x[6], x[7], options)
                    .hit()
              : tetseg::edge_edge_ccd(x[0], x[1], x[2], x[3], x[4], x[5], x[6], x[7], options).hit();
+}
+
+/// Wall time of one steady_clock interval around nothing (the median of many): what timing a
+/// query alone adds, subtracted from each per-query time.
+double clock_overhead_us() {
+  using clock = std::chrono::steady_clock;
+  std::vector<double> samples(10001);
+  for (double& sample : samples) {
+    const auto start = clock::now();
+    sample = std::chrono::duration<double, std::micro>(clock::now() - start).count();
+  }
+  std::nth_element(samples.begin(), samples.begin() + 5000, samples.end());
+  return samples[5000];
 }
 
 Tally run_folder(const fs::path& folder, bool vertex_face, bool fast,
@@ -91,6 +117,17 @@ Tally run_folder(const fs::path& folder, bool vertex_face, bool fast,
     for (std::size_t i = 0; i < queries.size(); ++i)
       results[i] = run_query(queries[i], vertex_face, fast, options);
     tally.seconds += thread_cpu_seconds() - start;
+    // Second pass for the distribution (medians beside means): each query timed alone by
+    // steady_clock (wall time, cheaper to read than the thread CPU clock), less the clock's cost.
+    static const double overhead_us = clock_overhead_us();
+    for (const auto& query : queries) {
+      const auto begin = std::chrono::steady_clock::now();
+      const volatile bool hit = run_query(query, vertex_face, fast, options);
+      const auto end = std::chrono::steady_clock::now();
+      (void)hit;
+      const double us = std::chrono::duration<double, std::micro>(end - begin).count();
+      tally.query_us.push_back(std::max(0.0, us - overhead_us));
+    }
     for (std::size_t i = 0; i < queries.size(); ++i) {
       ++tally.queries;
       tally.positives += queries[i].truth;
@@ -136,11 +173,12 @@ int command_queries(const std::string& dir, bool json, const std::string& method
     out << "}}\n";
     std::cout << out.str();
   } else {
-    std::printf("%-30s %-3s %8s %9s %4s %4s %10s\n", "scene", "", "queries", "positives", "FN",
-                "FP", "mean_us");
+    std::printf("%-30s %-3s %8s %9s %4s %4s %10s %10s %10s\n", "scene", "", "queries", "positives",
+                "FN", "FP", "mean_us", "median_us", "p90_us");
     auto line = [](const std::string& name, const char* kind, const Tally& t) {
-      std::printf("%-30s %-3s %8ld %9ld %4ld %4ld %10.2f\n", name.c_str(), kind, t.queries,
-                  t.positives, t.false_negatives, t.false_positives, t.mean_us());
+      std::printf("%-30s %-3s %8ld %9ld %4ld %4ld %10.2f %10.3f %10.3f\n", name.c_str(), kind,
+                  t.queries, t.positives, t.false_negatives, t.false_positives, t.mean_us(),
+                  t.quantile_us(0.5), t.quantile_us(0.9));
     };
     for (const auto& [name, t] : per_scene) {
       line(name, "VF", t[0]);

@@ -14,6 +14,7 @@
 #include "charge_tree.hpp"
 #include "tetseg/preprocess/charge.hpp"
 #include "tetseg/preprocess/names.hpp"
+#include "tetseg/preprocess/option_ranges.hpp"
 
 namespace tetseg::preprocess {
 namespace {
@@ -86,18 +87,14 @@ ChargeResult compute_charge(const std::vector<Vec3>& points, const std::vector<T
   };
   const PanelSet panels = make_panels(points, triangles, file);
   const std::size_t n = panels.size();
-  if (!(options.tolerance >= 0.0 && options.tolerance < 1.0)) {
-    throw std::invalid_argument("charge tolerance must lie in (0, 1), or be 0 for automatic");
-  }
+  check_option(option_ranges::kTolerance, options.tolerance);  // 0: automatic
   const double tolerance =
       options.tolerance > 0.0 ? options.tolerance
                               : (n < kAutoTightToleranceMin ? kAutoTolerance : kAutoTightTolerance);
   if (options.schwarz_set < 0) {
     throw std::invalid_argument("charge schwarz_set must be positive, or 0 for automatic");
   }
-  if (!(options.fast_theta >= 0.0 && options.fast_theta < 1.0)) {
-    throw std::invalid_argument("charge fast_theta must lie in (0, 1), or be 0 for automatic");
-  }
+  check_option(option_ranges::kTheta, options.fast_theta);  // 0: automatic
   const std::size_t limit =
       options.memory_limit_bytes ? options.memory_limit_bytes : available_memory() / 2;
   const double dense_bytes = 8.0 * static_cast<double>(n) * static_cast<double>(n);

@@ -1,5 +1,5 @@
-// Tet meshes with several components: splitting the surface by component, the per-component
-// checks, and running charge, segmentation and detector choice per component.
+// Tet meshes with several components: splitting the surface by component and the
+// per-component checks (the per-part pipeline stages are in part_stages.cpp).
 
 #include "components.hpp"
 
@@ -7,7 +7,7 @@
 #include <cmath>
 #include <numeric>
 
-#include "segment_topology.hpp"
+#include "mesh_topology.hpp"
 #include "vec3_math.hpp"
 
 namespace tetseg::preprocess::detail {
@@ -162,126 +162,6 @@ void check_surface_not_nested(const TriangleMesh& mesh, const std::string& file)
     triangle_component.push_back(c);
   }
   check_not_nested(mesh.vertices, mesh.triangles, triangle_component, count, file);
-}
-
-std::vector<double> part_values(const std::vector<double>& whole, const SurfacePart& part) {
-  std::vector<double> out;
-  out.reserve(part.triangles.size());
-  for (std::uint32_t t : part.triangles) out.push_back(whole[t]);
-  return out;
-}
-
-ChargeResult charge_by_part(const std::vector<Vec3>& nodes, const std::vector<SurfacePart>& parts,
-                            std::size_t triangle_count, const ChargeOptions& options,
-                            const std::string& file) {
-  if (parts.size() == 1) return compute_charge(nodes, parts[0].surface.triangles, options, file);
-  ChargeResult total;
-  total.density.assign(triangle_count, 0.0);
-  total.converged = true;
-  for (const SurfacePart& part : parts) {
-    ChargeResult r = compute_charge(nodes, part.surface.triangles, options, file);
-    for (std::size_t i = 0; i < part.triangles.size(); ++i)
-      total.density[part.triangles[i]] = r.density[i];
-    total.capacitance += r.capacitance;
-    total.total_area += r.total_area;
-    if (total.solver.empty()) {
-      total.solver = r.solver;
-    } else if (total.solver != r.solver) {
-      total.solver += "+" + r.solver;
-    }
-    total.iterations += r.iterations;
-    total.relaxed_products += r.relaxed_products;
-    total.residual = std::max(total.residual, r.residual);
-    total.tolerance = std::max(total.tolerance, r.tolerance);
-    total.converged = total.converged && r.converged;
-    total.near_entries += r.near_entries;
-    total.assembly_seconds += r.assembly_seconds;
-    total.solve_seconds += r.solve_seconds;
-  }
-  return total;
-}
-
-Segmentation join_segmentations(const std::vector<SurfacePart>& parts,
-                                const std::vector<Segmentation>& pieces,
-                                std::size_t triangle_count) {
-  if (parts.size() == 1) return pieces.front();
-  // Global cluster ids in order of each cluster's smallest triangle id.
-  std::vector<std::uint32_t> offset(parts.size() + 1, 0);
-  for (std::size_t p = 0; p < parts.size(); ++p)
-    offset[p + 1] = offset[p] + pieces[p].cluster_count;
-  std::vector<std::uint32_t> key(triangle_count, kUnset);  // offset[p] + local cluster
-  for (std::size_t p = 0; p < parts.size(); ++p)
-    for (std::size_t i = 0; i < parts[p].triangles.size(); ++i)
-      key[parts[p].triangles[i]] = offset[p] + pieces[p].triangle_cluster[i];
-  std::vector<std::uint32_t> renumber(offset.back(), kUnset);
-  Segmentation out;
-  out.triangle_cluster.resize(triangle_count);
-  for (std::size_t t = 0; t < triangle_count; ++t) {
-    if (renumber[key[t]] == kUnset) renumber[key[t]] = out.cluster_count++;
-    out.triangle_cluster[t] = renumber[key[t]];
-  }
-  out.min_cluster_triangles = pieces.front().min_cluster_triangles;
-  for (const Segmentation& s : pieces) {
-    out.boundary_loops.insert(out.boundary_loops.end(), s.boundary_loops.begin(),
-                              s.boundary_loops.end());
-    out.boundary_lengths.insert(out.boundary_lengths.end(), s.boundary_lengths.begin(),
-                                s.boundary_lengths.end());
-    out.min_cluster_triangles = std::min(out.min_cluster_triangles, s.min_cluster_triangles);
-    out.counts.segments_found += s.counts.segments_found;
-    out.counts.segments_grown += s.counts.segments_grown;
-    out.counts.segments_shrunk += s.counts.segments_shrunk;
-    out.counts.boundaries += s.counts.boundaries;
-    out.counts.clusters_merged += s.counts.clusters_merged;
-  }
-  out.counts.clusters = out.cluster_count;
-  return out;
-}
-
-Segmentation one_cluster_per_part(const std::vector<SurfacePart>& parts,
-                                  std::size_t triangle_count) {
-  Segmentation out;
-  out.triangle_cluster.assign(triangle_count, 0);
-  for (std::uint32_t p = 0; p < parts.size(); ++p)
-    for (std::uint32_t t : parts[p].triangles) out.triangle_cluster[t] = p;
-  out.cluster_count = static_cast<std::uint32_t>(parts.size());
-  out.counts.clusters = out.cluster_count;
-  return out;
-}
-
-std::vector<DetectorChoice> detectors_by_part(const TetMesh& mesh,
-                                              const std::vector<SurfacePart>& parts,
-                                              const Segmentation& segmentation,
-                                              DetectorStrategy strategy, double min_visibility) {
-  if (parts.size() == 1)
-    return choose_detector_points(mesh, parts[0].surface, segmentation.triangle_cluster,
-                                  segmentation.cluster_count, strategy, min_visibility);
-  std::vector<DetectorChoice> out(segmentation.cluster_count);
-  std::vector<std::uint32_t> local_of(segmentation.cluster_count, kUnset);
-  TetMesh component;  // all nodes (ids kept), the part's tets
-  component.nodes = mesh.nodes;
-  for (const SurfacePart& part : parts) {
-    std::vector<std::uint32_t> global_of;  // local cluster -> global cluster
-    std::vector<std::uint32_t> local(part.triangles.size());
-    for (std::size_t i = 0; i < part.triangles.size(); ++i) {
-      const std::uint32_t c = segmentation.triangle_cluster[part.triangles[i]];
-      if (local_of[c] == kUnset) {
-        local_of[c] = static_cast<std::uint32_t>(global_of.size());
-        global_of.push_back(c);
-      }
-      local[i] = local_of[c];
-    }
-    component.tets.clear();
-    for (std::uint32_t t : part.tets) component.tets.push_back(mesh.tets[t]);
-    std::vector<DetectorChoice> chosen = choose_detector_points(
-        component, part.surface, local, static_cast<std::uint32_t>(global_of.size()), strategy,
-        min_visibility);
-    for (std::size_t k = 0; k < chosen.size(); ++k) {
-      if (chosen[k].point.tet != format::kNoTet)
-        chosen[k].point.tet = part.tets[chosen[k].point.tet];
-      out[global_of[k]] = chosen[k];
-    }
-  }
-  return out;
 }
 
 }  // namespace tetseg::preprocess::detail

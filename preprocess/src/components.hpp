@@ -1,15 +1,16 @@
 #pragma once
-// Private: tet meshes with several components (bodies). A component is a set of nodes
-// connected through tets; each becomes its own set of clusters, charge and detectors in one
-// asset that keeps the input's node numbering (docs/segmentation.md, "Several components").
+// Private: the topology of tet meshes and surfaces with several components (bodies). A
+// component is a set of nodes connected through tets; each becomes its own set of clusters,
+// charge and detectors in one asset that keeps the input's node numbering
+// (docs/segmentation.md, "Several components"; the per-part stages: part_stages.hpp).
+// Validation, surface extraction and meshing use it: it includes no charge or segmentation
+// header.
 
 #include <cstdint>
 #include <string>
 #include <vector>
 
-#include "tetseg/preprocess/charge.hpp"
 #include "tetseg/preprocess/mesh.hpp"
-#include "tetseg/preprocess/segmentation.hpp"
 
 namespace tetseg::preprocess::detail {
 
@@ -59,34 +60,5 @@ void check_not_nested(const std::vector<Vec3>& points, const std::vector<Tri>& t
 /// check_not_nested for a validated closed surface whose components are its triangles joined
 /// through shared vertices (the input of tetrahedralize).
 void check_surface_not_nested(const TriangleMesh& mesh, const std::string& file);
-
-/// The values of `whole` (one per surface triangle) at the part's triangles, in order.
-std::vector<double> part_values(const std::vector<double>& whole, const SurfacePart& part);
-
-/// compute_charge on each part's surface alone (each component is its own conductor, so it
-/// gets the charge, and hence the clusters, it would get in an asset of its own). Densities
-/// are gathered into one value per surface triangle; capacitance, area and iterations add up,
-/// the residual is the largest, converged only when every part converged.
-ChargeResult charge_by_part(const std::vector<Vec3>& nodes, const std::vector<SurfacePart>& parts,
-                            std::size_t triangle_count, const ChargeOptions& options,
-                            const std::string& file);
-
-/// One segmentation of the whole surface from one per part (in part order, local triangle
-/// ids): cluster ids renumbered by their smallest triangle id, loops and counts concatenated.
-Segmentation join_segmentations(const std::vector<SurfacePart>& parts,
-                                const std::vector<Segmentation>& pieces,
-                                std::size_t triangle_count);
-
-/// One cluster per part (--clusters single on a mesh with several components).
-Segmentation one_cluster_per_part(const std::vector<SurfacePart>& parts,
-                                  std::size_t triangle_count);
-
-/// choose_detector_points for each part on its own (only its interior nodes and tets are
-/// candidates), for a segmentation whose clusters never span two parts; one detector per
-/// cluster, tet ids those of `mesh`. Copies the node array once when there are several parts.
-std::vector<DetectorChoice> detectors_by_part(const TetMesh& mesh,
-                                              const std::vector<SurfacePart>& parts,
-                                              const Segmentation& segmentation,
-                                              DetectorStrategy strategy, double min_visibility);
 
 }  // namespace tetseg::preprocess::detail

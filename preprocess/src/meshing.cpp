@@ -31,7 +31,7 @@ constexpr double kMaxDiagonalPerSize = 1e5;
 /// criteria's sizes filling the bounding-box diagonal's cube, (D/cell)^3 + 6 (D/facet)^2, and
 /// at least kMinBudget. Real meshes use under 2 % of it at default sizes (elephant 2.4k
 /// vertices, cube_quad 11k of 589k). It stops runaway refinement; it cannot stop a loop that
-/// inserts nothing (colored_tetra.ply, docs/benchmarks.md).
+/// inserts nothing (colored_tetra.ply, docs/benchmarks-history.md, "Protected sharp edges").
 constexpr double kBudgetFactor = 8.0;
 constexpr double kMinBudget = 200000.0;
 /// Edges whose two triangles' normals differ by more than this (degrees; CGAL
@@ -41,7 +41,7 @@ constexpr double kMinBudget = 200000.0;
 /// faces Mesh_3 refines, like the cube, the tetrahedra or the pyramid). Unprotected, Mesh_3's
 /// manifold refinement can loop forever at such a corner (colored_tetra.ply); on finely tessellated
 /// inputs (edges shorter than the facet size) the sharp edges are mostly tessellation noise, and
-/// protecting them made dino and femur run over 180 s and hand fail (docs/benchmarks.md).
+/// protecting them made dino and femur run over 180 s, hand fail (docs/benchmarks-history.md).
 constexpr double kSharpEdgeDegrees = 60.0;
 constexpr double kProtectEdgeFacets = 8.0;
 /// When no optimisation gives a valid boundary, meshing is retried with every size (facet,
@@ -331,7 +331,7 @@ std::pair<double, double> area_and_volume(const TriangleMesh& s) {
 ///   a volume of about offset x area; a solid's is far more);
 /// - at least kThinShare of kThinProbes vertices (every k-th) are on a thin part: the point
 ///   kThinProbeDepth x offset inside along the vertex normal is outside the wrap (generalised
-///   winding number below 1/2). On libcgal-demo (docs/benchmarks.md, "Real meshes") the
+///   winding number below 1/2). On libcgal-demo (docs/benchmarks-history.md, "Real meshes") the
 ///   wraps of closed solids have shares 0-0.09; cube-ouvert's partly entered wrap (alpha
 ///   0.16), which the volume test lets through, 0.61. Wraps of open surfaces that Mesh_3 did
 ///   mesh reach 0.66, so no threshold is exact: three of them now take one more doubling.

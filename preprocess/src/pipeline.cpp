@@ -13,7 +13,7 @@
 
 #include <sys/resource.h>
 
-#include "components.hpp"
+#include "part_stages.hpp"
 #include "tetseg/format/asset_io.hpp"
 #include "tetseg/preprocess/names.hpp"
 #include "tetseg/preprocess/surface.hpp"

@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "components.hpp"
-#include "segment_topology.hpp"
+#include "mesh_topology.hpp"
 #include "tetseg/preprocess/surface.hpp"
 #include "validate_internal.hpp"
 #include "vec3_math.hpp"

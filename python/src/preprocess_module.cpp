@@ -1,14 +1,14 @@
 // tetseg.preprocess: build assets and charge densities from Python (docs/python.md). Links
 // tetseg::preprocess, hence CGAL (GPL); tetseg's runtime package never imports this module.
 // Options and defaults are those of `tetseg build` and `tetseg charge` (docs/cli.md): the
-// defaults come from the library's option structs, the checks below mirror the CLI's.
+// defaults come from the library's option structs, the ranges from option_ranges.hpp, and
+// the work and the reports from the same library jobs (jobs.hpp) as the CLI's.
 
 #include <pybind11/functional.h>
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
-#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -22,10 +22,10 @@
 #include "tetseg/format/asset_io.hpp"
 #include "tetseg/preprocess/charge.hpp"
 #include "tetseg/preprocess/io.hpp"
+#include "tetseg/preprocess/jobs.hpp"
 #include "tetseg/preprocess/meshing.hpp"
 #include "tetseg/preprocess/names.hpp"
-#include "tetseg/preprocess/pipeline.hpp"
-#include "tetseg/preprocess/surface.hpp"
+#include "tetseg/preprocess/option_ranges.hpp"
 
 namespace tetseg::python {
 namespace {
@@ -41,25 +41,6 @@ Enum enum_from_name(const char* option, const std::string& name) {
   throw py::value_error(std::string(option) + ": unknown value '" + name + "' (" +
                         name_list<Enum>(", ") + ")");
 }
-
-std::string number(double value) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.17g", value);
-  return text;
-}
-
-/// The CLI's range checks (CLI::Range, NonNegativeNumber, PositiveNumber); NaN is refused.
-void check_range(const char* option, double value, double low, double high) {
-  if (!(value >= low && value <= high)) {
-    throw py::value_error(std::string(option) + " must be in [" + number(low) + ", " +
-                          number(high) + "], got " + number(value));
-  }
-}
-void check_positive(const char* option, double value) {
-  if (!(value > 0) || std::isinf(value))
-    throw py::value_error(std::string(option) + " must be positive, got " + number(value));
-}
-constexpr double kUnbounded = HUGE_VAL;
 
 // ---------------------------------------------------------------------------------------
 // Input: a mesh file, or (nodes, tets) / (points, triangles) arrays.
@@ -139,16 +120,6 @@ Input input_from(const py::object& mesh, const py::object& source) {
   return in;
 }
 
-/// Reads the file named by `in.path` (no-op for arrays). Runs without the GIL.
-void read_input(Input& in) {
-  if (in.path.empty()) return;
-  if (in.is_tet_mesh) {
-    in.tet_mesh = read_tet_mesh(in.path);
-  } else {
-    in.surface = read_triangle_mesh(in.path);
-  }
-}
-
 /// CGAL's meshing resets a global random generator and Eigen's thread count is global: one
 /// preprocess call at a time. Lock it only after releasing the GIL (a stage callback takes
 /// the GIL while the lock is held).
@@ -180,95 +151,13 @@ py::array_t<double> doubles_array(const std::vector<double>& v) {
 // ---------------------------------------------------------------------------------------
 // build
 
-/// The memory fields of the CLI reports (docs/cli.md): per stage, the process's peak RSS at
-/// its end and how much the stage raised it (StageTimer measures both).
-void add_memory_fields(py::dict& d, const std::vector<StageReport>& stages) {
-  py::dict peak_rss_bytes;
-  py::dict peak_rss_growth_bytes;
-  for (const StageReport& s : stages) {
-    peak_rss_bytes[py::str(s.name)] = s.peak_rss_bytes;
-    peak_rss_growth_bytes[py::str(s.name)] = s.peak_rss_growth_bytes;
-  }
-  d["peak_rss_bytes"] = peak_rss_bytes;
-  d["peak_rss_growth_bytes"] = peak_rss_growth_bytes;
-}
-
-py::dict report_dict(const std::string& source, const BuildReport& report,
-                     const format::Asset& asset, std::size_t asset_bytes, double total) {
-  py::dict seconds;
-  py::list stages;
-  for (const StageReport& s : report.stages) {
-    seconds[py::str(s.name)] = s.seconds;
-    stages.append(py::make_tuple(s.name, s.seconds, s.summary));
-  }
-  seconds["total"] = total;
-  py::dict counts;
-  counts["nodes"] = report.nodes;
-  counts["tets"] = report.tets;
-  counts["surface_triangles"] = report.surface_triangles;
-  counts["interior_nodes"] = report.interior_nodes;
-  counts["components"] = report.components;
-  counts["clusters"] = report.clusters;
-  counts["boundaries"] = report.boundaries;
-  const SegmentationCounts& seg = report.segmentation;
-  py::dict segmentation;
-  segmentation["segments_found"] = seg.segments_found;
-  segmentation["segments_grown"] = seg.segments_grown;
-  segmentation["segments_shrunk"] = seg.segments_shrunk;
-  segmentation["boundaries"] = seg.boundaries;
-  segmentation["clusters"] = seg.clusters;
-  segmentation["clusters_merged"] = seg.clusters_merged;
-  py::dict refinement;
-  refinement["clusters_before"] = report.refinement.clusters_before;
-  refinement["splits"] = report.refinement.splits;
-  refinement["merges"] = report.refinement.merges;
-  py::list clusters;
-  for (const format::Cluster& c : asset.clusters) {
-    py::dict d;
-    d["triangles"] = c.triangle_count;
-    // The same members as the CLI report's "detector" (tools/common/mesh_output.cpp).
-    py::dict detector;
-    detector["nodes"] = c.detector.nodes;
-    detector["weights"] = c.detector.weights;
-    detector["tet"] = c.detector.tet == format::kNoTet ? py::object(py::none())
-                                                       : py::object(py::int_(c.detector.tet));
-    if (!asset.rest_positions.empty() && asset.rest_positions.size() == asset.node_count)
-      detector["position"] =
-          format::detector_position(c.detector, asset.rest_positions.front().data());
-    d["detector"] = detector;
-    d["overlap_only"] = (c.flags & format::kClusterOverlapOnly) != 0;
-    d["rest_positive_fraction"] = c.rest_positive_fraction;
-    clusters.append(d);
-  }
-  py::dict options;
-  for (const auto& [key, value] : asset.provenance.options) options[py::str(key)] = value;
-
-  py::dict d;
-  d["input"] = source;
-  d["asset_bytes"] = asset_bytes;
-  d["seconds"] = seconds;
-  add_memory_fields(d, report.stages);
-  d["stages"] = stages;
-  d["counts"] = counts;
-  d["segmentation"] = segmentation;
-  d["refinement"] = refinement;
-  if (!report.charge.solver.empty()) {
-    const ChargeResult& c = report.charge;
-    py::dict charge;
-    charge["solver"] = c.solver;
-    charge["tolerance"] = c.tolerance;
-    charge["converged"] = c.converged;
-    charge["iterations"] = c.iterations;
-    charge["relaxed_products"] = c.relaxed_products;
-    charge["residual"] = c.residual;
-    charge["capacitance"] = c.capacitance;
-    charge["assembly_seconds"] = c.assembly_seconds;
-    charge["solve_seconds"] = c.solve_seconds;
-    d["charge"] = charge;
-  }
-  d["clusters"] = clusters;
-  d["options"] = options;
-  return d;
+/// Python calls on_stage(name, seconds, summary) after each stage, with the GIL.
+StageCallback stage_callback_from(const py::object& on_stage) {
+  if (on_stage.is_none()) return {};
+  return [&on_stage](const StageReport& stage) {
+    py::gil_scoped_acquire gil;
+    on_stage(stage.name, stage.seconds, stage.summary);
+  };
 }
 
 py::tuple build(const py::object& mesh, const py::object& source, const std::string& clusters,
@@ -281,18 +170,13 @@ py::tuple build(const py::object& mesh, const py::object& source, const std::str
                 int threads, const std::string& repair, double wrap_alpha, double wrap_offset,
                 double wrap_sheet_offset, bool keep_largest_component, bool rest_positions,
                 const py::object& on_stage) {
-  BuildOptions options;
+  BuildJobOptions job;
+  BuildOptions& options = job.build;
   options.clusters = enum_from_name<ClusterMethod>("clusters", clusters);
-  check_range("refine_visibility", refine_visibility, 0.0, 1.0);
-  check_range("refine_max_clusters", refine_max_clusters, 1, 100000);
-  check_range("refine_gain", refine_gain, 0.0, kUnbounded);
   options.refinement.min_visibility = refine_visibility;
   options.refinement.max_clusters = refine_max_clusters;
   options.refinement.gain_per_cut_edge = refine_gain;
   options.refinement.merge = refine_merge;
-  check_range("alpha", alpha, 0.0, 1.0);
-  check_positive("beta_divisor", beta_divisor);
-  check_range("growth_bound", growth_bound, 0.0, 1.0);
   options.segmentation.alpha = alpha;
   options.segmentation.beta_divisor = beta_divisor;
   options.segmentation.equalization = enum_from_name<Equalization>("equalization", equalization);
@@ -300,88 +184,48 @@ py::tuple build(const py::object& mesh, const py::object& source, const std::str
   options.segmentation.grow_through_marked = grow_through_marked;
   options.segmentation.min_cluster_triangles = min_cluster_triangles;
   options.segmentation.detector = enum_from_name<DetectorStrategy>("detector", detector);
-  check_range("min_visibility", min_visibility, 0.0, 1.0);
   options.segmentation.min_visibility = min_visibility;
   options.charge.solver = enum_from_name<ChargeSolver>("solver", solver);
-  check_range("tolerance", tolerance, 0.0, 0.5);
   options.charge.tolerance = tolerance;
   options.keep_rest_positions = rest_positions;
-  MeshingOptions meshing;
-  check_range("cell_size", cell_size, 0.0, kUnbounded);
-  check_range("facet_size", facet_size, 0.0, kUnbounded);
-  check_range("facet_distance", facet_distance, 0.0, kUnbounded);
+  MeshingOptions& meshing = job.meshing;
   meshing.cell_size = cell_size;
   meshing.facet_size = facet_size;
   meshing.facet_distance = facet_distance;
   meshing.optimize = optimize;
-  check_range("threads", threads, 0, 4096);
   meshing.threads = threads;
   meshing.repair = enum_from_name<MeshingOptions::Repair>("repair", repair);
-  check_range("wrap_alpha", wrap_alpha, 1e-4, 1.0);
-  check_range("wrap_offset", wrap_offset, 1e-4, 1.0);
-  check_range("wrap_sheet_offset", wrap_sheet_offset, 1e-4, 1.0);
   meshing.wrap_alpha = wrap_alpha;
   meshing.wrap_offset = wrap_offset;
   meshing.wrap_sheet_offset = wrap_sheet_offset;
   meshing.keep_largest_component = keep_largest_component;
+  validate_options(job);  // std::invalid_argument: ValueError, before any work
 
   Input in = input_from(mesh, source);
-  std::function<void(const StageReport&)> stage_callback;
-  if (!on_stage.is_none()) {
-    stage_callback = [&on_stage](const StageReport& stage) {
-      py::gil_scoped_acquire gil;
-      on_stage(stage.name, stage.seconds, stage.summary);
-    };
-  }
-
-  using Clock = std::chrono::steady_clock;
-  BuildReport report;
-  format::Asset asset;
-  std::vector<std::uint8_t> bytes;
-  double total = 0;
+  const StageCallback stage_callback = stage_callback_from(on_stage);
+  BuildJobResult result;
   {
     py::gil_scoped_release release;
     std::lock_guard<std::mutex> lock(preprocess_mutex());
-    const auto start = Clock::now();
-    StageTimer timer(report, stage_callback);
-    // As `tetseg build`: a tet mesh is used as is, a closed surface is tetrahedralised.
-    if (in.is_tet_mesh) {
-      timer.run("read", [&](std::string& summary) {
-        read_input(in);
-        summary = std::to_string(in.tet_mesh.nodes.size()) + " nodes, " +
-                  std::to_string(in.tet_mesh.tets.size()) + " tets";
-        return 0;
-      });
-    } else {
-      timer.run("read", [&](std::string& summary) {
-        read_input(in);
-        // As `tetseg build`: with repair "fix", tetrahedralize validates after repairing.
-        if (meshing.repair == MeshingOptions::Repair::kNone)
-          validate_closed_surface(in.surface, in.source, /*allow_components=*/true);
-        summary = std::to_string(in.surface.vertices.size()) + " vertices, " +
-                  std::to_string(in.surface.triangles.size()) + " triangles (surface)";
-        return 0;
-      });
-      in.tet_mesh = timer.run("tetrahedralize", [&](std::string& summary) {
-        TetrahedralizeNotes notes;
-        TetMesh m = tetrahedralize(in.surface, meshing, in.source, &notes);
-        options.meshing = meshing;  // recorded in the provenance, as by `tetseg build`
-        options.repairs = notes.repairs;
-        summary =
-            std::to_string(m.nodes.size()) + " nodes, " + std::to_string(m.tets.size()) + " tets";
-        return m;
-      });
-    }
-    asset = build_asset(in.tet_mesh, in.source, options, report, stage_callback);
-    bytes = timer.run("write", [&](std::string& summary) {
-      std::vector<std::uint8_t> b = format::write_asset(asset);
-      summary = std::to_string(b.size()) + " bytes";
-      return b;
-    });
-    total = std::chrono::duration<double>(Clock::now() - start).count();
+    // As `tetseg build`: the same job, so the same stages, checks and report.
+    if (!in.path.empty())
+      result = build_asset_from_file(in.path, job, stage_callback, in.source);
+    else if (in.is_tet_mesh)
+      result = build_asset_from_tet_mesh(std::move(in.tet_mesh), in.source, job, stage_callback);
+    else
+      result = build_asset_from_surface(std::move(in.surface), in.source, job, stage_callback);
   }
-  py::bytes data(reinterpret_cast<const char*>(bytes.data()), bytes.size());
-  return py::make_tuple(data, report_dict(in.source, report, asset, bytes.size(), total));
+  // The report of `tetseg build --report` (without "output": no file is written), plus the
+  // stages as (name, seconds, summary).
+  py::dict report = py::module_::import("json").attr("loads")(
+      build_report_json(result, in.source, /*output=*/""));
+  py::list stages;
+  for (const StageReport& s : result.report.stages)
+    stages.append(py::make_tuple(s.name, s.seconds, s.summary));
+  report["stages"] = stages;
+  py::bytes data(reinterpret_cast<const char*>(result.asset_bytes.data()),
+                 result.asset_bytes.size());
+  return py::make_tuple(data, report);
 }
 
 // ---------------------------------------------------------------------------------------
@@ -390,67 +234,38 @@ py::tuple build(const py::object& mesh, const py::object& source, const std::str
 py::dict charge(const py::object& mesh, const py::object& source, const std::string& solver,
                 double tolerance, int max_iterations, double theta, int order,
                 bool relaxed_products, const std::string& equalize_name, int bins) {
-  ChargeOptions options;
-  options.solver = enum_from_name<ChargeSolver>("solver", solver);
-  const Equalization method = enum_from_name<Equalization>("equalize", equalize_name);
-  check_range("tolerance", tolerance, 0.0, 0.5);
-  check_range("max_iterations", max_iterations, 1, 100000);
-  check_range("theta", theta, 0.0, 0.95);
-  check_range("order", order, -1, 16);
-  check_range("bins", bins, 1, 1 << 20);
-  options.tolerance = tolerance;
-  options.max_iterations = max_iterations;
-  options.fast_theta = theta;
-  options.fast_order = order;
-  options.relaxed_products = relaxed_products;
+  ChargeJobOptions job;
+  job.charge.solver = enum_from_name<ChargeSolver>("solver", solver);
+  job.equalization = enum_from_name<Equalization>("equalize", equalize_name);
+  job.charge.tolerance = tolerance;
+  job.charge.max_iterations = max_iterations;
+  job.charge.fast_theta = theta;
+  job.charge.fast_order = order;
+  job.charge.relaxed_products = relaxed_products;
+  job.bins = bins;
+  validate_options(job);
 
   Input in = input_from(mesh, source);
-  std::vector<Vec3> points;
-  std::vector<Tri> triangles;
-  ChargeResult result;
-  std::vector<double> equalized;
-  BuildReport report;  // the stages of `tetseg charge --report`: read (and validate), charge
+  ChargeJobResult result;
   {
     py::gil_scoped_release release;
     std::lock_guard<std::mutex> lock(preprocess_mutex());
-    StageTimer timer(report, nullptr);
-    timer.run("read", [&](std::string&) {
-      // As `tetseg charge`: a tet mesh's boundary, or a closed surface as given.
-      read_input(in);
-      if (in.is_tet_mesh) {
-        const Surface surface = extract_valid_surface(in.tet_mesh, in.source);
-        points = std::move(in.tet_mesh.nodes);
-        triangles = surface.triangles;
-      } else {
-        validate_closed_surface(in.surface, in.source);
-        points = std::move(in.surface.vertices);
-        triangles = std::move(in.surface.triangles);
-      }
-      return 0;
-    });
-    timer.run("charge", [&](std::string&) {
-      result = compute_charge(points, triangles, options, in.source);
-      equalized = equalize(result.density, method, bins);
-      return 0;
-    });
+    // As `tetseg charge`: a tet mesh's boundary, or a closed surface as given.
+    if (!in.path.empty())
+      result = charge_from_file(in.path, job, {}, in.source);
+    else if (in.is_tet_mesh)
+      result = charge_tet_mesh(std::move(in.tet_mesh), in.source, job);
+    else
+      result = charge_surface(std::move(in.surface), in.source, job);
   }
-  py::dict d;
-  d["density"] = doubles_array(result.density);
-  d["equalized"] = doubles_array(equalized);
-  d["points"] = nodes_array(points);
-  d["triangles"] = cells_array(triangles);
-  d["solver"] = result.solver;
-  d["iterations"] = result.iterations;
-  d["relaxed_products"] = result.relaxed_products;
-  d["residual"] = result.residual;
-  d["converged"] = result.converged;
-  d["tolerance"] = result.tolerance;
-  d["capacitance"] = result.capacitance;
-  d["total_area"] = result.total_area;
-  d["equalization"] = name_of(method);
-  d["assembly_seconds"] = result.assembly_seconds;
-  d["solve_seconds"] = result.solve_seconds;
-  add_memory_fields(d, report.stages);
+  // The report of `tetseg charge --report` but input and triangles, plus the arrays.
+  py::dict d = py::module_::import("json").attr("loads")(charge_report_json(result, in.source));
+  d.attr("pop")("input");
+  d.attr("pop")("triangles");
+  d["density"] = doubles_array(result.charge.density);
+  d["equalized"] = doubles_array(result.equalized);
+  d["points"] = nodes_array(result.points);
+  d["triangles"] = cells_array(result.triangles);
   return d;
 }
 
@@ -473,7 +288,7 @@ py::tuple generate(const std::string& shape_name, double size, double radius,
   meshing.facet_angle = facet_angle;
   meshing.cell_radius_edge_ratio = radius_edge_ratio;
   meshing.optimize = optimize;
-  check_range("threads", threads, 0, 4096);
+  check_option(option_ranges::kThreads, threads);
   meshing.threads = threads;
   TetMesh mesh;
   {
@@ -553,8 +368,8 @@ PYBIND11_MODULE(preprocess, m) {
         "recorded in the asset's provenance and used in messages (default: the path, or "
         "'arrays'). Every other option is the `tetseg build` option of the same name "
         "(--no-optimize is optimize=False, --no-rest-positions is rest_positions=False). "
-        "on_stage(name, seconds, summary) is called after each stage. The report dict has the "
-        "keys of `tetseg build --report` plus 'stages'. Load the bytes with "
+        "on_stage(name, seconds, summary) is called after each stage. The report dict is "
+        "`tetseg build --report` (the same writer; no 'output') plus 'stages'. Load the bytes with "
         "tetseg.load_asset. Raises InputError for a bad mesh, ValueError for a bad option.");
 
   const ChargeOptions c;
@@ -562,7 +377,8 @@ PYBIND11_MODULE(preprocess, m) {
         py::arg("solver") = std::string(name_of(c.solver)), py::arg("tolerance") = c.tolerance,
         py::arg("max_iterations") = c.max_iterations, py::arg("theta") = c.fast_theta,
         py::arg("order") = c.fast_order, py::arg("relaxed_products") = c.relaxed_products,
-        py::arg("equalize") = std::string(name_of(Equalization::kHistogram)), py::arg("bins") = 256,
+        py::arg("equalize") = std::string(name_of(ChargeJobOptions{}.equalization)),
+        py::arg("bins") = ChargeJobOptions{}.bins,
         "Returns a dict. "
         "Relative charge density of a tet mesh's boundary or of a closed surface, as "
         "`tetseg charge` computes it (docs/charge.md). mesh as for build. Returns density and "

@@ -99,6 +99,43 @@ def test_build_from_closed_surface_equals_cli(pp, bin_dir, sphere_mesh, tmp_path
     assert report["counts"] == expected_report["counts"]
 
 
+CUBE_OFF = """OFF
+8 7 0
+0 0 0
+1 0 0
+1 1 0
+0 1 0
+0 0 1
+1 0 1
+1 1 1
+0 1 1
+4 0 3 2 1
+4 4 5 6 7
+4 0 1 5 4
+4 1 2 6 5
+4 2 3 7 6
+4 3 0 4 7
+4 0 3 2 1
+"""
+
+
+def test_repaired_surface_build_reports_like_cli(pp, bin_dir, tmp_path):
+    """A cube with a duplicated face: both front doors run the same job and print the same
+    report, repairs and Hausdorff distances included (one writer; Python adds 'stages' and
+    writes no file, so it has no 'output')."""
+    off = tmp_path / "cube_dup.off"
+    off.write_text(CUBE_OFF)
+    flags = ["--clusters", "single", "--facet-size", 0.25, "--no-optimize"]
+    expected_bytes, expected = cli_build(bin_dir, off, tmp_path, *flags)
+    data, report = pp.build(off, clusters="single", facet_size=0.25, optimize=False)
+    assert data == expected_bytes
+    assert set(report) - {"stages"} == set(expected) - {"output"}
+    assert report["repairs"] == expected["repairs"] == {"duplicate triangles removed": 2}
+    assert report["hausdorff"] == pytest.approx(expected["hausdorff"])
+    for key in ("counts", "clusters", "options", "input"):
+        assert report[key] == expected[key], key
+
+
 def test_charge_equals_cli(pp, bin_dir, sphere_mesh, tmp_path):
     csv = tmp_path / "charge.csv"
     run_tool(bin_dir, "tetseg", "charge", sphere_mesh, "-o", csv, "--solver", "direct",

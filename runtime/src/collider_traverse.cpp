@@ -107,8 +107,8 @@ void test_features(Worker& w, const Collider::Impl& A, std::uint32_t t1, const C
                    std::uint32_t t2, Claimed&& claimed) noexcept {
   const double ms = A.opt.ccd.min_separation;
   // The plane filter first, in every mode: with its static error bound it costs less than the
-  // feature boxes it saves (rvbc evaluated it lazily before; docs/benchmarks.md, "Static error
-  // bounds").
+  // feature boxes it saves (rvbc evaluated it lazily before; docs/benchmarks-history.md, "Static
+  // error bounds").
   if (ms <= 0 && plane_separated(w, A, t1, B, t2)) {
     ++w.stats.triangle_pairs_plane_filtered;
     return;

@@ -62,6 +62,52 @@ expect_exit 3 "tetseg: error: cube_dup.off: surface has [0-9]* non-manifold edge
 [ ! -e dup2.mesh ] || fail "a refused surface left a mesh"
 expect_exit 2 "repair" -- "$bin/tetseg" build cube.off -o x.tetseg --repair bogus
 
+# --repair none: build accepts and refuses exactly the surfaces tetrahedralize does (both run
+# tetrahedralize's checks, once). Two cubes touching at one corner (a pinched vertex, as in
+# modelled meshes) are accepted by both; without its top the cube is refused by both.
+cat >pinch.off <<'EOF'
+OFF
+15 12 0
+0 0 0
+1 0 0
+1 1 0
+0 1 0
+0 0 1
+1 0 1
+1 1 1
+0 1 1
+2 1 1
+2 2 1
+1 2 1
+1 1 2
+2 1 2
+2 2 2
+1 2 2
+4 0 3 2 1
+4 4 5 6 7
+4 0 1 5 4
+4 1 2 6 5
+4 2 3 7 6
+4 3 0 4 7
+4 6 10 9 8
+4 11 12 13 14
+4 6 8 12 11
+4 8 9 13 12
+4 9 10 14 13
+4 10 6 11 14
+EOF
+pinch_options=(--repair none --facet-size 0.2 --no-optimize)
+expect_exit 0 "" -- "$bin/tetseg" tetrahedralize pinch.off -o pinch.mesh "${pinch_options[@]}"
+expect_exit 0 "tetseg: done" -- \
+  "$bin/tetseg" build pinch.off -o pinch.tetseg --clusters single "${pinch_options[@]}"
+"$bin/tetseg-dump" pinch.tetseg --json | grep -q '"components": 2' || fail "pinch: not two bodies"
+head -n 10 cube.off | sed 's/^8 6 0$/8 5 0/' >open.off
+tail -n 5 cube.off >>open.off
+for command in "tetrahedralize open.off -o open.mesh" "build open.off -o open.tetseg"; do
+  expect_exit 3 "tetseg: error: open.off: surface is not closed" -- \
+    "$bin/tetseg" $command --repair none
+done
+
 # The repairs go to the report and the provenance.
 "$bin/tetseg" build cube_dup.off -o dup.tetseg --clusters single --facet-size 0.25 -q \
   --report dup.json

@@ -5,8 +5,8 @@
 
 #include <memory>
 
-#include "format/test_assets.hpp"
-#include "support/allocation_probe.hpp"
+#include "format/support/test_assets.hpp"
+#include "tetseg/testing/allocation_probe.hpp"
 
 using namespace tetseg::format;
 using namespace tetseg::test;

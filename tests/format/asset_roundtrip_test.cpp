@@ -6,7 +6,7 @@
 #include <set>
 #include <thread>
 
-#include "format/test_assets.hpp"
+#include "format/support/test_assets.hpp"
 
 using namespace tetseg::format;
 using namespace tetseg::test;

@@ -5,7 +5,7 @@
 #include <functional>
 #include <limits>
 
-#include "format/test_assets.hpp"
+#include "format/support/test_assets.hpp"
 
 using namespace tetseg::format;
 using namespace tetseg::test;

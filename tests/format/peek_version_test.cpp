@@ -1,6 +1,6 @@
 #include <catch2/catch.hpp>
 
-#include "format/test_assets.hpp"
+#include "format/support/test_assets.hpp"
 
 using namespace tetseg;
 using namespace tetseg::test;

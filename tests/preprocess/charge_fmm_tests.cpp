@@ -14,9 +14,9 @@
 #include "../../preprocess/src/charge_potential.hpp"
 #include "../../preprocess/src/charge_solvers.hpp"
 #include "../../preprocess/src/charge_tree.hpp"
-#include "support/test_data.hpp"
 #include "tetseg/preprocess/charge.hpp"
 #include "tetseg/testing/charge_shapes.hpp"
+#include "tetseg/testing/test_data.hpp"
 
 using namespace tetseg::preprocess::charge_detail;
 

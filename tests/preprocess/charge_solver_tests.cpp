@@ -5,10 +5,10 @@
 #include <cmath>
 #include <numeric>
 
-#include "support/test_data.hpp"
 #include "tetseg/preprocess/charge.hpp"
 #include "tetseg/preprocess/names.hpp"
 #include "tetseg/testing/charge_shapes.hpp"
+#include "tetseg/testing/test_data.hpp"
 
 using namespace tetseg::preprocess;
 using tetseg::test::TriangleMesh;

@@ -7,7 +7,7 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "segment_test_shapes.hpp"
+#include "preprocess/support/segment_test_shapes.hpp"
 #include "tetseg/preprocess/segmentation.hpp"
 
 using namespace tetseg::preprocess;

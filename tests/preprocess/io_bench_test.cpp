@@ -14,7 +14,7 @@
 #include <numeric>
 #include <random>
 
-#include "preprocess/grid_mesh.hpp"
+#include "preprocess/support/grid_mesh.hpp"
 #include "tetseg/preprocess/io.hpp"
 #include "tetseg/preprocess/meshing.hpp"
 #include "tetseg/preprocess/surface.hpp"
@@ -87,7 +87,7 @@ TEST_CASE("Benchmark: tet mesh I/O, extraction and validation", "[.bench][io-ben
               surface.triangles.size(), t_validate);
 }
 
-// Issue 17 (docs/benchmarks.md, "Scale"): a 93^3 Kuhn grid (830,584 nodes, 4,826,142 tets,
+// Issue 17 (docs/benchmarks-history.md, "Scale"): a 93^3 Kuhn grid (830,584 nodes, 4,826,142 tets,
 // close to the 4.87 M-tet dumbbell), interior nodes jittered and nodes and tets shuffled as in
 // a Mesh_3 output; wall and process CPU time of each step, one run each.
 TEST_CASE("Benchmark: read, extract and validate 4.8 M tets", "[.bench][scale-bench]") {

@@ -13,7 +13,7 @@
 #include <sstream>
 #include <string>
 
-#include "preprocess/grid_mesh.hpp"
+#include "preprocess/support/grid_mesh.hpp"
 #include "tetseg/preprocess/io.hpp"
 
 namespace fs = std::filesystem;

@@ -18,7 +18,7 @@
 #include <string>
 #include <vector>
 
-#include "preprocess/grid_mesh.hpp"
+#include "preprocess/support/grid_mesh.hpp"
 #include "tetseg/preprocess/io.hpp"
 
 namespace fs = std::filesystem;

@@ -12,8 +12,8 @@
 #include <vector>
 
 #include "../../preprocess/src/io_text.hpp"
-#include "support/test_data.hpp"
 #include "tetseg/preprocess/io.hpp"
+#include "tetseg/testing/test_data.hpp"
 
 namespace fs = std::filesystem;
 using namespace tetseg::preprocess;

@@ -12,7 +12,7 @@
 #include <sstream>
 #include <string>
 
-#include "preprocess/grid_mesh.hpp"
+#include "preprocess/support/grid_mesh.hpp"
 #include "tetseg/preprocess/io.hpp"
 #include "tetseg/preprocess/surface.hpp"
 

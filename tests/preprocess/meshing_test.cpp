@@ -10,11 +10,11 @@
 #include <fstream>
 #include <stdexcept>
 
-#include "support/test_data.hpp"
 #include "tetseg/preprocess/io.hpp"
 #include "tetseg/preprocess/meshing.hpp"
 #include "tetseg/preprocess/surface.hpp"
 #include "tetseg/testing/charge_shapes.hpp"
+#include "tetseg/testing/test_data.hpp"
 
 using namespace tetseg::preprocess;
 

@@ -6,7 +6,7 @@
 #include <cstdio>
 #include <set>
 
-#include "preprocess/grid_mesh.hpp"
+#include "preprocess/support/grid_mesh.hpp"
 #include "tetseg/format/asset_io.hpp"
 #include "tetseg/preprocess/meshing.hpp"
 #include "tetseg/preprocess/pipeline.hpp"

@@ -10,8 +10,8 @@
 #include <vector>
 
 #include "../../preprocess/src/min_cut.hpp"
-#include "segment_invariants.hpp"
-#include "segment_test_shapes.hpp"
+#include "preprocess/support/segment_invariants.hpp"
+#include "preprocess/support/segment_test_shapes.hpp"
 #include "tetseg/preprocess/segmentation.hpp"
 
 using namespace tetseg::preprocess;

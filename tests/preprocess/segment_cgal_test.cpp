@@ -9,8 +9,7 @@
 #include <set>
 #include <string>
 
-#include "segment_invariants.hpp"
-#include "support/test_data.hpp"
+#include "preprocess/support/segment_invariants.hpp"
 #include "tetseg/format/asset_io.hpp"
 #include "tetseg/preprocess/charge.hpp"
 #include "tetseg/preprocess/io.hpp"
@@ -18,6 +17,7 @@
 #include "tetseg/preprocess/pipeline.hpp"
 #include "tetseg/preprocess/segmentation.hpp"
 #include "tetseg/preprocess/surface.hpp"
+#include "tetseg/testing/test_data.hpp"
 
 using namespace tetseg::preprocess;
 

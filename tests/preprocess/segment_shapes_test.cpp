@@ -7,7 +7,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "segment_invariants.hpp"
+#include "preprocess/support/segment_invariants.hpp"
 #include "tetseg/preprocess/charge.hpp"
 #include "tetseg/preprocess/meshing.hpp"
 #include "tetseg/preprocess/segmentation.hpp"

@@ -7,8 +7,8 @@
 #include <limits>
 
 #include "../../preprocess/src/segment_topology.hpp"
-#include "segment_invariants.hpp"
-#include "segment_test_shapes.hpp"
+#include "preprocess/support/segment_invariants.hpp"
+#include "preprocess/support/segment_test_shapes.hpp"
 #include "tetseg/preprocess/segmentation.hpp"
 
 using namespace tetseg::preprocess;

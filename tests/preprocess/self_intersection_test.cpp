@@ -22,11 +22,11 @@
 #include <vector>
 
 #include "../../preprocess/src/validate_internal.hpp"
-#include "preprocess/grid_mesh.hpp"
-#include "support/test_data.hpp"
+#include "preprocess/support/grid_mesh.hpp"
 #include "tetseg/preprocess/io.hpp"
 #include "tetseg/preprocess/surface.hpp"
 #include "tetseg/testing/charge_shapes.hpp"
+#include "tetseg/testing/test_data.hpp"
 
 using namespace tetseg::preprocess;
 

@@ -218,7 +218,7 @@ TEST_CASE("The runtime finds the contacts between two components as brute force 
 TEST_CASE("A mat one tet thick builds and its contacts equal brute force when it folds over",
           "[thin][collider]") {
   preprocess::StructuredOptions options;
-  options.resolution = 24;  // tetseg-sim runs the 40 x 40 mat (docs/benchmarks.md)
+  options.resolution = 24;  // tetseg-sim runs the 40 x 40 mat (docs/benchmarks-history.md)
   const TetMesh mat = preprocess::generate_structured(StructuredShape::kMat, options);
   REQUIRE(preprocess::extract_surface(mat).interior_nodes.empty());
   const Asset asset = load(build(mat));

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <limits>
 
-#include "preprocess/grid_mesh.hpp"
+#include "preprocess/support/grid_mesh.hpp"
 #include "tetseg/preprocess/surface.hpp"
 
 using namespace tetseg::preprocess;

@@ -1,7 +1,7 @@
 // Loading assets through the runtime API (tetseg::load_asset), which wraps tetseg::format.
 #include <catch2/catch.hpp>
 
-#include "format/test_assets.hpp"
+#include "format/support/test_assets.hpp"
 #include "tetseg/runtime/asset.hpp"
 
 using tetseg::test::get_le;

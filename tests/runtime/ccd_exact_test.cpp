@@ -13,10 +13,10 @@
 
 #include <catch2/catch.hpp>
 
-#include "support/test_data.hpp"
 #include "tetseg/runtime/ccd.hpp"
 #include "tetseg/testing/ccd_io.hpp"
 #include "tetseg/testing/exact_ccd.hpp"
+#include "tetseg/testing/test_data.hpp"
 
 using tetseg::Vec3d;
 using tetseg::test::exact_edge_edge;

@@ -10,8 +10,8 @@
 
 #include <catch2/catch.hpp>
 
-#include "support/test_data.hpp"
 #include "tetseg/testing/ccd_io.hpp"
+#include "tetseg/testing/test_data.hpp"
 
 namespace {
 

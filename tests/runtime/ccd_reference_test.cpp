@@ -1,5 +1,5 @@
 // Elementary CCD tests against the exact ground truth of the public reference data
-// (../shared/data/ccd-queries, read in place; skipped when absent, support/test_data.hpp).
+// (../shared/data/ccd-queries, read in place; skipped when absent, tetseg/testing/test_data.hpp).
 
 #include <algorithm>
 #include <array>
@@ -9,9 +9,9 @@
 
 #include <catch2/catch.hpp>
 
-#include "support/test_data.hpp"
 #include "tetseg/runtime/ccd.hpp"
 #include "tetseg/testing/ccd_io.hpp"
+#include "tetseg/testing/test_data.hpp"
 
 namespace {
 

@@ -1,12 +1,12 @@
 // A collider step and its queries allocate nothing (counted by the test executable's
-// replacement operator new, tests/support/allocation_probe.cpp); OpenMP results equal serial.
+// replacement operator new, testing/src/allocation_probe.cpp); OpenMP results equal serial.
 
 #include <catch2/catch.hpp>
 #include <random>
 
 #include "runtime/support/queries.hpp"
-#include "support/allocation_probe.hpp"
 #include "tetseg/runtime/collider.hpp"
+#include "tetseg/testing/allocation_probe.hpp"
 #include "tetseg/testing/synthetic_scenes.hpp"
 
 using namespace tetseg;

@@ -1,5 +1,5 @@
 // The collider against brute force on random smooth deformations of real meshes (CGAL demo
-// meshes unpacked into the build tree; skipped when absent, support/test_data.hpp).
+// meshes unpacked into the build tree; skipped when absent, tetseg/testing/test_data.hpp).
 
 #include <catch2/catch.hpp>
 #include <cmath>
@@ -7,7 +7,7 @@
 
 #include "runtime/support/compare.hpp"
 #include "runtime/support/off.hpp"
-#include "support/test_data.hpp"
+#include "tetseg/testing/test_data.hpp"
 
 using namespace tetseg;
 using namespace tetseg::test;

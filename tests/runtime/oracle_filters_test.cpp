@@ -9,7 +9,7 @@
 
 #include <catch2/catch.hpp>
 
-#include "support/compare.hpp"
+#include "runtime/support/compare.hpp"
 #include "tetseg/runtime/body_shape.hpp"
 #include "tetseg/runtime/collider.hpp"
 

@@ -10,7 +10,7 @@
 #include <memory>
 #include <vector>
 
-#include "support/allocation_probe.hpp"
+#include "tetseg/testing/allocation_probe.hpp"
 #include "tetseg/runtime/collider.hpp"
 #include "tetseg/runtime/scene.hpp"
 #include "tetseg/testing/scene_oracle.hpp"

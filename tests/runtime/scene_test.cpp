@@ -16,9 +16,9 @@
 #include <tuple>
 #include <vector>
 
-#include "support/allocation_probe.hpp"
 #include "tetseg/runtime/ccd.hpp"
 #include "tetseg/runtime/scene.hpp"
+#include "tetseg/testing/allocation_probe.hpp"
 #include "tetseg/testing/scene_oracle.hpp"
 #include "tetseg/testing/synthetic_scenes.hpp"
 

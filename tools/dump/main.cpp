@@ -13,6 +13,7 @@
 #include <CLI/CLI.hpp>
 
 #include "mesh_output.hpp"
+#include "tetseg/format/asset_json.hpp"
 #include "tetseg/runtime/asset.hpp"
 #include "tool_support.hpp"
 
@@ -127,7 +128,7 @@ void print_summary(const std::string& path, const std::string& version, const As
 }
 
 void print_json(const std::string& version, const Asset& asset) {
-  using tetseg::tools::json_escape;
+  using tetseg::format::json_escape;
   const auto edges = boundary_edges_per_cluster(asset);
   std::ostringstream out;
   out.precision(9);
@@ -141,7 +142,7 @@ void print_json(const std::string& version, const Asset& asset) {
   for (std::size_t c = 0; c < asset.clusters.size(); ++c) {
     const auto& cluster = asset.clusters[c];
     out << (c ? ",\n    " : "\n    ") << "{\"triangles\": " << cluster.triangle_count << ", "
-        << tetseg::tools::detector_json(asset, cluster)
+        << tetseg::format::detector_json(asset, cluster)
         << ", \"rest_positive_fraction\": " << cluster.rest_positive_fraction
         << ", \"boundary_edges\": " << edges[c] << ", \"bvh_nodes\": " << cluster.bvh_count << "}";
   }
@@ -155,12 +156,8 @@ void print_json(const std::string& version, const Asset& asset) {
     out << "]}";
   }
   out << "],\n  \"provenance\": {\"tool_version\": \"" << json_escape(asset.provenance.tool_version)
-      << "\", \"source\": \"" << json_escape(asset.provenance.source) << "\", \"options\": {";
-  for (std::size_t i = 0; i < asset.provenance.options.size(); ++i) {
-    const auto& [key, value] = asset.provenance.options[i];
-    out << (i ? ", " : "") << '"' << json_escape(key) << "\": \"" << json_escape(value) << '"';
-  }
-  out << "}}\n}\n";
+      << "\", \"source\": \"" << json_escape(asset.provenance.source)
+      << "\", \"options\": " << tetseg::format::provenance_options_json(asset) << "}\n}\n";
   std::cout << out.str();
 }
 

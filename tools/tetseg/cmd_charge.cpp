@@ -10,7 +10,6 @@
 #include <cstdint>
 #include <cstdio>
 #include <memory>
-#include <sstream>
 #include <string>
 #include <utility>
 #include <vector>
@@ -18,10 +17,9 @@
 #include "commands.hpp"
 #include "mesh_io.hpp"
 #include "tetseg/preprocess/charge.hpp"
-#include "tetseg/preprocess/io.hpp"
+#include "tetseg/preprocess/jobs.hpp"
 #include "tetseg/preprocess/names.hpp"
-#include "tetseg/preprocess/pipeline.hpp"
-#include "tetseg/preprocess/surface.hpp"
+#include "tetseg/preprocess/option_ranges.hpp"
 #include "tool_support.hpp"
 
 namespace tetseg::tools {
@@ -31,14 +29,8 @@ struct ChargeArgs {
   std::string input;
   std::string output;
   std::string report;
-  preprocess::ChargeSolver solver = preprocess::ChargeSolver::kAuto;
-  preprocess::Equalization equalization = preprocess::Equalization::kHistogram;
-  double tolerance = 0.0;  // 0: automatic (charge.hpp)
-  int max_iterations = 500;
-  double theta = 0.0;  // 0: automatic (charge.hpp)
-  int order = -1;
+  preprocess::ChargeJobOptions job;  ///< the library's defaults
   bool exact_products = false;
-  int bins = 256;
 };
 
 /// Progress on stderr: a live bar when stderr is a terminal, otherwise a line per quarter.
@@ -185,91 +177,32 @@ void run_charge(const ChargeArgs& args) {
   if (ext != ".csv" && ext != ".vtu" && ext != ".ply") {
     throw CLI::ValidationError("--output", "output must end in .csv, .vtu or .ply: " + args.output);
   }
-  preprocess::ChargeOptions options;
-  options.solver = args.solver;
-  const preprocess::Equalization method = args.equalization;
-  options.tolerance = args.tolerance;
-  options.max_iterations = args.max_iterations;
-  options.fast_theta = args.theta;
-  options.fast_order = args.order;
-  options.relaxed_products = !args.exact_products;
-
-  // Process peak RSS at the end of each step, and how much the step raised it (docs/cli.md).
-  std::vector<std::pair<const char*, std::uint64_t>> peaks;
-  std::uint64_t last_peak = preprocess::process_peak_rss_bytes();
-  std::vector<std::uint64_t> growths;
-  auto take_peak = [&](const char* step) {
-    const std::uint64_t peak = preprocess::process_peak_rss_bytes();
-    peaks.emplace_back(step, peak);
-    growths.push_back(peak > last_peak ? peak - last_peak : 0);
-    last_peak = peak;
-  };
-  auto t0 = std::chrono::steady_clock::now();
-  std::vector<preprocess::Vec3> points;
-  std::vector<preprocess::Tri> triangles;
-  if (preprocess::is_tet_mesh_path(args.input)) {
-    preprocess::TetMesh mesh = preprocess::read_tet_mesh(args.input);
-    const preprocess::Surface surface = preprocess::extract_valid_surface(mesh, args.input);
-    points = std::move(mesh.nodes);
-    triangles = surface.triangles;
-  } else {
-    preprocess::TriangleMesh mesh = preprocess::read_triangle_mesh(args.input);
-    preprocess::validate_closed_surface(mesh, args.input);
-    points = std::move(mesh.vertices);
-    triangles = std::move(mesh.triangles);
-  }
-  take_peak("read");
-  std::fprintf(stderr, "tetseg: reading %s ... %.2f s, %zu surface triangles\n",
-               base_name(args.input).c_str(),
-               std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(),
-               triangles.size());
-
+  preprocess::ChargeJobOptions options = args.job;
+  options.charge.relaxed_products = !args.exact_products;
   Progress progress;
-  options.progress = [&](const char* stage, double f) { progress.update(stage, f); };
-  const preprocess::ChargeResult r =
-      preprocess::compute_charge(points, triangles, options, args.input);
-  progress.finish();
-  take_peak("charge");
-  std::fprintf(stderr,
-               "tetseg: charge ... %.2f s (assembly %.2f s, solve %.2f s), solver %s, %d "
-               "iterations (%d relaxed), residual %.2e, capacitance %.6g\n",
-               r.assembly_seconds + r.solve_seconds, r.assembly_seconds, r.solve_seconds,
-               r.solver.c_str(), r.iterations, r.relaxed_products, r.residual, r.capacitance);
+  options.charge.progress = [&](const char* stage, double f) { progress.update(stage, f); };
+  preprocess::ChargeJobResult result =
+      preprocess::charge_from_file(args.input, options, [&](const preprocess::StageReport& stage) {
+        progress.finish();
+        print_stage(stage);
+      });
+  const preprocess::ChargeResult& r = result.charge;
   if (!r.converged) {
     std::fprintf(stderr,
                  "tetseg: warning: the solver stopped at residual %.2e above the tolerance %.2e "
                  "after %d iterations (raise --max-iterations)\n",
                  r.residual, r.tolerance, r.iterations);
   }
-  const std::vector<double> eq = preprocess::equalize(r.density, method, args.bins);
-  const Outputs out{points, triangles, r.density, eq};
-  const std::string text =
-      ext == ".csv" ? format_csv(out) : (ext == ".vtu" ? format_vtu(out) : format_ply(out));
-  write_file_atomic(args.output, text);
-  std::fprintf(stderr, "tetseg: wrote %s\n", base_name(args.output).c_str());
-  take_peak("write");
-
-  if (!args.report.empty()) {
-    std::ostringstream j;
-    j.precision(10);
-    j << "{\n  \"input\": \"" << json_escape(args.input)
-      << "\",\n  \"triangles\": " << triangles.size() << ",\n  \"solver\": \"" << r.solver
-      << "\",\n  \"iterations\": " << r.iterations
-      << ",\n  \"relaxed_products\": " << r.relaxed_products << ",\n  \"residual\": " << r.residual
-      << ",\n  \"converged\": " << (r.converged ? "true" : "false")
-      << ",\n  \"tolerance\": " << r.tolerance << ",\n  \"capacitance\": " << r.capacitance
-      << ",\n  \"total_area\": " << r.total_area << ",\n  \"equalization\": \""
-      << preprocess::name_of(method) << "\",\n  \"assembly_seconds\": " << r.assembly_seconds
-      << ",\n  \"solve_seconds\": " << r.solve_seconds;
-    j << ",\n  \"peak_rss_bytes\": {";
-    for (std::size_t i = 0; i < peaks.size(); ++i)
-      j << (i ? ", " : "") << '"' << peaks[i].first << "\": " << peaks[i].second;
-    j << "},\n  \"peak_rss_growth_bytes\": {";
-    for (std::size_t i = 0; i < peaks.size(); ++i)
-      j << (i ? ", " : "") << '"' << peaks[i].first << "\": " << growths[i];
-    j << "}\n}\n";
-    write_file_atomic(args.report, j.str());
-  }
+  preprocess::StageTimer(result.report, print_stage).run("write", [&](std::string& summary) {
+    const Outputs out{result.points, result.triangles, r.density, result.equalized};
+    const std::string text =
+        ext == ".csv" ? format_csv(out) : (ext == ".vtu" ? format_vtu(out) : format_ply(out));
+    write_file_atomic(args.output, text);
+    summary = args.output;
+    return 0;
+  });
+  if (!args.report.empty())
+    write_file_atomic(args.report, preprocess::charge_report_json(result, args.input));
 }
 
 }  // namespace
@@ -285,30 +218,32 @@ void add_charge_command(CLI::App& root) {
                   "Per-triangle output: .csv (triangle,cx,cy,cz,area,density,equalized), "
                   ".vtu (cell data) or .ply (gray faces)")
       ->required();
-  cmd->add_option("--solver", args->solver, "Charge solver")
+  cmd->add_option("--solver", args->job.charge.solver, "Charge solver")
       ->transform(CLI::CheckedTransformer(preprocess::name_map<preprocess::ChargeSolver>()))
       ->option_text(preprocess::name_list<preprocess::ChargeSolver>() + " (auto)");
-  cmd->add_option("--tolerance", args->tolerance,
+  cmd->add_option("--tolerance", args->job.charge.tolerance,
                   "Relative residual of the iterative solvers (0: 1e-6 below 10k triangles, "
                   "1e-8 above)")
-      ->check(CLI::Range(0.0, 0.5));
-  cmd->add_option("--max-iterations", args->max_iterations, "Iteration cap")
-      ->check(CLI::Range(1, 100000));
-  cmd->add_option("--theta", args->theta,
-                  "Fast solver opening parameter, (0, 1) (0: 0.4 below 10k triangles, 0.45 above)")
-      ->check(CLI::Range(0.0, 0.95));
-  cmd->add_option("--order", args->order,
+      ->check(range_check(preprocess::option_ranges::kTolerance));
+  cmd->add_option("--max-iterations", args->job.charge.max_iterations, "Iteration cap")
+      ->check(range_check(preprocess::option_ranges::kMaxIterations));
+  cmd->add_option(
+         "--theta", args->job.charge.fast_theta,
+         "Fast solver opening parameter, (0, 0.95] (0: 0.4 below 10k triangles, 0.45 above)")
+      ->check(range_check(preprocess::option_ranges::kTheta));
+  cmd->add_option("--order", args->job.charge.fast_order,
                   "Fast solver expansion order (-1 = 6 below 10k triangles, else 8)")
-      ->check(CLI::Range(-1, 16));
+      ->check(range_check(preprocess::option_ranges::kOrder));
   cmd->add_flag("--exact-products", args->exact_products,
                 "Fast solver: every GMRES product at --order and --theta (default: once the "
                 "residual is small, a cheaper order-4 FMM within half the tolerance; "
                 "docs/charge.md)");
-  cmd->add_option("--equalization,--equalize", args->equalization,
+  cmd->add_option("--equalization,--equalize", args->job.equalization,
                   "histogram (the paper), rank or log-histogram (alias log)")
       ->transform(CLI::CheckedTransformer(preprocess::name_map<preprocess::Equalization>()))
       ->option_text(preprocess::name_list<preprocess::Equalization>() + " (histogram)");
-  cmd->add_option("--bins", args->bins, "Histogram bins")->check(CLI::Range(1, 1 << 20));
+  cmd->add_option("--bins", args->job.bins, "Histogram bins")
+      ->check(range_check(preprocess::option_ranges::kBins));
   cmd->add_option("--report", args->report, "Write a JSON report (solver, iterations, times)");
   cmd->callback([args] { run_naming_file(args->input, [&] { run_charge(*args); }); });
 }

@@ -19,24 +19,17 @@
 
 namespace tetseg::tools {
 
+void print_stage(const preprocess::StageReport& stage) {
+  std::fprintf(stderr, "tetseg: %-13s %8.3f s  %s\n", stage.name.c_str(), stage.seconds,
+               stage.summary.c_str());
+}
+
 namespace mesh_cli {
 
-/// Wall-clock stage timer that prints "tetseg: <label> ... <s> s, <details>" to stderr.
-class Stage {
- public:
-  explicit Stage(std::string label)
-      : m_label(std::move(label)), m_start(std::chrono::steady_clock::now()) {}
-  void done(const std::string& details) const {
-    const double s =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - m_start).count();
-    std::fprintf(stderr, "tetseg: %s ... %.2f s%s%s\n", m_label.c_str(), s,
-                 details.empty() ? "" : ", ", details.c_str());
-  }
-
- private:
-  std::string m_label;
-  std::chrono::steady_clock::time_point m_start;
-};
+std::string tet_mesh_summary(const preprocess::TetMesh& mesh) {
+  return std::to_string(mesh.nodes.size()) + " nodes, " + std::to_string(mesh.tets.size()) +
+         " tets";
+}
 
 void add_threads_option(CLI::App& cmd, preprocess::MeshingOptions& m, const std::string& prefix) {
   cmd.add_option("--threads", m.threads,
@@ -44,20 +37,20 @@ void add_threads_option(CLI::App& cmd, preprocess::MeshingOptions& m, const std:
                      "Mesh_3 threads: 1 = sequential and reproducible; N > 1 = parallel "
                      "(oneTBB), can be faster on idle cores, but the mesh differs from run to "
                      "run; 0 = all cores")
-      ->check(CLI::NonNegativeNumber)
+      ->check(range_check(preprocess::option_ranges::kThreads))
       ->capture_default_str();
 }
 
 void add_meshing_options(CLI::App& cmd, preprocess::MeshingOptions& m, MshOutput& msh) {
   cmd.add_option("--cell-size", m.cell_size,
                  "Max tet circumradius (0 = facet size; see docs/cli.md, Meshing options)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(range_check(preprocess::option_ranges::kCellSize));
   cmd.add_option("--facet-size", m.facet_size,
                  "Max surface Delaunay-ball radius (0 = cell size, else derived)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(range_check(preprocess::option_ranges::kFacetSize));
   cmd.add_option("--facet-distance", m.facet_distance,
                  "Max distance of the meshed surface from the input (0 = facet size / 10)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(range_check(preprocess::option_ranges::kFacetDistance));
   cmd.add_option("--facet-angle", m.facet_angle, "Min facet angle in degrees, (0, 30]")
       ->check(CLI::Range(0.01, 30.0));
   cmd.add_option("--radius-edge-ratio", m.cell_radius_edge_ratio,
@@ -131,18 +124,18 @@ void add_repair_option(CLI::App& cmd, preprocess::MeshingOptions& m) {
   cmd.add_option("--wrap-alpha", m.wrap_alpha,
                  "--repair wrap: gaps narrower than this fraction of the bounding-box diagonal "
                  "are closed")
-      ->check(CLI::Range(1e-4, 1.0))
+      ->check(range_check(preprocess::option_ranges::kWrapAlpha))
       ->capture_default_str();
   cmd.add_option("--wrap-offset", m.wrap_offset,
                  "--repair wrap: distance of the wrap from the input, as a fraction of the "
                  "bounding-box diagonal")
-      ->check(CLI::Range(1e-4, 1.0))
+      ->check(range_check(preprocess::option_ranges::kWrapOffset))
       ->capture_default_str();
   cmd.add_option("--wrap-sheet-offset", m.wrap_sheet_offset,
                  "--repair wrap, an input that encloses no volume (a flat or open sheet): the "
                  "offset of the slab (about twice as thick) it is wrapped into, as a fraction "
                  "of the bounding-box diagonal")
-      ->check(CLI::Range(1e-4, 1.0))
+      ->check(range_check(preprocess::option_ranges::kWrapSheetOffset))
       ->capture_default_str();
 }
 
@@ -161,9 +154,8 @@ void print_repairs(const std::string& file, const preprocess::TetrahedralizeNote
 }
 
 void finish_tet_mesh(const preprocess::TetMesh& mesh, const std::string& output,
-                     const MshOutput& msh, const std::string& what) {
-  {
-    Stage stage("validating " + what);
+                     const MshOutput& msh) {
+  run_stage("validate", [&](std::string& summary) {
     preprocess::Surface surface;
     try {
       surface = preprocess::extract_valid_surface(mesh, output);
@@ -172,12 +164,15 @@ void finish_tet_mesh(const preprocess::TetMesh& mesh, const std::string& output,
                       std::string("meshing produced an invalid mesh: ") + e.what() +
                           " (thin parts may need a smaller --facet-size)");
     }
-    stage.done(std::to_string(surface.triangles.size()) + " surface triangles, " +
-               std::to_string(surface.interior_nodes.size()) + " interior nodes");
-  }
-  Stage stage("writing " + base_name(output));
-  write_atomic(output, mesh, msh);
-  stage.done("");
+    summary = std::to_string(surface.triangles.size()) + " surface triangles, " +
+              std::to_string(surface.interior_nodes.size()) + " interior nodes";
+    return 0;
+  });
+  run_stage("write", [&](std::string& summary) {
+    write_atomic(output, mesh, msh);
+    summary = output;
+    return 0;
+  });
 }
 
 }  // namespace mesh_cli
@@ -198,27 +193,29 @@ void run_generate(const GenerateArgs& args) {
   mesh_cli::check_output_path(args.output);
   preprocess::StructuredShape structured;
   if (preprocess::parse_name(args.shape, structured)) {
-    mesh_cli::Stage stage("building " + args.shape);
-    preprocess::TetMesh mesh;
-    try {
-      mesh = preprocess::generate_structured(structured, args.structured);
-    } catch (const std::invalid_argument& e) {
-      throw CLI::ValidationError(args.shape, e.what());
-    }
-    stage.done(std::to_string(mesh.nodes.size()) + " nodes, " + std::to_string(mesh.tets.size()) +
-               " tets");
-    mesh_cli::finish_tet_mesh(mesh, args.output, args.msh, args.shape);
+    const preprocess::TetMesh mesh = mesh_cli::run_stage("generate", [&](std::string& summary) {
+      preprocess::TetMesh m;
+      try {
+        m = preprocess::generate_structured(structured, args.structured);
+      } catch (const std::invalid_argument& e) {
+        throw CLI::ValidationError(args.shape, e.what());
+      }
+      summary = args.shape + ": " + mesh_cli::tet_mesh_summary(m);
+      return m;
+    });
+    mesh_cli::finish_tet_mesh(mesh, args.output, args.msh);
     return;
   }
   preprocess::ShapeOptions shape_options = args.shape_options;
   if (!args.axes.empty())
     for (int k = 0; k < 3; ++k) shape_options.axes[k] = args.axes[static_cast<std::size_t>(k)];
   const preprocess::Shape shape = preprocess::shape_from_name(args.shape);
-  mesh_cli::Stage stage("meshing " + args.shape);
-  const preprocess::TetMesh mesh = preprocess::generate_shape(shape, shape_options, args.meshing);
-  stage.done(std::to_string(mesh.nodes.size()) + " nodes, " + std::to_string(mesh.tets.size()) +
-             " tets");
-  mesh_cli::finish_tet_mesh(mesh, args.output, args.msh, args.shape);
+  const preprocess::TetMesh mesh = mesh_cli::run_stage("generate", [&](std::string& summary) {
+    preprocess::TetMesh m = preprocess::generate_shape(shape, shape_options, args.meshing);
+    summary = args.shape + ": " + mesh_cli::tet_mesh_summary(m);
+    return m;
+  });
+  mesh_cli::finish_tet_mesh(mesh, args.output, args.msh);
 }
 
 }  // namespace

@@ -1,7 +1,6 @@
 // `tetseg tetrahedralize`: a closed surface (OBJ, PLY, STL, OFF, glTF, ...) to a tet mesh with
 // CGAL Mesh_3.
 
-#include <chrono>
 #include <cstdio>
 #include <memory>
 #include <string>
@@ -23,27 +22,23 @@ struct TetrahedralizeArgs {
   mesh_cli::MshOutput msh;
 };
 
-double seconds_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
-
 void run_tetrahedralize(const TetrahedralizeArgs& args) {
   mesh_cli::check_output_path(args.output);
-  auto start = std::chrono::steady_clock::now();
-  const preprocess::TriangleMesh surface = preprocess::read_triangle_mesh(args.input);
-  std::fprintf(stderr, "tetseg: reading %s ... %.2f s, %zu vertices, %zu triangles\n",
-               base_name(args.input).c_str(), seconds_since(start), surface.vertices.size(),
-               surface.triangles.size());
-  start = std::chrono::steady_clock::now();
+  const preprocess::TriangleMesh surface = mesh_cli::run_stage("read", [&](std::string& summary) {
+    preprocess::TriangleMesh s = preprocess::read_triangle_mesh(args.input);
+    summary = std::to_string(s.vertices.size()) + " vertices, " +
+              std::to_string(s.triangles.size()) + " triangles (surface)";
+    return s;
+  });
   preprocess::TetrahedralizeNotes notes;
-  const preprocess::TetMesh mesh =
-      preprocess::tetrahedralize(surface, args.meshing, args.input, &notes);
+  const preprocess::TetMesh mesh = mesh_cli::run_stage("tetrahedralize", [&](std::string& summary) {
+    preprocess::TetMesh m = preprocess::tetrahedralize(surface, args.meshing, args.input, &notes);
+    summary = mesh_cli::tet_mesh_summary(m);
+    return m;
+  });
   mesh_cli::print_repairs(args.input, notes);
   if (!notes.optimization_used.empty()) mesh_cli::print_retry_note(args.input, notes);
-  std::fprintf(stderr, "tetseg: meshing %s ... %.2f s, %zu nodes, %zu tets\n",
-               base_name(args.input).c_str(), seconds_since(start), mesh.nodes.size(),
-               mesh.tets.size());
-  mesh_cli::finish_tet_mesh(mesh, args.output, args.msh, base_name(args.input));
+  mesh_cli::finish_tet_mesh(mesh, args.output, args.msh);
 }
 
 }  // namespace

@@ -8,9 +8,12 @@
 #include <exception>
 #include <new>
 #include <string>
+#include <utility>
 
 #include "tetseg/preprocess/mesh.hpp"
 #include "tetseg/preprocess/meshing.hpp"
+#include "tetseg/preprocess/option_ranges.hpp"
+#include "tetseg/preprocess/pipeline.hpp"
 #include "tool_support.hpp"
 
 namespace tetseg::tools {
@@ -42,6 +45,17 @@ void run_naming_file(const std::string& file, Command&& command) {
   }
 }
 
+/// The CLI11 check of an option's declared range (tetseg/preprocess/option_ranges.hpp). A range
+/// open at its minimum is (0, inf] (CLI::PositiveNumber).
+inline CLI::Validator range_check(const preprocess::OptionRange& range) {
+  if (range.min_exclusive) return CLI::PositiveNumber;
+  return CLI::Range(range.min, range.max);
+}
+
+/// The one stage printer of the `tetseg` commands: `tetseg: <stage> <seconds> s  <summary>` on
+/// stderr, for each finished stage of a job (defined in cmd_generate.cpp).
+void print_stage(const preprocess::StageReport& stage);
+
 /// Helpers shared by the commands that write tet meshes (defined in cmd_generate.cpp).
 namespace mesh_cli {
 
@@ -51,13 +65,26 @@ struct MshOutput {
   bool binary = false;  ///< Gmsh 4.1 binary
 };
 
+/// Runs `work(summary)` (returning its result) as one stage named `name`, timed and printed
+/// by print_stage. Defined here: a template.
+template <typename Work>
+auto run_stage(const char* name, Work&& work) {
+  preprocess::BuildReport stages;
+  preprocess::StageTimer timer(stages, print_stage);
+  return timer.run(name, std::forward<Work>(work));
+}
+
+/// "N nodes, M tets".
+std::string tet_mesh_summary(const preprocess::TetMesh& mesh);
+
 /// Adds the Mesh_3 options (--cell-size, ...) and the .msh flags (--gmsh22, --binary).
 void add_meshing_options(CLI::App& cmd, preprocess::MeshingOptions& m, MshOutput& msh);
 /// Throws a usage error unless `path` names a tet mesh format.
 void check_output_path(const std::string& path);
-/// Validates `mesh` (exit 1 when invalid) and writes it atomically to `output`.
+/// Validates `mesh` (exit 1 when invalid) and writes it atomically to `output` (stages
+/// validate and write).
 void finish_tet_mesh(const preprocess::TetMesh& mesh, const std::string& output,
-                     const MshOutput& msh, const std::string& what);
+                     const MshOutput& msh);
 
 /// Says on stderr that tetrahedralize meshed `file` again with less optimisation because the
 /// optimised mesh's boundary was invalid (`notes`).

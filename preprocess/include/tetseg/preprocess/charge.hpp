@@ -38,18 +38,19 @@ enum class ChargePreconditioner {
 
 struct ChargeOptions {
   ChargeSolver solver = ChargeSolver::kAuto;
-  /// Relative residual ||1 - M y|| / ||1|| at which the iterative solvers stop, in (0, 1),
-  /// or 0 for automatic: 1e-6 below 10,000 triangles, 1e-8 from there on. The density error
-  /// left by a given residual grows with N (at 100k triangles 1e-6 leaves ~1 % max error,
-  /// 1e-8 below 0.1 % on an ellipsoid and the CGAL elephant; docs/charge.md). Negative values
-  /// are rejected.
+  /// Relative residual ||1 - M y|| / ||1|| at which the iterative solvers stop, in (0, 0.5]
+  /// (option_ranges::kTolerance), or 0 for automatic: 1e-6 below 10,000 triangles, 1e-8 from there
+  /// on. The density error left by a given residual grows with N (at 100k triangles 1e-6 leaves ~1
+  /// % max error, 1e-8 below 0.1 % on an ellipsoid and the CGAL elephant; docs/charge.md). Negative
+  /// values are rejected.
   double tolerance = 0.0;
   int max_iterations = 500;  ///< matrix products, iterative solvers only
   int restart = 80;          ///< GMRES restart length
   ChargePreconditioner preconditioner = ChargePreconditioner::kTwoLevel;
   /// FMM opening parameter: two clusters interact through expansions when
-  /// (r_target + r_source) < theta * distance. Smaller is more accurate and slower; (0, 1),
-  /// or 0 for automatic: 0.4 below 10,000 triangles, 0.45 from there on (docs/charge.md).
+  /// (r_target + r_source) < theta * distance. Smaller is more accurate and slower; (0, 0.95]
+  /// (option_ranges::kTheta), or 0 for automatic: 0.4 below 10,000 triangles, 0.45 from there on
+  /// (docs/charge.md).
   double fast_theta = 0.0;
   /// Total order of the fast solver's Taylor expansions, 0..16; error ~ theta^(order + 1).
   /// Negative means automatic: 6 below 10,000 triangles (with theta 0.4 the residual against
@@ -92,6 +93,7 @@ struct ChargeResult {
 /// Computes the relative charge density of the closed surface `triangles` over `points`
 /// (orientation does not matter). Throws InputError(file, ...) for no triangles, an index out
 /// of range, a non-finite coordinate or a degenerate (zero-area or needle) triangle; throws
+/// std::invalid_argument for a tolerance or fast_theta outside its option range; throws
 /// std::runtime_error when the requested dense solver does not fit memory_limit_bytes, when
 /// the dense matrix is singular or the iteration produces non-finite values. Non-convergence
 /// within max_iterations is not an error: check `converged`. Uses OpenMP threads internally;

@@ -27,7 +27,7 @@ enum class ClusterMethod {
 
 struct BuildOptions {
   /// kRefined measured faster per frame than kCharge on every benchmark scene
-  /// (docs/benchmarks.md, "Cluster refinement").
+  /// (docs/benchmarks-history.md, "Cluster refinement").
   ClusterMethod clusters = ClusterMethod::kRefined;
   ChargeOptions charge;
   SegmentationOptions segmentation;

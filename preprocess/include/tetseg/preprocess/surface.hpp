@@ -34,7 +34,8 @@ Surface extract_surface(const TetMesh& mesh);
 /// closed (3 border edges, first between vertices 4 and 7)". Cost: the face matching of
 /// extract_surface with the O(T) checks of the tets made in its counting pass, O(B log B)
 /// checks of the B boundary triangles and the self-intersection test (about 1.2 s of CPU for
-/// 4.8 M tets / 104k triangles with the extraction; docs/benchmarks.md, "Scale"). Thread-safe.
+/// 4.8 M tets / 104k triangles with the extraction; docs/benchmarks-history.md, "Scale").
+/// Thread-safe.
 void validate_tet_mesh(const TetMesh& mesh, const Surface& surface, const std::string& file);
 
 /// extract_surface then validate_tet_mesh (same result, same InputError), matching the faces

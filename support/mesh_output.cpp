@@ -176,26 +176,6 @@ std::string asset_to_ply(const format::Asset& asset, const std::string& source) 
   return io::ply_text(ply);
 }
 
-std::string detector_json(const format::Asset& asset, const format::Cluster& cluster) {
-  const format::DetectorPoint& d = cluster.detector;
-  std::ostringstream out;
-  out.precision(17);
-  out << "\"detector\": {\"nodes\": [" << d.nodes[0] << ", " << d.nodes[1] << ", " << d.nodes[2]
-      << ", " << d.nodes[3] << "], \"weights\": [" << d.weights[0] << ", " << d.weights[1] << ", "
-      << d.weights[2] << ", " << d.weights[3] << "], \"tet\": ";
-  if (d.tet == format::kNoTet)
-    out << "null";
-  else
-    out << d.tet;
-  if (!asset.rest_positions.empty() && asset.rest_positions.size() == asset.node_count) {
-    const auto p = format::detector_position(d, asset.rest_positions.front().data());
-    out << ", \"position\": [" << p[0] << ", " << p[1] << ", " << p[2] << "]";
-  }
-  out << "}, \"overlap_only\": "
-      << ((cluster.flags & format::kClusterOverlapOnly) ? "true" : "false");
-  return out.str();
-}
-
 std::string detector_text(const format::Cluster& cluster) {
   const format::DetectorPoint& d = cluster.detector;
   char buf[160];

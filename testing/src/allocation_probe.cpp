@@ -1,4 +1,4 @@
-#include "support/allocation_probe.hpp"
+#include "tetseg/testing/allocation_probe.hpp"
 
 #include <atomic>
 #include <cstdlib>

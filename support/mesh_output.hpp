@@ -43,11 +43,6 @@ std::string asset_to_vtu(const format::Asset& asset, const std::string& source);
 /// Calls require_rest_positions first.
 std::string asset_to_ply(const format::Asset& asset, const std::string& source);
 
-/// A cluster's detector and flag as JSON members (no braces), shared by `tetseg-dump --json`
-/// and the build report: `"detector": {"nodes": [4 ids], "weights": [4], "tet": id or null,
-/// "position": [x, y, z] (when rest positions are given, else omitted)}, "overlap_only": bool`.
-std::string detector_json(const format::Asset& asset, const format::Cluster& cluster);
-
 /// One-line human form of a detector: "node 17" for the node form, else
 /// "tet 512 (3 9 10 44) w 0.25 0.25 0.25 0.25".
 std::string detector_text(const format::Cluster& cluster);

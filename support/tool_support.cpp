@@ -1,5 +1,7 @@
 #include "tool_support.hpp"
 
+#include "tetseg/format/asset_json.hpp"
+
 #include <cctype>
 #include <cerrno>
 #include <cstdio>
@@ -77,36 +79,7 @@ std::string extension_of(const std::string& path) {
 }
 
 std::string json_escape(const std::string& text) {
-  std::string out;
-  out.reserve(text.size());
-  for (unsigned char c : text) {
-    switch (c) {
-      case '"':
-        out += "\\\"";
-        break;
-      case '\\':
-        out += "\\\\";
-        break;
-      case '\n':
-        out += "\\n";
-        break;
-      case '\t':
-        out += "\\t";
-        break;
-      case '\r':
-        out += "\\r";
-        break;
-      default:
-        if (c < 0x20) {
-          char buf[8];
-          std::snprintf(buf, sizeof buf, "\\u%04x", c);
-          out += buf;
-        } else {
-          out += static_cast<char>(c);
-        }
-    }
-  }
-  return out;
+  return format::json_escape(text);
 }
 
 int parse_error_exit(const CLI::App& app, const CLI::ParseError& error) {

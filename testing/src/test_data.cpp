@@ -1,4 +1,4 @@
-#include "support/test_data.hpp"
+#include "tetseg/testing/test_data.hpp"
 
 #include <catch2/catch.hpp>
 #include <filesystem>

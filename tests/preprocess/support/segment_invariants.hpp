@@ -7,7 +7,7 @@
 #include <set>
 #include <vector>
 
-#include "segment_test_shapes.hpp"
+#include "preprocess/support/segment_test_shapes.hpp"
 #include "tetseg/preprocess/segmentation.hpp"
 
 namespace tetseg::test {

@@ -67,7 +67,7 @@ std::string base_name(const std::string& path);
 /// Lower-case extension with the dot (".mesh"), or "" when there is none.
 std::string extension_of(const std::string& path);
 
-/// Escapes a string for a JSON string literal (without the surrounding quotes).
+/// format::json_escape (tetseg/format/asset_json.hpp), for tools that link no asset code.
 std::string json_escape(const std::string& text);
 
 }  // namespace tetseg::tools

@@ -1,0 +1,46 @@
+#pragma once
+// Private: the pipeline stages of build_asset run per component of a tet mesh (each component
+// is its own conductor, segmentation and detector set; docs/segmentation.md, "Several
+// components"). The component topology itself is in components.hpp.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "components.hpp"
+#include "tetseg/preprocess/charge.hpp"
+#include "tetseg/preprocess/mesh.hpp"
+#include "tetseg/preprocess/segmentation.hpp"
+
+namespace tetseg::preprocess::detail {
+
+/// The values of `whole` (one per surface triangle) at the part's triangles, in order.
+std::vector<double> part_values(const std::vector<double>& whole, const SurfacePart& part);
+
+/// compute_charge on each part's surface alone (each component is its own conductor, so it
+/// gets the charge, and hence the clusters, it would get in an asset of its own). Densities
+/// are gathered into one value per surface triangle; capacitance, area and iterations add up,
+/// the residual is the largest, converged only when every part converged.
+ChargeResult charge_by_part(const std::vector<Vec3>& nodes, const std::vector<SurfacePart>& parts,
+                            std::size_t triangle_count, const ChargeOptions& options,
+                            const std::string& file);
+
+/// One segmentation of the whole surface from one per part (in part order, local triangle
+/// ids): cluster ids renumbered by their smallest triangle id, loops and counts concatenated.
+Segmentation join_segmentations(const std::vector<SurfacePart>& parts,
+                                const std::vector<Segmentation>& pieces,
+                                std::size_t triangle_count);
+
+/// One cluster per part (--clusters single on a mesh with several components).
+Segmentation one_cluster_per_part(const std::vector<SurfacePart>& parts,
+                                  std::size_t triangle_count);
+
+/// choose_detector_points for each part on its own (only its interior nodes and tets are
+/// candidates), for a segmentation whose clusters never span two parts; one detector per
+/// cluster, tet ids those of `mesh`. Copies the node array once when there are several parts.
+std::vector<DetectorChoice> detectors_by_part(const TetMesh& mesh,
+                                              const std::vector<SurfacePart>& parts,
+                                              const Segmentation& segmentation,
+                                              DetectorStrategy strategy, double min_visibility);
+
+}  // namespace tetseg::preprocess::detail
