@@ -10,9 +10,9 @@
 #include <memory>
 #include <vector>
 
-#include "tetseg/testing/allocation_probe.hpp"
 #include "tetseg/runtime/collider.hpp"
 #include "tetseg/runtime/scene.hpp"
+#include "tetseg/testing/allocation_probe.hpp"
 #include "tetseg/testing/scene_oracle.hpp"
 #include "tetseg/testing/synthetic_scenes.hpp"
 
