@@ -16,6 +16,8 @@
 #  2. per frame, the thread CPU seconds of `tetseg-ccd frames` (PLY reading excluded, fastest
 #     of 3 runs) and the pairs reported against the frame's exact truth (boxes + mma_bool).
 # Timings are CPU time except the thread columns (wall time: CPU time sums the threads).
+# To compare with an older build, run the script once per build in the same minutes (a build
+# whose tetseg-bench reports no medians prints n/a for them).
 set -euo pipefail
 repo=$(cd "$(dirname "$0")/.." && pwd)
 [ $# -ge 2 ] || { echo "usage: $0 BUILD_DIR SCENES_DIR [DATA_DIR]" >&2; exit 2; }
@@ -52,10 +54,12 @@ def rows(name, kind):
     return json.load(open(f"{work}/{name}.{kind}.json"))["rows"]
 def pick(rs, mode, openmp=False):
     return next(r for r in rs if r["mode"] == mode and r["openmp"] == openmp)
+def median(r, key):  # builds before 2026-11-28 report no medians
+    return f"{r[key]:.3f}" if key in r else "n/a"
 def cpu(r):
-    return f"{r['total_cpu_ms']:.3f} / {r['median_cpu_ms']:.3f}"
+    return f"{r['total_cpu_ms']:.3f} / {median(r, 'median_cpu_ms')}"
 def wall(r):
-    return f"{r['total_ms']:.3f} / {r['median_total_ms']:.3f}"
+    return f"{r['total_ms']:.3f} / {median(r, 'median_total_ms')}"
 print("CPU ms per step, mean / median over steps (single thread); wall ms with 1 and 2 threads.")
 print()
 print("| scene | steps | contacts/step | rvbc | cone | bvh | rvbc earliest_toi "
