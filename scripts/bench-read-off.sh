@@ -40,8 +40,11 @@ for round in 1 2; do
     start=$(date +%s.%N)
     "$bin" charge "$off" -o "$scratch/out.csv" --max-iterations 1 2>"$scratch/log.txt"
     end=$(date +%s.%N)
-    read_s=$(sed -n 's/^tetseg: reading .* \.\.\. \([0-9.]*\) s.*/\1/p' "$scratch/log.txt")
-    charge_s=$(sed -n 's/^tetseg: charge \.\.\. \([0-9.]*\) s.*/\1/p' "$scratch/log.txt")
+    # Stage lines: "tetseg: read   0.12 s  ..." (since issue 27), "tetseg: reading x ... 0.12 s" before.
+    read_s=$(sed -n -e 's/^tetseg: reading .* \.\.\. \([0-9.]*\) s.*/\1/p' \
+      -e 's/^tetseg: read  *\([0-9.]*\) s .*/\1/p' "$scratch/log.txt")
+    charge_s=$(sed -n -e 's/^tetseg: charge \.\.\. \([0-9.]*\) s.*/\1/p' \
+      -e 's/^tetseg: charge  *\([0-9.]*\) s .*/\1/p' "$scratch/log.txt")
     awk -v b="$bin" -v r="$read_s" -v c="$charge_s" -v s="$start" -v e="$end" \
       'BEGIN { printf "| %s | %s | %s | %.2f |\n", b, r, c, e - s }'
   done

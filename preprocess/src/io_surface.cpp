@@ -2,7 +2,6 @@
 // triangulated here), every other format through assimp (io_assimp.cpp). CGAL I/O only; no
 // Mesh_3 in this translation unit.
 
-#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/IO/polygon_soup_io.h>
 #include <CGAL/Polygon_mesh_processing/triangulate_hole.h>
 
@@ -23,6 +22,7 @@
 #include <utility>
 #include <vector>
 
+#include "cgal_mesh.hpp"
 #include "io_text.hpp"
 #include "tetseg/preprocess/io.hpp"
 
@@ -33,8 +33,7 @@ TriangleMesh read_triangle_mesh_assimp(const std::string& path);
 
 namespace {
 
-using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
-using Point = Kernel::Point_3;
+using detail::cgal::Point;
 using Polygon = std::vector<std::size_t>;
 using detail::host_is_little_endian;
 using detail::parse_int;
@@ -350,8 +349,7 @@ TriangleMesh read_with_cgal(const std::string& path, const std::string& ext) {
   if (ext == ".off" && detail::read_plain_off(text, plain_points, polygons)) {
     // Plain ASCII OFF, parsed here (CGAL's stream reader took 5-10x longer); anything else
     // goes to CGAL's reader.
-    points.reserve(plain_points.size());
-    for (const Vec3& p : plain_points) points.emplace_back(p[0], p[1], p[2]);
+    points = detail::cgal::to_points(plain_points);
     ok = true;
   } else if (ext == ".off") {
     check_off_counts(path, text);
@@ -384,7 +382,7 @@ TriangleMesh read_with_cgal(const std::string& path, const std::string& ext) {
     for (std::size_t k = 0; k < 3; ++k) {
       const Point& p = points[t[k]];
       const auto [it, inserted] = index_of.emplace(
-          Vec3{p.x(), p.y(), p.z()}, static_cast<std::uint32_t>(mesh.vertices.size()));
+          detail::cgal::to_vec3(p), static_cast<std::uint32_t>(mesh.vertices.size()));
       if (inserted) mesh.vertices.push_back(it->first);
       tri[k] = it->second;
     }

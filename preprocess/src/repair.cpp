@@ -4,7 +4,6 @@
 // Eigen) and few self-intersections (CGAL local remeshing).
 
 #define CGAL_EIGEN3_ENABLED 1
-#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Polygon_mesh_processing/border.h>
 #include <CGAL/Polygon_mesh_processing/measure.h>
 #include <CGAL/Polygon_mesh_processing/orient_polygon_soup.h>
@@ -17,7 +16,6 @@
 #include <CGAL/Polygon_mesh_processing/shape_predicates.h>
 #include <CGAL/Polygon_mesh_processing/stitch_borders.h>
 #include <CGAL/Polygon_mesh_processing/triangulate_hole.h>
-#include <CGAL/Surface_mesh.h>
 
 #include <algorithm>
 #include <array>
@@ -28,14 +26,14 @@
 #include <utility>
 #include <vector>
 
+#include "cgal_mesh.hpp"
 #include "mesh_topology.hpp"
 #include "repair_internal.hpp"
 
 namespace tetseg::preprocess::detail {
 namespace {
 
-using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
-using Point = Kernel::Point_3;
+using cgal::Point;
 using Polygon = std::array<std::size_t, 3>;
 
 /// Holes with at most this many border edges are filled (docs/cli.md).
@@ -49,7 +47,7 @@ constexpr double kMinVolumeOverArea = 1e-3;
 /// Self-intersections are not removed when hole filling made more than this share of the area.
 constexpr double kMaxPatchAreaForRemoval = 0.25;
 
-using Mesh = CGAL::Surface_mesh<Point>;
+using Mesh = cgal::SurfaceMesh;
 
 /// Fills every hole of `mesh` with at most kMaxHoleBorderEdges border edges (triangulated,
 /// refined, faired: CGAL triangulate_refine_and_fair_hole; when fairing fails the refined
@@ -205,9 +203,7 @@ std::vector<RepairCount> repair_soup(TriangleMesh& mesh, bool keep_largest) {
   auto record = [&repairs](const char* kind, std::size_t count) {
     if (count > 0) repairs.push_back({kind, count});
   };
-  std::vector<Point> points;
-  points.reserve(mesh.vertices.size());
-  for (const Vec3& p : mesh.vertices) points.emplace_back(p[0], p[1], p[2]);
+  std::vector<Point> points = cgal::to_points(mesh.vertices);
   std::vector<Polygon> polygons;
   polygons.reserve(mesh.triangles.size());
   std::size_t degenerate = 0;
@@ -257,8 +253,7 @@ std::vector<RepairCount> repair_soup(TriangleMesh& mesh, bool keep_largest) {
       std::uint32_t& id = new_id[polygon[k]];
       if (id == UINT32_MAX) {
         id = static_cast<std::uint32_t>(repaired.vertices.size());
-        const Point& p = points[polygon[k]];
-        repaired.vertices.push_back({p.x(), p.y(), p.z()});
+        repaired.vertices.push_back(cgal::to_vec3(points[polygon[k]]));
       }
       tri[k] = id;
     }

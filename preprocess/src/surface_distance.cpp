@@ -1,38 +1,33 @@
 // Approximate Hausdorff distances between two triangle surfaces (CGAL Polygon Mesh
 // Processing): what a repair or a wrap cost.
 
-#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Polygon_mesh_processing/distance.h>
 #include <CGAL/Polygon_mesh_processing/orient_polygon_soup.h>
 #include <CGAL/Polygon_mesh_processing/polygon_soup_to_polygon_mesh.h>
 #include <CGAL/Polygon_mesh_processing/repair_polygon_soup.h>
-#include <CGAL/Surface_mesh.h>
 
 #include <algorithm>
 #include <array>
 #include <utility>
 #include <vector>
 
+#include "cgal_mesh.hpp"
 #include "repair_internal.hpp"
 
 namespace tetseg::preprocess::detail {
 namespace {
 
-using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
-using Point = Kernel::Point_3;
-using Mesh = CGAL::Surface_mesh<Point>;
+using cgal::Kernel;
+using cgal::Point;
+using Mesh = cgal::SurfaceMesh;
 
 /// The soup as a polygon mesh with the same triangles: degenerate and duplicate triangles
 /// dropped, orientation made consistent and non-manifold vertices duplicated (CGAL), which
 /// leaves the point set covered unchanged.
 Mesh as_polygon_mesh(const TriangleMesh& soup) {
   namespace pmp = CGAL::Polygon_mesh_processing;
-  std::vector<Point> points;
-  points.reserve(soup.vertices.size());
-  for (const Vec3& p : soup.vertices) points.emplace_back(p[0], p[1], p[2]);
-  std::vector<std::vector<std::size_t>> polygons;
-  polygons.reserve(soup.triangles.size());
-  for (const Tri& t : soup.triangles) polygons.push_back({t[0], t[1], t[2]});
+  std::vector<Point> points = cgal::to_points(soup.vertices);
+  auto polygons = cgal::to_faces<std::vector<std::size_t>>(soup.triangles);
   pmp::repair_polygon_soup(points, polygons);
   pmp::orient_polygon_soup(points, polygons);
   Mesh mesh;

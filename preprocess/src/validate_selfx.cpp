@@ -3,7 +3,6 @@
 // touch, each pair decided as CGAL's does_self_intersect / self_intersections decide it. The
 // only validation unit that includes CGAL.
 
-#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Intersections_3/Segment_3_Triangle_3.h>
 #include <CGAL/Intersections_3/Triangle_3_Triangle_3.h>
 
@@ -12,14 +11,15 @@
 #include <numeric>
 #include <vector>
 
+#include "cgal_mesh.hpp"
 #include "tetseg/runtime/median_bvh.hpp"
 #include "validate_internal.hpp"
 
 namespace tetseg::preprocess::detail {
 namespace {
 
-using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
-using Point = Kernel::Point_3;
+using cgal::Kernel;
+using cgal::Point;
 using Segment = Kernel::Segment_3;
 using Triangle = Kernel::Triangle_3;
 using Pair = std::pair<std::size_t, std::size_t>;
@@ -29,7 +29,7 @@ struct Box {
 };
 
 Point point(const std::vector<Vec3>& points, std::uint32_t i) {
-  return Point(points[i][0], points[i][1], points[i][2]);
+  return cgal::to_point(points[i]);
 }
 
 /// Closed boxes, as CGAL's box intersection uses: touching boxes overlap.

@@ -383,7 +383,8 @@ PYBIND11_MODULE(preprocess, m) {
         py::arg("solver") = std::string(name_of(c.solver)), py::arg("tolerance") = c.tolerance,
         py::arg("max_iterations") = c.max_iterations, py::arg("theta") = c.fast_theta,
         py::arg("order") = c.fast_order, py::arg("relaxed_products") = c.relaxed_products,
-        py::arg("equalize") = std::string(name_of(Equalization::kHistogram)), py::arg("bins") = 256,
+        py::arg("equalize") = std::string(name_of(ChargeJobOptions{}.equalization)),
+        py::arg("bins") = ChargeJobOptions{}.bins,
         "Returns a dict. "
         "Relative charge density of a tet mesh's boundary or of a closed surface, as "
         "`tetseg charge` computes it (docs/charge.md). mesh as for build. Returns density and "

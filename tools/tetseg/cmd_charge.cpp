@@ -29,14 +29,8 @@ struct ChargeArgs {
   std::string input;
   std::string output;
   std::string report;
-  preprocess::ChargeSolver solver = preprocess::ChargeSolver::kAuto;
-  preprocess::Equalization equalization = preprocess::Equalization::kHistogram;
-  double tolerance = 0.0;  // 0: automatic (charge.hpp)
-  int max_iterations = 500;
-  double theta = 0.0;  // 0: automatic (charge.hpp)
-  int order = -1;
+  preprocess::ChargeJobOptions job;  ///< the library's defaults
   bool exact_products = false;
-  int bins = 256;
 };
 
 /// Progress on stderr: a live bar when stderr is a terminal, otherwise a line per quarter.
@@ -183,15 +177,8 @@ void run_charge(const ChargeArgs& args) {
   if (ext != ".csv" && ext != ".vtu" && ext != ".ply") {
     throw CLI::ValidationError("--output", "output must end in .csv, .vtu or .ply: " + args.output);
   }
-  preprocess::ChargeJobOptions options;
-  options.charge.solver = args.solver;
-  options.charge.tolerance = args.tolerance;
-  options.charge.max_iterations = args.max_iterations;
-  options.charge.fast_theta = args.theta;
-  options.charge.fast_order = args.order;
+  preprocess::ChargeJobOptions options = args.job;
   options.charge.relaxed_products = !args.exact_products;
-  options.equalization = args.equalization;
-  options.bins = args.bins;
   Progress progress;
   options.charge.progress = [&](const char* stage, double f) { progress.update(stage, f); };
   preprocess::ChargeJobResult result =
@@ -231,31 +218,31 @@ void add_charge_command(CLI::App& root) {
                   "Per-triangle output: .csv (triangle,cx,cy,cz,area,density,equalized), "
                   ".vtu (cell data) or .ply (gray faces)")
       ->required();
-  cmd->add_option("--solver", args->solver, "Charge solver")
+  cmd->add_option("--solver", args->job.charge.solver, "Charge solver")
       ->transform(CLI::CheckedTransformer(preprocess::name_map<preprocess::ChargeSolver>()))
       ->option_text(preprocess::name_list<preprocess::ChargeSolver>() + " (auto)");
-  cmd->add_option("--tolerance", args->tolerance,
+  cmd->add_option("--tolerance", args->job.charge.tolerance,
                   "Relative residual of the iterative solvers (0: 1e-6 below 10k triangles, "
                   "1e-8 above)")
       ->check(range_check(preprocess::option_ranges::kTolerance));
-  cmd->add_option("--max-iterations", args->max_iterations, "Iteration cap")
+  cmd->add_option("--max-iterations", args->job.charge.max_iterations, "Iteration cap")
       ->check(range_check(preprocess::option_ranges::kMaxIterations));
   cmd->add_option(
-         "--theta", args->theta,
+         "--theta", args->job.charge.fast_theta,
          "Fast solver opening parameter, (0, 0.95] (0: 0.4 below 10k triangles, 0.45 above)")
       ->check(range_check(preprocess::option_ranges::kTheta));
-  cmd->add_option("--order", args->order,
+  cmd->add_option("--order", args->job.charge.fast_order,
                   "Fast solver expansion order (-1 = 6 below 10k triangles, else 8)")
       ->check(range_check(preprocess::option_ranges::kOrder));
   cmd->add_flag("--exact-products", args->exact_products,
                 "Fast solver: every GMRES product at --order and --theta (default: once the "
                 "residual is small, a cheaper order-4 FMM within half the tolerance; "
                 "docs/charge.md)");
-  cmd->add_option("--equalization,--equalize", args->equalization,
+  cmd->add_option("--equalization,--equalize", args->job.equalization,
                   "histogram (the paper), rank or log-histogram (alias log)")
       ->transform(CLI::CheckedTransformer(preprocess::name_map<preprocess::Equalization>()))
       ->option_text(preprocess::name_list<preprocess::Equalization>() + " (histogram)");
-  cmd->add_option("--bins", args->bins, "Histogram bins")
+  cmd->add_option("--bins", args->job.bins, "Histogram bins")
       ->check(range_check(preprocess::option_ranges::kBins));
   cmd->add_option("--report", args->report, "Write a JSON report (solver, iterations, times)");
   cmd->callback([args] { run_naming_file(args->input, [&] { run_charge(*args); }); });
