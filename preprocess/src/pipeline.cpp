@@ -476,6 +476,8 @@ format::Asset build_asset(const TetMesh& mesh, const std::string& source,
   asset.provenance.source = base_name(source);
   BuildOptions used = options;  // with the charge solver actually used in place of "auto"
   if (!report.charge.solver.empty()) parse_name(report.charge.solver, used.charge.solver);
+  // A tet mesh not made from a surface here is the asset's surface: deviation 0.
+  if (!used.meshing && !used.deviation) used.deviation = SurfaceDeviation{};
   asset.provenance.options = provenance_options(used);
   for (const DetectorChoice& detector : detectors) {
     report.rest_positive_fraction.push_back(detector.rest_positive_fraction);

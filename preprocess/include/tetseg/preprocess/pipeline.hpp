@@ -49,8 +49,9 @@ struct BuildOptions {
   /// With `meshing`: the repairs tetrahedralize made (TetrahedralizeNotes::repairs), recorded
   /// as provenance keys "repairs.<kind, spaces as underscores>" = count.
   std::vector<RepairCount> repairs;
-  /// When set (every `tetseg build`): recorded as provenance keys deviation.* (the relative
-  /// ones and deviation.*_absolute); only recorded.
+  /// Recorded as provenance keys deviation.* (the relative ones and deviation.*_absolute);
+  /// only recorded. build_asset records 0 when neither this nor `meshing` is set (a tet mesh
+  /// is its own surface); the build jobs set it for a surface input.
   std::optional<SurfaceDeviation> deviation;
   /// With `meshing` and MeshingOptions::Repair::kAuto: the repair used ("fix" or "wrap") and
   /// why the wrap was needed (TetrahedralizeNotes), recorded as provenance keys
