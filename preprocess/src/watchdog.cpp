@@ -40,9 +40,8 @@ void Watchdog::run() {
     double wake = next_report;
     if (m_limit > 0.0 && !m_stop.load()) wake = std::min(wake, m_limit);
     if (m_bound_end > 0.0 && !m_bound_reached) wake = std::min(wake, m_bound_end);
-    const auto until =
-        m_start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(
-                      std::min(wake, kNever)));
+    const auto until = m_start + std::chrono::duration_cast<Clock::duration>(
+                                     std::chrono::duration<double>(std::min(wake, kNever)));
     m_wake.wait_until(lock, until, [this] { return m_done || m_changed; });
     m_changed = false;
     if (m_done) break;

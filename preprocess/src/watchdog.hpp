@@ -52,8 +52,8 @@ class Watchdog {
   mutable std::mutex m_mutex;
   std::condition_variable m_wake;
   bool m_done = false;
-  bool m_changed = false;      ///< wakes the thread to recompute its next wake-up
-  double m_bound_end = 0.0;    ///< begin_bounded's end, seconds from the start; 0: none
+  bool m_changed = false;    ///< wakes the thread to recompute its next wake-up
+  double m_bound_end = 0.0;  ///< begin_bounded's end, seconds from the start; 0: none
   bool m_bound_reached = false;
   std::string m_step;
   std::thread m_thread;

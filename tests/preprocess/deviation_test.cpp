@@ -1,8 +1,8 @@
 // Issue 28: how far the asset's surface is from the input (the deviation, always measured)
 // and every input ending (the time limit), through the build job as the CLI and Python run it.
 
-#include <catch2/catch.hpp>
 #include <algorithm>
+#include <catch2/catch.hpp>
 #include <cmath>
 #include <string>
 
@@ -43,9 +43,10 @@ TEST_CASE("A tet-mesh input deviates by 0, recorded in the report and the proven
         std::string::npos);
 }
 
-TEST_CASE("A clean sphere's deviation is measured without any repair and lies within the "
-          "documented default",
-          "[deviation]") {
+TEST_CASE(
+    "A clean sphere's deviation is measured without any repair and lies within the "
+    "documented default",
+    "[deviation]") {
   // A unit sphere, 5120 triangles (chord error 1 - cos(edge / 2) ~ 1e-3 of the radius), meshed
   // at the default sizes (facet distance 1/400 of the diagonal): Mesh_3 puts its surface
   // vertices on the input, so both distances are about the facet distance, 0.0025 of the
@@ -130,7 +131,7 @@ TEST_CASE("A build past its time limit is refused with the stage named", "[time-
   }
 }
 
-TEST_CASE("--max-deviation bounds the re-meshing, and says by how much an input exceeds it",
+TEST_CASE("The maximum deviation bounds the re-meshing, and says by how much an input exceeds it",
           "[deviation][max-deviation]") {
   const TriangleMesh sphere = tetseg::test::icosphere(16);
   SECTION("A tighter bound halves the facet distance it derives: the sphere stays within it") {

@@ -50,14 +50,14 @@ TEST_CASE("The library refuses the option values the front ends refuse", "[jobs]
   // ends refused above 0.5 and 0.95.
   ChargeOptions charge;
   charge.tolerance = 0.7;
-  CHECK_THROWS_AS(compute_charge(small_sphere().nodes, extract_surface(small_sphere()).triangles,
-                                 charge),
-                  std::invalid_argument);
+  CHECK_THROWS_AS(
+      compute_charge(small_sphere().nodes, extract_surface(small_sphere()).triangles, charge),
+      std::invalid_argument);
   charge.tolerance = 0.0;
   charge.fast_theta = 0.96;
-  CHECK_THROWS_AS(compute_charge(small_sphere().nodes, extract_surface(small_sphere()).triangles,
-                                 charge),
-                  std::invalid_argument);
+  CHECK_THROWS_AS(
+      compute_charge(small_sphere().nodes, extract_surface(small_sphere()).triangles, charge),
+      std::invalid_argument);
 
   BuildJobOptions build;
   CHECK_NOTHROW(validate_options(build));  // the defaults lie in their ranges
@@ -80,9 +80,9 @@ TEST_CASE("A build job gives the asset build_asset gives, with every stage repor
   std::vector<std::uint8_t> written;
   options.write_output = [&](const std::vector<std::uint8_t>& bytes) { written = bytes; };
   options.output_name = "out.tetseg";
-  const BuildJobResult result = build_asset_from_tet_mesh(
-      small_sphere(), "sphere.mesh", options,
-      [&](const StageReport& stage) { seen.push_back(stage.name); });
+  const BuildJobResult result =
+      build_asset_from_tet_mesh(small_sphere(), "sphere.mesh", options,
+                                [&](const StageReport& stage) { seen.push_back(stage.name); });
 
   BuildReport report;
   const auto expected = tetseg::format::write_asset(
