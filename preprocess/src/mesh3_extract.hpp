@@ -4,7 +4,6 @@
 // and builds the criteria and optimisation parameters. Include only from mesh3_*.cpp.
 
 #include <CGAL/Cartesian_converter.h>
-#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Exact_rational.h>
 #include <CGAL/Mesh_complex_3_in_triangulation_3.h>
 #include <CGAL/Mesh_criteria_3.h>
@@ -17,6 +16,7 @@
 #include <string>
 #include <unordered_map>
 
+#include "cgal_mesh.hpp"
 #include "meshing_internal.hpp"
 #include "vec3_math.hpp"
 
@@ -26,8 +26,8 @@
 
 namespace tetseg::preprocess::detail {
 
-/// Epick with one construction made robust: the power distance of a point to the power sphere
-/// of four weighted points, used by Mesh_3's sliver exuder to choose vertex weights.
+/// Epick (cgal::Kernel) with one construction made robust: the power distance of a point to the
+/// power sphere of four weighted points, used by Mesh_3's sliver exuder to choose vertex weights.
 ///
 /// Why: on planar parts of a surface (a cube, the pyramid of libcgal-demo) Mesh_3 puts many
 /// vertices on one plane up to rounding, and the triangulation then holds nearly flat cells
@@ -39,18 +39,18 @@ namespace tetseg::preprocess::detail {
 /// double result is recomputed exactly (rationals) and rounded; an exact result beyond the
 /// double range (a truly far power sphere) becomes a large finite distance, and exactly
 /// coplanar corners (never in a valid triangulation) one too.
-struct ExactFallbackKernel : public CGAL::Epick {
+struct ExactFallbackKernel : public cgal::Kernel {
   struct Compute_power_distance_to_power_sphere_3 {
-    using Weighted_point_3 = CGAL::Epick::Weighted_point_3;
-    using result_type = CGAL::Epick::FT;
+    using Weighted_point_3 = cgal::Kernel::Weighted_point_3;
+    using result_type = cgal::Kernel::FT;
     double operator()(const Weighted_point_3& p, const Weighted_point_3& q,
                       const Weighted_point_3& r, const Weighted_point_3& s,
                       const Weighted_point_3& t) const {
       const double fast =
-          CGAL::Epick().compute_power_distance_to_power_sphere_3_object()(p, q, r, s, t);
+          cgal::Kernel().compute_power_distance_to_power_sphere_3_object()(p, q, r, s, t);
       if (std::isfinite(fast)) return fast;
       using Exact = CGAL::Simple_cartesian<CGAL::Exact_rational>;
-      const CGAL::Cartesian_converter<CGAL::Epick, Exact> to_exact;
+      const CGAL::Cartesian_converter<cgal::Kernel, Exact> to_exact;
       const Exact::Weighted_point_3 ep = to_exact(p), eq = to_exact(q), er = to_exact(r),
                                     es = to_exact(s), et = to_exact(t);
       constexpr double kFar = std::numeric_limits<double>::max() / 8;

@@ -1,7 +1,6 @@
 // CGAL Mesh_3 on implicit functions: the procedural shapes (sphere, ellipsoid, dumbbell, pawn).
 // Slow to compile; keep changes rare.
 
-#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Labeled_mesh_domain_3.h>
 #include <CGAL/Mesh_complex_3_in_triangulation_3.h>
 #include <CGAL/Mesh_triangulation_3.h>
@@ -10,14 +9,15 @@
 #include <cmath>
 #include <functional>
 
+#include "cgal_mesh.hpp"
 #include "mesh3_extract.hpp"
 
 namespace tetseg::preprocess::detail {
 namespace {
 
-using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
+using cgal::Kernel;
 using FT = Kernel::FT;
-using Point = Kernel::Point_3;
+using cgal::Point;
 using Domain = CGAL::Labeled_mesh_domain_3<Kernel>;
 
 /// Polynomial smooth minimum (blend width k): C1, equal to min where |a - b| >= k.
