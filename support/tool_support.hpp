@@ -22,6 +22,7 @@ enum ExitCode : int {
   kExitUsage = 2,
   kExitBadInput = 3,
   kExitOutputFailed = 4,
+  kExitTimeLimit = 5,  ///< a stage ran past --time-limit; nothing was written
 };
 
 /// An error that ends the tool with `code` after printing `<tool>: error: <file>: <message>`.

@@ -2,7 +2,9 @@
 
 #include "tetseg/preprocess/jobs.hpp"
 
+#include <algorithm>
 #include <chrono>
+#include <cstdio>
 #include <sstream>
 #include <utility>
 
@@ -44,8 +46,21 @@ BuildJobResult run_build(const std::function<BuildInput(std::string& summary)>& 
                          const StageCallback& on_stage) {
   validate_options(options);
   const auto start = Clock::now();
+  // The time limit, checked after every stage but the last ("write": the output exists then).
+  const auto seconds_left = [&] { return options.time_limit - seconds_since(start); };
+  const StageCallback checked_on_stage = [&](const StageReport& stage) {
+    if (on_stage) on_stage(stage);
+    if (options.time_limit > 0.0 && stage.name != "write" && seconds_left() <= 0.0) {
+      char text[160];
+      std::snprintf(text, sizeof text,
+                    "time limit of %g s reached in stage %s (%.1f s in all); nothing was "
+                    "written (raise --time-limit)",
+                    options.time_limit, stage.name.c_str(), seconds_since(start));
+      throw TimeLimitExceeded(source, text);
+    }
+  };
   BuildJobResult result;
-  StageTimer timer(result.report, on_stage);
+  StageTimer timer(result.report, checked_on_stage);
   BuildInput input = timer.run("read", read);
   result.surface_input = input.is_surface;
   BuildOptions build = options.build;
@@ -55,15 +70,43 @@ BuildJobResult run_build(const std::function<BuildInput(std::string& summary)>& 
     // tetrahedralize alone judges the surface (with its own rules: pinch points accepted), so
     // that a build accepts exactly the surfaces `tetseg tetrahedralize` accepts.
     input.tet_mesh = timer.run("tetrahedralize", [&](std::string& summary) {
-      TetMesh mesh = tetrahedralize(input.surface, options.meshing, source, &result.meshing_notes);
-      summary = tet_mesh_summary(mesh);
+      MeshingOptions meshing = options.meshing;
+      // The time left, at least a millisecond (0 would mean no limit).
+      meshing.time_limit = options.time_limit > 0.0 ? std::max(seconds_left(), 1e-3) : 0.0;
+      TetMesh mesh;
+      try {
+        mesh = tetrahedralize(input.surface, meshing, source, &result.meshing_notes);
+      } catch (const TimeLimitExceeded& e) {
+        // Named with the build's limit (tetrahedralize had the time left) and its step.
+        const std::string inner = e.what();
+        const auto from = inner.find("reached in ");
+        const std::string step =
+            from == std::string::npos ? "" : inner.substr(from + 11, inner.find(';') - from - 11);
+        char text[96];
+        std::snprintf(text, sizeof text, "time limit of %g s reached in stage tetrahedralize",
+                      options.time_limit);
+        throw TimeLimitExceeded(source, text + (step.empty() ? "" : ", in " + step) +
+                                            "; nothing was written (raise --time-limit, give "
+                                            "larger meshing sizes, or try --repair wrap)");
+      }
+      summary = tet_mesh_summary(mesh) + ", " + deviation_summary(result.meshing_notes);
       return mesh;
     });
     input.surface = TriangleMesh{};
     build.meshing = options.meshing;  // recorded in the provenance, with the repairs
     build.repairs = result.meshing_notes.repairs;
+    const TetrahedralizeNotes& notes = result.meshing_notes;
+    if (options.meshing.repair == MeshingOptions::Repair::kAuto) {
+      build.repair_used = name_of(notes.repair_used);
+      build.fallback_reason = notes.fallback_reason;
+    }
+    if (notes.hausdorff_input_to_mesh >= 0.0)
+      result.deviation = {notes.hausdorff_input_to_mesh, notes.hausdorff_mesh_to_input,
+                          notes.hausdorff_input_to_mesh * notes.diagonal,
+                          notes.hausdorff_mesh_to_input * notes.diagonal};
   }
-  result.asset = build_asset(input.tet_mesh, source, build, result.report, on_stage);
+  build.deviation = result.deviation;  // a tet-mesh input: 0, its boundary is the surface
+  result.asset = build_asset(input.tet_mesh, source, build, result.report, checked_on_stage);
   result.asset_bytes = timer.run("write", [&](std::string& summary) {
     std::vector<std::uint8_t> bytes = format::write_asset(result.asset);
     if (options.write_output) options.write_output(bytes);
@@ -167,6 +210,8 @@ void validate_options(const BuildJobOptions& options) {
   check_option(range::kWrapAlpha, m.wrap_alpha);
   check_option(range::kWrapOffset, m.wrap_offset);
   check_option(range::kWrapSheetOffset, m.wrap_sheet_offset);
+  check_option(range::kMaxDeviation, m.max_deviation);
+  check_option(range::kTimeLimit, options.time_limit);
 }
 
 void validate_options(const ChargeJobOptions& options) {
@@ -269,7 +314,14 @@ std::string build_report_json(const BuildJobResult& result, const std::string& i
         << ", \"assembly_seconds\": " << c.assembly_seconds
         << ", \"solve_seconds\": " << c.solve_seconds << "},\n";
   }
-  // Surface input: what the repair changed and what it cost (docs/cli.md, "Repair").
+  // How far the asset's surface is from the input's, always (docs/cli.md, "Deviation").
+  const SurfaceDeviation& d = result.deviation;
+  out << "  \"hausdorff\": {\"input_to_mesh\": " << d.input_to_asset
+      << ", \"mesh_to_input\": " << d.asset_to_input
+      << ", \"relative_to\": \"input bounding-box diagonal\", \"input_to_mesh_absolute\": "
+      << d.input_to_asset_absolute << ", \"mesh_to_input_absolute\": " << d.asset_to_input_absolute
+      << "},\n";
+  // Surface input: what the repair changed (docs/cli.md, "Repair").
   if (result.surface_input) {
     const TetrahedralizeNotes& notes = result.meshing_notes;
     out << "  \"repairs\": {";
@@ -277,10 +329,11 @@ std::string build_report_json(const BuildJobResult& result, const std::string& i
       out << (i ? ", " : "") << '"' << json_escape(notes.repairs[i].kind)
           << "\": " << notes.repairs[i].count;
     out << "},\n";
-    if (notes.hausdorff_input_to_mesh >= 0.0)
-      out << "  \"hausdorff\": {\"input_to_mesh\": " << notes.hausdorff_input_to_mesh
-          << ", \"mesh_to_input\": " << notes.hausdorff_mesh_to_input
-          << ", \"relative_to\": \"input bounding-box diagonal\"},\n";
+    out << "  \"repair_used\": \"" << name_of(notes.repair_used) << "\",\n";
+    // Over --max-deviation (options: meshing.max_deviation) by this much; 0 within it.
+    out << "  \"deviation_excess\": " << notes.deviation_excess << ",\n";
+    if (!notes.fallback_reason.empty())
+      out << "  \"fallback_reason\": \"" << json_escape(notes.fallback_reason) << "\",\n";
     if (!notes.optimization_used.empty())
       out << "  \"meshing_retry\": \"" << json_escape(notes.optimization_used) << "\",\n";
   }

@@ -114,33 +114,44 @@ Criteria make_criteria(const Mesh3Criteria& c) {
 }
 
 /// Runs make_mesh_3 deterministically: the default random generator is reset to seed 0 and
-/// the optimisers get no time limit (their default limit is the refinement time, which would
-/// make the result depend on the machine's speed). Refinement uses Mesh_3's manifold option:
-/// surface facets are refined until every surface vertex and edge is manifold, so the
-/// boundary of the cells in the complex is a closed 2-manifold. Optimisation: sliver
-/// perturbation until every dihedral angle is at least kPerturbBoundDegrees (or nothing
-/// improves), then sliver exudation; ODT and Lloyd are off.
+/// the optimisers get no time limit of their own (their default limit is the refinement time,
+/// which would make the result depend on the machine's speed; with a stop flag, see below).
+/// Refinement uses Mesh_3's manifold option: surface facets are refined until every surface vertex
+/// and edge is manifold, so the boundary of the cells in the complex is a closed 2-manifold.
+/// Optimisation: sliver perturbation until every dihedral angle is at least kPerturbBoundDegrees
+/// (or nothing improves), then sliver exudation; ODT and Lloyd are off.
 constexpr double kPerturbBoundDegrees = 10.0;
 
 template <class C3t3, class Domain, class Criteria>
 C3t3 run_mesh_3(const Domain& domain, const Criteria& criteria, const Mesh3Criteria& options) {
   namespace params = CGAL::parameters;
   CGAL::get_default_random() = CGAL::Random(0);
-  const auto perturb =
-      options.optimize && options.perturb
-          ? params::perturb(params::time_limit = 0, params::sliver_bound = kPerturbBoundDegrees)
-          : params::no_perturb();
-  const auto exude = options.optimize && options.exude
-                         ? params::exude(params::time_limit = 0, params::sliver_bound = 0)
-                         : params::no_exude();
+  // Refinement, then the optimisers as make_mesh_3 runs them (same order, same random
+  // state), called apart so that a refinement stopped at the time limit is not optimised.
+  // With a stop flag the optimisers' time limit is the time left plus a second, so the flag is
+  // always up when they are cut short: a run they cut short is refused below, and a returned
+  // mesh never depends on the machine's speed.
+  const auto stopped = [&] { return options.stop != nullptr && options.stop->load(); };
+  if (stopped()) throw MeshingStopped("stopped before refinement");
   CGAL::Mesh_error_code error = CGAL::CGAL_MESH_3_NO_ERROR;
   C3t3 c3t3 = CGAL::make_mesh_3<C3t3>(
-      domain, criteria, params::no_odt(), params::no_lloyd(), perturb, exude, params::manifold(),
+      domain, criteria, params::no_odt(), params::no_lloyd(), params::no_perturb(),
+      params::no_exude(), params::manifold(),
       params::mesh_3_options(params::maximal_number_of_vertices = options.max_vertices,
-                             params::pointer_to_error_code = &error));
+                             params::pointer_to_error_code = &error,
+                             params::pointer_to_stop_atomic_boolean = options.stop));
+  if (error == CGAL::CGAL_MESH_3_STOPPED || stopped())
+    throw MeshingStopped("stopped at the time limit in refinement");
   if (error == CGAL::CGAL_MESH_3_MAXIMAL_NUMBER_OF_VERTICES_REACHED)
     throw MeshingBudgetExceeded("refinement reached " + std::to_string(options.max_vertices) +
                                 " vertices without meeting the criteria");
+  const double optimiser_limit = options.stop != nullptr ? options.seconds_left + 1.0 : 0.0;
+  if (options.optimize && options.perturb)
+    CGAL::perturb_mesh_3(c3t3, domain, params::time_limit = optimiser_limit,
+                         params::sliver_bound = kPerturbBoundDegrees);
+  if (options.optimize && options.exude && !stopped())
+    CGAL::exude_mesh_3(c3t3, params::time_limit = optimiser_limit, params::sliver_bound = 0);
+  if (stopped()) throw MeshingStopped("stopped at the time limit in optimisation");
   return c3t3;
 }
 

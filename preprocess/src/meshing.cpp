@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <filesystem>
 #include <new>
 #include <stdexcept>
@@ -18,6 +19,7 @@
 #include "tetseg/preprocess/surface.hpp"
 #include "validate_internal.hpp"
 #include "vec3_math.hpp"
+#include "watchdog.hpp"
 
 namespace tetseg::preprocess {
 namespace {
@@ -44,6 +46,20 @@ constexpr double kMinBudget = 200000.0;
 /// protecting them made dino and femur run over 180 s, hand fail (docs/benchmarks-history.md).
 constexpr double kSharpEdgeDegrees = 60.0;
 constexpr double kProtectEdgeFacets = 8.0;
+/// Mesh_3 with protected sharp edges stops after this many seconds and the surface is
+/// refused like one whose refinement reached the vertex budget: on corners much sharper than
+/// the sizes (the needle tetrahedron (0,0,0), (1,0,0), (0,L,0), (0,0,1): L = 40 took 8 s, 80
+/// 45 s, 160 over 5 min) CGAL's protection loops without inserting vertices, which the budget
+/// cannot see. Coarse polyhedra that protection serves mesh in seconds (colored_tetra 1.6 s).
+constexpr double kProtectedMeshingSeconds = 20.0;
+/// Sharp edges meeting at a smaller angle (degrees) are not protected: the surface is refused
+/// at once (auto then wraps it). The needle above: L = 40 (1.4 degrees) meshes in 8 s, L = 80
+/// (0.72) took 45 s, L = 160 (0.36) over 5 minutes, L = 1000 not stopped by the bound above
+/// for 100 s on a loaded machine (CGAL's protection polls its stop flag rarely there).
+constexpr double kMinProtectedCornerDegrees = 1.0;
+/// Likewise for a sharp edge's dihedral angle (flat slivers, thin blades): a tetrahedron of
+/// height 1e-2 (1.9 degrees) ran into the 20 s bound.
+constexpr double kMinProtectedDihedralDegrees = 5.0;
 /// When no optimisation gives a valid boundary, meshing is retried with every size (facet,
 /// cell, facet distance) times these factors in turn (the first is the asked size).
 constexpr double kRetrySizeFactors[] = {1.0, 0.7, 0.5};
@@ -136,9 +152,18 @@ TetMesh generate_shape(Shape shape, const ShapeOptions& shape_options,
 
 namespace {
 
-/// Whether some edge shared by two triangles of `s` is sharp: their unit normals differ by
-/// more than `degrees` (the test of CGAL detect_sharp_edges; degenerate triangles ignored).
-bool has_sharp_edge(const TriangleMesh& s, double degrees) {
+/// The sharp edges of `s` (two triangles whose unit normals differ by more than `degrees`: the
+/// test of CGAL detect_sharp_edges; degenerate triangles ignored) and how sharp they meet.
+struct SharpEdges {
+  std::size_t count = 0;
+  /// The smallest angle between two sharp edges at a common vertex, degrees (180 when none).
+  double min_corner_degrees = 180.0;
+  /// The largest angle between the normals of a sharp edge's two triangles, degrees: 180
+  /// minus it is the edge's smallest (wedge or slit) dihedral angle.
+  double max_normal_degrees = 0.0;
+};
+
+SharpEdges sharp_edges(const TriangleMesh& s, double degrees) {
   std::vector<Vec3> normal(s.triangles.size());
   for (std::size_t t = 0; t < s.triangles.size(); ++t) {
     const Vec3& a = s.vertices[s.triangles[t][0]];
@@ -156,13 +181,39 @@ bool has_sharp_edge(const TriangleMesh& s, double degrees) {
     }
   std::sort(edges.begin(), edges.end());
   const double min_cos = std::cos(degrees * M_PI / 180.0);
+  SharpEdges out;
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> sharp;  // (vertex, other end)
   for (std::size_t i = 1; i < edges.size(); ++i) {
     if (edges[i].first != edges[i - 1].first) continue;
     const Vec3& n = normal[edges[i].second];
     const Vec3& m = normal[edges[i - 1].second];
-    if (detail::norm(n) > 0 && detail::norm(m) > 0 && detail::dot(n, m) < min_cos) return true;
+    if (detail::norm(n) > 0 && detail::norm(m) > 0 && detail::dot(n, m) < min_cos) {
+      const double c = std::clamp(detail::dot(n, m), -1.0, 1.0);
+      out.max_normal_degrees = std::max(out.max_normal_degrees, std::acos(c) * 180.0 / M_PI);
+      const auto [a, b] = edges[i].first;
+      sharp.push_back({a, b});
+      sharp.push_back({b, a});
+    }
   }
-  return false;
+  out.count = sharp.size() / 2;
+  std::sort(sharp.begin(), sharp.end());
+  sharp.erase(std::unique(sharp.begin(), sharp.end()), sharp.end());
+  for (std::size_t i = 0; i < sharp.size();) {
+    std::size_t j = i;
+    while (j < sharp.size() && sharp[j].first == sharp[i].first) ++j;
+    const Vec3& p = s.vertices[sharp[i].first];
+    for (std::size_t a = i; a < j; ++a)
+      for (std::size_t b = a + 1; b < j; ++b) {
+        const Vec3 u = detail::sub(s.vertices[sharp[a].second], p);
+        const Vec3 v = detail::sub(s.vertices[sharp[b].second], p);
+        const double lengths = detail::norm(u) * detail::norm(v);
+        if (!(lengths > 0)) continue;
+        const double c = std::clamp(detail::dot(u, v) / lengths, -1.0, 1.0);
+        out.min_corner_degrees = std::min(out.min_corner_degrees, std::acos(c) * 180.0 / M_PI);
+      }
+    i = j;
+  }
+  return out;
 }
 
 /// The median length of the triangles' edges (each edge counted once per triangle).
@@ -187,8 +238,26 @@ std::size_t vertex_budget(const detail::Mesh3Criteria& criteria, double diagonal
 
 /// Runs one CGAL Mesh_3 call; whatever CGAL throws becomes an InputError naming the file and
 /// the stage.
-TetMesh run_mesh_3_guarded(const TriangleMesh& input, const detail::Mesh3Criteria& criteria,
-                           const std::string& file) {
+/// `step` names it for the time limit and progress; with sharp-edge protection the call is
+/// also bounded by kProtectedMeshingSeconds.
+TetMesh run_mesh_3_guarded(const TriangleMesh& input, detail::Mesh3Criteria criteria,
+                           const std::string& file, detail::Watchdog& watchdog,
+                           const std::string& step) {
+  const bool bounded = criteria.sharp_edge_angle > 0.0;
+  if (bounded)
+    watchdog.begin_bounded(step + ", sharp edges protected", kProtectedMeshingSeconds);
+  else
+    watchdog.begin(step);
+  struct EndBound {
+    detail::Watchdog& watchdog;
+    bool bounded;
+    ~EndBound() {
+      if (bounded) watchdog.end_bounded();
+    }
+  } end_bound{watchdog, bounded};
+  criteria.stop = watchdog.stop_flag();
+  criteria.seconds_left = bounded ? std::min(watchdog.seconds_left(), kProtectedMeshingSeconds)
+                                  : watchdog.seconds_left();
   // CGAL 5.5 writes dump-bug.mesh and dump-bug.binary.cgal to the working directory when a
   // Mesh_3 assertion fails (Refine_facets_3.h, "already inserted on surface"); those it made
   // here are removed, so that a failed run leaves no file.
@@ -205,6 +274,15 @@ TetMesh run_mesh_3_guarded(const TriangleMesh& input, const detail::Mesh3Criteri
   } catch (const InputError&) {
     remove_new_dumps();
     throw;
+  } catch (const detail::MeshingStopped&) {
+    remove_new_dumps();
+    watchdog.check();  // the time limit: throws TimeLimitExceeded naming the step
+    end_bound.bounded = false;
+    if (!bounded || !watchdog.end_bounded()) throw;
+    throw InputError(file, "tetrahedralize: CGAL Mesh_3 did not converge: it did not finish in " +
+                               std::to_string(static_cast<int>(kProtectedMeshingSeconds)) +
+                               " s with the sharp edges protected (corners too sharp or parts "
+                               "too thin for its feature protection); try --repair wrap");
   } catch (const detail::MeshingBudgetExceeded& e) {
     remove_new_dumps();
     throw InputError(file, std::string("tetrahedralize: CGAL Mesh_3 did not converge: ") +
@@ -235,13 +313,18 @@ std::string boundary_defect(const TetMesh& mesh, const std::string& file) {
 /// Mesh_3 on a closed surface (pinch points allowed), checked, with the retries of
 /// tetrahedralize; notes.optimization_used and notes.first_defect say which mesh was returned.
 TetMesh mesh_closed_surface(const TriangleMesh& input, const MeshingOptions& meshing,
-                            const std::string& file, TetrahedralizeNotes& notes) {
+                            const std::string& file, TetrahedralizeNotes& notes,
+                            detail::Watchdog& watchdog) {
   const double diagonal = bounding_box_diagonal(input.vertices);
   // Criteria are checked before CGAL sees them: every size finite and positive, and not so
   // small against the surface that refinement could never end (kMaxDiagonalPerSize).
   detail::Mesh3Criteria criteria = resolve(meshing, default_facet_size_for_diagonal(diagonal));
   if (!(diagonal > 0.0) || !std::isfinite(diagonal))
     throw InputError(file, "tetrahedralize: the surface has no extent");
+  // A derived facet distance keeps Mesh_3's re-meshing within half of --max-deviation.
+  if (meshing.facet_distance == 0.0)
+    criteria.facet_distance =
+        std::min(criteria.facet_distance, 0.5 * meshing.max_deviation * diagonal);
   for (const double size : {criteria.facet_size, criteria.cell_size, criteria.facet_distance})
     if (!(size * kMaxDiagonalPerSize >= diagonal))
       throw InputError(file, "tetrahedralize: a meshing size is below 1/" +
@@ -249,7 +332,8 @@ TetMesh mesh_closed_surface(const TriangleMesh& input, const MeshingOptions& mes
                                  " of the bounding-box diagonal (" + std::to_string(diagonal) +
                                  "); give larger --facet-size / --cell-size / --facet-distance");
   const double median_edge = median_edge_length(input);
-  const bool sharp = has_sharp_edge(input, kSharpEdgeDegrees);
+  const SharpEdges sharp_features = sharp_edges(input, kSharpEdgeDegrees);
+  const bool sharp = sharp_features.count > 0;
   // Mesh_3 refines with its manifold option, so the boundary of the refined tets is a closed
   // 2-manifold; sliver perturbation can break that (it moves vertices after refinement: on
   // rotor, homer, couplingdown and cheese it leaves non-manifold vertices or edges), and
@@ -275,13 +359,35 @@ TetMesh mesh_closed_surface(const TriangleMesh& input, const MeshingOptions& mes
     sized.cell_size *= factor;
     sized.facet_distance *= factor;
     sized.max_vertices = vertex_budget(sized, diagonal);
-    if (sharp && median_edge >= kProtectEdgeFacets * sized.facet_size)
+    if (sharp && median_edge >= kProtectEdgeFacets * sized.facet_size) {
       sized.sharp_edge_angle = kSharpEdgeDegrees;
+      if (sharp_features.min_corner_degrees < kMinProtectedCornerDegrees)
+        throw InputError(
+            file, "tetrahedralize: CGAL Mesh_3 did not converge: sharp edges meet at " +
+                      std::to_string(sharp_features.min_corner_degrees).substr(0, 6) +
+                      " degrees, under the " +
+                      std::to_string(kMinProtectedCornerDegrees).substr(0, 3) +
+                      " its feature protection meshes in bounded time (a needle or spike); try "
+                      "--repair wrap");
+      const double dihedral = 180.0 - sharp_features.max_normal_degrees;
+      if (dihedral < kMinProtectedDihedralDegrees)
+        throw InputError(
+            file,
+            "tetrahedralize: CGAL Mesh_3 did not converge: a sharp edge has a dihedral "
+            "angle of " +
+                std::to_string(dihedral).substr(0, 6) + " degrees, under the " +
+                std::to_string(kMinProtectedDihedralDegrees).substr(0, 3) +
+                " its feature protection meshes in bounded time (a sliver or thin "
+                "blade); try --repair wrap");
+    }
     for (const Attempt& attempt : attempts) {
       detail::Mesh3Criteria tried = sized;
       tried.optimize = attempt.optimize;
       tried.perturb = attempt.perturb;
-      const TetMesh mesh = run_mesh_3_guarded(input, tried, file);
+      const TetMesh mesh =
+          run_mesh_3_guarded(input, tried, file, watchdog,
+                             std::string("CGAL Mesh_3 (") + attempt.name + ", sizes x" +
+                                 std::to_string(factor).substr(0, 3) + ")");
       if (mesh.tets.empty())
         throw InputError(file,
                          "meshing produced no tetrahedra (is the surface closed and "
@@ -380,7 +486,9 @@ bool is_thin_shell(const TriangleMesh& wrap, double offset) {
 /// The alpha wrap of `surface` (`--repair wrap`) with alpha `alpha` and offset `offset`, both
 /// fractions of the bounding-box diagonal `diagonal`.
 TriangleMesh wrapped_surface(const TriangleMesh& surface, double alpha, double offset,
-                             double diagonal, const std::string& file) {
+                             double diagonal, const std::string& file, detail::Watchdog& watchdog) {
+  watchdog.begin("CGAL alpha wrap (alpha " + std::to_string(alpha) + ", offset " +
+                 std::to_string(offset) + ")");
   try {
     return detail::alpha_wrap(surface, alpha * diagonal, offset * diagonal);
   } catch (const std::bad_alloc&) {
@@ -396,7 +504,9 @@ TriangleMesh wrapped_surface(const TriangleMesh& surface, double alpha, double o
 /// output is validated strictly) and Mesh_3 of a surface; after --repair fix, what is left is
 /// named with a pointer to wrap.
 TetMesh validate_and_mesh(const TriangleMesh& source, const MeshingOptions& meshing,
-                          const std::string& file, TetrahedralizeNotes& notes) {
+                          const std::string& file, TetrahedralizeNotes& notes,
+                          detail::Watchdog& watchdog) {
+  watchdog.begin("surface validation");
   TriangleMesh split;
   detail::SurfaceCheck check;
   check.allow_pinched_vertices = true;
@@ -410,19 +520,23 @@ TetMesh validate_and_mesh(const TriangleMesh& source, const MeshingOptions& mesh
                                "of any input (docs/cli.md)");
   }
   detail::check_surface_not_nested(source, file);
-  return mesh_closed_surface(split.triangles.empty() ? source : split, meshing, file, notes);
+  return mesh_closed_surface(split.triangles.empty() ? source : split, meshing, file, notes,
+                             watchdog);
 }
 
 /// An input that encloses no volume (its wrap is a thin shell even with alpha = the diagonal:
 /// a flat or open sheet) is wrapped again, with --wrap-alpha and the larger offset
 /// --wrap-sheet-offset, into a closed slab about 2 x that offset thick, and meshed.
 TetMesh mesh_sheet_slab(const TriangleMesh& surface, const MeshingOptions& meshing, double diagonal,
-                        const std::string& file, TetrahedralizeNotes& notes) {
-  const TriangleMesh slab =
-      wrapped_surface(surface, meshing.wrap_alpha, meshing.wrap_sheet_offset, diagonal, file);
+                        const std::string& file, TetrahedralizeNotes& notes,
+                        detail::Watchdog& watchdog) {
+  const TriangleMesh slab = wrapped_surface(surface, meshing.wrap_alpha, meshing.wrap_sheet_offset,
+                                            diagonal, file, watchdog);
   TetMesh mesh;
   try {
-    mesh = validate_and_mesh(slab, meshing, file, notes);
+    mesh = validate_and_mesh(slab, meshing, file, notes, watchdog);
+  } catch (const TimeLimitExceeded&) {
+    throw;
   } catch (const InputError& e) {
     throw InputError(file, std::string(e.what()) +
                                " (meshing the slab wrapped around an input that encloses no "
@@ -442,7 +556,8 @@ TetMesh mesh_sheet_slab(const TriangleMesh& surface, const MeshingOptions& meshi
 /// diagonal), without running Mesh_3 on thin wraps (slow on them). A wrap still thin at the end
 /// means that the input encloses no volume: mesh_sheet_slab.
 TetMesh wrap_and_mesh(const TriangleMesh& surface, const MeshingOptions& meshing,
-                      const std::string& file, TetrahedralizeNotes& notes) {
+                      const std::string& file, TetrahedralizeNotes& notes,
+                      detail::Watchdog& watchdog) {
   const auto check_fraction = [](double value, const char* what) {
     if (!(value >= kMinWrapFraction && value <= 1.0))
       throw std::invalid_argument(std::string(what) +
@@ -456,20 +571,24 @@ TetMesh wrap_and_mesh(const TriangleMesh& surface, const MeshingOptions& meshing
   if (!(diagonal > 0.0) || !std::isfinite(diagonal))
     throw InputError(file, "tetrahedralize: the surface has no extent");
   double alpha = meshing.wrap_alpha;
+  // The wrap lies `offset` outside the input: at most a quarter of --max-deviation.
+  const double offset = std::min(meshing.wrap_offset, 0.25 * meshing.max_deviation);
   for (std::size_t doublings = 0;; ++doublings) {
     const bool last = doublings == kMaxAlphaDoublings || alpha >= 1.0;
-    const TriangleMesh wrap = wrapped_surface(surface, alpha, meshing.wrap_offset, diagonal, file);
-    const bool thin = is_thin_shell(wrap, meshing.wrap_offset * diagonal);
-    if (last && thin) return mesh_sheet_slab(surface, meshing, diagonal, file, notes);
+    const TriangleMesh wrap = wrapped_surface(surface, alpha, offset, diagonal, file, watchdog);
+    const bool thin = is_thin_shell(wrap, offset * diagonal);
+    if (last && thin) return mesh_sheet_slab(surface, meshing, diagonal, file, notes, watchdog);
     if (!thin) {
       try {
-        TetMesh mesh = validate_and_mesh(wrap, meshing, file, notes);
+        TetMesh mesh = validate_and_mesh(wrap, meshing, file, notes, watchdog);
         notes.repairs = {
             {"surface replaced by an alpha wrap of this many triangles", wrap.triangles.size()}};
         if (doublings > 0)
           notes.repairs.push_back(
               {"alpha doublings as the wrap was a thin shell or did not mesh", doublings});
         return mesh;
+      } catch (const TimeLimitExceeded&) {
+        throw;
       } catch (const InputError& e) {
         if (last)
           throw InputError(file, std::string(e.what()) + " (meshing the alpha wrap, alpha " +
@@ -482,35 +601,140 @@ TetMesh wrap_and_mesh(const TriangleMesh& surface, const MeshingOptions& meshing
 
 }  // namespace
 
+std::string deviation_summary(const TetrahedralizeNotes& notes) {
+  if (notes.hausdorff_input_to_mesh < 0.0) return "deviation not measured";
+  char text[160];
+  std::snprintf(text, sizeof text,
+                "deviation %.2g / %.2g of the diagonal (input to mesh / mesh to input)",
+                notes.hausdorff_input_to_mesh, notes.hausdorff_mesh_to_input);
+  return text;
+}
+
+namespace {
+
+/// tetrahedralize in the surface's own coordinates (below).
+TetMesh tetrahedralize_in_place(const TriangleMesh& surface, const MeshingOptions& meshing,
+                                const std::string& file, TetrahedralizeNotes* notes);
+
+/// Where a surface is meshed: far from the origin against its size, or very large or small,
+/// it is moved to the origin and scaled by a power of two to a diagonal in [1, 2) (Mesh_3's
+/// constructions lose precision there: a tetrahedron of side 1e11 at 1e12 sent its exuder into
+/// exact arithmetic for minutes); other surfaces are meshed where they are (`moved` false).
+struct MeshingFrame {
+  bool moved = false;
+  Vec3 centre{0.0, 0.0, 0.0};
+  double scale = 1.0;  ///< a power of two
+};
+
+MeshingFrame meshing_frame(const TriangleMesh& s) {
+  MeshingFrame frame;
+  if (s.vertices.empty()) return frame;
+  Vec3 lo = s.vertices.front(), hi = lo;
+  for (const Vec3& p : s.vertices)
+    for (int k = 0; k < 3; ++k) {
+      lo[k] = std::min(lo[k], p[k]);
+      hi[k] = std::max(hi[k], p[k]);
+    }
+  const double diagonal = std::hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
+  if (!(diagonal > 0.0) || !std::isfinite(diagonal)) return frame;
+  double far = 0.0;
+  for (int k = 0; k < 3; ++k) far = std::max(far, std::fabs(0.5 * (lo[k] + hi[k])));
+  frame.moved = diagonal < 1e-3 || diagonal > 1e6 || far > 1e3 * diagonal;
+  if (!frame.moved) return frame;
+  for (int k = 0; k < 3; ++k) frame.centre[k] = 0.5 * (lo[k] + hi[k]);
+  frame.scale = std::ldexp(1.0, -std::ilogb(diagonal));
+  return frame;
+}
+
+}  // namespace
+
 TetMesh tetrahedralize(const TriangleMesh& surface, const MeshingOptions& meshing,
                        const std::string& file, TetrahedralizeNotes* notes) {
+  const MeshingFrame frame = meshing_frame(surface);
+  if (!frame.moved) return tetrahedralize_in_place(surface, meshing, file, notes);
+  TriangleMesh moved = surface;
+  for (Vec3& p : moved.vertices)
+    for (int k = 0; k < 3; ++k) p[k] = (p[k] - frame.centre[k]) * frame.scale;
+  MeshingOptions scaled = meshing;
+  for (double* size : {&scaled.cell_size, &scaled.facet_size, &scaled.facet_distance})
+    *size *= frame.scale;
   TetrahedralizeNotes local_notes;
   TetrahedralizeNotes& out_notes = notes != nullptr ? *notes : local_notes;
+  TetMesh mesh = tetrahedralize_in_place(moved, scaled, file, &out_notes);
+  for (Vec3& p : mesh.nodes)
+    for (int k = 0; k < 3; ++k) p[k] = p[k] / frame.scale + frame.centre[k];
+  out_notes.diagonal /= frame.scale;  // the relative distances do not change
+  return mesh;
+}
+
+namespace {
+
+TetMesh tetrahedralize_in_place(const TriangleMesh& surface, const MeshingOptions& meshing,
+                                const std::string& file, TetrahedralizeNotes* notes) {
+  TetrahedralizeNotes local_notes;
+  TetrahedralizeNotes& out_notes = notes != nullptr ? *notes : local_notes;
+  if (!(meshing.time_limit >= 0.0))
+    throw std::invalid_argument("time limit must be zero (none) or a positive number of seconds");
+  if (!(meshing.max_deviation >= 1e-4 && meshing.max_deviation <= 1.0))
+    throw std::invalid_argument("max deviation must be in [1e-4, 1] (a fraction of the diagonal)");
+  detail::Watchdog watchdog(meshing.time_limit, meshing.progress, file);
   using Repair = MeshingOptions::Repair;
-  TetMesh mesh;
-  if (meshing.repair == Repair::kFix) {
+  const auto fix_and_mesh = [&] {
+    watchdog.begin("repair");
     TriangleMesh fixed = surface;
     out_notes.repairs = detail::repair_soup(fixed, meshing.keep_largest_component);
     if (fixed.triangles.empty())
       throw InputError(file, "tetrahedralize: no triangle is left after repair");
-    mesh = validate_and_mesh(fixed, meshing, file, out_notes);
+    return validate_and_mesh(fixed, meshing, file, out_notes, watchdog);
+  };
+  TetMesh mesh;
+  out_notes.repair_used = meshing.repair;
+  if (meshing.repair == Repair::kFix) {
+    mesh = fix_and_mesh();
   } else if (meshing.repair == Repair::kWrap) {
-    mesh = wrap_and_mesh(surface, meshing, file, out_notes);
-  } else {
-    mesh = validate_and_mesh(surface, meshing, file, out_notes);
-  }
-  // What a repair cost: distances between the input and the boundary of the tets.
-  if (!out_notes.repairs.empty()) {
-    const Surface boundary = extract_surface(mesh);
-    TriangleMesh meshed{mesh.nodes, boundary.triangles};
-    const double diagonal = bounding_box_diagonal(surface.vertices);
-    const auto [there, back] = detail::hausdorff_distances(surface, meshed);
-    if (there >= 0.0 && diagonal > 0.0) {
-      out_notes.hausdorff_input_to_mesh = there / diagonal;
-      out_notes.hausdorff_mesh_to_input = back / diagonal;
+    mesh = wrap_and_mesh(surface, meshing, file, out_notes, watchdog);
+  } else if (meshing.repair == Repair::kAuto) {
+    // fix, and the wrap when what fix leaves cannot be meshed (any refusal of the surface or
+    // of Mesh_3 but the time limit, which is the user's bound on the whole).
+    try {
+      out_notes.repair_used = Repair::kFix;
+      mesh = fix_and_mesh();
+    } catch (const TimeLimitExceeded&) {
+      throw;
+    } catch (const InputError& e) {
+      out_notes = TetrahedralizeNotes{};
+      out_notes.repair_used = Repair::kWrap;
+      out_notes.fallback_reason = e.what();
+      try {
+        mesh = wrap_and_mesh(surface, meshing, file, out_notes, watchdog);
+      } catch (const TimeLimitExceeded&) {
+        throw;
+      } catch (const InputError& wrap_error) {
+        throw InputError(file, std::string(wrap_error.what()) +
+                                   " (--repair auto: the wrap, after fix left: " + e.what() + ")");
+      }
     }
+  } else {
+    mesh = validate_and_mesh(surface, meshing, file, out_notes, watchdog);
   }
+  watchdog.begin("deviation measurement");
+  // How far the surface moved (repairs, wrap and Mesh_3's re-meshing of the boundary):
+  // distances between the input and the boundary of the tets, whatever the repair.
+  const Surface boundary = extract_surface(mesh);
+  const TriangleMesh meshed{mesh.nodes, boundary.triangles};
+  const double diagonal = bounding_box_diagonal(surface.vertices);
+  const auto [there, back] = detail::hausdorff_distances(surface, meshed);
+  if (there >= 0.0 && diagonal > 0.0) {
+    out_notes.hausdorff_input_to_mesh = there / diagonal;
+    out_notes.hausdorff_mesh_to_input = back / diagonal;
+    out_notes.diagonal = diagonal;
+    out_notes.deviation_excess =
+        std::max(0.0, std::max(there, back) / diagonal - meshing.max_deviation);
+  }
+  watchdog.check();
   return mesh;
 }
+
+}  // namespace
 
 }  // namespace tetseg::preprocess

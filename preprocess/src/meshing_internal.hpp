@@ -2,6 +2,7 @@
 // Private interface between meshing.cpp (options, rules; no CGAL) and the two CGAL Mesh_3
 // translation units (mesh3_implicit.cpp, mesh3_polyhedral.cpp).
 
+#include <atomic>
 #include <cstddef>
 #include <stdexcept>
 
@@ -29,6 +30,16 @@ struct Mesh3Criteria {
   /// Polyhedral_mesh_domain_with_features_3, detect_features; edge size = facet_size), which
   /// Mesh_3's manifold refinement needs to terminate at sharp corners. 0: no protection.
   double sharp_edge_angle = 0.0;
+  /// When set: refinement stops once it is true (CGAL pointer_to_stop_atomic_boolean) and
+  /// MeshingStopped is thrown; the optimisers get `seconds_left` as their time limit.
+  std::atomic<bool>* stop = nullptr;
+  double seconds_left = 0.0;
+};
+
+/// Thrown by the Mesh_3 calls when Mesh3Criteria::stop was raised (the time limit).
+class MeshingStopped : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
 };
 
 /// Thrown by the Mesh_3 calls when refinement reached Mesh3Criteria::max_vertices.

@@ -73,8 +73,10 @@ const std::vector<EnumName<StructuredShape>>& enum_names<StructuredShape>() {
 template <>
 const std::vector<EnumName<MeshingOptions::Repair>>& enum_names<MeshingOptions::Repair>() {
   using Repair = MeshingOptions::Repair;
-  static const std::vector<EnumName<Repair>> table = {
-      {"none", Repair::kNone}, {"fix", Repair::kFix}, {"wrap", Repair::kWrap}};
+  static const std::vector<EnumName<Repair>> table = {{"none", Repair::kNone},
+                                                      {"fix", Repair::kFix},
+                                                      {"wrap", Repair::kWrap},
+                                                      {"auto", Repair::kAuto}};
   return table;
 }
 

@@ -66,8 +66,19 @@ bool meshed(const BuildOptions& o) {
 bool largest_component_kept(const BuildOptions& o) {
   return o.meshing.has_value() && o.meshing->keep_largest_component;
 }
-bool wrapped(const BuildOptions& o) {
-  return o.meshing.has_value() && o.meshing->repair == MeshingOptions::Repair::kWrap;
+bool wrapped(const BuildOptions& o) {  // the wrap options matter: wrap, or auto's fallback
+  return o.meshing.has_value() && (o.meshing->repair == MeshingOptions::Repair::kWrap ||
+                                   o.meshing->repair == MeshingOptions::Repair::kAuto);
+}
+bool auto_repaired(const BuildOptions& o) {
+  return o.meshing.has_value() && o.meshing->repair == MeshingOptions::Repair::kAuto;
+}
+bool fell_back(const BuildOptions& o) {
+  return auto_repaired(o) && !o.fallback_reason.empty();
+}
+
+bool deviation_known(const BuildOptions& o) {
+  return o.deviation.has_value();
 }
 
 bool parse_double(const std::string& text, double& value) {
@@ -120,6 +131,16 @@ ProvenanceField number(const char* key, bool (*recorded)(const BuildOptions&),
           }};
 }
 
+// Text recorded as it is.
+ProvenanceField text(const char* key, bool (*recorded)(const BuildOptions&),
+                     std::string& (*access)(BuildOptions&)) {
+  return {key, recorded, [=](BuildOptions& o) { return access(o); },
+          [=](const std::string& value, BuildOptions& o) {
+            access(o) = value;
+            return true;
+          }};
+}
+
 ProvenanceField flag(const char* key, bool (*recorded)(const BuildOptions&),
                      bool& (*access)(BuildOptions&)) {
   return {key, recorded, [=](BuildOptions& o) { return std::string(access(o) ? "yes" : "no"); },
@@ -135,6 +156,11 @@ ProvenanceField named(const char* key, bool (*recorded)(const BuildOptions&),
                       Enum& (*access)(BuildOptions&)) {
   return {key, recorded, [=](BuildOptions& o) { return std::string(name_of(access(o))); },
           [=](const std::string& text, BuildOptions& o) { return parse_name(text, access(o)); }};
+}
+
+SurfaceDeviation& deviation_of(BuildOptions& o) {
+  if (!o.deviation) o.deviation = SurfaceDeviation{};
+  return *o.deviation;
 }
 
 MeshingOptions& meshing_of(BuildOptions& o) {
@@ -208,6 +234,8 @@ const std::vector<ProvenanceField>& provenance_fields() {
       number<double>("meshing.cell_radius_edge_ratio", meshed,
                      [](O& o) -> double& { return meshing_of(o).cell_radius_edge_ratio; }),
       flag("meshing.optimize", meshed, [](O& o) -> bool& { return meshing_of(o).optimize; }),
+      number<double>("meshing.max_deviation", meshed,
+                     [](O& o) -> double& { return meshing_of(o).max_deviation; }),
       named<MeshingOptions::Repair>(
           "meshing.repair", meshed,
           [](O& o) -> MeshingOptions::Repair& { return meshing_of(o).repair; }),
@@ -219,6 +247,18 @@ const std::vector<ProvenanceField>& provenance_fields() {
                      [](O& o) -> double& { return meshing_of(o).wrap_offset; }),
       number<double>("meshing.wrap_sheet_offset", wrapped,
                      [](O& o) -> double& { return meshing_of(o).wrap_sheet_offset; }),
+      text("meshing.repair_used", auto_repaired,
+           [](O& o) -> std::string& { return o.repair_used; }),
+      text("meshing.fallback_reason", fell_back,
+           [](O& o) -> std::string& { return o.fallback_reason; }),
+      number<double>("deviation.input_to_asset", deviation_known,
+                     [](O& o) -> double& { return deviation_of(o).input_to_asset; }),
+      number<double>("deviation.asset_to_input", deviation_known,
+                     [](O& o) -> double& { return deviation_of(o).asset_to_input; }),
+      number<double>("deviation.input_to_asset_absolute", deviation_known,
+                     [](O& o) -> double& { return deviation_of(o).input_to_asset_absolute; }),
+      number<double>("deviation.asset_to_input_absolute", deviation_known,
+                     [](O& o) -> double& { return deviation_of(o).asset_to_input_absolute; }),
   };
   return fields;
 }
@@ -436,6 +476,8 @@ format::Asset build_asset(const TetMesh& mesh, const std::string& source,
   asset.provenance.source = base_name(source);
   BuildOptions used = options;  // with the charge solver actually used in place of "auto"
   if (!report.charge.solver.empty()) parse_name(report.charge.solver, used.charge.solver);
+  // A tet mesh not made from a surface here is the asset's surface: deviation 0.
+  if (!used.meshing && !used.deviation) used.deviation = SurfaceDeviation{};
   asset.provenance.options = provenance_options(used);
   for (const DetectorChoice& detector : detectors) {
     report.rest_positive_fraction.push_back(detector.rest_positive_fraction);

@@ -168,8 +168,8 @@ py::tuple build(const py::object& mesh, const py::object& source, const std::str
                 double min_visibility, const std::string& solver, double tolerance,
                 double cell_size, double facet_size, double facet_distance, bool optimize,
                 int threads, const std::string& repair, double wrap_alpha, double wrap_offset,
-                double wrap_sheet_offset, bool keep_largest_component, bool rest_positions,
-                const py::object& on_stage) {
+                double wrap_sheet_offset, bool keep_largest_component, double max_deviation,
+                double time_limit, bool rest_positions, const py::object& on_stage) {
   BuildJobOptions job;
   BuildOptions& options = job.build;
   options.clusters = enum_from_name<ClusterMethod>("clusters", clusters);
@@ -199,6 +199,8 @@ py::tuple build(const py::object& mesh, const py::object& source, const std::str
   meshing.wrap_offset = wrap_offset;
   meshing.wrap_sheet_offset = wrap_sheet_offset;
   meshing.keep_largest_component = keep_largest_component;
+  meshing.max_deviation = max_deviation;
+  job.time_limit = time_limit;
   validate_options(job);  // std::invalid_argument: ValueError, before any work
 
   Input in = input_from(mesh, source);
@@ -358,19 +360,23 @@ PYBIND11_MODULE(preprocess, m) {
         py::arg("wrap_alpha") = meshing.wrap_alpha, py::arg("wrap_offset") = meshing.wrap_offset,
         py::arg("wrap_sheet_offset") = meshing.wrap_sheet_offset,
         py::arg("keep_largest_component") = meshing.keep_largest_component,
+        py::arg("max_deviation") = meshing.max_deviation,
+        py::arg("time_limit") = BuildJobOptions{}.time_limit,
         py::arg("rest_positions") = b.keep_rest_positions, py::arg("on_stage") = py::none(),
         "Returns (asset bytes, report dict). "
         "Runs the whole pipeline as `tetseg build` does. mesh: a tet mesh file (.mesh, "
         ".node/.ele, .msh), a closed surface file (.obj, .ply, .stl, .off, ...; tetrahedralised "
         "first with cell_size, facet_size, facet_distance, optimize, threads, repair, "
-        "wrap_alpha, wrap_offset, wrap_sheet_offset, keep_largest_component), or a pair of arrays "
+        "wrap_alpha, wrap_offset, wrap_sheet_offset, keep_largest_component, max_deviation), or a "
+        "pair of arrays "
         "(nodes (N, 3), tets (M, 4)) or (points (N, 3), triangles (M, 3)). source: the name "
         "recorded in the asset's provenance and used in messages (default: the path, or "
         "'arrays'). Every other option is the `tetseg build` option of the same name "
         "(--no-optimize is optimize=False, --no-rest-positions is rest_positions=False). "
         "on_stage(name, seconds, summary) is called after each stage. The report dict is "
         "`tetseg build --report` (the same writer; no 'output') plus 'stages'. Load the bytes with "
-        "tetseg.load_asset. Raises InputError for a bad mesh, ValueError for a bad option.");
+        "tetseg.load_asset. Raises InputError for a bad mesh or a build past time_limit seconds "
+        "(its detail names the stage), ValueError for a bad option.");
 
   const ChargeOptions c;
   m.def("charge", &charge, py::arg("mesh"), py::kw_only(), py::arg("source") = py::none(),

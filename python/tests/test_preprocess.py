@@ -308,3 +308,32 @@ def test_wrap_meshes_a_flat_sheet_as_a_slab(pp):
     provenance = tetseg.load_asset(data).provenance["options"]
     assert float(provenance["meshing.wrap_sheet_offset"]) == 0.02
     assert provenance["repairs." + kind.replace(" ", "_")] == "400"
+
+
+def test_deviation_is_reported_for_every_build(pp, sphere_mesh):
+    """The deviation (two-sided Hausdorff distance, relative and absolute) is in every build's
+    report and provenance: 0 for a tet mesh, measured (not 0: Mesh_3 rounds the corners a
+    little) for a closed box that needs no repair."""
+    import tetseg
+    data, report = pp.build(sphere_mesh, clusters="single")
+    assert report["hausdorff"]["input_to_mesh"] == 0 == report["hausdorff"]["mesh_to_input"]
+    assert tetseg.load_asset(data).provenance["options"]["deviation.input_to_asset"] == "0"
+    corners = np.array([[x, y, z] for z in (0, 1) for y in (0, 1) for x in (0, 1)], float)
+    quads = [(0, 2, 3, 1), (0, 1, 5, 4), (1, 3, 7, 5), (3, 2, 6, 7), (2, 0, 4, 6), (4, 5, 7, 6)]
+    triangles = np.array([t for a, b, c, d in quads for t in ((a, b, c), (a, c, d))])
+    data, report = pp.build((corners, triangles), clusters="single", cell_size=0.2)
+    assert report["repairs"] == {}
+    h = report["hausdorff"]
+    assert 0 < h["input_to_mesh"] < 0.05 and 0 <= h["mesh_to_input"] < 0.05
+    assert h["input_to_mesh_absolute"] == pytest.approx(h["input_to_mesh"] * 3 ** 0.5)
+    provenance = tetseg.load_asset(data).provenance["options"]
+    assert float(provenance["deviation.input_to_asset"]) == pytest.approx(h["input_to_mesh"])
+
+
+def test_time_limit_refuses_with_the_stage_named(pp, sphere_mesh):
+    """time_limit as `tetseg build --time-limit`: past it InputError names the stage; it is
+    range-checked (ValueError)."""
+    with pytest.raises(pp.InputError, match="time limit of 1e-09 s reached in stage read"):
+        pp.build(sphere_mesh, time_limit=1e-9)
+    with pytest.raises(ValueError, match="time_limit"):
+        pp.build(sphere_mesh, time_limit=-1)

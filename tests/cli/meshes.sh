@@ -53,7 +53,7 @@ expect_exit 0 "tetseg: done" -- "$bin/tetseg" build cube.msh -o from_binary.tets
 expect_exit 2 "" -- "$bin/tetseg" tetrahedralize cube.off -o x.msh --binary --gmsh22
 [ ! -e x.msh ] || fail "a usage error left a mesh"
 
-# --repair fix (the default) removes a duplicated face and says so; --repair none refuses it.
+# --repair auto (the default) fixes a duplicated face and says so; --repair none refuses it.
 { cat cube.off; echo "4 0 3 2 1"; } | sed 's/^8 6 0$/8 7 0/' >cube_dup.off
 expect_exit 0 "tetseg: repaired cube_dup.off: 2 duplicate triangles removed" -- \
   "$bin/tetseg" tetrahedralize cube_dup.off -o dup.mesh --facet-size 0.25 --no-optimize
@@ -141,8 +141,18 @@ for i in range(n):
     print(3, i, j, j + n)
     print(3, i, j + n, i + n)' >tube.off
 expect_exit 3 "tetseg: error: tube.off: surface is not closed (160 border edges.*left after --repair fix; --repair wrap" -- \
-  "$bin/tetseg" build tube.off -o tube.tetseg --clusters single
+  "$bin/tetseg" build tube.off -o tube.tetseg --clusters single --repair fix
 [ ! -e tube.tetseg ] || fail "a refused surface left an asset"
+# --repair auto (the default) wraps what fix leaves and says why: stderr, report, provenance;
+# the deviation is in the provenance of every build.
+expect_exit 0 "tetseg: note: tube.off: --repair auto wrapped the surface, as fix left: .*surface is not closed (160 border edges" -- \
+  "$bin/tetseg" build tube.off -o tube.tetseg --clusters single --report tube.json
+grep -q '"repair_used": "wrap"' tube.json || fail "the report lacks the repair used"
+grep -q '"fallback_reason": ".*surface is not closed' tube.json || fail "the report lacks the reason"
+"$bin/tetseg-dump" tube.tetseg >tube.txt
+grep -q 'meshing.repair_used *wrap' tube.txt || fail "the provenance lacks the repair used"
+grep -q 'meshing.fallback_reason *.*not closed' tube.txt || fail "the provenance lacks the reason"
+grep -q 'deviation.asset_to_input_absolute' tube.txt || fail "the provenance lacks the deviation"
 expect_exit 0 "tetseg: repaired holed.off: [0-9]* surface replaced by an alpha wrap" -- \
   "$bin/tetseg" build holed.off -o holed.tetseg --clusters single --repair wrap --wrap-alpha 0.5 \
   --facet-size 0.2 --no-optimize --report holed.json

@@ -111,6 +111,10 @@ TEST_CASE("The pipeline turns a dumbbell into a valid, loadable asset", "[pipeli
       {"charge.solver", report.charge.solver},
       {"charge.tolerance", "auto"},
       {"clusters", "refined"},
+      {"deviation.asset_to_input", "0"},  // a tet mesh is its own surface
+      {"deviation.asset_to_input_absolute", "0"},
+      {"deviation.input_to_asset", "0"},
+      {"deviation.input_to_asset_absolute", "0"},
       {"refine.gain_per_cut_edge", "0.5"},
       {"refine.invisibility_cost", "1"},
       {"refine.max_clusters", "32"},

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "tetseg/preprocess/meshing.hpp"
 #include "tetseg/preprocess/surface.hpp"
@@ -405,4 +406,92 @@ TEST_CASE("Wrap builds a cube without one face, without meshing its thin wraps",
   CHECK(total_tet_volume(m) == Approx(1.0).epsilon(0.05));
   // The lid is farthest from the input at its centre: half a side, over the diagonal.
   CHECK(notes.hausdorff_mesh_to_input == Approx(0.5 / std::sqrt(3.0)).margin(0.02));
+}
+
+namespace {
+
+/// A torus about z: centre radius `major`, tube radius `minor`, n x m quads split in two.
+TriangleMesh torus(double major, double minor, std::uint32_t n, std::uint32_t m, Vec3 shift) {
+  TriangleMesh t;
+  const double pi = std::acos(-1.0);
+  for (std::uint32_t i = 0; i < n; ++i)
+    for (std::uint32_t j = 0; j < m; ++j) {
+      const double u = 2.0 * pi * i / n, v = 2.0 * pi * j / m;
+      const double ring = major + minor * std::cos(v);
+      t.vertices.push_back({shift[0] + ring * std::cos(u), shift[1] + ring * std::sin(u),
+                            shift[2] + minor * std::sin(v)});
+    }
+  const auto id = [&](std::uint32_t i, std::uint32_t j) { return (i % n) * m + j % m; };
+  for (std::uint32_t i = 0; i < n; ++i)
+    for (std::uint32_t j = 0; j < m; ++j) {
+      t.triangles.push_back({id(i, j), id(i + 1, j), id(i + 1, j + 1)});
+      t.triangles.push_back({id(i, j), id(i + 1, j + 1), id(i, j + 1)});
+    }
+  return t;
+}
+
+/// `s` through --repair auto (facet size `facet`, no optimisation); the mesh must be valid.
+TetrahedralizeNotes auto_repaired(const TriangleMesh& s, double facet) {
+  MeshingOptions m = coarse(MeshingOptions::Repair::kAuto);
+  m.facet_size = facet;
+  TetrahedralizeNotes notes;
+  const TetMesh mesh = tetrahedralize(s, m, "auto.off", &notes);
+  validate_tet_mesh(mesh, extract_surface(mesh), "auto");
+  return notes;
+}
+
+}  // namespace
+
+TEST_CASE("Auto is fix, and the wrap with the reason where fix leaves a defect",
+          "[meshing][repair][auto]") {
+  using Repair = MeshingOptions::Repair;
+  CHECK(MeshingOptions{}.repair == Repair::kAuto);  // the default
+  SECTION("A clean closed surface takes fix.") {
+    const TetrahedralizeNotes notes = auto_repaired(cube(), 0.25);
+    CHECK(notes.repair_used == Repair::kFix);
+    CHECK(notes.fallback_reason.empty());
+    CHECK(notes.repairs.empty());
+  }
+  SECTION("A small hole is filled by fix, no wrap.") {
+    TriangleMesh s = cube();
+    s.triangles.erase(s.triangles.begin());
+    const TetrahedralizeNotes notes = auto_repaired(s, 0.25);
+    CHECK(notes.repair_used == Repair::kFix);
+    CHECK(count_of(notes, "holes filled") == 1);
+  }
+  SECTION("A sphere with a hole over the fill limit falls back to the wrap.") {
+    // The cap z > 0.6 of an 11.5k-triangle unit sphere removed: a hole of about 110 border edges
+    // (radius 0.8), over fix's 64. The wrap closes it (alpha doubles until the wrap no
+    // longer enters the sphere) with a patch across the hole, whose centre is 0.8 (the hole's
+    // radius: the nearest input points are on its rim) from the input, over the diagonal
+    // 2 sqrt 3 (a little more where the patch sags inward); elsewhere it is close.
+    TriangleMesh s = tetseg::test::icosphere(24);
+    std::vector<Tri> kept;
+    for (const Tri& t : s.triangles)
+      if (s.vertices[t[0]][2] <= 0.6 || s.vertices[t[1]][2] <= 0.6 || s.vertices[t[2]][2] <= 0.6)
+        kept.push_back(t);
+    s.triangles = kept;
+    const TetrahedralizeNotes notes = auto_repaired(s, 0.2);
+    CHECK(notes.repair_used == Repair::kWrap);
+    CHECK_THAT(notes.fallback_reason, Catch::Contains("surface is not closed ("));
+    CHECK(count_of(notes, "alpha wrap") > 0);
+    CHECK(notes.hausdorff_input_to_mesh < 0.05);
+    CHECK(notes.hausdorff_mesh_to_input == Approx(0.8 / (2.0 * std::sqrt(3.0))).margin(0.04));
+  }
+  SECTION("Two interpenetrating tori (more crossing pairs than fix removes) are wrapped.") {
+    TriangleMesh s = torus(1.0, 0.3, 64, 16, {0, 0, 0});
+    const TriangleMesh other = torus(1.0, 0.3, 64, 16, {0.5, 0, 0});
+    const std::uint32_t base = static_cast<std::uint32_t>(s.vertices.size());
+    for (const Vec3& p : other.vertices) s.vertices.push_back(p);
+    for (const Tri& t : other.triangles)
+      s.triangles.push_back({t[0] + base, t[1] + base, t[2] + base});
+    const TetrahedralizeNotes notes = auto_repaired(s, 0.1);
+    CHECK(notes.repair_used == Repair::kWrap);
+    CHECK_THAT(notes.fallback_reason, Catch::Contains("surface self-intersects ("));
+    // The wrap is their union: every input point on or inside it, within the offset and
+    // Mesh_3's facet distance of the outer surface (the inner parts lie up to a tube
+    // diameter inside: 0.6 over the diagonal of 3.0 x 2.6 x 0.6, about 0.15).
+    CHECK(notes.hausdorff_mesh_to_input < 0.03);
+    CHECK(notes.hausdorff_input_to_mesh < 0.2);
+  }
 }

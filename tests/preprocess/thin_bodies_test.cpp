@@ -284,14 +284,21 @@ TEST_CASE("A surface with two closed components is tetrahedralised into one two-
   preprocess::BuildReport report;
   preprocess::build_asset(mesh, "two.off", preprocess::BuildOptions{}, report);
   CHECK(report.components == 2);
-  // A sphere inside the other encloses a cavity: refused before meshing, naming both.
+  // A sphere inside the other encloses a cavity: fix refuses it before meshing, naming both;
+  // auto (the default) wraps it (the outer sphere, cavity filled) and says why.
   try {
-    preprocess::tetrahedralize(two_spheres(0.2, 0.4), meshing, "nested.off");
+    preprocess::MeshingOptions fix = meshing;
+    fix.repair = preprocess::MeshingOptions::Repair::kFix;
+    preprocess::tetrahedralize(two_spheres(0.2, 0.4), fix, "nested.off");
     FAIL("a sphere inside another was meshed");
   } catch (const preprocess::InputError& e) {
     CHECK(e.file() == "nested.off");
     CHECK_THAT(e.what(), Catch::Contains("lies inside component 1 of 2"));
   }
+  preprocess::TetrahedralizeNotes notes;
+  preprocess::tetrahedralize(two_spheres(0.2, 0.4), meshing, "nested.off", &notes);
+  CHECK(notes.repair_used == preprocess::MeshingOptions::Repair::kWrap);
+  CHECK_THAT(notes.fallback_reason, Catch::Contains("lies inside component 1 of 2"));
 }
 
 TEST_CASE("Flat faces of thin shapes turned off the axes are not taken for rest intersections",

@@ -7,6 +7,7 @@
 #include <iterator>
 #include <map>
 #include <sstream>
+#include <string>
 #include <unordered_map>
 #include <vector>
 
@@ -106,6 +107,19 @@ void print_summary(const std::string& path, const std::string& version, const As
   for (const auto& [key, value] : asset.provenance.options) {
     std::printf("    %-36s %s\n", key.c_str(), value.c_str());
   }
+  // How far the asset's surface is from the input's (recorded by tetseg build since 0.2).
+  const auto recorded = [&](const char* key) -> std::string {
+    for (const auto& [k, v] : asset.provenance.options)
+      if (k == key) return v;
+    return "";
+  };
+  if (!recorded("deviation.input_to_asset").empty())
+    std::printf(
+        "  deviation           %s / %s of the input's diagonal, %s / %s absolute "
+        "(input to asset / asset to input)\n",
+        recorded("deviation.input_to_asset").c_str(), recorded("deviation.asset_to_input").c_str(),
+        recorded("deviation.input_to_asset_absolute").c_str(),
+        recorded("deviation.asset_to_input_absolute").c_str());
   std::size_t flagged = 0;
   for (const auto& cluster : asset.clusters)
     flagged += (cluster.flags & tetseg::format::kClusterOverlapOnly) ? 1 : 0;

@@ -49,6 +49,7 @@ void run_build(const BuildArgs& args) {
   BuildJobOptions options = args.job;
   options.build.keep_rest_positions = !args.no_rest_positions;
   options.output_name = args.output;
+  if (!args.quiet) mesh_cli::report_meshing_progress(options.meshing);
   options.write_output = [&](const std::vector<std::uint8_t>& bytes) {
     write_file_atomic(args.output, bytes);
   };
@@ -167,6 +168,7 @@ void add_build_command(CLI::App& root) {
       "Surface input only: skip sliver perturbation and exudation (faster meshing)");
   mesh_cli::add_threads_option(*cmd, args->job.meshing, "Surface input only: ");
   mesh_cli::add_repair_option(*cmd, args->job.meshing);
+  mesh_cli::add_time_limit_option(*cmd, args->job.time_limit, "the whole build");
   cmd->add_flag("--no-rest-positions", args->no_rest_positions,
                 "Do not store rest positions in the asset (smaller; tools cannot draw it)");
   cmd->add_flag("-q,--quiet", args->quiet, "No stage lines");

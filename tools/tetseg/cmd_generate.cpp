@@ -2,6 +2,7 @@
 // and structured thin shapes (mat, plate, bar, torus, tori) built directly from hexes.
 // Also defines the meshing-option and output helpers shared with cmd_tetrahedralize.cpp.
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <map>
@@ -110,14 +111,38 @@ void print_retry_note(const std::string& file, const preprocess::TetrahedralizeN
                notes.optimization_used.c_str());
 }
 
+void add_time_limit_option(CLI::App& cmd, double& seconds, const std::string& what) {
+  cmd.add_option("--time-limit", seconds,
+                 "Seconds " + what +
+                     " may take (0: no limit); past it the input is refused with exit code 5, "
+                     "the stage named and nothing written")
+      ->check(range_check(preprocess::option_ranges::kTimeLimit))
+      ->capture_default_str();
+}
+
+void report_meshing_progress(preprocess::MeshingOptions& m) {
+  m.progress = [](double seconds, const std::string& step) {
+    std::fprintf(stderr, "tetseg: tetrahedralize: still in %s after %.0f s\n", step.c_str(),
+                 seconds);
+  };
+}
+
 void add_repair_option(CLI::App& cmd, preprocess::MeshingOptions& m) {
   using Repair = preprocess::MeshingOptions::Repair;
   cmd.add_option("--repair", m.repair,
                  "Surface input: none; fix (remove degenerate and duplicate triangles, make "
-                 "the orientation consistent); or wrap (replace the surface by its alpha wrap: "
-                 "closed and manifold for any input; docs/cli.md)")
+                 "the orientation consistent, fill small holes, ...); wrap (replace the surface "
+                 "by its alpha wrap: closed and manifold for any input); or auto (fix, and wrap "
+                 "when what fix leaves cannot be meshed, the reason reported; docs/cli.md)")
       ->transform(CLI::CheckedTransformer(preprocess::name_map<Repair>(), CLI::ignore_case))
       ->option_text(preprocess::name_list<Repair>() + " (" + preprocess::name_of(m.repair) + ")");
+  cmd.add_option("--max-deviation", m.max_deviation,
+                 "Surface input: how far the asset's surface may be from the input (two-sided "
+                 "Hausdorff distance), a fraction of the bounding-box diagonal: bounds the "
+                 "derived facet distance (half) and the wrap offset (a quarter); a mesh still "
+                 "farther is reported (report deviation_excess)")
+      ->check(range_check(preprocess::option_ranges::kMaxDeviation))
+      ->capture_default_str();
   cmd.add_flag("--keep-largest-component", m.keep_largest_component,
                "--repair fix: keep only the connected component of largest area (drops "
                "floating debris and stray parts)");
@@ -140,6 +165,18 @@ void add_repair_option(CLI::App& cmd, preprocess::MeshingOptions& m) {
 }
 
 void print_repairs(const std::string& file, const preprocess::TetrahedralizeNotes& notes) {
+  if (!notes.fallback_reason.empty())
+    std::fprintf(stderr, "tetseg: note: %s: --repair auto wrapped the surface, as fix left: %s\n",
+                 base_name(file).c_str(), notes.fallback_reason.c_str());
+  if (notes.deviation_excess > 0.0)
+    std::fprintf(stderr,
+                 "tetseg: note: %s: the meshed surface deviates %.3g of the bounding-box diagonal "
+                 "from the input, %.3g over --max-deviation (a sheet wrapped as a slab, a hole "
+                 "closed across, sharp corners Mesh_3 rounds, or sizes too coarse: a smaller "
+                 "--facet-distance)\n",
+                 base_name(file).c_str(),
+                 std::max(notes.hausdorff_input_to_mesh, notes.hausdorff_mesh_to_input),
+                 notes.deviation_excess);
   if (notes.repairs.empty()) return;
   std::string list;
   for (const preprocess::RepairCount& r : notes.repairs)

@@ -31,9 +31,11 @@ void run_tetrahedralize(const TetrahedralizeArgs& args) {
     return s;
   });
   preprocess::TetrahedralizeNotes notes;
+  preprocess::MeshingOptions meshing = args.meshing;
+  mesh_cli::report_meshing_progress(meshing);
   const preprocess::TetMesh mesh = mesh_cli::run_stage("tetrahedralize", [&](std::string& summary) {
-    preprocess::TetMesh m = preprocess::tetrahedralize(surface, args.meshing, args.input, &notes);
-    summary = mesh_cli::tet_mesh_summary(m);
+    preprocess::TetMesh m = preprocess::tetrahedralize(surface, meshing, args.input, &notes);
+    summary = mesh_cli::tet_mesh_summary(m) + ", " + preprocess::deviation_summary(notes);
     return m;
   });
   mesh_cli::print_repairs(args.input, notes);
@@ -54,6 +56,7 @@ void add_tetrahedralize_command(CLI::App& root) {
       ->required();
   mesh_cli::add_meshing_options(*cmd, args->meshing, args->msh);
   mesh_cli::add_repair_option(*cmd, args->meshing);
+  mesh_cli::add_time_limit_option(*cmd, args->meshing.time_limit, "tetrahedralisation");
   cmd->callback([args] { run_naming_file(args->input, [&] { run_tetrahedralize(*args); }); });
 }
 

@@ -94,8 +94,13 @@ void print_retry_note(const std::string& file, const preprocess::TetrahedralizeN
 void add_threads_option(CLI::App& cmd, preprocess::MeshingOptions& m, const std::string& prefix);
 /// Adds `--repair none|fix` (MeshingOptions::repair).
 void add_repair_option(CLI::App& cmd, preprocess::MeshingOptions& m);
-/// Prints the repairs tetrahedralize made to `file` ("tetseg: repaired x.off: 2 duplicate
-/// triangles removed, ..."), nothing when there were none.
+/// Adds `--time-limit SECONDS` (option_ranges kTimeLimit; default kDefaultTimeLimitSeconds):
+/// `what` says what it bounds.
+void add_time_limit_option(CLI::App& cmd, double& seconds, const std::string& what);
+/// Sets `m.progress` to print "tetseg: tetrahedralize: still in <step> after N s" on stderr.
+void report_meshing_progress(preprocess::MeshingOptions& m);
+/// Prints why --repair auto wrapped `file` (when it did) and the repairs tetrahedralize made
+/// ("tetseg: repaired x.off: 2 duplicate triangles removed, ..."), nothing when none.
 void print_repairs(const std::string& file, const preprocess::TetrahedralizeNotes& notes);
 
 }  // namespace mesh_cli

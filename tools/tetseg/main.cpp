@@ -28,6 +28,9 @@ int main(int argc, char** argv) {
   } catch (const ToolError& e) {
     print_error("tetseg", e.file(), e.what());
     return e.code();
+  } catch (const tetseg::preprocess::TimeLimitExceeded& e) {
+    print_error("tetseg", e.file(), e.what());
+    return kExitTimeLimit;
   } catch (const tetseg::preprocess::InputError& e) {
     print_error("tetseg", e.file(), e.what());
     return kExitBadInput;

@@ -32,6 +32,11 @@ struct BuildJobOptions {
   /// throw. The stage summary is "<output_name> (N bytes)", or "N bytes" without a name.
   std::function<void(const std::vector<std::uint8_t>& bytes)> write_output;
   std::string output_name;
+  /// Seconds the whole build may take (0: no limit; option_ranges kTimeLimit). Checked after
+  /// every stage before "write", and inside tetrahedralize (which gets the time left as its
+  /// MeshingOptions::time_limit, so Mesh_3 is stopped there): past it the build throws
+  /// TimeLimitExceeded naming the stage, before anything is written.
+  double time_limit = kDefaultTimeLimitSeconds;
 };
 
 /// A finished build.
@@ -41,7 +46,10 @@ struct BuildJobResult {
   BuildReport report;                     ///< stages (read ... write), counts, charge figures
   bool surface_input = false;             ///< tetrahedralised from a surface
   TetrahedralizeNotes meshing_notes;      ///< surface input: repairs, Hausdorff, retries
-  double total_seconds = 0.0;             ///< wall time of the whole job
+  /// How far the asset's surface is from the input's (0 for a tet-mesh input); also in the
+  /// provenance (deviation.*) and the report ("hausdorff").
+  SurfaceDeviation deviation;
+  double total_seconds = 0.0;  ///< wall time of the whole job
 };
 
 /// Throws std::invalid_argument naming the first option outside its range
@@ -54,8 +62,9 @@ void validate_options(const BuildJobOptions& options);
 /// build_asset, serialise. Stages: read, [tetrahedralize,] surface, [charge, equalize,
 /// segmentation, [refinement,]] detectors, bvh, write; `on_stage` is called after each.
 /// `source` names the input in messages and the provenance (default: `path`). Throws what the
-/// stages throw: InputError naming the file for bad input, std::invalid_argument for bad
-/// options (validate_options, first), and whatever on_stage or write_output throw.
+/// stages throw: InputError naming the file for bad input, TimeLimitExceeded (an InputError)
+/// past options.time_limit, std::invalid_argument for bad options (validate_options, first),
+/// and whatever on_stage or write_output throw.
 BuildJobResult build_asset_from_file(const std::string& path, const BuildJobOptions& options,
                                      const StageCallback& on_stage = {},
                                      const std::string& source = {});
@@ -70,8 +79,9 @@ BuildJobResult build_asset_from_surface(TriangleMesh surface, const std::string&
 
 /// The build report (`tetseg build --report`, docs/cli.md): input, output (omitted when
 /// empty), asset_bytes, seconds per stage and total, peak_rss_bytes, peak_rss_growth_bytes,
-/// counts, segmentation, refinement, charge (when computed), repairs, hausdorff and
-/// meshing_retry (surface input), clusters, options. Numbers at 9 digits (detectors at 17).
+/// counts, segmentation, refinement, charge (when computed), hausdorff (every input: the
+/// deviation, 0 for a tet mesh), repairs and meshing_retry (surface input), clusters, options.
+/// Numbers at 9 digits (detectors at 17).
 std::string build_report_json(const BuildJobResult& result, const std::string& input,
                               const std::string& output);
 

@@ -48,6 +48,13 @@ class InputError : public std::runtime_error {
   std::string m_file;
 };
 
+/// A job that ran past its time limit (`--time-limit`; the CLI's exit code 5): the message
+/// names the stage. An InputError, since the input's geometry decides how long a stage runs.
+class TimeLimitExceeded : public InputError {
+ public:
+  using InputError::InputError;
+};
+
 /// Output that could not be written (exit code 4).
 class OutputError : public std::runtime_error {
  public:

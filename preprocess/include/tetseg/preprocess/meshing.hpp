@@ -5,12 +5,16 @@
 /// mesh. MeshingOptions::threads > 1 trades that for speed.
 
 #include <cstddef>
+#include <functional>
 #include <string>
 #include <vector>
 
 #include "tetseg/preprocess/mesh.hpp"
 
 namespace tetseg::preprocess {
+
+/// The default time limit of a build and of tetrahedralize, seconds (docs/cli.md).
+inline constexpr double kDefaultTimeLimitSeconds = 600.0;
 
 /// Mesh size controls, in the input's length units (procedural shapes: the shape's own
 /// units, about 1 across). 0 means "derive" by the rule documented in docs/cli.md
@@ -24,8 +28,9 @@ struct MeshingOptions {
   double cell_radius_edge_ratio = 3.0;  ///< tet quality bound, >= 2
   bool optimize = true;  ///< sliver perturbation (10 degree bound) + exudation; no ODT/Lloyd
   /// Surfaces only: kFix repairs the input before validation; kWrap replaces it by its alpha
-  /// wrap (tetrahedralize).
-  enum class Repair { kNone, kFix, kWrap } repair = Repair::kFix;
+  /// wrap; kAuto (the default) is kFix, and kWrap when what kFix leaves cannot be meshed
+  /// (tetrahedralize; TetrahedralizeNotes::repair_used and ::fallback_reason say which).
+  enum class Repair { kNone, kFix, kWrap, kAuto } repair = Repair::kAuto;
   /// kWrap: alpha (the size of the gaps the wrap does not enter) and offset (its distance
   /// from the input), as fractions of the input's bounding-box diagonal; > 0.
   double wrap_alpha = 0.02;
@@ -45,6 +50,21 @@ struct MeshingOptions {
   /// any value but 1 throws std::invalid_argument. Not recorded in an asset's provenance: an
   /// asset meshed with several threads does not rebuild byte for byte.
   int threads = 1;
+  /// Surfaces only: how far the asset's surface may be from the input's (the two-sided
+  /// Hausdorff distance), a fraction of the bounding-box diagonal (option_ranges
+  /// kMaxDeviation). A derived facet distance is at most half of it and the wrap offset at most
+  /// a quarter (the defaults are below both at 0.01); a mesh that still deviates more (a sheet
+  /// wrapped as a slab, a hole closed across) is kept, and TetrahedralizeNotes says by how
+  /// much.
+  double max_deviation = 0.01;
+  /// Surfaces only: seconds tetrahedralize may run (0: no limit; option_ranges kTimeLimit).
+  /// Mesh_3 is stopped there, and the other steps (repair, wrap, deviation) are checked
+  /// between them; past it tetrahedralize throws TimeLimitExceeded naming the step. Not
+  /// recorded in an asset's provenance.
+  double time_limit = kDefaultTimeLimitSeconds;
+  /// Surfaces only: called about every 10 s while tetrahedralize runs, from another thread,
+  /// with the seconds since it started and the step it is in ("CGAL Mesh_3", ...).
+  std::function<void(double seconds, const std::string& step)> progress;
 };
 
 /// Whether this build meshes in parallel (linked with oneTBB): MeshingOptions::threads != 1.
@@ -88,11 +108,20 @@ struct TetrahedralizeNotes {
   std::string optimization_used;
   std::string first_defect;          ///< the first mesh's boundary defect, when retried
   std::vector<RepairCount> repairs;  ///< repairs of the input (MeshingOptions::repair)
-  /// When a repair changed the input or it was wrapped: approximate Hausdorff distances
-  /// between the input triangles and the boundary of the returned tets, relative to the
-  /// input's bounding-box diagonal (input to mesh, mesh to input); -1 when not measured.
+  /// The repair that gave the mesh: MeshingOptions::repair, or kFix / kWrap for kAuto.
+  MeshingOptions::Repair repair_used = MeshingOptions::Repair::kNone;
+  /// kAuto fell back to the wrap: why (the error of kFix, naming the defect); else "".
+  std::string fallback_reason;
+  /// Always measured (whatever the repair; Mesh_3 re-meshes the boundary even of a clean
+  /// input): approximate Hausdorff distances between the input triangles and the boundary of
+  /// the returned tets, relative to the input's bounding-box diagonal (input to mesh, mesh to
+  /// input); -1 when not measured (no tets returned).
   double hausdorff_input_to_mesh = -1.0;
   double hausdorff_mesh_to_input = -1.0;
+  double diagonal = 0.0;  ///< the input's bounding-box diagonal: absolute = relative x diagonal
+  /// How much the larger of the two distances exceeds MeshingOptions::max_deviation (relative
+  /// to the diagonal); 0 when within it.
+  double deviation_excess = 0.0;
 };
 
 /// Tetrahedralises a closed, manifold surface (interior nodes included). With
@@ -106,9 +135,8 @@ struct TetrahedralizeNotes {
 /// free of self-intersections for any soup; while that wrap is a thin shell (all over, or half
 /// of it) or does not mesh, alpha is doubled (at most 6 times); an input whose wrap is still a
 /// thin shell with alpha = the diagonal encloses no volume (a sheet) and is wrapped again with
-/// wrap_sheet_offset into a slab (a repair in `notes`). When a repair changed the input,
-/// `notes` gets the Hausdorff
-/// distances between input and meshed boundary. The boundary is
+/// wrap_sheet_offset into a slab (a repair in `notes`). `notes` gets the Hausdorff distances
+/// between input and meshed boundary (always: how far the surface moved). The boundary is
 /// re-meshed (Mesh_3 does not keep the input triangles); Mesh_3 runs with its manifold option.
 /// Unlike validate_closed_surface, pinch points (separate fans of triangles touching at one
 /// vertex position, common in modelled meshes) are accepted. The result is checked like
@@ -122,6 +150,10 @@ struct TetrahedralizeNotes {
 /// as generate_shape.
 TetMesh tetrahedralize(const TriangleMesh& surface, const MeshingOptions& meshing,
                        const std::string& file, TetrahedralizeNotes* notes = nullptr);
+
+/// "deviation 0.0012 / 0.0015 of the diagonal (input to mesh / mesh to input)" from `notes`
+/// ("deviation not measured" without tets), for stage summaries.
+std::string deviation_summary(const TetrahedralizeNotes& notes);
 
 /// Default facet size (before `size` scaling) of a procedural shape, and for a surface of
 /// bounding-box diagonal `diagonal`: the rules behind "0 = derive".

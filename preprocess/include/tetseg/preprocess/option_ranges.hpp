@@ -48,6 +48,10 @@ inline constexpr OptionRange kThreads{"threads", 0, 4096};  ///< 0: one per hard
 inline constexpr OptionRange kWrapAlpha{"wrap_alpha", 1e-4, 1.0};
 inline constexpr OptionRange kWrapOffset{"wrap_offset", 1e-4, 1.0};
 inline constexpr OptionRange kWrapSheetOffset{"wrap_sheet_offset", 1e-4, 1.0};
+inline constexpr OptionRange kMaxDeviation{"max_deviation", 1e-4, 1.0};
+
+// tetseg build and tetseg tetrahedralize: seconds before the job is refused (0: no limit).
+inline constexpr OptionRange kTimeLimit{"time_limit", 0.0, 1e7};
 
 }  // namespace option_ranges
 

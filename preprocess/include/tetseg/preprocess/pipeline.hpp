@@ -25,6 +25,16 @@ enum class ClusterMethod {
   kRefined,  ///< kCharge, then refine_clusters (split by rest visibility, merge)
 };
 
+/// How far the asset's surface is from the input surface: the two-sided (approximate)
+/// Hausdorff distance, relative to the input's bounding-box diagonal and absolute (input
+/// units). 0 for a tet-mesh input, whose boundary is the asset's surface.
+struct SurfaceDeviation {
+  double input_to_asset = 0.0;  ///< relative to the diagonal
+  double asset_to_input = 0.0;  ///< relative to the diagonal
+  double input_to_asset_absolute = 0.0;
+  double asset_to_input_absolute = 0.0;
+};
+
 struct BuildOptions {
   /// kRefined measured faster per frame than kCharge on every benchmark scene
   /// (docs/benchmarks-history.md, "Cluster refinement").
@@ -39,6 +49,15 @@ struct BuildOptions {
   /// With `meshing`: the repairs tetrahedralize made (TetrahedralizeNotes::repairs), recorded
   /// as provenance keys "repairs.<kind, spaces as underscores>" = count.
   std::vector<RepairCount> repairs;
+  /// Recorded as provenance keys deviation.* (the relative ones and deviation.*_absolute);
+  /// only recorded. build_asset records 0 when neither this nor `meshing` is set (a tet mesh
+  /// is its own surface); the build jobs set it for a surface input.
+  std::optional<SurfaceDeviation> deviation;
+  /// With `meshing` and MeshingOptions::Repair::kAuto: the repair used ("fix" or "wrap") and
+  /// why the wrap was needed (TetrahedralizeNotes), recorded as provenance keys
+  /// meshing.repair_used and meshing.fallback_reason (only recorded).
+  std::string repair_used;
+  std::string fallback_reason;
 };
 
 /// One finished stage: its name, wall time, memory and a short human summary.
