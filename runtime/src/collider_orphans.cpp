@@ -35,12 +35,20 @@ void Collider::Impl::for_each_adjacent_feature_pair(bool across_clusters, Vertex
                                                     EdgeEdge&& edge_edge) const {
   const BodyShape::Data& T = *topo;
   std::vector<std::uint32_t> near, candidates;
-  // Appends the triangles sharing a node with triangle t (t included).
+  // Deduplication by stamps: an id is listed once per round (each vertex or edge e1 is a
+  // round), then the short unique list is sorted, so pairs come out in ascending order.
+  std::vector<std::uint32_t> tri_round(tri_count, 0), edge_round(T.edges.size(), 0);
+  std::uint32_t round = 0;
+  // Appends the triangles sharing a node with triangle t (t included), each once per round.
   auto gather_near = [&](std::uint32_t t) {
     for (std::uint32_t n : tris[t]) {
       const std::uint32_t i = T.surf_index[n];
-      near.insert(near.end(), T.vt_list.begin() + T.vt_offset[i],
-                  T.vt_list.begin() + T.vt_offset[i + 1]);
+      for (std::uint32_t k = T.vt_offset[i]; k < T.vt_offset[i + 1]; ++k) {
+        const std::uint32_t u = T.vt_list[k];
+        if (tri_round[u] == round) continue;
+        tri_round[u] = round;
+        near.push_back(u);
+      }
     }
   };
   // With `across_clusters`, a vertex or edge whose neighbour triangles (its own included) lie
@@ -51,18 +59,15 @@ void Collider::Impl::for_each_adjacent_feature_pair(bool across_clusters, Vertex
       if (asset->triangle_cluster[t] != asset->triangle_cluster[near[0]]) return false;
     return true;
   };
-  auto sort_unique = [](std::vector<std::uint32_t>& v) {
-    std::sort(v.begin(), v.end());
-    v.erase(std::unique(v.begin(), v.end()), v.end());
-  };
   // Vertex-face (p, F), p not in F, F sharing a node with a triangle around p: F is among
   // those triangles' neighbours.
   for (std::uint32_t ip = 0; ip < T.surf_nodes.size(); ++ip) {
     const std::uint32_t p = T.surf_nodes[ip];
     near.clear();
+    ++round;
     for (std::uint32_t k = T.vt_offset[ip]; k < T.vt_offset[ip + 1]; ++k) gather_near(T.vt_list[k]);
     if (one_cluster()) continue;
-    sort_unique(near);
+    std::sort(near.begin(), near.end());
     for (std::uint32_t f : near) {
       const auto& F = tris[f];
       if (p != F[0] && p != F[1] && p != F[2]) vertex_face(p, f);
@@ -73,13 +78,17 @@ void Collider::Impl::for_each_adjacent_feature_pair(bool across_clusters, Vertex
   const std::uint32_t ne = static_cast<std::uint32_t>(T.edges.size());
   for (std::uint32_t e1 = 0; e1 < ne; ++e1) {
     near.clear();
+    ++round;
     for (std::uint32_t k = T.et_offset[e1]; k < T.et_offset[e1 + 1]; ++k) gather_near(T.et_list[k]);
     if (one_cluster()) continue;
     candidates.clear();
     for (std::uint32_t t : near)
       for (std::uint32_t e2 : T.tri_edges[t])
-        if (e2 > e1) candidates.push_back(e2);
-    sort_unique(candidates);
+        if (e2 > e1 && edge_round[e2] != round) {
+          edge_round[e2] = round;
+          candidates.push_back(e2);
+        }
+    std::sort(candidates.begin(), candidates.end());
     const auto& E1 = T.edges[e1];
     for (std::uint32_t e2 : candidates) {
       const auto& E2 = T.edges[e2];
