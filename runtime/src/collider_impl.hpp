@@ -472,10 +472,12 @@ struct Collider::Impl {
   /// Calls vertex_face(p, f) for every vertex-face pair (p not in f) and edge_edge(e1, e2)
   /// for every edge pair (e1 < e2, four distinct nodes) held by some triangle pair that shares
   /// a node (construction; allocates, may throw). With `across_clusters`, only those where
-  /// such a pair spans two clusters, and maybe some others.
+  /// such a pair spans two clusters, and maybe some others. With `first_holder_only`, only
+  /// those where such a pair holds the first triangle around p (e1), and maybe some others:
+  /// enough for the orphans, whose every holding pair shares a node.
   template <typename VertexFace, typename EdgeEdge>
-  void for_each_adjacent_feature_pair(bool across_clusters, VertexFace&& vertex_face,
-                                      EdgeEdge&& edge_edge) const;
+  void for_each_adjacent_feature_pair(bool across_clusters, bool first_holder_only,
+                                      VertexFace&& vertex_face, EdgeEdge&& edge_edge) const;
   /// holder(t1, t2) is true for some triangle pair holding the feature pair: (t around p, f),
   /// or (t1 around e1, t2 around e2).
   template <typename Holder>

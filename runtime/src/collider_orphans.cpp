@@ -31,7 +31,8 @@ inline bool Collider::Impl::any_edge_edge_holder(std::uint32_t e1, std::uint32_t
 }
 
 template <typename VertexFace, typename EdgeEdge>
-void Collider::Impl::for_each_adjacent_feature_pair(bool across_clusters, VertexFace&& vertex_face,
+void Collider::Impl::for_each_adjacent_feature_pair(bool across_clusters, bool first_holder_only,
+                                                    VertexFace&& vertex_face,
                                                     EdgeEdge&& edge_edge) const {
   const BodyShape::Data& T = *topo;
   std::vector<std::uint32_t> near, candidates;
@@ -65,7 +66,8 @@ void Collider::Impl::for_each_adjacent_feature_pair(bool across_clusters, Vertex
     const std::uint32_t p = T.surf_nodes[ip];
     near.clear();
     ++round;
-    for (std::uint32_t k = T.vt_offset[ip]; k < T.vt_offset[ip + 1]; ++k) gather_near(T.vt_list[k]);
+    const std::uint32_t end = first_holder_only ? T.vt_offset[ip] + 1 : T.vt_offset[ip + 1];
+    for (std::uint32_t k = T.vt_offset[ip]; k < end; ++k) gather_near(T.vt_list[k]);
     if (one_cluster()) continue;
     std::sort(near.begin(), near.end());
     for (std::uint32_t f : near) {
@@ -79,7 +81,8 @@ void Collider::Impl::for_each_adjacent_feature_pair(bool across_clusters, Vertex
   for (std::uint32_t e1 = 0; e1 < ne; ++e1) {
     near.clear();
     ++round;
-    for (std::uint32_t k = T.et_offset[e1]; k < T.et_offset[e1 + 1]; ++k) gather_near(T.et_list[k]);
+    const std::uint32_t end = first_holder_only ? T.et_offset[e1] + 1 : T.et_offset[e1 + 1];
+    for (std::uint32_t k = T.et_offset[e1]; k < end; ++k) gather_near(T.et_list[k]);
     if (one_cluster()) continue;
     candidates.clear();
     for (std::uint32_t t : near)
@@ -103,7 +106,7 @@ void Collider::Impl::build_orphan_sets() {
   // Orphans: every holding triangle pair shares a node.
   auto disjoint = [&](std::uint32_t u, std::uint32_t v) { return !share_node(tris[u], tris[v]); };
   for_each_adjacent_feature_pair(
-      false,
+      false, true,
       [&](std::uint32_t p, std::uint32_t f) {
         if (!any_vertex_face_holder(p, f, disjoint)) orphan_vf.push_back({p, f});
       },
@@ -122,7 +125,7 @@ void Collider::Impl::build_seam_orphans() {
     return cluster[u] != cluster[v] && !share_node(tris[u], tris[v]);
   };
   for_each_adjacent_feature_pair(
-      true,
+      true, false,
       [&](std::uint32_t p, std::uint32_t f) {
         if (any_vertex_face_holder(p, f, cross) && !any_vertex_face_holder(p, f, cross_disjoint))
           seam_vf.push_back({p, f});
