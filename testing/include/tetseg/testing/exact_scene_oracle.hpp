@@ -16,39 +16,15 @@ namespace tetseg::test {
 /// runtime names them; `toi` is the exact first contact time rounded up. Sorted by
 /// `contact_less`.
 inline std::vector<Contact> scene_exact_contacts(const std::vector<OracleBody>& bodies) {
-  std::vector<Contact> out;
-  auto add = [&](ContactKind kind, std::uint32_t ba, std::uint32_t bb,
-                 std::array<std::uint32_t, 4> nodes, std::uint32_t tri, const ExactCcd& r) {
-    if (!r.hit) return;
-    Contact c;
-    c.kind = kind;
-    c.bodies = {ba, bb};
-    c.nodes = nodes;
-    c.triangle = tri;
-    c.at_start = r.at_start;
-    c.toi = r.toi_upper;
-    out.push_back(c);
-  };
-  auto at = [&](std::uint32_t b, std::uint32_t n, bool end) {
-    return oracle_point(bodies[b], n, end);
-  };
-  for_each_feature_pair(
+  auto answer = [](const ExactCcd& r) { return OracleAnswer{r.hit, r.at_start, r.toi_upper}; };
+  return scene_contacts(
       bodies,
-      [&](std::uint32_t vb, std::uint32_t p, std::uint32_t fb, std::uint32_t tri,
-          const std::array<std::uint32_t, 3>& F) {
-        add(ContactKind::kVertexFace, vb, fb, {p, F[0], F[1], F[2]}, tri,
-            exact_vertex_face(at(vb, p, false), at(fb, F[0], false), at(fb, F[1], false),
-                              at(fb, F[2], false), at(vb, p, true), at(fb, F[0], true),
-                              at(fb, F[1], true), at(fb, F[2], true)));
-      },
-      [&](std::uint32_t eb, std::uint32_t a, std::uint32_t b, std::uint32_t gb, std::uint32_t c,
-          std::uint32_t d) {
-        add(ContactKind::kEdgeEdge, eb, gb, {a, b, c, d}, 0,
-            exact_edge_edge(at(eb, a, false), at(eb, b, false), at(gb, c, false), at(gb, d, false),
-                            at(eb, a, true), at(eb, b, true), at(gb, c, true), at(gb, d, true)));
-      });
-  std::sort(out.begin(), out.end(), contact_less);
-  return out;
+      [&](const Vec3d& p0, const Vec3d& a0, const Vec3d& b0, const Vec3d& c0, const Vec3d& p1,
+          const Vec3d& a1, const Vec3d& b1,
+          const Vec3d& c1) { return answer(exact_vertex_face(p0, a0, b0, c0, p1, a1, b1, c1)); },
+      [&](const Vec3d& a0, const Vec3d& b0, const Vec3d& c0, const Vec3d& d0, const Vec3d& a1,
+          const Vec3d& b1, const Vec3d& c1,
+          const Vec3d& d1) { return answer(exact_edge_edge(a0, b0, c0, d0, a1, b1, c1, d1)); });
 }
 
 }  // namespace tetseg::test

@@ -132,21 +132,31 @@ inline Vec3d oracle_point(const OracleBody& body, std::uint32_t n, bool end) {
   return Vec3d{x[0], x[1], x[2]};
 }
 
-/// All contacts of the step through the elementary tests of ccd.hpp, sorted by
-/// `contact_less`, named as the runtime names them.
-inline std::vector<Contact> scene_brute_contacts(const std::vector<OracleBody>& bodies,
-                                                 bool include_still = false) {
+/// The answer of an elementary test for one feature pair, as the oracles record it.
+struct OracleAnswer {
+  bool hit = false;
+  bool at_start = false;  ///< touching at t = 0 (toi 0)
+  double toi = 1.0;
+};
+
+/// All contacts of the step, every feature pair of for_each_feature_pair decided by
+/// `vertex_face(p0, a0, b0, c0, p1, a1, b1, c1)` or `edge_edge(a0, b0, c0, d0, a1, b1, c1, d1)`
+/// (each returning an OracleAnswer), sorted by `contact_less`, named as the runtime names them.
+template <class VertexFaceTest, class EdgeEdgeTest>
+std::vector<Contact> scene_contacts(const std::vector<OracleBody>& bodies,
+                                    VertexFaceTest&& vertex_face, EdgeEdgeTest&& edge_edge,
+                                    bool include_still = false) {
   std::vector<Contact> out;
   auto add = [&](ContactKind kind, std::uint32_t ba, std::uint32_t bb,
-                 std::array<std::uint32_t, 4> nodes, std::uint32_t tri, CcdResult r) {
-    if (!r.hit()) return;
+                 std::array<std::uint32_t, 4> nodes, std::uint32_t tri, const OracleAnswer& r) {
+    if (!r.hit) return;
     Contact c;
     c.kind = kind;
     c.bodies = {ba, bb};
     c.nodes = nodes;
     c.triangle = tri;
-    c.at_start = r.outcome == CcdOutcome::kContactAtStart;
-    c.toi = c.at_start ? 0.0 : r.toi;
+    c.at_start = r.at_start;
+    c.toi = r.at_start ? 0.0 : r.toi;
     out.push_back(c);
   };
   auto at = [&](std::uint32_t b, std::uint32_t n, bool end) {
@@ -157,19 +167,37 @@ inline std::vector<Contact> scene_brute_contacts(const std::vector<OracleBody>& 
       [&](std::uint32_t vb, std::uint32_t p, std::uint32_t fb, std::uint32_t tri,
           const std::array<std::uint32_t, 3>& F) {
         add(ContactKind::kVertexFace, vb, fb, {p, F[0], F[1], F[2]}, tri,
-            vertex_face_ccd(at(vb, p, false), at(fb, F[0], false), at(fb, F[1], false),
-                            at(fb, F[2], false), at(vb, p, true), at(fb, F[0], true),
-                            at(fb, F[1], true), at(fb, F[2], true)));
+            vertex_face(at(vb, p, false), at(fb, F[0], false), at(fb, F[1], false),
+                        at(fb, F[2], false), at(vb, p, true), at(fb, F[0], true),
+                        at(fb, F[1], true), at(fb, F[2], true)));
       },
       [&](std::uint32_t eb, std::uint32_t a, std::uint32_t b, std::uint32_t gb, std::uint32_t c,
           std::uint32_t d) {
         add(ContactKind::kEdgeEdge, eb, gb, {a, b, c, d}, 0,
-            edge_edge_ccd(at(eb, a, false), at(eb, b, false), at(gb, c, false), at(gb, d, false),
-                          at(eb, a, true), at(eb, b, true), at(gb, c, true), at(gb, d, true)));
+            edge_edge(at(eb, a, false), at(eb, b, false), at(gb, c, false), at(gb, d, false),
+                      at(eb, a, true), at(eb, b, true), at(gb, c, true), at(gb, d, true)));
       },
       include_still);
   std::sort(out.begin(), out.end(), contact_less);
   return out;
+}
+
+/// All contacts of the step through the elementary tests of ccd.hpp, sorted by
+/// `contact_less`, named as the runtime names them.
+inline std::vector<Contact> scene_brute_contacts(const std::vector<OracleBody>& bodies,
+                                                 bool include_still = false) {
+  auto answer = [](const CcdResult& r) {
+    return OracleAnswer{r.hit(), r.outcome == CcdOutcome::kContactAtStart, r.toi};
+  };
+  return scene_contacts(
+      bodies,
+      [&](const Vec3d& p0, const Vec3d& a0, const Vec3d& b0, const Vec3d& c0, const Vec3d& p1,
+          const Vec3d& a1, const Vec3d& b1,
+          const Vec3d& c1) { return answer(vertex_face_ccd(p0, a0, b0, c0, p1, a1, b1, c1)); },
+      [&](const Vec3d& a0, const Vec3d& b0, const Vec3d& c0, const Vec3d& d0, const Vec3d& a1,
+          const Vec3d& b1, const Vec3d& c1,
+          const Vec3d& d1) { return answer(edge_edge_ccd(a0, b0, c0, d0, a1, b1, c1, d1)); },
+      include_still);
 }
 
 /// Closed box [lo, hi] with n x n quads (two triangles each) per face, wound outward; with
