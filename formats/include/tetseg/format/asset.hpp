@@ -19,9 +19,10 @@ namespace tetseg::format {
 
 /// Asset format version. Major must match to load; an asset with an older or equal minor
 /// version loads, a newer minor does not. 1.1 added detector points inside tets and the
-/// overlap-only cluster flag; `write_asset` writes 1.0 when the asset needs neither.
+/// overlap-only cluster flag; 1.2 added surface bodies and detectors carried by surface
+/// weights or bones. `write_asset` writes the oldest minor version the asset needs.
 inline constexpr std::uint16_t kVersionMajor = 1;
-inline constexpr std::uint16_t kVersionMinor = 1;
+inline constexpr std::uint16_t kVersionMinor = 1;  // 1.2: being implemented (issue 29)
 
 /// Documented limits, checked on load (docs/format.md). They bound memory for hostile input.
 inline constexpr std::uint32_t kMaxNodes = 1u << 26;              ///< 67,108,864 tet-mesh nodes
@@ -32,6 +33,8 @@ inline constexpr std::uint32_t kMaxStringBytes = 1u << 16;        ///< one prove
 inline constexpr std::uint32_t kMaxProvenanceOptions = 1024;      ///< provenance key/value pairs
 inline constexpr std::uint32_t kMaxBvhNodes = 2 * kMaxTriangles;  ///< all clusters' BVH nodes
 inline constexpr std::uint32_t kMaxBoundaryNodes = 3 * kMaxTriangles;  ///< all loops' node ids
+inline constexpr std::uint32_t kMaxDetectorTerms = 256;  ///< terms of one cluster's detector (1.2)
+inline constexpr std::uint32_t kMaxBones = 1u << 16;     ///< bones of a kBones asset (1.2)
 
 using Triangle = std::array<std::uint32_t, 3>;  ///< tet-mesh node ids, wound outward
 
@@ -92,6 +95,37 @@ inline std::array<double, 3> detector_position(const DetectorPoint& d, const dou
   return out;
 }
 
+/// What the asset's nodes are (1.2; 1.0 and 1.1 assets are kTet).
+enum class BodyKind : std::uint32_t {
+  /// Nodes of a tet mesh (surface vertices and interior nodes, `Cluster::detector` in tets).
+  kTet = 0,
+  /// A surface body, built with no tets behind it (`tetseg build --body surface`): node i is
+  /// vertex i of the input surface, in the input's order, and `triangles` are the input's
+  /// triangles in the input's order, so frames of the same simulation apply unchanged.
+  kSurface = 1,
+};
+
+/// How the clusters' detector points move (1.2; one form per asset; 1.0 and 1.1 are kTetPoint).
+enum class DetectorForm : std::uint32_t {
+  /// `Cluster::detector`: a node or a point of one tet (kTet bodies only).
+  kTetPoint = 0,
+  /// A fixed combination of nodes, `sum weight * x[index]` over the cluster's
+  /// `detector_terms` (index: node id), evaluated by the runtime from each step's positions.
+  kSurfaceWeights = 1,
+  /// Carried by bones: `Cluster::detector_rest` moved by linear blend skinning with the
+  /// cluster's `detector_terms` (index: bone id, into `Asset::bone_names`). The application
+  /// poses its skeleton and passes every detector's position at both ends of each step.
+  kBones = 2,
+};
+
+/// One term of a kSurfaceWeights or kBones detector: a node id or a bone id, and its weight
+/// (finite, >= 0; a cluster's weights sum to 1 within kDetectorWeightSumTolerance; indices of
+/// one cluster distinct).
+struct DetectorTerm {
+  std::uint32_t index = 0;
+  double weight = 0.0;
+};
+
 /// Cluster flag: no detector point sees the cluster well at rest, so it is culled by BVH
 /// overlap only (its triangles are never classified by orientation).
 inline constexpr std::uint32_t kClusterOverlapOnly = 1u;
@@ -101,13 +135,23 @@ inline constexpr std::uint32_t kKnownClusterFlags = kClusterOverlapOnly;
 /// A cluster: a connected patch of the surface bounded by segment boundaries, culled with
 /// radial views from its detector point (or by overlap only when flagged).
 struct Cluster {
-  DetectorPoint detector;               ///< node form: an interior node
+  /// kTetPoint assets: the detector. Other forms: the node form at node 0, never read.
+  DetectorPoint detector;
   std::uint32_t flags = 0;              ///< kClusterOverlapOnly or 0
   float rest_positive_fraction = 0.0f;  ///< in [0,1]: share of triangles positive at rest
   std::uint32_t triangle_offset = 0;    ///< into Asset::cluster_triangles
   std::uint32_t triangle_count = 0;     ///< > 0
   std::uint32_t bvh_offset = 0;         ///< into Asset::bvh_nodes
   std::uint32_t bvh_count = 0;          ///< > 0; 2 * leaves - 1
+  /// kSurfaceWeights and kBones (1.2): the detector's terms, `Asset::detector_terms`
+  /// `[detector_term_offset ..+ detector_term_count)`, stored contiguously in cluster order
+  /// like triangles; 1..kMaxDetectorTerms terms, or 0 for an overlap-only cluster.
+  /// kTetPoint: both 0.
+  std::uint32_t detector_term_offset = 0;
+  std::uint32_t detector_term_count = 0;
+  /// The detector's rest position (1.2; finite): kSurfaceWeights: the combination at rest;
+  /// kBones: the point the bones move. kTetPoint: unused (0).
+  std::array<double, 3> detector_rest{};
 };
 
 /// A segment boundary: a closed edge loop of surface nodes (consecutive nodes share a surface
@@ -142,6 +186,13 @@ struct Asset {
   std::vector<BoundaryLoop> boundaries;
   std::vector<std::uint32_t> boundary_nodes;  ///< loops' node ids, grouped, in loop order
   Provenance provenance;
+  // 1.2 (an asset with kTet and kTetPoint is written as 1.1 or 1.0):
+  BodyKind body_kind = BodyKind::kTet;
+  DetectorForm detector_form = DetectorForm::kTetPoint;
+  std::vector<DetectorTerm> detector_terms;  ///< all clusters' detector terms, grouped
+  /// kBones: the skeleton's bone names (from the input's skin), indexed by bone id; the
+  /// application maps its bones to these. Empty for other forms.
+  std::vector<std::string> bone_names;
 };
 
 }  // namespace tetseg::format
