@@ -244,8 +244,11 @@ BuildJobResult build_asset_from_file(const std::string& path, const BuildJobOpti
   const std::string& name = source.empty() ? path : source;
   return run_build(
       [&](std::string& summary) {
-        return is_tet_mesh_path(path) ? read_tet_mesh_input(read_tet_mesh(path), summary)
-                                      : read_surface_input(read_triangle_mesh(path), summary);
+        if (is_tet_mesh_path(path)) return read_tet_mesh_input(read_tet_mesh(path), summary);
+        return read_surface_input(options.build.body == format::BodyKind::kSurface
+                                      ? read_triangle_mesh_keeping_vertices(path)
+                                      : read_triangle_mesh(path),
+                                  summary);
       },
       name, options, on_stage);
 }
