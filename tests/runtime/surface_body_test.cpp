@@ -148,11 +148,13 @@ TEST_CASE("Surface bodies with weighted detectors find the contacts brute force 
   }
   SECTION("One cluster: every contact is inside the cluster, where orientation culls.") {
     const Surface bell = dumbbell(16, 26);
-    const Scene tet = make_scene(bell, std::vector<std::uint32_t>(bell.tris.size(), 0), {{0, 0, 0}});
+    const Scene tet =
+        make_scene(bell, std::vector<std::uint32_t>(bell.tris.size(), 0), {{0, 0, 0}});
     for (std::uint32_t terms : {2u, 8u}) {
       CAPTURE(terms);
       const Scene scene = as_weighted_surface_body(tet, terms);
-      const SequenceReport rep = compare_with_oracle(scene, make_frames(scene, 16, bend_dumbbell()));
+      const SequenceReport rep =
+          compare_with_oracle(scene, make_frames(scene, 16, bend_dumbbell()));
       REQUIRE(rep.contact_frames == 1);
       CHECK(rep.orientation_culled + rep.clusters_skipped > 0);
       for (unsigned seed : {3u, 17u}) {
@@ -204,8 +206,8 @@ TEST_CASE("Bone-carried detectors are exact at any positions, right or wrong",
   std::mt19937 rng(2026);
   auto u = [&] { return (rng() / 4294967296.0) * 2 - 1; };
   SECTION("Right: each detector moved by the same bend as the surface.") {
-    const auto det = detector_frames(
-        scene, frames.size(), [](std::size_t, const P3& rest, double t) {
+    const auto det =
+        detector_frames(scene, frames.size(), [](std::size_t, const P3& rest, double t) {
           return bend_about_x(rest, t, 2.6, -0.5, 0.5, 0.0);
         });
     const SequenceReport rep = compare_bones_with_oracle(scene, frames, det);
@@ -213,8 +215,8 @@ TEST_CASE("Bone-carried detectors are exact at any positions, right or wrong",
     CHECK(rep.orientation_culled > 0);  // a right pose culls
   }
   SECTION("Wrong: the skeleton stays at rest while the body bends.") {
-    const auto det =
-        detector_frames(scene, frames.size(), [](std::size_t, const P3& rest, double) { return rest; });
+    const auto det = detector_frames(scene, frames.size(),
+                                     [](std::size_t, const P3& rest, double) { return rest; });
     CHECK(compare_bones_with_oracle(scene, frames, det).contact_frames == 1);
   }
   SECTION("Wrong: detectors swapped between clusters and thrown far outside.") {
@@ -266,8 +268,9 @@ TEST_CASE("Surface bodies on deformed real meshes match brute force",
   double lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300};
   for (const P3& p : s.verts)
     for (int a = 0; a < 3; ++a) lo[a] = std::min(lo[a], p[a]), hi[a] = std::max(hi[a], p[a]);
-  const double size = std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) +
-                                (hi[1] - lo[1]) * (hi[1] - lo[1]) + (hi[2] - lo[2]) * (hi[2] - lo[2]));
+  const double size =
+      std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                (hi[2] - lo[2]) * (hi[2] - lo[2]));
   Waves waves(11, 0.2 * size, 6.0 / size);
   const SequenceReport rep = compare_with_oracle(scene, make_frames(scene, 10, waves));
   CHECK(rep.contact_frames == 1);
@@ -341,10 +344,9 @@ TEST_CASE("Surface bodies in a scene: self contacts equal the collider's", "[sur
   const Scene weights = as_weighted_surface_body(tet, 4);
   const Scene bones = as_bone_surface_body(tet, 3);
   const auto frames = make_frames(weights, 16, bend_dumbbell());
-  const auto det =
-      detector_frames(bones, frames.size(), [](std::size_t, const P3& rest, double t) {
-        return bend_about_x(rest, t, 2.6, -0.5, 0.5, 0.0);
-      });
+  const auto det = detector_frames(bones, frames.size(), [](std::size_t, const P3& rest, double t) {
+    return bend_about_x(rest, t, 2.6, -0.5, 0.5, 0.0);
+  });
   tetseg::Scene scene;
   std::uint32_t wid = 0, bid = 0;
   REQUIRE(scene.add_body(BodyShape::from_asset(weights.asset), {}, &wid) == ColliderStatus::kOk);
@@ -402,9 +404,8 @@ TEST_CASE("Surface bodies: steps and queries allocate nothing", "[surface][alloc
   const Scene weights = as_weighted_surface_body(tet, 4);
   const Scene bones = as_bone_surface_body(tet, 3);
   const auto frames = make_frames(weights, 16, bend_dumbbell());
-  const auto det = detector_frames(bones, frames.size(), [](std::size_t, const P3& rest, double) {
-    return rest;
-  });
+  const auto det = detector_frames(bones, frames.size(),
+                                   [](std::size_t, const P3& rest, double) { return rest; });
   std::vector<Contact> buffer(256);
   for (const Scene* s : {&weights, &bones}) {
     Collider c(s->asset);
