@@ -41,7 +41,8 @@ int run(const Args& a) {
   for (const auto& matrices : poses) {
     const std::vector<double> x = tetseg::test::skin_tube(tube, matrices);
     surface.positions.insert(surface.positions.end(), x.begin(), x.end());
-    for (const auto& m : matrices) bones.positions.insert(bones.positions.end(), m.begin(), m.end());
+    for (const auto& m : matrices)
+      bones.positions.insert(bones.positions.end(), m.begin(), m.end());
   }
   const std::string gltf = tetseg::test::tube_gltf(tube);
   const auto surface_bytes = tetseg::write_frames(surface);
@@ -59,8 +60,8 @@ int run(const Args& a) {
     write(tmp[1], surface_bytes.data(), surface_bytes.size());
     write(tmp[2], bone_bytes.data(), bone_bytes.size());
   });
-  std::printf("%s: %zu vertices, %zu triangles, %u bones, %u frames\n", kTool,
-              tube.vertex_count(), tube.triangles.size(), tube.options.bones, a.frames);
+  std::printf("%s: %zu vertices, %zu triangles, %u bones, %u frames\n", kTool, tube.vertex_count(),
+              tube.triangles.size(), tube.options.bones, a.frames);
   return kExitOk;
 }
 

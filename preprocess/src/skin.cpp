@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <map>
+#include <stdexcept>
 
 namespace tetseg::preprocess {
 
@@ -45,19 +46,17 @@ std::vector<std::vector<BoneInfluence>> skin_weights_at(const Skin& skin,
     if (!inserted && !same_influences(skin.influences[it->second], skin.influences[v]))
       throw InputError(path, "skin vertices " + std::to_string(it->second) + " and " +
                                  std::to_string(v) + " share the position " +
-                                 position_text(skin.vertices[v]) +
-                                 " but not their bone weights");
+                                 position_text(skin.vertices[v]) + " but not their bone weights");
   }
   std::vector<std::vector<BoneInfluence>> out;
   out.reserve(vertices.size());
   for (std::size_t v = 0; v < vertices.size(); ++v) {
     const auto it = skin_vertex_at.find(vertices[v]);
     if (it == skin_vertex_at.end())
-      throw InputError(path, "surface vertex " + std::to_string(v) + " at " +
-                                 position_text(vertices[v]) +
-                                 " has no skinned vertex at its position (" +
-                                 std::to_string(vertices.size()) + " surface vertices, " +
-                                 std::to_string(skin.vertices.size()) + " skinned)");
+      throw InputError(
+          path, "surface vertex " + std::to_string(v) + " at " + position_text(vertices[v]) +
+                    " has no skinned vertex at its position (" + std::to_string(vertices.size()) +
+                    " surface vertices, " + std::to_string(skin.vertices.size()) + " skinned)");
     out.push_back(skin.influences[it->second]);
   }
   return out;
@@ -87,6 +86,37 @@ std::vector<format::DetectorTerm> bone_detector_terms(
   std::sort(terms.begin(), terms.end(),
             [](const auto& a, const auto& b) { return a.index < b.index; });
   return terms;
+}
+
+void carry_detectors_by_bones(format::Asset& asset, const Skin& skin, const std::string& path,
+                              std::uint32_t max_terms) {
+  if (asset.body_kind != format::BodyKind::kSurface)
+    throw std::invalid_argument("carry_detectors_by_bones: not a surface body");
+  if (asset.rest_positions.size() != asset.node_count)
+    throw std::invalid_argument("carry_detectors_by_bones: the asset has no rest positions");
+  if (skin.bone_names.size() > format::kMaxBones)
+    throw InputError(path, std::to_string(skin.bone_names.size()) + " bones, more than " +
+                               std::to_string(format::kMaxBones));
+  const std::vector<Vec3> vertices(asset.rest_positions.begin(), asset.rest_positions.end());
+  const auto influences = skin_weights_at(skin, vertices, path);
+  std::vector<Tri> triangles(asset.triangles.begin(), asset.triangles.end());
+  std::vector<format::DetectorTerm> terms;
+  std::vector<format::Cluster> clusters = asset.clusters;
+  for (format::Cluster& c : clusters) {
+    c.detector_term_offset = static_cast<std::uint32_t>(terms.size());
+    c.detector_term_count = 0;
+    if (c.flags & format::kClusterOverlapOnly) continue;
+    const std::vector<std::uint32_t> own(
+        asset.cluster_triangles.begin() + c.triangle_offset,
+        asset.cluster_triangles.begin() + c.triangle_offset + c.triangle_count);
+    const auto cluster_terms = bone_detector_terms(influences, triangles, own, max_terms);
+    terms.insert(terms.end(), cluster_terms.begin(), cluster_terms.end());
+    c.detector_term_count = static_cast<std::uint32_t>(cluster_terms.size());
+  }
+  asset.clusters = std::move(clusters);
+  asset.detector_terms = std::move(terms);
+  asset.detector_form = format::DetectorForm::kBones;
+  asset.bone_names = skin.bone_names;
 }
 
 }  // namespace tetseg::preprocess

@@ -4,7 +4,11 @@
 
 #include <unistd.h>
 
+#include <assimp/scene.h>
+
 #include <algorithm>
+#include <assimp/Exporter.hpp>
+#include <assimp/Importer.hpp>
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <filesystem>
@@ -234,8 +238,7 @@ TEST_CASE("skin_weights_at: surfaces that the skin does not cover are refused", 
   }
 }
 
-TEST_CASE("bone_detector_terms: the cluster's averaged weights, heaviest bones, sum 1",
-          "[skin]") {
+TEST_CASE("bone_detector_terms: the cluster's averaged weights, heaviest bones, sum 1", "[skin]") {
   const SkinnedTube tube = tetseg::test::make_skinned_tube();
   std::vector<std::vector<BoneInfluence>> influences;
   for (const auto& vw : tube.weights) {
@@ -269,4 +272,111 @@ TEST_CASE("bone_detector_terms: the cluster's averaged weights, heaviest bones, 
   CHECK(two[0].index == 0);
   CHECK(two[1].index == 3);
   CHECK(std::fabs(two[0].weight + two[1].weight - 1) <= 1e-12);
+}
+
+TEST_CASE("carry_detectors_by_bones: every classified cluster carried by its own bones", "[skin]") {
+  const SkinnedTube tube = tetseg::test::make_skinned_tube();
+  TempDir dir("carry");
+  const std::string path = dir.write("tube.gltf", tetseg::test::tube_gltf(tube));
+  const Skin skin = read_skin(path);
+  // A surface body by hand: one cluster per bone by triangle-centroid x (the last one
+  // overlap-only), detectors on the axis at the bones' middles.
+  tetseg::format::Asset asset;
+  asset.body_kind = tetseg::format::BodyKind::kSurface;
+  asset.detector_form = tetseg::format::DetectorForm::kSurfaceWeights;
+  asset.node_count = static_cast<std::uint32_t>(tube.vertex_count());
+  for (std::size_t v = 0; v < tube.vertex_count(); ++v)
+    asset.rest_positions.push_back({tube.rest[3 * v], tube.rest[3 * v + 1], tube.rest[3 * v + 2]});
+  asset.triangles.assign(tube.triangles.begin(), tube.triangles.end());
+  const std::uint32_t bones = tube.options.bones;
+  std::vector<std::vector<std::uint32_t>> by_bone(bones);
+  for (std::uint32_t t = 0; t < asset.triangles.size(); ++t) {
+    double x = 0;
+    for (std::uint32_t v : asset.triangles[t]) x += tube.rest[3 * v] / 3;
+    by_bone[std::min<std::uint32_t>(bones - 1, x < 0 ? 0 : std::uint32_t(x))].push_back(t);
+  }
+  asset.triangle_cluster.resize(asset.triangles.size());
+  for (std::uint32_t b = 0; b < bones; ++b) {
+    tetseg::format::Cluster c;
+    c.triangle_offset = static_cast<std::uint32_t>(asset.cluster_triangles.size());
+    c.triangle_count = static_cast<std::uint32_t>(by_bone[b].size());
+    c.detector_rest = {b + 0.5, 0, 0};
+    if (b + 1 == bones) c.flags = tetseg::format::kClusterOverlapOnly;
+    for (std::uint32_t t : by_bone[b]) {
+      asset.cluster_triangles.push_back(t);
+      asset.triangle_cluster[t] = b;
+    }
+    asset.clusters.push_back(c);
+  }
+  SECTION("carried") {
+    carry_detectors_by_bones(asset, skin, path, 2);
+    CHECK(asset.detector_form == tetseg::format::DetectorForm::kBones);
+    CHECK(asset.bone_names == tube.bone_names);
+    std::uint32_t offset = 0;
+    for (std::uint32_t b = 0; b < bones; ++b) {
+      const auto& c = asset.clusters[b];
+      CHECK(c.detector_rest == std::array<double, 3>{b + 0.5, 0, 0});
+      REQUIRE(c.detector_term_offset == offset);
+      offset += c.detector_term_count;
+      if (b + 1 == bones) {
+        CHECK(c.detector_term_count == 0);
+        continue;
+      }
+      REQUIRE(c.detector_term_count >= 1);
+      REQUIRE(c.detector_term_count <= 2);
+      double sum = 0, own = 0;
+      for (std::uint32_t k = 0; k < c.detector_term_count; ++k) {
+        const auto& term = asset.detector_terms[c.detector_term_offset + k];
+        sum += term.weight;
+        if (term.index == b) own = term.weight;
+      }
+      CHECK(std::fabs(sum - 1) <= 1e-12);
+      CHECK(own > 0.5);  // the bone the cluster sits on carries most of it
+    }
+    CHECK(offset == asset.detector_terms.size());
+  }
+  SECTION("refused when the skin is of another surface; the asset unchanged") {
+    asset.rest_positions[17][1] += 1e-3;
+    const tetseg::format::Asset before = asset;
+    CHECK_THROWS_AS(carry_detectors_by_bones(asset, skin, path), InputError);
+    CHECK(asset.detector_form == before.detector_form);
+    CHECK(asset.detector_terms.empty());
+    CHECK(asset.bone_names.empty());
+  }
+}
+
+TEST_CASE("read_skin: FBX bones, with the per-corner vertices mapped back onto the surface",
+          "[skin]") {
+  // 4 vertices per ring and one cap ring: every coordinate prints exactly in ASCII FBX's six
+  // decimals. assimp's ASCII FBX exporter writes the file; its FBX importer gives every
+  // triangle corner its own vertex, which skin_weights_at maps back by position.
+  const SkinnedTube tube = tetseg::test::make_skinned_tube({3, 1.0, 0.25, 4, 2, 1, 0.35});
+  TempDir dir("fbx");
+  const std::string gltf = dir.write("tube.gltf", tetseg::test::tube_gltf(tube));
+  const std::string fbx = (dir.path / "tube.fbx").string();
+  {
+    Assimp::Importer importer;
+    const aiScene* scene = importer.ReadFile(gltf, 0);
+    REQUIRE(scene != nullptr);
+    Assimp::Exporter exporter;
+    REQUIRE(exporter.Export(scene, "fbxa", fbx) == aiReturn_SUCCESS);
+  }
+  const Skin skin = read_skin(fbx);
+  CHECK(skin.vertices.size() == 3 * tube.triangles.size());  // split per corner
+  REQUIRE(skin.bone_names == tube.bone_names);
+  for (std::uint32_t b = 0; b < tube.options.bones; ++b) {
+    const auto expected = tube.inverse_bind(b);
+    for (int k = 0; k < 12; ++k) CHECK(skin.inverse_bind[b][k] == Approx(expected[k]).margin(1e-6));
+  }
+  std::vector<Vec3> rest;
+  for (std::size_t v = 0; v < tube.vertex_count(); ++v)
+    rest.push_back({tube.rest[3 * v], tube.rest[3 * v + 1], tube.rest[3 * v + 2]});
+  const auto weights = skin_weights_at(skin, rest, fbx);
+  for (std::size_t v = 0; v < tube.vertex_count(); ++v) {
+    REQUIRE(weights[v].size() == tube.weights[v].size());
+    for (std::size_t k = 0; k < weights[v].size(); ++k) {
+      REQUIRE(weights[v][k].bone == tube.weights[v][k].bone);
+      REQUIRE(weights[v][k].weight == Approx(tube.weights[v][k].weight).margin(1e-5));
+    }
+  }
 }

@@ -23,7 +23,9 @@ namespace tetseg::test {
 /// A row-major 3x4 affine matrix: (R | t), applied as R p + t.
 using Affine = std::array<double, 12>;
 
-inline Affine affine_identity() { return {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0}; }
+inline Affine affine_identity() {
+  return {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
+}
 
 /// a * b (apply b first).
 inline Affine affine_multiply(const Affine& a, const Affine& b) {
@@ -69,13 +71,13 @@ struct BoneWeight {
 };
 
 struct SkinnedTubeOptions {
-  std::uint32_t bones = 4;              ///< bones along the tube, >= 1
-  double bone_length = 1.0;             ///< length of each bone along x
-  double radius = 0.25;                 ///< tube radius; caps are hemispheres
-  std::uint32_t around = 24;            ///< vertices per ring, >= 3
-  std::uint32_t rings_per_bone = 8;     ///< rings per bone along the cylinder, >= 1
-  std::uint32_t cap_rings = 4;          ///< rings of each hemispherical cap (pole excluded), >= 1
-  double blend = 0.35;                  ///< half-width of the weight blend at a joint, / bone_length, in (0, 0.5)
+  std::uint32_t bones = 4;           ///< bones along the tube, >= 1
+  double bone_length = 1.0;          ///< length of each bone along x
+  double radius = 0.25;              ///< tube radius; caps are hemispheres
+  std::uint32_t around = 24;         ///< vertices per ring, >= 3
+  std::uint32_t rings_per_bone = 8;  ///< rings per bone along the cylinder, >= 1
+  std::uint32_t cap_rings = 4;       ///< rings of each hemispherical cap (pole excluded), >= 1
+  double blend = 0.35;  ///< half-width of the weight blend at a joint, / bone_length, in (0, 0.5)
 };
 
 /// The tube at rest (bind pose): bone b spans x in [b, b+1] * bone_length, its joint (origin)
@@ -83,10 +85,10 @@ struct SkinnedTubeOptions {
 /// two beside its nearest joint, smoothly blended within `blend` of the joint).
 struct SkinnedTube {
   SkinnedTubeOptions options;
-  std::vector<double> rest;                          ///< vertex_count * 3 (float32 values)
+  std::vector<double> rest;                             ///< vertex_count * 3 (float32 values)
   std::vector<std::array<std::uint32_t, 3>> triangles;  ///< closed, outward winding
-  std::vector<std::vector<BoneWeight>> weights;      ///< per vertex (float32 values, sum 1)
-  std::vector<std::string> bone_names;               ///< "bone0", "bone1", ...
+  std::vector<std::vector<BoneWeight>> weights;         ///< per vertex (float32 values, sum 1)
+  std::vector<std::string> bone_names;                  ///< "bone0", "bone1", ...
   std::size_t vertex_count() const { return rest.size() / 3; }
   /// Bone b's inverse bind matrix (a translation by -b * bone_length along x).
   Affine inverse_bind(std::uint32_t b) const {
@@ -111,8 +113,10 @@ inline SkinnedTube make_skinned_tube(const SkinnedTubeOptions& options = {}) {
     const double phi = 0.5 * M_PI * k / options.cap_rings;
     profile.push_back({length + r * std::cos(phi), r * std::sin(phi)});
   }
+  // float32 values; cos(pi/2) and the like become exact zeros (so that a tube with 4 or 8
+  // vertices per ring and one cap ring has coordinates that print exactly).
   auto add_vertex = [&](double x, double y, double z) {
-    for (double v : {x, y, z}) tube.rest.push_back(double(float(v)));
+    for (double v : {x, y, z}) tube.rest.push_back(std::fabs(v) < 1e-12 ? 0.0 : double(float(v)));
   };
   add_vertex(-r, 0, 0);
   for (const auto& [x, ring_radius] : profile) {
