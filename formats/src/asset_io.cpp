@@ -156,10 +156,19 @@ const char* to_string(Status status) noexcept {
 }
 
 std::uint16_t minor_version_needed(const Asset& asset) noexcept {
+  // Anything 1.2 stores (also when it is invalid, so the reader refuses it rather than the
+  // writer dropping it).
+  if (asset.body_kind != BodyKind::kTet || asset.detector_form != DetectorForm::kTetPoint ||
+      !asset.detector_terms.empty() || !asset.bone_names.empty())
+    return 2;
+  std::uint16_t minor = 0;
   for (const Cluster& c : asset.clusters) {
-    if (!c.detector.is_node() || c.detector.tet != kNoTet || c.flags != 0) return 1;
+    if (c.detector_term_offset != 0 || c.detector_term_count != 0 ||
+        c.detector_rest != std::array<double, 3>{})
+      return 2;
+    if (!c.detector.is_node() || c.detector.tet != kNoTet || c.flags != 0) minor = 1;
   }
-  return 0;
+  return minor;
 }
 
 std::vector<std::uint8_t> write_asset(const Asset& asset) {

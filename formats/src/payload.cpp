@@ -164,15 +164,25 @@ void decode_u32_vector(Decoder& d, const char* what, std::uint64_t limit, std::v
 }
 
 /// Bytes of one cluster record: 1.0 stores the detector node, 1.1 the detector point (four
-/// node ids, four weights, the tet id) and the flags.
+/// node ids, four weights, the tet id) and the flags, 1.2 also the detector's term range and
+/// rest position.
 constexpr std::size_t cluster_record_bytes(std::uint16_t minor) {
-  return minor == 0 ? 24 : 76;
+  return minor == 0 ? 24 : minor == 1 ? 76 : 108;
 }
+
+/// Bytes of one detector term (u32 index, f64 weight).
+constexpr std::size_t kDetectorTermBytes = 12;
+/// Largest detector_terms count: every cluster with the most terms.
+constexpr std::uint64_t kMaxDetectorTermsTotal = std::uint64_t(kMaxClusters) * kMaxDetectorTerms;
 
 }  // namespace
 
 std::size_t payload_bytes(const Asset& a, std::uint16_t minor) {
   std::size_t n = 1 + 4 + 8 * 11;
+  if (minor >= 2) {
+    n += 8 + 8 + 8 + kDetectorTermBytes * a.detector_terms.size();
+    for (const std::string& name : a.bone_names) n += 8 + name.size();
+  }
   n += 24 * a.rest_positions.size() + 12 * a.triangles.size() + 4 * a.triangle_cluster.size();
   n += cluster_record_bytes(minor) * a.clusters.size() + 4 * a.cluster_triangles.size() +
        12 * a.bvh_nodes.size();
@@ -186,6 +196,10 @@ void encode_payload(const Asset& a, std::uint16_t minor, std::vector<std::uint8_
   out.reserve(out.size() + payload_bytes(a, minor));
   Encoder e(out);  // writes the little-endian tag byte
   e.scalar(a.node_count);
+  if (minor >= 2) {
+    e.scalar(static_cast<std::uint32_t>(a.body_kind));
+    e.scalar(static_cast<std::uint32_t>(a.detector_form));
+  }
   e.count(a.rest_positions.size());
   if (!a.rest_positions.empty())
     e.array(a.rest_positions.front().data(), 3 * a.rest_positions.size());
@@ -208,6 +222,11 @@ void encode_payload(const Asset& a, std::uint16_t minor, std::vector<std::uint8_
     e.scalar(c.triangle_count);
     e.scalar(c.bvh_offset);
     e.scalar(c.bvh_count);
+    if (minor >= 2) {
+      e.scalar(c.detector_term_offset);
+      e.scalar(c.detector_term_count);
+      for (double x : c.detector_rest) e.scalar(x);
+    }
   }
   e.count(a.cluster_triangles.size());
   e.array(a.cluster_triangles.data(), a.cluster_triangles.size());
@@ -217,6 +236,15 @@ void encode_payload(const Asset& a, std::uint16_t minor, std::vector<std::uint8_
   e.array(reinterpret_cast<const std::uint32_t*>(a.boundaries.data()), 2 * a.boundaries.size());
   e.count(a.boundary_nodes.size());
   e.array(a.boundary_nodes.data(), a.boundary_nodes.size());
+  if (minor >= 2) {
+    e.count(a.detector_terms.size());
+    for (const DetectorTerm& term : a.detector_terms) {
+      e.scalar(term.index);
+      e.scalar(term.weight);
+    }
+    e.count(a.bone_names.size());
+    for (const std::string& name : a.bone_names) e.string(name);
+  }
   e.string(a.provenance.tool_version);
   e.string(a.provenance.source);
   e.count(a.provenance.options.size());
@@ -239,6 +267,11 @@ Status decode_payload(const std::uint8_t* data, std::size_t size, std::uint16_t 
     }
     Decoder d(data, size);
     a.node_count = d.scalar<std::uint32_t>();
+    if (minor >= 2) {
+      // Any value decodes; validation judges unknown kinds and forms.
+      a.body_kind = static_cast<BodyKind>(d.scalar<std::uint32_t>());
+      a.detector_form = static_cast<DetectorForm>(d.scalar<std::uint32_t>());
+    }
     {
       const std::size_t n = d.count("rest_positions", kMaxNodes, 3 * sizeof(double));
       a.rest_positions.resize(n);
@@ -267,12 +300,30 @@ Status decode_payload(const std::uint8_t* data, std::size_t size, std::uint16_t 
         c.triangle_count = d.scalar<std::uint32_t>();
         c.bvh_offset = d.scalar<std::uint32_t>();
         c.bvh_count = d.scalar<std::uint32_t>();
+        if (minor >= 2) {
+          c.detector_term_offset = d.scalar<std::uint32_t>();
+          c.detector_term_count = d.scalar<std::uint32_t>();
+          for (double& x : c.detector_rest) x = d.scalar<double>();
+        }
       }
     }
     decode_u32_vector(d, "cluster_triangles", kMaxTriangles, a.cluster_triangles);
     decode_u32_vector(d, "bvh_nodes", kMaxBvhNodes, a.bvh_nodes);
     decode_u32_vector(d, "boundaries", kMaxBoundaryLoops, a.boundaries);
     decode_u32_vector(d, "boundary_nodes", kMaxBoundaryNodes, a.boundary_nodes);
+    if (minor >= 2) {
+      const std::size_t terms =
+          d.count("detector_terms", kMaxDetectorTermsTotal, kDetectorTermBytes);
+      a.detector_terms.resize(terms);
+      for (DetectorTerm& term : a.detector_terms) {
+        term.index = d.scalar<std::uint32_t>();
+        term.weight = d.scalar<double>();
+      }
+      // Each name is at least its 8-byte size tag.
+      const std::size_t bones = d.count("bone_names", kMaxBones, 8);
+      a.bone_names.resize(bones);
+      for (std::string& name : a.bone_names) d.string("bone name", name);
+    }
     d.string("provenance.tool_version", a.provenance.tool_version);
     d.string("provenance.source", a.provenance.source);
     {

@@ -16,7 +16,7 @@ namespace tetseg::format::detail {
 /// Exact size in bytes of the payload of `asset` in format 1.`minor`.
 std::size_t payload_bytes(const Asset& asset, std::uint16_t minor);
 
-/// Appends the payload of `asset` in format 1.`minor` (0 or 1) to `out`. Deterministic. In
+/// Appends the payload of `asset` in format 1.`minor` (0, 1 or 2) to `out`. Deterministic. In
 /// 1.0, a cluster's detector is stored as `detector.nodes[0]` (the caller checks that the
 /// asset needs no more, minor_version_needed). Throws std::bad_alloc only.
 void encode_payload(const Asset& asset, std::uint16_t minor, std::vector<std::uint8_t>& out);

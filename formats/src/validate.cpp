@@ -2,6 +2,7 @@
 // allocation here is bounded by the sizes of vectors that already exist, never by a scalar
 // read from the file (node_count in particular is never used to size anything).
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -44,6 +45,9 @@ void check_limits(const Asset& a) {
   limit("bvh_nodes", a.bvh_nodes.size(), kMaxBvhNodes);
   limit("boundaries", a.boundaries.size(), kMaxBoundaryLoops);
   limit("boundary_nodes", a.boundary_nodes.size(), kMaxBoundaryNodes);
+  limit("detector_terms", a.detector_terms.size(), std::uint64_t(kMaxClusters) * kMaxDetectorTerms);
+  limit("bone_names", a.bone_names.size(), kMaxBones);
+  for (const std::string& name : a.bone_names) limit("bone name", name.size(), kMaxStringBytes);
   limit("provenance.tool_version", a.provenance.tool_version.size(), kMaxStringBytes);
   limit("provenance.source", a.provenance.source.size(), kMaxStringBytes);
   limit("provenance.options", a.provenance.options.size(), kMaxProvenanceOptions);
@@ -83,14 +87,21 @@ void check_nodes_and_triangles(const Asset& a) {
   }
 }
 
-/// A cluster's detector is in node form or point form (asset.hpp, DetectorPoint), its ids
-/// below node_count, and its flags known. Whether a point-form detector lies inside the body
-/// is not checked (the asset stores no tets); the runtime is correct for any detector point.
+/// A cluster's flags are known. kTetPoint: its detector is in node form or point form
+/// (asset.hpp, DetectorPoint), its ids below node_count. Whether a point-form detector lies
+/// inside the body is not checked (the asset stores no tets); the runtime is correct for any
+/// detector point. Other forms: the unused detector is the node form at node 0, no tet id.
 void check_detector_point(const Asset& a, std::size_t c) {
   const Cluster& cl = a.clusters[c];
   const DetectorPoint& d = cl.detector;
   if ((cl.flags & ~kKnownClusterFlags) != 0) {
     fail(at("clusters", c) + ".flags has unknown bits " + std::to_string(cl.flags));
+  }
+  if (a.detector_form != DetectorForm::kTetPoint) {
+    if (!d.is_node() || d.nodes[0] != 0 || d.tet != kNoTet)
+      fail(at("clusters", c) +
+           ".detector is not the unused node form at node 0 (the detector form is not kTetPoint)");
+    return;
   }
   for (std::uint32_t id : d.nodes) {
     if (id >= a.node_count) {
@@ -185,9 +196,101 @@ void check_partition(const Asset& a) {
   // cluster_triangles.size() == tri_count every triangle appears exactly once.
 }
 
-/// Node-form detectors are interior: not a vertex of any surface triangle. Searches the (few)
-/// detector ids for every triangle corner rather than sorting all surface nodes.
+/// Body kind and detector form are known and go together: kTetPoint needs a kTet body (its
+/// detectors are points of tets); kSurfaceWeights and kBones may move the detectors of either
+/// body kind (the runtime evaluates them the same way). kTetPoint stores no detector terms, no
+/// bone names and zero term ranges and rest positions; kSurfaceWeights no bone names.
+void check_body_and_form(const Asset& a) {
+  const auto kind = static_cast<std::uint32_t>(a.body_kind);
+  const auto form = static_cast<std::uint32_t>(a.detector_form);
+  if (a.body_kind != BodyKind::kTet && a.body_kind != BodyKind::kSurface)
+    fail("body_kind " + std::to_string(kind) + " is unknown");
+  if (a.detector_form != DetectorForm::kTetPoint &&
+      a.detector_form != DetectorForm::kSurfaceWeights && a.detector_form != DetectorForm::kBones)
+    fail("detector_form " + std::to_string(form) + " is unknown");
+  if (a.detector_form == DetectorForm::kTetPoint && a.body_kind != BodyKind::kTet)
+    fail("detector_form kTetPoint needs body_kind kTet (a surface body has no tets)");
+  if (a.detector_form != DetectorForm::kBones && !a.bone_names.empty())
+    fail("bone_names has " + std::to_string(a.bone_names.size()) +
+         " entries but the detector form is not kBones");
+  if (a.detector_form != DetectorForm::kTetPoint) return;
+  if (!a.detector_terms.empty())
+    fail("detector_terms has " + std::to_string(a.detector_terms.size()) +
+         " entries but the detector form is kTetPoint");
+  for (std::size_t c = 0; c < a.clusters.size(); ++c) {
+    const Cluster& cl = a.clusters[c];
+    if (cl.detector_term_offset != 0 || cl.detector_term_count != 0 ||
+        cl.detector_rest != std::array<double, 3>{})
+      fail(at("clusters", c) + " has a detector term range or rest position (kTetPoint: all 0)");
+  }
+}
+
+/// kSurfaceWeights and kBones: each cluster's terms are contiguous in cluster order and cover
+/// detector_terms exactly; 1..kMaxDetectorTerms terms (0 allowed for an overlap-only cluster);
+/// indices below node_count (weights) or bone_names.size() (bones) and distinct within the
+/// cluster; weights finite, >= 0, summing to 1 within kDetectorWeightSumTolerance;
+/// detector_rest finite.
+void check_detector_terms(const Asset& a) {
+  if (a.detector_form == DetectorForm::kTetPoint) return;
+  const bool bones = a.detector_form == DetectorForm::kBones;
+  const std::uint64_t bound = bones ? a.bone_names.size() : a.node_count;
+  const char* bound_name = bones ? "bone_names.size()" : "node_count";
+  std::uint64_t next = 0;
+  std::vector<std::uint32_t> ids;
+  ids.reserve(kMaxDetectorTerms);
+  for (std::size_t c = 0; c < a.clusters.size(); ++c) {
+    const Cluster& cl = a.clusters[c];
+    const std::string where = at("clusters", c);
+    for (double x : cl.detector_rest) {
+      if (!std::isfinite(x)) fail(where + ".detector_rest is not finite");
+    }
+    if (cl.detector_term_offset != next) {
+      fail(where + ".detector_term_offset is " + std::to_string(cl.detector_term_offset) +
+           ", expected " + std::to_string(next) + " (detector terms are contiguous)");
+    }
+    if (cl.detector_term_count > kMaxDetectorTerms) {
+      fail(where + " has " + std::to_string(cl.detector_term_count) +
+           " detector terms, the limit is " + std::to_string(kMaxDetectorTerms));
+    }
+    if (cl.detector_term_count == 0 && !(cl.flags & kClusterOverlapOnly))
+      fail(where + " has no detector terms and is not overlap-only");
+    next += cl.detector_term_count;
+    if (next > a.detector_terms.size()) fail(where + " detector term range exceeds detector_terms");
+    const DetectorTerm* terms = a.detector_terms.data() + cl.detector_term_offset;
+    ids.clear();
+    double sum = 0.0;
+    for (std::uint32_t i = 0; i < cl.detector_term_count; ++i) {
+      const DetectorTerm& term = terms[i];
+      if (term.index >= bound) {
+        fail(where + " detector term " + std::to_string(i) + " has index " +
+             std::to_string(term.index) + " >= " + bound_name + " " + std::to_string(bound));
+      }
+      if (!std::isfinite(term.weight) || term.weight < 0.0) {
+        fail(where + " detector term " + std::to_string(i) + " weight " +
+             std::to_string(term.weight) + " is not a finite non-negative value");
+      }
+      sum += term.weight;
+      ids.push_back(term.index);
+    }
+    if (cl.detector_term_count > 0 && !(std::fabs(sum - 1.0) <= kDetectorWeightSumTolerance)) {
+      fail(where + " detector term weights sum to " + std::to_string(sum) + ", not 1 within " +
+           std::to_string(kDetectorWeightSumTolerance));
+    }
+    std::sort(ids.begin(), ids.end());
+    const auto repeat = std::adjacent_find(ids.begin(), ids.end());
+    if (repeat != ids.end())
+      fail(where + " detector terms repeat index " + std::to_string(*repeat));
+  }
+  if (next != a.detector_terms.size()) {
+    fail("clusters use " + std::to_string(next) + " of " + std::to_string(a.detector_terms.size()) +
+         " detector_terms");
+  }
+}
+
+/// kTetPoint: node-form detectors are interior: not a vertex of any surface triangle. Searches
+/// the (few) detector ids for every triangle corner rather than sorting all surface nodes.
 void check_detectors(const Asset& a) {
+  if (a.detector_form != DetectorForm::kTetPoint) return;
   std::vector<std::uint32_t> detectors;
   detectors.reserve(a.clusters.size());
   for (const Cluster& c : a.clusters)
@@ -336,7 +439,9 @@ Status validate(const Asset& asset, std::string* detail) noexcept {
   try {
     check_limits(asset);
     check_nodes_and_triangles(asset);
+    check_body_and_form(asset);
     check_partition(asset);
+    check_detector_terms(asset);
     check_detectors(asset);
     check_bvhs(asset);
     check_boundaries(asset);

@@ -34,7 +34,9 @@ Asset dirty() {
 
 TEST_CASE("Every truncated prefix of a valid asset is rejected", "[format][hostile]") {
   const Asset source =
-      GENERATE(make_octahedron_asset(), make_octahedron_asset_v11(), make_cube_asset(2));
+      GENERATE(make_octahedron_asset(), make_octahedron_asset_v11(), make_cube_asset(2),
+               make_surface_octahedron_v12(DetectorForm::kSurfaceWeights),
+               make_surface_octahedron_v12(DetectorForm::kBones));
   const auto bytes = write_asset(source);
   SECTION("A prefix shorter than the envelope is too short; a longer one has a short payload.") {
     for (std::size_t len = 0; len < bytes.size(); ++len) {
@@ -75,9 +77,11 @@ TEST_CASE("Any payload byte changed behind a consistent envelope is decoded safe
   // Every payload byte is set to each of a few values and the envelope resealed, so the
   // change reaches the decoder and the validator. Whatever the status, a failure leaves the
   // asset empty, an accepted result re-writes to the same bytes, and no single allocation
-  // exceeds a small multiple of the input size. Both layouts: 1.0 and 1.1 (detector points,
-  // weights and flags).
-  const auto good = write_asset(GENERATE(make_octahedron_asset(), make_octahedron_asset_v11()));
+  // exceeds a small multiple of the input size. Every layout: 1.0, 1.1 (detector points,
+  // weights and flags) and 1.2 (surface bodies, detector terms, bone names).
+  const auto good = write_asset(GENERATE(make_octahedron_asset(), make_octahedron_asset_v11(),
+                                         make_surface_octahedron_v12(DetectorForm::kSurfaceWeights),
+                                         make_surface_octahedron_v12(DetectorForm::kBones)));
   std::size_t accepted = 0;
   std::size_t decode_failed = 0;
   std::size_t invalid = 0;
@@ -136,7 +140,8 @@ TEST_CASE("Bytes after the payload are rejected", "[format][hostile]") {
 }
 
 TEST_CASE("Single-byte flips are caught by the documented step", "[format][hostile]") {
-  const auto bytes = write_asset(GENERATE(make_octahedron_asset(), make_octahedron_asset_v11()));
+  const auto bytes = write_asset(GENERATE(make_octahedron_asset(), make_octahedron_asset_v11(),
+                                          make_surface_octahedron_v12(DetectorForm::kBones)));
   struct Range {
     std::size_t begin, end;
     Status expected;
@@ -221,8 +226,8 @@ TEST_CASE("Versions: major must match and a newer minor is rejected", "[format][
   // A reader of 1.N rejects 1.(N+1) by its version status before decoding anything: this is
   // how a 1.0 reader rejects a 1.1 asset (the 1.0 reader's check is this same code).
   CHECK(read_exact(with(kMinorAt, kVersionMinor + 1, 2), out, &why) == Status::kUnsupportedVersion);
-  CHECK(why.find("1.2") != std::string::npos);
-  CHECK(why.find("reads 1.0 to 1.1") != std::string::npos);
+  CHECK(why.find("1.3") != std::string::npos);
+  CHECK(why.find("reads 1.0 to 1.2") != std::string::npos);
   CHECK(read_exact(with(kMinorAt, 0xFFFF, 2), out) == Status::kUnsupportedVersion);
   CHECK(read_exact(with(kMajorAt, kVersionMajor + 1, 2), out) == Status::kUnsupportedVersion);
   CHECK(read_exact(with(kMajorAt, kVersionMajor - 1, 2), out) == Status::kUnsupportedVersion);
@@ -237,6 +242,17 @@ TEST_CASE("Versions: major must match and a newer minor is rejected", "[format][
     REQUIRE(get_le(v11, kMinorAt, 2) == 1);
     CHECK(read_exact(v11, back) == Status::kOk);
     CHECK(assets_equal(back, make_octahedron_asset_v11()));
+    const Asset surface = make_surface_octahedron_v12(DetectorForm::kSurfaceWeights);
+    const auto v12 = write_asset(surface);
+    REQUIRE(get_le(v12, kMinorAt, 2) == 2);
+    CHECK(read_exact(v12, back) == Status::kOk);
+    CHECK(assets_equal(back, surface));
+  }
+  SECTION("A 1.1 reader rejects a 1.2 asset by its version status, before decoding.") {
+    // The 1.1 reader's check is `minor > kVersionMinor` with kVersionMinor = 1: this same code.
+    const auto v12 = write_asset(make_surface_octahedron_v12(DetectorForm::kBones));
+    CHECK(get_le(v12, kMinorAt, 2) > 1);
+    CHECK(get_le(v12, kMinorAt, 2) <= kVersionMinor);
   }
   SECTION("A payload relabelled with the other minor does not decode (the layouts differ).") {
     CHECK(read_exact(with(kMinorAt, 1, 2), out) == Status::kDecodeFailed);
@@ -245,11 +261,20 @@ TEST_CASE("Versions: major must match and a newer minor is rejected", "[format][
     reseal_header(v11);
     CHECK(read_exact(v11, out) == Status::kDecodeFailed);
     CHECK(is_empty(out));
+    for (std::uint16_t other : {0, 1}) {
+      auto v12 = write_asset(make_surface_octahedron_v12(DetectorForm::kSurfaceWeights));
+      put_le(v12, kMinorAt, other, 2);
+      reseal_header(v12);
+      CHECK(read_exact(v12, out) == Status::kDecodeFailed);
+    }
+    CHECK(read_exact(with(kMinorAt, 2, 2), out) == Status::kDecodeFailed);
+    CHECK(is_empty(out));
   }
 }
 
 TEST_CASE("Payloads that claim huge vectors are rejected without allocating", "[format][hostile]") {
-  const Asset source = make_octahedron_asset();
+  const Asset source =
+      GENERATE(make_octahedron_asset(), make_surface_octahedron_v12(DetectorForm::kBones));
   const auto good = write_asset(source);
   const auto tags = payload_size_tags(source);
   {

@@ -1,8 +1,9 @@
 // libFuzzer harness for the asset reader. It must never crash, and it must be deterministic:
 // the same bytes give the same status twice, and an accepted input re-writes to exactly the
 // bytes it was read from (the encoding is canonical) and to the same bytes every time. The
-// one exception (docs/format.md, "Determinism"): a 1.1 input that needs nothing of 1.1 is
-// re-written as 1.0, which must read back to an asset that writes the same bytes again.
+// one exception (docs/format.md, "Determinism"): an input that needs only an older minor (a
+// 1.1 input that needs nothing of 1.1, a 1.2 one with a kTet body and kTetPoint detectors) is
+// re-written in that minor, which must read back to an asset that writes the same bytes again.
 //
 // Each input is read twice over: as given (exercises the envelope checks), and "resealed"
 // with payload size and both checksums recomputed, so mutations of the payload reach the

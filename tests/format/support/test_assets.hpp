@@ -20,9 +20,12 @@
 namespace tetseg::test {
 
 using format::Asset;
+using format::BodyKind;
 using format::BvhNode;
 using format::Cluster;
+using format::DetectorForm;
 using format::DetectorPoint;
+using format::DetectorTerm;
 using format::kClusterOverlapOnly;
 using format::kNoTet;
 using format::minor_version_needed;
@@ -76,7 +79,9 @@ inline void reseal(std::vector<std::uint8_t>& b) {
 /// computed from the documented field order. Names match docs/format.md.
 inline std::vector<std::pair<std::string, std::size_t>> payload_size_tags(const Asset& a) {
   std::vector<std::pair<std::string, std::size_t>> tags;
-  std::size_t at = 1 + 4;  // endianness tag, node_count
+  const std::uint16_t minor = minor_version_needed(a);
+  std::size_t at = 1 + 4;       // endianness tag, node_count
+  if (minor >= 2) at += 4 + 4;  // body_kind, detector_form
   auto tag = [&](const char* name, std::size_t n, std::size_t element_bytes) {
     tags.emplace_back(name, at);
     at += 8 + n * element_bytes;
@@ -84,11 +89,17 @@ inline std::vector<std::pair<std::string, std::size_t>> payload_size_tags(const 
   tag("rest_positions", a.rest_positions.size(), 24);
   tag("triangles", a.triangles.size(), 12);
   tag("triangle_cluster", a.triangle_cluster.size(), 4);
-  tag("clusters", a.clusters.size(), minor_version_needed(a) == 0 ? 24 : 76);
+  tag("clusters", a.clusters.size(), minor == 0 ? 24 : minor == 1 ? 76 : 108);
   tag("cluster_triangles", a.cluster_triangles.size(), 4);
   tag("bvh_nodes", a.bvh_nodes.size(), 12);
   tag("boundaries", a.boundaries.size(), 8);
   tag("boundary_nodes", a.boundary_nodes.size(), 4);
+  if (minor >= 2) {
+    tag("detector_terms", a.detector_terms.size(), 12);
+    tags.emplace_back("bone_names", at);
+    at += 8;
+    for (const std::string& name : a.bone_names) tag("bone name", name.size(), 1);
+  }
   tag("provenance.tool_version", a.provenance.tool_version.size(), 1);
   tag("provenance.source", a.provenance.source.size(), 1);
   tags.emplace_back("provenance.options", at);
@@ -131,8 +142,10 @@ inline double dot(const Vec3& a, const Vec3& b) {
   return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
 }
 
-/// Rest position of a cluster's detector.
+/// Rest position of a cluster's detector (kTetPoint: evaluated from the rest positions; other
+/// forms: `detector_rest`).
 inline Vec3 detector_position(const Asset& a, const Cluster& c) {
+  if (a.detector_form != DetectorForm::kTetPoint) return c.detector_rest;
   return format::detector_position(c.detector, a.rest_positions.front().data());
 }
 
@@ -219,6 +232,47 @@ inline Asset make_octahedron_asset_v11() {
   lower.weights = {0.25, 0.25, 0.25, 0.25};
   lower.tet = 9;
   return make_octahedron(upper, lower, kClusterOverlapOnly);
+}
+
+/// Gives cluster `c` (called in cluster order, after every earlier cluster's terms) the
+/// detector `terms` at rest position `rest`, and recomputes its rest_positive_fraction.
+inline void set_detector_terms(Asset& a, std::size_t c, const std::vector<DetectorTerm>& terms,
+                               const Vec3& rest) {
+  Cluster& cl = a.clusters[c];
+  cl.detector_term_offset = static_cast<std::uint32_t>(a.detector_terms.size());
+  cl.detector_term_count = static_cast<std::uint32_t>(terms.size());
+  cl.detector_rest = rest;
+  a.detector_terms.insert(a.detector_terms.end(), terms.begin(), terms.end());
+  cl.rest_positive_fraction = positive_fraction(a, cl);
+}
+
+/// The golden assets of version 1.2: the octahedron as a surface body (no interior nodes; node
+/// 6 is a vertex no triangle uses, as an input surface may have), same clusters and loop.
+/// kSurfaceWeights: the upper cluster seen from (0, 0, 0.5) = 1/8 of each equator vertex + 1/2
+/// of the top, the lower one from (0, 0, -0.5) = 1/4 of +x and -x + 1/2 of the bottom.
+/// kBones: bones "root", "spine", "head"; the upper detector at (0, 0, 0.5) carried 3/4 by
+/// "spine" and 1/4 by "head"; the lower cluster overlap-only without terms, at (0, 0, -0.5).
+inline Asset make_surface_octahedron_v12(DetectorForm form) {
+  Asset a = make_octahedron(DetectorPoint::at_node(0), DetectorPoint::at_node(0));
+  a.rest_positions.resize(6);
+  a.rest_positions.push_back({3, 3, 3});
+  a.node_count = 7;
+  a.body_kind = BodyKind::kSurface;
+  a.detector_form = form;
+  if (form == DetectorForm::kBones) {
+    a.bone_names = {"root", "spine", "head"};
+    set_detector_terms(a, 0, {{1, 0.75}, {2, 0.25}}, {0, 0, 0.5});
+    a.clusters[1].flags = kClusterOverlapOnly;
+    set_detector_terms(a, 1, {}, {0, 0, -0.5});
+  } else {
+    set_detector_terms(a, 0, {{0, 0.125}, {2, 0.125}, {1, 0.125}, {3, 0.125}, {4, 0.5}},
+                       {0, 0, 0.5});
+    set_detector_terms(a, 1, {{5, 0.5}, {0, 0.25}, {1, 0.25}}, {0, 0, -0.5});
+  }
+  a.provenance.source = "octahedron.obj";
+  a.provenance.options = {{"body", "surface"},
+                          {"detectors", form == DetectorForm::kBones ? "skin" : "weights"}};
+  return a;
 }
 
 /// A larger asset: the surface of the cube [-1,1]^3 with an n x n grid per face (shared
@@ -311,7 +365,19 @@ inline bool assets_equal(const Asset& a, const Asset& b) {
       if (!same_bits(x.detector.weights[k], y.detector.weights[k])) return false;
     if (!same_bits(x.rest_positive_fraction, y.rest_positive_fraction) ||
         x.triangle_offset != y.triangle_offset || x.triangle_count != y.triangle_count ||
-        x.bvh_offset != y.bvh_offset || x.bvh_count != y.bvh_count)
+        x.bvh_offset != y.bvh_offset || x.bvh_count != y.bvh_count ||
+        x.detector_term_offset != y.detector_term_offset ||
+        x.detector_term_count != y.detector_term_count)
+      return false;
+    for (int k = 0; k < 3; ++k)
+      if (!same_bits(x.detector_rest[k], y.detector_rest[k])) return false;
+  }
+  if (a.body_kind != b.body_kind || a.detector_form != b.detector_form ||
+      a.bone_names != b.bone_names || a.detector_terms.size() != b.detector_terms.size())
+    return false;
+  for (std::size_t i = 0; i < a.detector_terms.size(); ++i) {
+    if (a.detector_terms[i].index != b.detector_terms[i].index ||
+        !same_bits(a.detector_terms[i].weight, b.detector_terms[i].weight))
       return false;
   }
   if (a.cluster_triangles != b.cluster_triangles || a.bvh_nodes.size() != b.bvh_nodes.size())
@@ -336,10 +402,10 @@ inline bool is_empty(const Asset& a) {
   return assets_equal(a, Asset{});
 }
 
-/// The committed golden asset of version 1.`minor`.
-inline std::string golden_path(int minor = 0) {
+/// The committed golden asset of version 1.`minor` (`variant`: e.g. "-bones").
+inline std::string golden_path(int minor = 0, const std::string& variant = "") {
   return std::string(TETSEG_SOURCE_DIR) + "/tests/golden/asset-v1." + std::to_string(minor) +
-         ".tetseg";
+         variant + ".tetseg";
 }
 
 inline std::vector<std::uint8_t> read_file(const std::string& path) {

@@ -1,12 +1,13 @@
 #pragma once
 /// \file
 /// The tetseg asset: everything the runtime needs to cull and query self-collisions of one
-/// deformable tetrahedral object, and nothing it does not. Plain structs, written by the
-/// preprocessor (`tetseg build`) and read by the runtime. The byte layout is in docs/format.md.
+/// deformable object (a tet mesh, or since 1.2 a surface without tets: `BodyKind`), and nothing
+/// it does not. Plain structs, written by the preprocessor (`tetseg build`) and read by the
+/// runtime. The byte layout is in docs/format.md.
 ///
-/// All indices are 0-based. "Node" always means a node of the tetrahedral mesh: the runtime
-/// receives positions of all nodes each step, so surface triangles and detector points refer
-/// to tet-mesh node ids.
+/// All indices are 0-based. "Node" means a node of the body: a tet-mesh node (kTet) or a vertex
+/// of the input surface (kSurface). The runtime receives positions of all nodes each step, so
+/// surface triangles and detectors refer to node ids.
 
 #include <array>
 #include <cstddef>
@@ -22,7 +23,7 @@ namespace tetseg::format {
 /// overlap-only cluster flag; 1.2 added surface bodies and detectors carried by surface
 /// weights or bones. `write_asset` writes the oldest minor version the asset needs.
 inline constexpr std::uint16_t kVersionMajor = 1;
-inline constexpr std::uint16_t kVersionMinor = 1;  // 1.2: being implemented (issue 29)
+inline constexpr std::uint16_t kVersionMinor = 2;
 
 /// Documented limits, checked on load (docs/format.md). They bound memory for hostile input.
 inline constexpr std::uint32_t kMaxNodes = 1u << 26;              ///< 67,108,864 tet-mesh nodes
@@ -125,6 +126,20 @@ struct DetectorTerm {
   std::uint32_t index = 0;
   double weight = 0.0;
 };
+
+/// A kSurfaceWeights detector's position given all node positions `xyz` (node_count x 3
+/// doubles): `sum weight * x[index]` over `terms[0, count)`, evaluated in term order. The one
+/// evaluation every reader uses (runtime per step, tools at rest); indices must be valid
+/// (validated assets).
+inline std::array<double, 3> weighted_detector_position(const DetectorTerm* terms,
+                                                        std::uint32_t count, const double* xyz) {
+  std::array<double, 3> out{0.0, 0.0, 0.0};
+  for (std::uint32_t i = 0; i < count; ++i) {
+    const double* p = xyz + 3 * std::size_t(terms[i].index);
+    for (int k = 0; k < 3; ++k) out[k] += terms[i].weight * p[k];
+  }
+  return out;
+}
 
 /// Cluster flag: no detector point sees the cluster well at rest, so it is culled by BVH
 /// overlap only (its triangles are never classified by orientation).

@@ -34,8 +34,10 @@ enum class Status : std::uint8_t {
 /// Short stable name of a status, e.g. "payload checksum". Never null.
 const char* to_string(Status status) noexcept;
 
-/// The oldest minor version of format 1 that holds `asset`: 0 when every detector is in node
-/// form without a tet id and no cluster has a flag, else 1 (docs/format.md, "Versions").
+/// The oldest minor version of format 1 that holds `asset` (docs/format.md, "Versioning"): 2
+/// when it stores anything of 1.2 (a body kind other than kTet, a detector form other than
+/// kTetPoint, detector terms, bone names, or a cluster's term range or rest position), else 0
+/// when every detector is in node form without a tet id and no cluster has a flag, else 1.
 std::uint16_t minor_version_needed(const Asset& asset) noexcept;
 
 /// Serialises `asset` (envelope + payload) into bytes, as version
@@ -68,7 +70,8 @@ Status read_asset_file(const std::string& path, Asset& out, std::string* detail 
 /// is in docs/format.md, "Validation rules"): counts within the documented limits, indices
 /// in range, clusters and loops contiguous, clusters partition the triangles, BVHs are
 /// trees whose leaves cover each cluster once, detectors well formed (node form: an interior
-/// node; point form: four distinct ids, barycentric weights), known cluster flags only, loop edges
+/// node; point form: four distinct ids, barycentric weights; 1.2 detector terms: contiguous,
+/// indices in range and distinct, weights summing to 1), known cluster flags only, loop edges
 /// on the surface, floats finite, provenance keys sorted. Returns kOk or kInvalidContent (with the
 /// first broken rule in `detail`). Memory is proportional to the asset's vectors, never to
 /// `node_count`. Thread-safe; never throws.
