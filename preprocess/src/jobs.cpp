@@ -66,7 +66,14 @@ BuildJobResult run_build(const std::function<BuildInput(std::string& summary)>& 
   BuildOptions build = options.build;
   build.meshing.reset();
   build.repairs.clear();
-  if (input.is_surface) {
+  if (build.body == format::BodyKind::kSurface) {
+    if (!input.is_surface)
+      throw InputError(source,
+                       "--body surface builds from a surface file (.obj, .ply, .off, ...), not "
+                       "a tet mesh");
+    result.asset =
+        build_surface_asset(input.surface, source, build, result.report, checked_on_stage);
+  } else if (input.is_surface) {
     // tetrahedralize alone judges the surface (with its own rules: pinch points accepted), so
     // that a build accepts exactly the surfaces `tetseg tetrahedralize` accepts.
     input.tet_mesh = timer.run("tetrahedralize", [&](std::string& summary) {
@@ -106,7 +113,8 @@ BuildJobResult run_build(const std::function<BuildInput(std::string& summary)>& 
                           notes.hausdorff_mesh_to_input * notes.diagonal};
   }
   build.deviation = result.deviation;  // a tet-mesh input: 0, its boundary is the surface
-  result.asset = build_asset(input.tet_mesh, source, build, result.report, checked_on_stage);
+  if (build.body == format::BodyKind::kTet)
+    result.asset = build_asset(input.tet_mesh, source, build, result.report, checked_on_stage);
   result.asset_bytes = timer.run("write", [&](std::string& summary) {
     std::vector<std::uint8_t> bytes = format::write_asset(result.asset);
     if (options.write_output) options.write_output(bytes);
@@ -212,6 +220,15 @@ void validate_options(const BuildJobOptions& options) {
   check_option(range::kWrapSheetOffset, m.wrap_sheet_offset);
   check_option(range::kMaxDeviation, m.max_deviation);
   check_option(range::kTimeLimit, options.time_limit);
+  const format::DetectorForm form = detector_form_of(b);
+  if (b.body == format::BodyKind::kTet && form != format::DetectorForm::kTetPoint)
+    throw std::invalid_argument(std::string("--detectors ") + name_of(form) +
+                                " needs --body surface");
+  if (b.body == format::BodyKind::kSurface && form != format::DetectorForm::kSurfaceWeights)
+    throw std::invalid_argument(std::string("--body surface takes --detectors weights") +
+                                (form == format::DetectorForm::kBones
+                                     ? " (skin: the skinned build is not implemented yet)"
+                                     : ""));
 }
 
 void validate_options(const ChargeJobOptions& options) {
@@ -282,6 +299,8 @@ std::string build_report_json(const BuildJobResult& result, const std::string& i
   out << "{\n  \"input\": \"" << json_escape(input) << "\",\n";
   if (!output.empty()) out << "  \"output\": \"" << json_escape(output) << "\",\n";
   out << "  \"asset_bytes\": " << result.asset_bytes.size() << ",\n";
+  out << "  \"body\": \"" << name_of(asset.body_kind) << "\", \"detectors\": \""
+      << name_of(asset.detector_form) << "\",\n";
   out << "  \"seconds\": {";
   stage_members(out, report.stages, [](const StageReport& s) { return s.seconds; });
   out << ", \"total\": " << result.total_seconds << "},\n";

@@ -89,4 +89,20 @@ Shape shape_from_name(const std::string& name) {
   return shape;
 }
 
+template <>
+const std::vector<EnumName<format::BodyKind>>& enum_names<format::BodyKind>() {
+  static const std::vector<EnumName<format::BodyKind>> table = {
+      {"tet", format::BodyKind::kTet}, {"surface", format::BodyKind::kSurface}};
+  return table;
+}
+
+template <>
+const std::vector<EnumName<format::DetectorForm>>& enum_names<format::DetectorForm>() {
+  static const std::vector<EnumName<format::DetectorForm>> table = {
+      {"tet", format::DetectorForm::kTetPoint},
+      {"weights", format::DetectorForm::kSurfaceWeights},
+      {"skin", format::DetectorForm::kBones}};
+  return table;
+}
+
 }  // namespace tetseg::preprocess

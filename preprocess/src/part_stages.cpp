@@ -4,6 +4,10 @@
 #include "part_stages.hpp"
 
 #include <algorithm>
+#include <sstream>
+#include <utility>
+
+#include "tetseg/preprocess/names.hpp"
 
 namespace tetseg::preprocess::detail {
 namespace {
@@ -130,6 +134,71 @@ std::vector<DetectorChoice> detectors_by_part(const TetMesh& mesh,
     }
   }
   return out;
+}
+
+Segmentation segment_parts(const std::vector<Vec3>& nodes, const std::vector<SurfacePart>& parts,
+                           std::size_t triangle_count, bool any_interior,
+                           const BuildOptions& options, const std::string& source,
+                           BuildReport& report, StageTimer& timer) {
+  Segmentation segmentation;
+  if (options.clusters == ClusterMethod::kSingle) {
+    segmentation = one_cluster_per_part(parts, triangle_count);
+  } else {
+    ChargeResult charge = timer.run("charge", [&](std::string& summary) {
+      ChargeResult r = charge_by_part(nodes, parts, triangle_count, options.charge, source);
+      std::ostringstream text;
+      text << r.solver << ", " << r.iterations << " iterations, residual " << r.residual
+           << " (tolerance " << r.tolerance << ")"
+           << ", capacitance " << r.capacitance;
+      summary = text.str();
+      return r;
+    });
+    std::vector<std::vector<double>> equalized;  // per part
+    timer.run("equalize", [&](std::string& summary) {
+      summary = name_of(options.segmentation.equalization);
+      for (const SurfacePart& part : parts)
+        equalized.push_back(
+            equalize(part_values(charge.density, part), options.segmentation.equalization));
+      return 0;
+    });
+    charge.density.clear();
+    report.charge = std::move(charge);
+    std::vector<Segmentation> pieces;  // per part
+    segmentation = timer.run("segmentation", [&](std::string& summary) {
+      for (std::size_t p = 0; p < parts.size(); ++p)
+        pieces.push_back(
+            segment_surface(nodes, parts[p].surface, equalized[p], options.segmentation));
+      Segmentation s = join_segmentations(parts, pieces, triangle_count);
+      summary = std::to_string(s.counts.segments_found) + " segments, " +
+                std::to_string(s.boundary_loops.size()) + " boundaries, " +
+                std::to_string(s.cluster_count) + " clusters";
+      return s;
+    });
+    // Refinement searches interior nodes; a mesh without one (a mat one tet thick) keeps the
+    // charge segmentation, and its detectors are points inside tets.
+    if (options.clusters == ClusterMethod::kRefined && any_interior) {
+      segmentation = timer.run("refinement", [&](std::string& summary) {
+        for (std::size_t p = 0; p < parts.size(); ++p) {
+          if (parts[p].surface.interior_nodes.empty()) {  // kept as segmented
+            report.refinement.clusters_before += pieces[p].cluster_count;
+            continue;
+          }
+          RefinementCounts counts;
+          pieces[p] = refine_clusters(nodes, parts[p].surface, equalized[p], pieces[p],
+                                      options.refinement, &counts);
+          report.refinement.clusters_before += counts.clusters_before;
+          report.refinement.splits += counts.splits;
+          report.refinement.merges += counts.merges;
+        }
+        Segmentation s = join_segmentations(parts, pieces, triangle_count);
+        summary = std::to_string(report.refinement.splits) + " splits, " +
+                  std::to_string(report.refinement.merges) + " merges, " +
+                  std::to_string(s.cluster_count) + " clusters";
+        return s;
+      });
+    }
+  }
+  return segmentation;
 }
 
 }  // namespace tetseg::preprocess::detail

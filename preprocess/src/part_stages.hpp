@@ -8,8 +8,10 @@
 #include <vector>
 
 #include "components.hpp"
+#include "tetseg/format/asset.hpp"
 #include "tetseg/preprocess/charge.hpp"
 #include "tetseg/preprocess/mesh.hpp"
+#include "tetseg/preprocess/pipeline.hpp"
 #include "tetseg/preprocess/segmentation.hpp"
 
 namespace tetseg::preprocess::detail {
@@ -42,5 +44,27 @@ std::vector<DetectorChoice> detectors_by_part(const TetMesh& mesh,
                                               const std::vector<SurfacePart>& parts,
                                               const Segmentation& segmentation,
                                               DetectorStrategy strategy, double min_visibility);
+
+/// The clustering stages of a build on `parts` (their triangle ids < triangle_count), timed by
+/// `timer`: kSingle: one cluster per part, no stage; else charge, equalize, segmentation and,
+/// for kRefined when `any_interior` (some part has interior nodes), refinement of the parts
+/// with interior nodes (the others keep their charge segmentation). Fills report.charge
+/// (density dropped) and report.refinement.
+Segmentation segment_parts(const std::vector<Vec3>& nodes, const std::vector<SurfacePart>& parts,
+                           std::size_t triangle_count, bool any_interior,
+                           const BuildOptions& options, const std::string& source,
+                           BuildReport& report, StageTimer& timer);
+
+/// The "bvh" stage and the rest of the asset's cluster sections: `triangles` and
+/// triangle_cluster, per cluster its BVH, detector (detectors[c]: point, overlap-only flag,
+/// rest fraction) and offsets, and the boundary loops of `segmentation`.
+void add_clusters(format::Asset& asset, const std::vector<Vec3>& nodes,
+                  const std::vector<Tri>& triangles, const Segmentation& segmentation,
+                  const std::vector<DetectorChoice>& detectors, StageTimer& timer);
+
+/// The asset's provenance: tool version, the source's file name, provenance_options of
+/// `options` with the charge solver report.charge used and deviation 0 when not set.
+void set_provenance(format::Asset& asset, const std::string& source, const BuildOptions& options,
+                    const BuildReport& report);
 
 }  // namespace tetseg::preprocess::detail

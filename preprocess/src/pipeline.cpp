@@ -77,6 +77,15 @@ bool fell_back(const BuildOptions& o) {
   return auto_repaired(o) && !o.fallback_reason.empty();
 }
 
+bool surface_body(const BuildOptions& o) {
+  return o.body == format::BodyKind::kSurface;
+}
+
+format::DetectorForm& detectors_of(BuildOptions& o) {
+  if (!o.detectors) o.detectors = detector_form_of(o);
+  return *o.detectors;
+}
+
 bool deviation_known(const BuildOptions& o) {
   return o.deviation.has_value();
 }
@@ -210,6 +219,9 @@ const std::vector<ProvenanceField>& provenance_fields() {
                               [](O& o) -> DetectorStrategy& { return o.segmentation.detector; }),
       number<double>("segmentation.min_visibility", always,
                      [](O& o) -> double& { return o.segmentation.min_visibility; }),
+      named<format::BodyKind>("body", surface_body,
+                              [](O& o) -> format::BodyKind& { return o.body; }),
+      named<format::DetectorForm>("detectors", surface_body, detectors_of),
       flag("rest_positions", always, [](O& o) -> bool& { return o.keep_rest_positions; }),
       number<double>("refine.min_visibility", refined,
                      [](O& o) -> double& { return o.refinement.min_visibility; }),
@@ -273,6 +285,12 @@ std::string swap_characters(std::string text, char from, char to) {
 
 }  // namespace
 
+format::DetectorForm detector_form_of(const BuildOptions& options) {
+  if (options.detectors) return *options.detectors;
+  return options.body == format::BodyKind::kSurface ? format::DetectorForm::kSurfaceWeights
+                                                    : format::DetectorForm::kTetPoint;
+}
+
 std::vector<std::pair<std::string, std::string>> provenance_options(const BuildOptions& options) {
   BuildOptions copy = options;
   std::vector<std::pair<std::string, std::string>> out;
@@ -331,6 +349,59 @@ std::uint64_t process_peak_rss_bytes() {
   return 0;
 }
 
+namespace detail {
+
+void add_clusters(format::Asset& asset, const std::vector<Vec3>& nodes,
+                  const std::vector<Tri>& triangles, const Segmentation& segmentation,
+                  const std::vector<DetectorChoice>& detectors, StageTimer& timer) {
+  asset.triangles = triangles;
+  asset.triangle_cluster = segmentation.triangle_cluster;
+  timer.run("bvh", [&](std::string& summary) {
+    std::vector<std::vector<std::uint32_t>> members(segmentation.cluster_count);
+    for (std::uint32_t t = 0; t < segmentation.triangle_cluster.size(); ++t) {
+      members[segmentation.triangle_cluster[t]].push_back(t);
+    }
+    for (std::uint32_t c = 0; c < segmentation.cluster_count; ++c) {
+      ClusterBvh bvh = build_cluster_bvh(nodes, triangles, members[c]);
+      format::Cluster cluster;
+      cluster.detector = detectors[c].point;
+      cluster.flags = detectors[c].overlap_only ? format::kClusterOverlapOnly : 0;
+      cluster.rest_positive_fraction = detectors[c].rest_positive_fraction;
+      cluster.triangle_offset = static_cast<std::uint32_t>(asset.cluster_triangles.size());
+      cluster.triangle_count = static_cast<std::uint32_t>(bvh.triangles.size());
+      cluster.bvh_offset = static_cast<std::uint32_t>(asset.bvh_nodes.size());
+      cluster.bvh_count = static_cast<std::uint32_t>(bvh.nodes.size());
+      asset.cluster_triangles.insert(asset.cluster_triangles.end(), bvh.triangles.begin(),
+                                     bvh.triangles.end());
+      asset.bvh_nodes.insert(asset.bvh_nodes.end(), bvh.nodes.begin(), bvh.nodes.end());
+      asset.clusters.push_back(cluster);
+    }
+    summary = std::to_string(asset.bvh_nodes.size()) + " nodes";
+    return 0;
+  });
+  for (const auto& loop : segmentation.boundary_loops) {
+    format::BoundaryLoop boundary;
+    boundary.node_offset = static_cast<std::uint32_t>(asset.boundary_nodes.size());
+    boundary.node_count = static_cast<std::uint32_t>(loop.size());
+    asset.boundary_nodes.insert(asset.boundary_nodes.end(), loop.begin(), loop.end());
+    asset.boundaries.push_back(boundary);
+  }
+}
+
+void set_provenance(format::Asset& asset, const std::string& source, const BuildOptions& options,
+                    const BuildReport& report) {
+  asset.provenance.tool_version = std::string("tetseg ") + TETSEG_VERSION_STRING;
+  asset.provenance.source = base_name(source);
+  BuildOptions used = options;  // with the charge solver actually used in place of "auto"
+  if (!report.charge.solver.empty()) parse_name(report.charge.solver, used.charge.solver);
+  // A tet mesh not made from a surface here (or a surface body: the input surface itself) is
+  // the asset's surface: deviation 0.
+  if (!used.meshing && !used.deviation) used.deviation = SurfaceDeviation{};
+  asset.provenance.options = provenance_options(used);
+}
+
+}  // namespace detail
+
 format::Asset build_asset(const TetMesh& mesh, const std::string& source,
                           const BuildOptions& options, BuildReport& report,
                           const std::function<void(const StageReport&)>& on_stage) {
@@ -352,65 +423,9 @@ format::Asset build_asset(const TetMesh& mesh, const std::string& source,
   report.interior_nodes = static_cast<std::uint32_t>(surface.interior_nodes.size());
   report.components = static_cast<std::uint32_t>(parts.size());
 
-  Segmentation segmentation;
-  if (options.clusters == ClusterMethod::kSingle) {
-    segmentation = detail::one_cluster_per_part(parts, surface.triangles.size());
-  } else {
-    ChargeResult charge = timer.run("charge", [&](std::string& summary) {
-      ChargeResult r = detail::charge_by_part(mesh.nodes, parts, surface.triangles.size(),
-                                              options.charge, source);
-      std::ostringstream text;
-      text << r.solver << ", " << r.iterations << " iterations, residual " << r.residual
-           << " (tolerance " << r.tolerance << ")"
-           << ", capacitance " << r.capacitance;
-      summary = text.str();
-      return r;
-    });
-    std::vector<std::vector<double>> equalized;  // per part
-    timer.run("equalize", [&](std::string& summary) {
-      summary = name_of(options.segmentation.equalization);
-      for (const detail::SurfacePart& part : parts)
-        equalized.push_back(
-            equalize(detail::part_values(charge.density, part), options.segmentation.equalization));
-      return 0;
-    });
-    charge.density.clear();
-    report.charge = std::move(charge);
-    std::vector<Segmentation> pieces;  // per part
-    segmentation = timer.run("segmentation", [&](std::string& summary) {
-      for (std::size_t p = 0; p < parts.size(); ++p)
-        pieces.push_back(
-            segment_surface(mesh.nodes, parts[p].surface, equalized[p], options.segmentation));
-      Segmentation s = detail::join_segmentations(parts, pieces, surface.triangles.size());
-      summary = std::to_string(s.counts.segments_found) + " segments, " +
-                std::to_string(s.boundary_loops.size()) + " boundaries, " +
-                std::to_string(s.cluster_count) + " clusters";
-      return s;
-    });
-    // Refinement searches interior nodes; a mesh without one (a mat one tet thick) keeps the
-    // charge segmentation, and its detectors are points inside tets.
-    if (options.clusters == ClusterMethod::kRefined && !surface.interior_nodes.empty()) {
-      segmentation = timer.run("refinement", [&](std::string& summary) {
-        for (std::size_t p = 0; p < parts.size(); ++p) {
-          if (parts[p].surface.interior_nodes.empty()) {  // kept as segmented
-            report.refinement.clusters_before += pieces[p].cluster_count;
-            continue;
-          }
-          RefinementCounts counts;
-          pieces[p] = refine_clusters(mesh.nodes, parts[p].surface, equalized[p], pieces[p],
-                                      options.refinement, &counts);
-          report.refinement.clusters_before += counts.clusters_before;
-          report.refinement.splits += counts.splits;
-          report.refinement.merges += counts.merges;
-        }
-        Segmentation s = detail::join_segmentations(parts, pieces, surface.triangles.size());
-        summary = std::to_string(report.refinement.splits) + " splits, " +
-                  std::to_string(report.refinement.merges) + " merges, " +
-                  std::to_string(s.cluster_count) + " clusters";
-        return s;
-      });
-    }
-  }
+  const Segmentation segmentation =
+      detail::segment_parts(mesh.nodes, parts, surface.triangles.size(),
+                            !surface.interior_nodes.empty(), options, source, report, timer);
   report.segmentation = segmentation.counts;
   report.clusters = segmentation.cluster_count;
   report.boundaries = static_cast<std::uint32_t>(segmentation.boundary_loops.size());
@@ -439,46 +454,9 @@ format::Asset build_asset(const TetMesh& mesh, const std::string& source,
 
   format::Asset asset;
   asset.node_count = static_cast<std::uint32_t>(mesh.nodes.size());
-  asset.triangles = surface.triangles;
-  asset.triangle_cluster = segmentation.triangle_cluster;
-  timer.run("bvh", [&](std::string& summary) {
-    std::vector<std::vector<std::uint32_t>> members(segmentation.cluster_count);
-    for (std::uint32_t t = 0; t < segmentation.triangle_cluster.size(); ++t) {
-      members[segmentation.triangle_cluster[t]].push_back(t);
-    }
-    for (std::uint32_t c = 0; c < segmentation.cluster_count; ++c) {
-      ClusterBvh bvh = build_cluster_bvh(mesh.nodes, surface.triangles, members[c]);
-      format::Cluster cluster;
-      cluster.detector = detectors[c].point;
-      cluster.flags = detectors[c].overlap_only ? format::kClusterOverlapOnly : 0;
-      cluster.rest_positive_fraction = detectors[c].rest_positive_fraction;
-      cluster.triangle_offset = static_cast<std::uint32_t>(asset.cluster_triangles.size());
-      cluster.triangle_count = static_cast<std::uint32_t>(bvh.triangles.size());
-      cluster.bvh_offset = static_cast<std::uint32_t>(asset.bvh_nodes.size());
-      cluster.bvh_count = static_cast<std::uint32_t>(bvh.nodes.size());
-      asset.cluster_triangles.insert(asset.cluster_triangles.end(), bvh.triangles.begin(),
-                                     bvh.triangles.end());
-      asset.bvh_nodes.insert(asset.bvh_nodes.end(), bvh.nodes.begin(), bvh.nodes.end());
-      asset.clusters.push_back(cluster);
-    }
-    summary = std::to_string(asset.bvh_nodes.size()) + " nodes";
-    return 0;
-  });
-  for (const auto& loop : segmentation.boundary_loops) {
-    format::BoundaryLoop boundary;
-    boundary.node_offset = static_cast<std::uint32_t>(asset.boundary_nodes.size());
-    boundary.node_count = static_cast<std::uint32_t>(loop.size());
-    asset.boundary_nodes.insert(asset.boundary_nodes.end(), loop.begin(), loop.end());
-    asset.boundaries.push_back(boundary);
-  }
+  detail::add_clusters(asset, mesh.nodes, surface.triangles, segmentation, detectors, timer);
   if (options.keep_rest_positions) asset.rest_positions = mesh.nodes;
-  asset.provenance.tool_version = std::string("tetseg ") + TETSEG_VERSION_STRING;
-  asset.provenance.source = base_name(source);
-  BuildOptions used = options;  // with the charge solver actually used in place of "auto"
-  if (!report.charge.solver.empty()) parse_name(report.charge.solver, used.charge.solver);
-  // A tet mesh not made from a surface here is the asset's surface: deviation 0.
-  if (!used.meshing && !used.deviation) used.deviation = SurfaceDeviation{};
-  asset.provenance.options = provenance_options(used);
+  detail::set_provenance(asset, source, options, report);
   for (const DetectorChoice& detector : detectors) {
     report.rest_positive_fraction.push_back(detector.rest_positive_fraction);
   }

@@ -1,6 +1,7 @@
 // `tetseg build`: the whole pipeline from a mesh file to an asset.
 
 #include <cstdio>
+#include <map>
 #include <memory>
 
 #include "commands.hpp"
@@ -85,6 +86,23 @@ void add_build_command(CLI::App& root) {
   cmd->add_option("-o,--output", args->output, "Asset file to write (.tetseg)")->required();
   cmd->add_option("--report", args->report_path, "Write a JSON report: per-stage seconds, counts");
 
+  cmd->add_option("--body", args->job.build.body,
+                  "tet: the asset's nodes are a tet mesh's (the input, or the surface "
+                  "tetrahedralised first); surface: the input surface as it is, its vertices "
+                  "and triangles in their order, no tets (docs/cli.md, \"Surface bodies\")")
+      ->transform(CLI::CheckedTransformer(name_map<format::BodyKind>(), CLI::ignore_case))
+      ->option_text(name_list<format::BodyKind>() + " (tet)");
+  cmd->add_option_function<format::DetectorForm>(
+         "--detectors",
+         [args](const format::DetectorForm& form) { args->job.build.detectors = form; },
+         "Detector form: weights (surface bodies' default: fixed weights of surface vertices); "
+         "skin (bones of the input's skin)")
+      ->transform(CLI::CheckedTransformer(
+          std::map<std::string, format::DetectorForm>{
+              {"weights", format::DetectorForm::kSurfaceWeights},
+              {"skin", format::DetectorForm::kBones}},
+          CLI::ignore_case))
+      ->option_text("weights|skin (weights with --body surface)");
   cmd->add_option("--clusters", args->job.build.clusters,
                   "single: one cluster; charge: the paper's charge-based segmentation; "
                   "refined: charge, then split clusters no node sees whole and merge neighbours "

@@ -24,7 +24,8 @@ struct EnumName {
 
 /// The table of `Enum`: every value once under its canonical name, in declaration order, then
 /// the aliases. Defined for ChargeSolver, ChargePreconditioner, Equalization, DetectorStrategy,
-/// ClusterMethod, Shape, StructuredShape and MeshingOptions::Repair.
+/// ClusterMethod, Shape, StructuredShape, MeshingOptions::Repair, format::BodyKind and
+/// format::DetectorForm.
 template <typename Enum>
 const std::vector<EnumName<Enum>>& enum_names();
 
@@ -45,6 +46,10 @@ const std::vector<EnumName<StructuredShape>>& enum_names<StructuredShape>();
 
 template <>
 const std::vector<EnumName<MeshingOptions::Repair>>& enum_names<MeshingOptions::Repair>();
+template <>
+const std::vector<EnumName<format::BodyKind>>& enum_names<format::BodyKind>();
+template <>
+const std::vector<EnumName<format::DetectorForm>>& enum_names<format::DetectorForm>();
 
 /// The canonical name of `value`.
 template <typename Enum>

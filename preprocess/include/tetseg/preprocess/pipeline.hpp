@@ -43,6 +43,14 @@ struct BuildOptions {
   SegmentationOptions segmentation;
   RefinementOptions refinement;     ///< used by kRefined
   bool keep_rest_positions = true;  ///< store rest positions in the asset (docs/format.md)
+  /// kTet: the asset's nodes are a tet mesh's (the input, or the input surface tetrahedralised
+  /// first). kSurface: the input surface as it is, no tets (build_surface_asset). Recorded as
+  /// provenance key "body" when kSurface.
+  format::BodyKind body = format::BodyKind::kTet;
+  /// The detector form; unset: the body's own (kTet: kTetPoint, kSurface: kSurfaceWeights).
+  /// A kTet body takes only kTetPoint; kBones (from the input's skin) is not built yet.
+  /// Recorded as provenance key "detectors" with a surface body.
+  std::optional<format::DetectorForm> detectors;
   /// Set when the tet mesh was made from the source surface by tetrahedralize with these
   /// options; only recorded (provenance keys meshing.*), so that the asset can be rebuilt.
   std::optional<MeshingOptions> meshing;
@@ -143,5 +151,26 @@ bool options_from_provenance(const std::vector<std::pair<std::string, std::strin
 format::Asset build_asset(const TetMesh& mesh, const std::string& source,
                           const BuildOptions& options, BuildReport& report,
                           const std::function<void(const StageReport&)>& on_stage = {});
+
+/// The detector form a build with `options` makes: options.detectors, else the body's own.
+format::DetectorForm detector_form_of(const BuildOptions& options);
+
+/// A surface body (docs/segmentation.md, "Surface bodies"): every stage on `surface` as it is.
+/// The asset's nodes are the surface's vertices and its triangles the surface's triangles,
+/// both in the input's order (format::BodyKind::kSurface). Validation (InputError naming the
+/// first defect): finite coordinates, indices in range, no zero-area triangle, no edge of
+/// more than two triangles, consistent orientation; closed components must also be
+/// vertex-manifold, free of self-intersection, outward and not nested. Closed components are
+/// charged, segmented and refined like a tet mesh's surface, with interior points sampled
+/// inside them as detector candidates (used only as candidates); each detector is then written
+/// as non-negative weights (sum 1) of at most kSurfaceDetectorTerms surface vertices around it
+/// (kSurfaceWeights). Open components, and clusters no candidate sees well at rest, are
+/// overlap-only clusters (one per open component). Deterministic.
+format::Asset build_surface_asset(const TriangleMesh& surface, const std::string& source,
+                                  const BuildOptions& options, BuildReport& report,
+                                  const std::function<void(const StageReport&)>& on_stage = {});
+
+/// Most terms of a surface body's detector (<= format::kMaxDetectorTerms).
+inline constexpr std::uint32_t kSurfaceDetectorTerms = 32;
 
 }  // namespace tetseg::preprocess
