@@ -83,6 +83,9 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(3u, 4096u));
   app.add_option("--rings-per-bone", a.tube.rings_per_bone, "Rings per bone (default 8)")
       ->check(CLI::Range(1u, 4096u));
+  app.add_option("--joint-pinch", a.tube.joint_pinch,
+                 "The tube narrows to (1 - this) x its radius at each joint (default 0.3)")
+      ->check(CLI::Range(0.0, 0.9));
   app.add_option("--frames", a.frames, "Frames, the rest pose first (default 61)")
       ->check(CLI::Range(2u, 100000u));
   app.add_option("--max-angle", a.max_angle,

@@ -88,16 +88,15 @@ std::vector<format::DetectorTerm> bone_detector_terms(
   return terms;
 }
 
-void carry_detectors_by_bones(format::Asset& asset, const Skin& skin, const std::string& path,
-                              std::uint32_t max_terms) {
+void carry_detectors_by_bones(format::Asset& asset, const std::vector<Vec3>& vertices,
+                              const Skin& skin, const std::string& path, std::uint32_t max_terms) {
   if (asset.body_kind != format::BodyKind::kSurface)
     throw std::invalid_argument("carry_detectors_by_bones: not a surface body");
-  if (asset.rest_positions.size() != asset.node_count)
-    throw std::invalid_argument("carry_detectors_by_bones: the asset has no rest positions");
+  if (vertices.size() != asset.node_count)
+    throw std::invalid_argument("carry_detectors_by_bones: not the asset's vertices");
   if (skin.bone_names.size() > format::kMaxBones)
     throw InputError(path, std::to_string(skin.bone_names.size()) + " bones, more than " +
                                std::to_string(format::kMaxBones));
-  const std::vector<Vec3> vertices(asset.rest_positions.begin(), asset.rest_positions.end());
   const auto influences = skin_weights_at(skin, vertices, path);
   std::vector<Tri> triangles(asset.triangles.begin(), asset.triangles.end());
   std::vector<format::DetectorTerm> terms;

@@ -104,8 +104,10 @@ SurfaceComponents check_triangles(const TriangleMesh& mesh, const std::string& f
     if (j - i == 2 && half[i].forward == half[i + 1].forward)
       throw InputError(file, "surface is not consistently oriented: triangles " +
                                  std::to_string(half[i].tri) + " and " +
-                                 std::to_string(half[i + 1].tri) + " run the same way along the "
-                                 "edge " + edge);
+                                 std::to_string(half[i + 1].tri) +
+                                 " run the same way along the "
+                                 "edge " +
+                                 edge);
     if (j - i == 1) open_root[sets.find(half[i].lo)] = 1;
     i = j;
   }
@@ -245,8 +247,8 @@ std::vector<Vec3> interior_candidates(const std::vector<Vec3>& points,
         const int index[3] = {i, j, l};
         Vec3 q;
         for (int k = 0; k < 3; ++k)
-          q[k] = test.lo()[k] + (test.hi()[k] - test.lo()[k]) *
-                                    ((index[k] + 0.5 + 0.0137 * (k + 1)) / count[k]);
+          q[k] = test.lo()[k] +
+                 (test.hi()[k] - test.lo()[k]) * ((index[k] + 0.5 + 0.0137 * (k + 1)) / count[k]);
         if (test.inside(q)) out.push_back(q);
       }
   std::vector<Vec3> normal(points.size(), Vec3{0.0, 0.0, 0.0});
@@ -356,8 +358,8 @@ bool spread_weights(const std::vector<Vec3>& points, const Vec3& p, double scale
   double sum = 0.0;
   for (std::size_t i = 0; i < n; ++i) {
     const auto& ai = a[i];
-    weights[i] = std::max(0.0, ai[0] * lambda[0] + ai[1] * lambda[1] + ai[2] * lambda[2] +
-                                   ai[3] * lambda[3]);
+    weights[i] = std::max(
+        0.0, ai[0] * lambda[0] + ai[1] * lambda[1] + ai[2] * lambda[2] + ai[3] * lambda[3]);
     sum += weights[i];
   }
   if (!(sum > 0.0)) return false;
@@ -617,8 +619,8 @@ format::Asset build_surface_asset(const TriangleMesh& input, const std::string& 
           d.position = weighted_position(points, terms[c]);
           d.positive_triangles =
               count_positive_triangles(points, input.triangles, members[c], d.position);
-          d.rest_positive_fraction = static_cast<float>(double(d.positive_triangles) /
-                                                        double(d.triangle_count));
+          d.rest_positive_fraction =
+              static_cast<float>(double(d.positive_triangles) / double(d.triangle_count));
           d.overlap_only =
               static_cast<double>(d.rest_positive_fraction) < options.segmentation.min_visibility;
         }

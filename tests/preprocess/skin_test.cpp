@@ -78,7 +78,12 @@ double max_difference(const std::vector<double>& a, const std::vector<double>& b
 
 TEST_CASE("skinned tube: a closed outward surface, weights summing to 1, rest = identity pose",
           "[skin]") {
+  tetseg::test::SkinnedTubeOptions capsule_options;
+  capsule_options.joint_pinch = 0;
+  const SkinnedTube capsule_tube = tetseg::test::make_skinned_tube(capsule_options);
   const SkinnedTube tube = tetseg::test::make_skinned_tube();
+  CHECK(signed_volume(tube.rest, tube.triangles) <
+        0.97 * signed_volume(capsule_tube.rest, capsule_tube.triangles));  // the necks
   // Closed: every undirected edge in exactly two triangles, once in each direction.
   std::map<std::pair<std::uint32_t, std::uint32_t>, int> directed;
   for (const auto& t : tube.triangles)
@@ -90,8 +95,8 @@ TEST_CASE("skinned tube: a closed outward surface, weights summing to 1, rest = 
   // Outward, and close to the capsule's volume pi r^2 (L + 4/3 r).
   const double r = tube.options.radius, length = tube.options.bones * tube.options.bone_length;
   const double capsule = M_PI * r * r * (length + 4.0 / 3.0 * r);
-  CHECK(signed_volume(tube.rest, tube.triangles) > 0.97 * capsule);
-  CHECK(signed_volume(tube.rest, tube.triangles) < capsule);
+  CHECK(signed_volume(capsule_tube.rest, capsule_tube.triangles) > 0.97 * capsule);
+  CHECK(signed_volume(capsule_tube.rest, capsule_tube.triangles) < capsule);
   std::size_t blended = 0;
   for (const auto& vw : tube.weights) {
     double sum = 0;
@@ -309,7 +314,7 @@ TEST_CASE("carry_detectors_by_bones: every classified cluster carried by its own
     asset.clusters.push_back(c);
   }
   SECTION("carried") {
-    carry_detectors_by_bones(asset, skin, path, 2);
+    carry_detectors_by_bones(asset, skin.vertices, skin, path, 2);
     CHECK(asset.detector_form == tetseg::format::DetectorForm::kBones);
     CHECK(asset.bone_names == tube.bone_names);
     std::uint32_t offset = 0;
@@ -336,9 +341,10 @@ TEST_CASE("carry_detectors_by_bones: every classified cluster carried by its own
     CHECK(offset == asset.detector_terms.size());
   }
   SECTION("refused when the skin is of another surface; the asset unchanged") {
-    asset.rest_positions[17][1] += 1e-3;
+    std::vector<Vec3> moved = skin.vertices;
+    moved[17][1] += 1e-3;
     const tetseg::format::Asset before = asset;
-    CHECK_THROWS_AS(carry_detectors_by_bones(asset, skin, path), InputError);
+    CHECK_THROWS_AS(carry_detectors_by_bones(asset, moved, skin, path), InputError);
     CHECK(asset.detector_form == before.detector_form);
     CHECK(asset.detector_terms.empty());
     CHECK(asset.bone_names.empty());
@@ -350,7 +356,7 @@ TEST_CASE("read_skin: FBX bones, with the per-corner vertices mapped back onto t
   // 4 vertices per ring and one cap ring: every coordinate prints exactly in ASCII FBX's six
   // decimals. assimp's ASCII FBX exporter writes the file; its FBX importer gives every
   // triangle corner its own vertex, which skin_weights_at maps back by position.
-  const SkinnedTube tube = tetseg::test::make_skinned_tube({3, 1.0, 0.25, 4, 2, 1, 0.35});
+  const SkinnedTube tube = tetseg::test::make_skinned_tube({3, 1.0, 0.25, 4, 2, 1, 0.35, 0.0});
   TempDir dir("fbx");
   const std::string gltf = dir.write("tube.gltf", tetseg::test::tube_gltf(tube));
   const std::string fbx = (dir.path / "tube.fbx").string();

@@ -75,10 +75,11 @@ std::vector<format::DetectorTerm> bone_detector_terms(
 /// classified cluster, bone_detector_terms over its triangles; overlap-only clusters get no
 /// terms. Keeps each cluster's `detector_rest` (the point the pipeline chose), sets
 /// `detector_form` = kBones, `detector_terms` and `bone_names` = the skin's. `asset`: a
-/// kSurface body with rest positions (its vertices are matched to the skin's by position,
-/// skin_weights_at). Throws InputError(path) when the skin does not cover the asset's
+/// kSurface body whose node i is at `vertices[i]` at rest (matched to the skin's vertices by
+/// position, skin_weights_at). Throws InputError(path) when the skin does not cover the
 /// vertices or has more than format::kMaxBones bones; `asset` is unchanged then.
-void carry_detectors_by_bones(format::Asset& asset, const Skin& skin, const std::string& path,
+void carry_detectors_by_bones(format::Asset& asset, const std::vector<Vec3>& vertices,
+                              const Skin& skin, const std::string& path,
                               std::uint32_t max_terms = 4);
 
 }  // namespace tetseg::preprocess

@@ -71,18 +71,22 @@ struct BoneWeight {
 };
 
 struct SkinnedTubeOptions {
-  std::uint32_t bones = 4;           ///< bones along the tube, >= 1
-  double bone_length = 1.0;          ///< length of each bone along x
-  double radius = 0.25;              ///< tube radius; caps are hemispheres
-  std::uint32_t around = 24;         ///< vertices per ring, >= 3
-  std::uint32_t rings_per_bone = 8;  ///< rings per bone along the cylinder, >= 1
-  std::uint32_t cap_rings = 4;       ///< rings of each hemispherical cap (pole excluded), >= 1
+  std::uint32_t bones = 4;            ///< bones along the tube, >= 1
+  double bone_length = 1.0;           ///< length of each bone along x
+  double radius = 0.25;               ///< tube radius; caps are hemispheres
+  std::uint32_t around = 24;          ///< vertices per ring, >= 3
+  std::uint32_t rings_per_bone = 12;  ///< rings per bone along the cylinder, >= 1
+  std::uint32_t cap_rings = 4;        ///< rings of each hemispherical cap (pole excluded), >= 1
   double blend = 0.35;  ///< half-width of the weight blend at a joint, / bone_length, in (0, 0.5)
+  /// The tube narrows at each joint to (1 - joint_pinch) x radius (a Gaussian of width
+  /// 0.15 bone lengths), a concave neck like a limb's joint; 0: a plain capsule. In [0, 1).
+  double joint_pinch = 0.3;
 };
 
-/// The tube at rest (bind pose): bone b spans x in [b, b+1] * bone_length, its joint (origin)
-/// at x = b * bone_length; bone b's parent is b - 1. Each vertex has one or two bones (the
-/// two beside its nearest joint, smoothly blended within `blend` of the joint).
+/// The tube at rest (bind pose), a capsule narrowed at the joints: bone b spans x in [b, b+1] *
+/// bone_length, its joint (origin) at x = b * bone_length; bone b's parent is b - 1. Each vertex
+/// has one or two bones (the two beside its nearest joint, smoothly blended within `blend` of the
+/// joint).
 struct SkinnedTube {
   SkinnedTubeOptions options;
   std::vector<double> rest;                             ///< vertex_count * 3 (float32 values)
@@ -108,7 +112,15 @@ inline SkinnedTube make_skinned_tube(const SkinnedTubeOptions& options = {}) {
     profile.push_back({-r * std::cos(phi), r * std::sin(phi)});
   }
   const std::uint32_t body_rings = options.bones * options.rings_per_bone;
-  for (std::uint32_t j = 1; j < body_rings; ++j) profile.push_back({length * j / body_rings, r});
+  for (std::uint32_t j = 1; j < body_rings; ++j) {
+    const double x = length * j / body_rings;
+    double narrowing = 0;
+    for (std::uint32_t b = 1; b < options.bones; ++b) {
+      const double d = (x - b * s) / (0.15 * s);
+      narrowing = std::max(narrowing, options.joint_pinch * std::exp(-d * d));
+    }
+    profile.push_back({x, r * (1 - narrowing)});
+  }
   for (std::uint32_t k = options.cap_rings; k >= 1; --k) {
     const double phi = 0.5 * M_PI * k / options.cap_rings;
     profile.push_back({length + r * std::cos(phi), r * std::sin(phi)});
