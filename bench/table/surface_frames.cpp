@@ -35,8 +35,8 @@ int surface_frames(const std::string& asset_path, const std::string& surface_pat
       vertex_of[n] = static_cast<std::uint32_t>(nodes.size());
       nodes.push_back(n);
     }
-  std::string off = "OFF\n" + std::to_string(nodes.size()) + " " +
-                    std::to_string(a.triangles.size()) + " 0\n";
+  std::string off =
+      "OFF\n" + std::to_string(nodes.size()) + " " + std::to_string(a.triangles.size()) + " 0\n";
   char line[128];
   for (std::uint32_t n : nodes) {
     const auto& p = a.rest_positions[n];

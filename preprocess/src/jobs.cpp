@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <optional>
 #include <sstream>
 #include <utility>
 
@@ -13,6 +14,7 @@
 #include "tetseg/preprocess/io.hpp"
 #include "tetseg/preprocess/names.hpp"
 #include "tetseg/preprocess/option_ranges.hpp"
+#include "tetseg/preprocess/skin.hpp"
 #include "tetseg/preprocess/surface.hpp"
 
 namespace tetseg::preprocess {
@@ -38,6 +40,7 @@ struct BuildInput {
   bool is_surface = false;
   TetMesh tet_mesh;
   TriangleMesh surface;
+  std::optional<Skin> skin;  ///< --detectors skin: the input's skin
 };
 
 /// The stages after read: [tetrahedralize,] build_asset's, write.
@@ -71,8 +74,27 @@ BuildJobResult run_build(const std::function<BuildInput(std::string& summary)>& 
       throw InputError(source,
                        "--body surface builds from a surface file (.obj, .ply, .off, ...), not "
                        "a tet mesh");
-    result.asset =
-        build_surface_asset(input.surface, source, build, result.report, checked_on_stage);
+    if (detector_form_of(build) == format::DetectorForm::kBones) {
+      // The surface pipeline chooses the clusters and detector points; the skin then carries
+      // them (skin.hpp).
+      if (!input.skin)
+        throw std::invalid_argument("--detectors skin reads the skin from the input file");
+      BuildOptions weights = build;
+      weights.detectors = format::DetectorForm::kSurfaceWeights;
+      result.asset =
+          build_surface_asset(input.surface, source, weights, result.report, checked_on_stage);
+      timer.run("skin", [&](std::string& summary) {
+        carry_detectors_by_bones(result.asset, input.surface.vertices, *input.skin, source);
+        for (auto& [key, value] : result.asset.provenance.options)
+          if (key == "detectors") value = name_of(format::DetectorForm::kBones);
+        summary = count_text(input.skin->bone_names.size(), "bones") + ", " +
+                  count_text(result.asset.detector_terms.size(), "detector terms");
+        return 0;
+      });
+    } else {
+      result.asset =
+          build_surface_asset(input.surface, source, build, result.report, checked_on_stage);
+    }
   } else if (input.is_surface) {
     // tetrahedralize alone judges the surface (with its own rules: pinch points accepted), so
     // that a build accepts exactly the surfaces `tetseg tetrahedralize` accepts.
@@ -224,11 +246,8 @@ void validate_options(const BuildJobOptions& options) {
   if (b.body == format::BodyKind::kTet && form != format::DetectorForm::kTetPoint)
     throw std::invalid_argument(std::string("--detectors ") + name_of(form) +
                                 " needs --body surface");
-  if (b.body == format::BodyKind::kSurface && form != format::DetectorForm::kSurfaceWeights)
-    throw std::invalid_argument(std::string("--body surface takes --detectors weights") +
-                                (form == format::DetectorForm::kBones
-                                     ? " (skin: the skinned build is not implemented yet)"
-                                     : ""));
+  if (b.body == format::BodyKind::kSurface && form == format::DetectorForm::kTetPoint)
+    throw std::invalid_argument("--body surface takes --detectors weights or skin");
 }
 
 void validate_options(const ChargeJobOptions& options) {
@@ -245,10 +264,15 @@ BuildJobResult build_asset_from_file(const std::string& path, const BuildJobOpti
   return run_build(
       [&](std::string& summary) {
         if (is_tet_mesh_path(path)) return read_tet_mesh_input(read_tet_mesh(path), summary);
-        return read_surface_input(options.build.body == format::BodyKind::kSurface
-                                      ? read_triangle_mesh_keeping_vertices(path)
-                                      : read_triangle_mesh(path),
-                                  summary);
+        BuildInput input = read_surface_input(options.build.body == format::BodyKind::kSurface
+                                                  ? read_triangle_mesh_keeping_vertices(path)
+                                                  : read_triangle_mesh(path),
+                                              summary);
+        if (detector_form_of(options.build) == format::DetectorForm::kBones) {
+          input.skin = read_skin(path);
+          summary += ", skin of " + count_text(input.skin->bone_names.size(), "bones");
+        }
+        return input;
       },
       name, options, on_stage);
 }

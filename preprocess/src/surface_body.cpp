@@ -475,10 +475,9 @@ format::Asset build_surface_asset(const TriangleMesh& input, const std::string& 
                                   const BuildOptions& options, BuildReport& report,
                                   const std::function<void(const StageReport&)>& on_stage) {
   if (detector_form_of(options) != format::DetectorForm::kSurfaceWeights)
-    throw std::invalid_argument(std::string("a surface body takes --detectors weights") +
-                                (detector_form_of(options) == format::DetectorForm::kBones
-                                     ? " (skin is not built yet)"
-                                     : ""));
+    throw std::invalid_argument(
+        "build_surface_asset builds detectors by weights (skin: carry_detectors_by_bones on "
+        "its asset)");
   StageTimer timer(report, on_stage);
   const std::vector<Vec3>& points = input.vertices;
   const std::size_t vertex_count = points.size();

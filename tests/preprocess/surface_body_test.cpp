@@ -322,8 +322,8 @@ TEST_CASE("The build job takes --body and --detectors only in pairs that exist",
   CHECK_THROWS_WITH(validate_options(options), Catch::Contains("needs --body surface"));
   options.build.body = format::BodyKind::kSurface;
   CHECK_NOTHROW(validate_options(options));
-  options.build.detectors = format::DetectorForm::kBones;
-  CHECK_THROWS_WITH(validate_options(options), Catch::Contains("skin"));
+  options.build.detectors = format::DetectorForm::kTetPoint;
+  CHECK_THROWS_WITH(validate_options(options), Catch::Contains("--body surface takes"));
   options.build.detectors.reset();
   CHECK(detector_form_of(options.build) == format::DetectorForm::kSurfaceWeights);
   // A tet mesh is not a surface body's input.

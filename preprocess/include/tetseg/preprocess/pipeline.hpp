@@ -48,7 +48,8 @@ struct BuildOptions {
   /// provenance key "body" when kSurface.
   format::BodyKind body = format::BodyKind::kTet;
   /// The detector form; unset: the body's own (kTet: kTetPoint, kSurface: kSurfaceWeights).
-  /// A kTet body takes only kTetPoint; kBones (from the input's skin) is not built yet.
+  /// A kTet body takes only kTetPoint; kBones: the surface body's detectors carried by the
+  /// input's skin (the build job, skin.hpp).
   /// Recorded as provenance key "detectors" with a surface body.
   std::optional<format::DetectorForm> detectors;
   /// Set when the tet mesh was made from the source surface by tetrahedralize with these
