@@ -51,5 +51,5 @@ sed 's/,"skin":0//' tube.gltf >bare.gltf
 expect_exit 3 "tetseg: error: bare.gltf: .*has no bones" -- \
   "$bin/tetseg" build bare.gltf --body surface --detectors skin -o bare.tetseg
 [ ! -e bare.tetseg ] || fail "a refused build left an asset"
-expect_exit 1 "needs --body surface" -- \
+expect_exit 2 "needs --body surface" -- \
   "$bin/tetseg" build tube.gltf --detectors skin -o tet.tetseg
