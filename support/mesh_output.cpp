@@ -44,7 +44,8 @@ UsedNodes used_nodes(const format::Asset& asset, bool with_detectors) {
   for (std::uint32_t v : asset.boundary_nodes) mark(v);
   if (with_detectors)
     for (const auto& c : asset.clusters)
-      if (c.detector.is_node()) mark(c.detector.nodes[0]);
+      if (asset.detector_form == format::DetectorForm::kTetPoint && c.detector.is_node())
+        mark(c.detector.nodes[0]);
   used.index.assign(n, UINT32_MAX);
   for (std::uint32_t v = 0; v < n; ++v)
     if (flag[v]) {
@@ -94,11 +95,11 @@ std::string asset_to_vtu(const format::Asset& asset, const std::string& source) 
   std::vector<std::uint32_t> detector_point(asset.clusters.size(), UINT32_MAX);
   for (std::size_t c = 0; c < asset.clusters.size(); ++c) {
     const format::DetectorPoint& d = asset.clusters[c].detector;
-    if (d.is_node()) {
+    if (asset.detector_form == format::DetectorForm::kTetPoint && d.is_node()) {
       detector_point[c] = used.index[d.nodes[0]];
     } else {
       detector_point[c] = static_cast<std::uint32_t>(grid.points.size());
-      grid.points.push_back(format::detector_position(d, asset.rest_positions.front().data()));
+      grid.points.push_back(format::rest_detector_position(asset, asset.clusters[c]));
       node_id.values.push_back(UINT32_MAX);
     }
   }
@@ -176,9 +177,23 @@ std::string asset_to_ply(const format::Asset& asset, const std::string& source) 
   return io::ply_text(ply);
 }
 
-std::string detector_text(const format::Cluster& cluster) {
+std::string detector_text(const format::Asset& asset, const format::Cluster& cluster) {
   const format::DetectorPoint& d = cluster.detector;
   char buf[160];
+  if (asset.detector_form != format::DetectorForm::kTetPoint) {
+    const bool bones = asset.detector_form == format::DetectorForm::kBones;
+    std::string text = bones ? "bones" : "weights";
+    const format::DetectorTerm* terms = asset.detector_terms.data() + cluster.detector_term_offset;
+    for (std::uint32_t i = 0; i < cluster.detector_term_count && i < 4; ++i) {
+      std::snprintf(buf, sizeof buf, " %s%u:%.3g", bones ? "" : "n", terms[i].index,
+                    terms[i].weight);
+      text += buf;
+    }
+    if (cluster.detector_term_count > 4)
+      text += " (+" + std::to_string(cluster.detector_term_count - 4) + " terms)";
+    if (cluster.detector_term_count == 0) text += " none";
+    return text;
+  }
   if (d.is_node()) {
     std::snprintf(buf, sizeof buf, "node %u", static_cast<unsigned>(d.nodes[0]));
   } else {

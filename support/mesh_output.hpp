@@ -44,7 +44,8 @@ std::string asset_to_vtu(const format::Asset& asset, const std::string& source);
 std::string asset_to_ply(const format::Asset& asset, const std::string& source);
 
 /// One-line human form of a detector: "node 17" for the node form, else
-/// "tet 512 (3 9 10 44) w 0.25 0.25 0.25 0.25".
-std::string detector_text(const format::Cluster& cluster);
+/// "tet 512 (3 9 10 44) w 0.25 0.25 0.25 0.25"; 1.2 forms: "weights n3:0.25 n9:0.75" or
+/// "bones 2:0.75 3:0.25" (the first four terms, then "(+N terms)"; "none" without terms).
+std::string detector_text(const format::Asset& asset, const format::Cluster& cluster);
 
 }  // namespace tetseg::tools

@@ -198,18 +198,50 @@ io::Mesh load_mesh(const std::string& path) {
   }
 }
 
+/// The asset `--asset` names, checked against frame `mesh` (read from `frame`): its nodes must
+/// be the frame's vertices and its triangles the frame's faces, in order.
+tetseg::Asset load_frame_asset(const std::string& path, const io::Mesh& mesh,
+                               const std::string& frame) {
+  tetseg::Asset asset;
+  std::string detail;
+  const tetseg::Status status = tetseg::load_asset_file(path, asset, &detail);
+  if (status != tetseg::Status::kOk)
+    throw ToolError(kExitBadInput, path,
+                    std::string(tetseg::to_string(status)) + (detail.empty() ? "" : ": " + detail));
+  const tetseg::format::Asset& a = asset.data();
+  if (a.node_count != mesh.vertices.size())
+    throw ToolError(kExitBadInput, frame,
+                    std::to_string(mesh.vertices.size()) + " vertices, the asset " + path +
+                        " has " + std::to_string(a.node_count) +
+                        " nodes (the frame's vertices must be the asset's nodes, in order)");
+  if (a.triangles.size() != mesh.faces.size())
+    throw ToolError(kExitBadInput, frame,
+                    std::to_string(mesh.faces.size()) + " faces, the asset " + path + " has " +
+                        std::to_string(a.triangles.size()) + " triangles");
+  for (std::size_t t = 0; t < a.triangles.size(); ++t) {
+    if (a.triangles[t] != mesh.faces[t])
+      throw ToolError(kExitBadInput, frame,
+                      "face " + std::to_string(t) + " differs from triangle " + std::to_string(t) +
+                          " of the asset " + path + " (same triangles, same order, needed)");
+  }
+  return asset;
+}
+
 int command_frames(const std::string& path0, const std::string& path1, bool json,
                    const tetseg::CcdOptions& options, soup::BroadPhase broad_phase,
-                   soup::StillPairs still_pairs) {
+                   soup::StillPairs still_pairs, const std::string& asset_path) {
   const io::Mesh m0 = load_mesh(path0);
   const io::Mesh m1 = load_mesh(path1);
   if (m0.vertices.size() != m1.vertices.size())
     throw ToolError(kExitBadInput, path1, "vertex count differs from " + path0);
   if (m0.faces != m1.faces) throw ToolError(kExitBadInput, path1, "faces differ from " + path0);
+  tetseg::Asset asset;
+  if (!asset_path.empty()) asset = load_frame_asset(asset_path, m0, path0);
   soup::FrameStats stats;
   const double cpu_start = thread_cpu_seconds();
-  const auto contacts = soup::find_contacts(m0.vertices, m1.vertices, m0.faces, options,
-                                            broad_phase, &stats, still_pairs);
+  const auto contacts =
+      soup::find_contacts(m0.vertices, m1.vertices, m0.faces, options, broad_phase, &stats,
+                          still_pairs, asset_path.empty() ? nullptr : &asset);
   const double cpu = thread_cpu_seconds() - cpu_start;
   std::ostringstream out;
   char buf[160];
@@ -248,11 +280,17 @@ int command_frames(const std::string& path0, const std::string& path1, bool json
                  stats.test_seconds);
   } else if (broad_phase == soup::BroadPhase::kScene) {
     std::fprintf(stderr,
-                 "%s: scene: %llu triangle pairs, %llu feature pairs, %llu elementary tests; CPU "
-                 "%.3f s (PLY reading excluded)\n",
-                 kTool, static_cast<unsigned long long>(stats.triangle_pairs),
+                 "%s: scene%s: %llu triangle pairs, %llu feature pairs, %llu elementary tests%s; "
+                 "CPU %.3f s (PLY reading excluded)\n",
+                 kTool, asset_path.empty() ? "" : " (rvbc with the asset's clusters)",
+                 static_cast<unsigned long long>(stats.triangle_pairs),
                  static_cast<unsigned long long>(stats.feature_pairs),
-                 static_cast<unsigned long long>(stats.tests), cpu);
+                 static_cast<unsigned long long>(stats.tests),
+                 asset_path.empty() ? ""
+                                    : (", " + std::to_string(stats.orientation_culled) +
+                                       " node pairs culled by orientation")
+                                          .c_str(),
+                 cpu);
   }
   return kExitOk;
 }
@@ -337,13 +375,22 @@ int main(int argc, char** argv) {
   bool sweep = false;
   auto* brute_flag = frames->add_flag("--brute", brute,
                                       "All face pairs instead of the BVH (quadratic; for tests)");
-  frames
-      ->add_flag("--sweep", sweep,
-                 "Sort and sweep over swept boxes, then the same elementary tests (baseline)")
-      ->excludes(brute_flag);
+  auto* sweep_flag =
+      frames
+          ->add_flag("--sweep", sweep,
+                     "Sort and sweep over swept boxes, then the same elementary tests (baseline)")
+          ->excludes(brute_flag);
   frames
       ->add_option("--min-separation", options.min_separation, "Minimum separation (length units)")
       ->check(CLI::NonNegativeNumber);
+  std::string asset_path;
+  frames
+      ->add_option("--asset", asset_path,
+                   "Cull with this asset's clusters and detectors (rvbc): its nodes are the "
+                   "frame's vertices and its triangles the frame's faces, in order (a surface "
+                   "asset built from the first frame). Steps are presumed to start contact-free")
+      ->excludes(brute_flag)
+      ->excludes(sweep_flag);
   bool skip_still = false;
   frames->add_flag("--skip-still", skip_still,
                    "Do not test pairs whose four vertices are still (x0 == x1): the runtime's "
@@ -371,7 +418,8 @@ int main(int argc, char** argv) {
                             brute   ? soup::BroadPhase::kBrute
                             : sweep ? soup::BroadPhase::kSweep
                                     : soup::BroadPhase::kScene,
-                            skip_still ? soup::StillPairs::kSkip : soup::StillPairs::kInclude);
+                            skip_still ? soup::StillPairs::kSkip : soup::StillPairs::kInclude,
+                            asset_path);
     return command_truth(truth_ply, boxes_path, bools_path, kind);
   } catch (const ToolError& e) {
     print_error(kTool, e.file(), e.what());

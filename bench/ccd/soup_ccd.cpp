@@ -197,13 +197,19 @@ std::vector<Contact> scene_contacts(const std::vector<std::array<double, 3>>& x0
                                     const std::vector<std::array<double, 3>>& x1,
                                     const std::vector<std::array<std::uint32_t, 3>>& faces,
                                     const CcdOptions& options, FrameStats* stats,
-                                    StillPairs still_pairs) {
+                                    StillPairs still_pairs, const tetseg::Asset* asset) {
   const auto nodes = static_cast<std::uint32_t>(x0.size());
-  std::vector<std::uint32_t> ids;
-  ids.reserve(faces.size() * 3);
-  for (const auto& f : faces) ids.insert(ids.end(), f.begin(), f.end());
-  auto shape = BodyShape::from_triangles(ids.data(), faces.size(), nodes);
-  if (!shape) throw std::runtime_error("faces with a repeated or out-of-range vertex");
+  std::shared_ptr<const BodyShape> shape;
+  if (asset != nullptr) {
+    shape = BodyShape::from_asset(*asset);
+    if (!shape) throw std::runtime_error("cannot set up the asset's body (out of memory)");
+  } else {
+    std::vector<std::uint32_t> ids;
+    ids.reserve(faces.size() * 3);
+    for (const auto& f : faces) ids.insert(ids.end(), f.begin(), f.end());
+    shape = BodyShape::from_triangles(ids.data(), faces.size(), nodes);
+    if (!shape) throw std::runtime_error("faces with a repeated or out-of-range vertex");
+  }
   std::vector<double> p0, p1;
   p0.reserve(x0.size() * 3);
   p1.reserve(x1.size() * 3);
@@ -218,6 +224,15 @@ std::vector<Contact> scene_contacts(const std::vector<std::array<double, 3>>& x0
   if (scene.add_body(shape, BodyOptions{}, &body) != ColliderStatus::kOk ||
       scene.set_positions(body, p0.data(), p1.data(), p0.size()) != ColliderStatus::kOk)
     throw std::runtime_error("cannot set up the scene (out of memory)");
+  // Bone-carried detectors: the frames carry no pose, so they stay at rest.
+  std::vector<double> rest_detectors;
+  if (asset != nullptr && asset->data().detector_form == tetseg::format::DetectorForm::kBones) {
+    for (const auto& c : asset->data().clusters)
+      rest_detectors.insert(rest_detectors.end(), c.detector_rest.begin(), c.detector_rest.end());
+    if (scene.set_detector_positions(body, rest_detectors.data(), rest_detectors.data(),
+                                     rest_detectors.size()) != ColliderStatus::kOk)
+      throw std::runtime_error("cannot set the detector positions");
+  }
   ColliderStatus st = scene.step();
   if (st != ColliderStatus::kOk)
     throw std::runtime_error(std::string("step rejected: ") + tetseg::to_string(st));
@@ -238,6 +253,7 @@ std::vector<Contact> scene_contacts(const std::vector<std::array<double, 3>>& x0
     stats->triangle_pairs = body_stats.triangle_pairs;
     stats->feature_pairs = body_stats.feature_pairs;
     stats->tests = body_stats.feature_tests;
+    stats->orientation_culled = body_stats.node_pairs_orientation_culled;
   }
   // Vertex-face by (vertex, face id), then edge-edge by nodes.
   std::sort(found.begin(), found.end(), [](const tetseg::Contact& a, const tetseg::Contact& b) {
@@ -266,9 +282,10 @@ std::vector<Contact> find_contacts(const std::vector<std::array<double, 3>>& x0,
                                    const std::vector<std::array<double, 3>>& x1,
                                    const std::vector<std::array<std::uint32_t, 3>>& faces,
                                    const CcdOptions& options, BroadPhase broad_phase,
-                                   FrameStats* stats, StillPairs still_pairs) {
+                                   FrameStats* stats, StillPairs still_pairs,
+                                   const tetseg::Asset* asset) {
   if (broad_phase == BroadPhase::kScene)
-    return scene_contacts(x0, x1, faces, options, stats, still_pairs);
+    return scene_contacts(x0, x1, faces, options, stats, still_pairs, asset);
   if (broad_phase == BroadPhase::kSweep)
     return sweep_contacts(x0, x1, faces, options, stats, still_pairs);
   const bool skip_still = still_pairs == StillPairs::kSkip;

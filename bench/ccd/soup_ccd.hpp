@@ -13,6 +13,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "tetseg/runtime/asset.hpp"
 #include "tetseg/runtime/ccd.hpp"
 
 namespace tetseg::tools::soup {
@@ -42,6 +43,7 @@ enum class StillPairs {
 /// body's `ColliderStats` counts. Both: elementary tests run (after the pre-filters).
 struct FrameStats {
   std::uint64_t vf_candidates = 0, ee_candidates = 0;
+  std::uint64_t orientation_culled = 0;  ///< kScene with an asset: node pairs culled (rvbc)
   double broad_seconds = 0, test_seconds = 0;
   std::uint64_t triangle_pairs = 0, feature_pairs = 0;
   std::uint64_t tests = 0;
@@ -51,14 +53,16 @@ struct FrameStats {
 /// by ids. Vertices not referenced by a face are ignored. Preconditions: face indices <
 /// x0.size() == x1.size(). Throws std::runtime_error for a face with a repeated vertex or when
 /// the runtime fails. `kBrute` is quadratic (a reference for tests); `stats`
-/// (optional) receives the work of `kSweep` and `kScene`.
-std::vector<Contact> find_contacts(const std::vector<std::array<double, 3>>& x0,
-                                   const std::vector<std::array<double, 3>>& x1,
-                                   const std::vector<std::array<std::uint32_t, 3>>& faces,
-                                   const CcdOptions& options,
-                                   BroadPhase broad_phase = BroadPhase::kScene,
-                                   FrameStats* stats = nullptr,
-                                   StillPairs still_pairs = StillPairs::kInclude);
+/// (optional) receives the work of `kSweep` and `kScene`. `asset` (kScene only; null: none):
+/// the soup is that asset's body (the caller checks that its nodes are the frame's vertices
+/// and its triangles the faces, in order) and is culled with its clusters and detectors
+/// (rvbc; a kBones asset's detectors stay at their rest positions, which is exact and only
+/// culls less); the step is then presumed to start contact-free (docs/runtime.md).
+std::vector<Contact> find_contacts(
+    const std::vector<std::array<double, 3>>& x0, const std::vector<std::array<double, 3>>& x1,
+    const std::vector<std::array<std::uint32_t, 3>>& faces, const CcdOptions& options,
+    BroadPhase broad_phase = BroadPhase::kScene, FrameStats* stats = nullptr,
+    StillPairs still_pairs = StillPairs::kInclude, const tetseg::Asset* asset = nullptr);
 
 /// CPU time of the calling thread, in seconds.
 double thread_cpu_seconds();

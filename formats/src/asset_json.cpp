@@ -38,10 +38,44 @@ std::string json_escape(const std::string& text) {
   return out;
 }
 
+const char* body_kind_name(BodyKind kind) noexcept {
+  switch (kind) {
+    case BodyKind::kTet:
+      return "tet";
+    case BodyKind::kSurface:
+      return "surface";
+  }
+  return "unknown";
+}
+
+const char* detector_form_name(DetectorForm form) noexcept {
+  switch (form) {
+    case DetectorForm::kTetPoint:
+      return "tet-point";
+    case DetectorForm::kSurfaceWeights:
+      return "surface-weights";
+    case DetectorForm::kBones:
+      return "bones";
+  }
+  return "unknown";
+}
+
 std::string detector_json(const Asset& asset, const Cluster& cluster) {
   const DetectorPoint& d = cluster.detector;
   std::ostringstream out;
   out.precision(17);
+  if (asset.detector_form != DetectorForm::kTetPoint) {
+    out << "\"detector\": {\"form\": \"" << detector_form_name(asset.detector_form)
+        << "\", \"terms\": [";
+    for (std::uint32_t i = 0; i < cluster.detector_term_count; ++i) {
+      const DetectorTerm& term = asset.detector_terms[cluster.detector_term_offset + i];
+      out << (i ? ", " : "") << "[" << term.index << ", " << term.weight << "]";
+    }
+    const auto& p = cluster.detector_rest;
+    out << "], \"position\": [" << p[0] << ", " << p[1] << ", " << p[2] << "]}";
+    out << ", \"overlap_only\": " << ((cluster.flags & kClusterOverlapOnly) ? "true" : "false");
+    return out.str();
+  }
   out << "\"detector\": {\"nodes\": [" << d.nodes[0] << ", " << d.nodes[1] << ", " << d.nodes[2]
       << ", " << d.nodes[3] << "], \"weights\": [" << d.weights[0] << ", " << d.weights[1] << ", "
       << d.weights[2] << ", " << d.weights[3] << "], \"tet\": ";

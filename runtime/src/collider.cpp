@@ -156,8 +156,8 @@ void Collider::Impl::construct(std::shared_ptr<const BodyShape> sh, const Collid
   ctor_status = ColliderStatus::kOk;
 }
 
-ColliderStatus Collider::Impl::begin_step(const double* p0, const double* p1,
-                                          std::size_t count) noexcept {
+ColliderStatus Collider::Impl::begin_step(const double* p0, const double* p1, std::size_t count,
+                                          bool rest_check) noexcept {
   have_step = false;
   ++step_serial;
   stats = ColliderStats{};
@@ -166,7 +166,7 @@ ColliderStatus Collider::Impl::begin_step(const double* p0, const double* p1,
   if (count != std::size_t(node_count) * 3) return ColliderStatus::kSizeMismatch;
   if (node_count > 0 && (!p0 || !p1)) return ColliderStatus::kNullInput;
   // Only surface vertices and the nodes of detectors that are classified against are read;
-  // check exactly those.
+  // check exactly those (and a kBones asset's detector positions when the step classifies).
   auto finite = [&](std::uint32_t n) {
     for (int k = 0; k < 3; ++k) {
       if (!std::isfinite(p0[std::size_t(n) * 3 + k]) || !std::isfinite(p1[std::size_t(n) * 3 + k]))
@@ -177,17 +177,68 @@ ColliderStatus Collider::Impl::begin_step(const double* p0, const double* p1,
   for (std::uint32_t n : topo->surf_nodes) {
     if (!finite(n)) return ColliderStatus::kNonFinite;
   }
+  const format::DetectorForm form = asset ? asset->detector_form : format::DetectorForm::kTetPoint;
+  const bool bones = form == format::DetectorForm::kBones;
+  if (bones && !rest_check && opt.mode == ColliderMode::kRvbc && (!bone_det0 || !bone_det1))
+    return ColliderStatus::kNullInput;
   for (std::uint32_t c = 0; c < cluster_count(); ++c) {
     const format::Cluster& cl = asset->clusters[c];
     if (cl.flags & format::kClusterOverlapOnly) continue;
-    for (std::uint32_t n : cl.detector.nodes) {
-      if (!finite(n)) return ColliderStatus::kNonFinite;
+    if (form == format::DetectorForm::kTetPoint) {
+      for (std::uint32_t n : cl.detector.nodes) {
+        if (!finite(n)) return ColliderStatus::kNonFinite;
+      }
+    } else if (form == format::DetectorForm::kSurfaceWeights) {
+      const format::DetectorTerm* terms = asset->detector_terms.data() + cl.detector_term_offset;
+      for (std::uint32_t i = 0; i < cl.detector_term_count; ++i) {
+        if (!finite(terms[i].index)) return ColliderStatus::kNonFinite;
+      }
+    } else if (!rest_check && opt.mode == ColliderMode::kRvbc) {
+      for (int k = 0; k < 3; ++k) {
+        if (!std::isfinite(bone_det0[3 * std::size_t(c) + k]) ||
+            !std::isfinite(bone_det1[3 * std::size_t(c) + k]))
+          return ColliderStatus::kNonFinite;
+      }
     }
   }
   x0 = p0;
   x1 = p1;
   have_step = true;
   return ColliderStatus::kOk;
+}
+
+ColliderStatus Collider::Impl::set_detector_positions(const double* d0, const double* d1,
+                                                      std::size_t value_count) noexcept {
+  if (ctor_status != ColliderStatus::kOk) return ColliderStatus::kNotReady;
+  if (!asset || asset->detector_form != format::DetectorForm::kBones)
+    return ColliderStatus::kInvalidArgument;
+  if (value_count != 3 * std::size_t(cluster_count())) return ColliderStatus::kSizeMismatch;
+  bone_det0 = d0;
+  bone_det1 = d1;
+  return ColliderStatus::kOk;
+}
+
+void Collider::Impl::detector_ends(std::uint32_t c, std::array<double, 3>& a,
+                                   std::array<double, 3>& b) const noexcept {
+  const format::Cluster& cl = asset->clusters[c];
+  switch (asset->detector_form) {
+    case format::DetectorForm::kTetPoint:
+      a = format::detector_position(cl.detector, x0);
+      b = format::detector_position(cl.detector, x1);
+      return;
+    case format::DetectorForm::kSurfaceWeights: {
+      const format::DetectorTerm* terms = asset->detector_terms.data() + cl.detector_term_offset;
+      a = format::weighted_detector_position(terms, cl.detector_term_count, x0);
+      b = format::weighted_detector_position(terms, cl.detector_term_count, x1);
+      return;
+    }
+    case format::DetectorForm::kBones:
+      for (int k = 0; k < 3; ++k) {
+        a[k] = bone_det0[3 * std::size_t(c) + k];
+        b[k] = bone_det1[3 * std::size_t(c) + k];
+      }
+      return;
+  }
 }
 
 void Collider::Impl::refit_and_classify() noexcept {
@@ -274,16 +325,17 @@ void Collider::Impl::refit_and_classify() noexcept {
 
   if (!orientation_mode()) return;
   const auto t_class = Clock::now();
-  // Detector points at both ends of the step; the detector moves linearly between them, like
-  // every node, so the orientation stays a cubic in t (docs/runtime.md, "Detector points").
+  // Detector points at both ends of the step (evaluated from the positions, or given for bone-
+  // carried detectors); the detector moves linearly between them, like every node, so the
+  // orientation stays a cubic in t (docs/runtime.md, "Detector points").
   // Static error bound of each cluster's cubics: its triangles lie in its root box (refit), so
   // the box widened by the detector's two positions bounds every coordinate difference.
   for (std::uint32_t c = 0; c < cluster_count(); ++c) {
     const format::Cluster& cl = asset->clusters[c];
     det_ok[c] = 0;
     if (cl.flags & format::kClusterOverlapOnly) continue;
-    const std::array<double, 3> a = format::detector_position(cl.detector, x0);
-    const std::array<double, 3> b = format::detector_position(cl.detector, x1);
+    std::array<double, 3> a, b;
+    detector_ends(c, a, b);
     bool ok = true;
     for (int k = 0; k < 3; ++k) {
       det0[3 * std::size_t(c) + k] = a[k];
@@ -485,6 +537,12 @@ const ColliderStats& Collider::stats() const noexcept {
 const RestCheck& Collider::rest_intersection() const noexcept {
   static const RestCheck kEmpty{};
   return m_impl ? m_impl->rest : kEmpty;
+}
+
+ColliderStatus Collider::set_detector_positions(const double* d0, const double* d1,
+                                                std::size_t value_count) noexcept {
+  if (!m_impl) return ColliderStatus::kNotReady;
+  return m_impl->set_detector_positions(d0, d1, value_count);
 }
 
 Orientation Collider::triangle_class(std::size_t t) const noexcept {

@@ -137,7 +137,7 @@ void rest_triangle_pair(Worker& w, const Collider::Impl& A, std::uint32_t t1,
 
 RestCheck Collider::Impl::rest_check(const double* x, std::size_t value_count) noexcept {
   RestCheck r;
-  r.status = begin_step(x, x, value_count);  // invalidates the current step
+  r.status = begin_step(x, x, value_count, true);  // invalidates the current step
   if (r.status != ColliderStatus::kOk) return r;
   rest_mode = true;
   refit_and_classify();

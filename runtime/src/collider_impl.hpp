@@ -351,6 +351,10 @@ struct Collider::Impl {
   // whether the cluster is classified at all (0: overlap-only, or a non-finite detector).
   std::vector<double> det0, det1;
   std::vector<std::uint8_t> det_ok;
+  // kBones assets: the application's detector positions at both ends of the step (cluster
+  // count x 3 doubles each; set_detector_positions), read by every classifying step.
+  const double* bone_det0 = nullptr;
+  const double* bone_det1 = nullptr;
   std::vector<std::uint8_t> tmov;
   // Whole-surface modes (bvh, cone, surface-only bodies): triangle pairs that share a node are
   // not candidates; the feature pairs only such pairs hold (orphan sets, built at construction)
@@ -405,7 +409,17 @@ struct Collider::Impl {
   bool uses_clusters() const noexcept {
     return asset && (opt.mode == ColliderMode::kRvbc || rest_mode);
   }
-  ColliderStatus begin_step(const double* p0, const double* p1, std::size_t count) noexcept;
+  /// Validates a step's inputs (`rest_check`: for a rest check, which classifies nothing, so
+  /// bone-carried detector positions are not needed) and makes it current.
+  ColliderStatus begin_step(const double* p0, const double* p1, std::size_t count,
+                            bool rest_check = false) noexcept;
+  /// Collider/Scene::set_detector_positions (a kBones asset's detectors; docs/runtime.md).
+  ColliderStatus set_detector_positions(const double* d0, const double* d1,
+                                        std::size_t value_count) noexcept;
+  /// Cluster c's detector at the start (`a`) and end (`b`) of the current step, by the
+  /// asset's detector form (a classified cluster of a validated step).
+  void detector_ends(std::uint32_t c, std::array<double, 3>& a,
+                     std::array<double, 3>& b) const noexcept;
   void refit_and_classify() noexcept;
   /// kOk when a query can run, else kNotReady or kNoStep.
   ColliderStatus query_status() const noexcept;

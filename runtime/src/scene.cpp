@@ -195,6 +195,13 @@ ColliderStatus Scene::set_positions(std::uint32_t body, const double* x0, const 
   return ColliderStatus::kOk;
 }
 
+ColliderStatus Scene::set_detector_positions(std::uint32_t body, const double* d0, const double* d1,
+                                             std::size_t value_count) noexcept {
+  if (!m_impl) return ColliderStatus::kNotReady;
+  if (body >= m_impl->bodies.size()) return ColliderStatus::kInvalidArgument;
+  return m_impl->bodies[body].core->set_detector_positions(d0, d1, value_count);
+}
+
 ColliderStatus Scene::step(const double* x0, const double* x1, std::size_t value_count) noexcept {
   if (!m_impl) return ColliderStatus::kNotReady;
   Impl& s = *m_impl;
@@ -430,7 +437,7 @@ RestCheck Scene::check_rest_intersection(const double* x, std::size_t value_coun
     const double *p0 = nullptr, *p1 = nullptr;
     r.status = s.body_positions(b, x, x, value_count, p0, p1);
     if (r.status == ColliderStatus::kOk)
-      r.status = core.begin_step(p0, p0, std::size_t(core.node_count) * 3);
+      r.status = core.begin_step(p0, p0, std::size_t(core.node_count) * 3, true);
     if (r.status != ColliderStatus::kOk) return finish(r);
     core.rest_mode = true;
     core.refit_and_classify();

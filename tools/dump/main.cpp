@@ -98,6 +98,9 @@ void print_summary(const std::string& path, const std::string& version, const As
               asset.rest_positions.empty() ? " (no rest positions)" : "");
   std::printf("  surface triangles   %zu\n", asset.triangles.size());
   std::printf("  components          %zu\n", surface_components(asset));
+  std::printf("  body                %s\n", tetseg::format::body_kind_name(asset.body_kind));
+  std::printf("  detector form       %s\n",
+              tetseg::format::detector_form_name(asset.detector_form));
   std::printf("  clusters            %zu\n", asset.clusters.size());
   std::printf("  segment boundaries  %zu (%zu boundary nodes)\n", asset.boundaries.size(),
               asset.boundary_nodes.size());
@@ -124,6 +127,23 @@ void print_summary(const std::string& path, const std::string& version, const As
   for (const auto& cluster : asset.clusters)
     flagged += (cluster.flags & tetseg::format::kClusterOverlapOnly) ? 1 : 0;
   std::printf("  overlap-only        %zu clusters (culled by BVH overlap only)\n", flagged);
+  if (asset.detector_form != tetseg::format::DetectorForm::kTetPoint && !asset.clusters.empty()) {
+    std::uint32_t least = UINT32_MAX, most = 0;
+    for (const auto& cluster : asset.clusters) {
+      least = std::min(least, cluster.detector_term_count);
+      most = std::max(most, cluster.detector_term_count);
+    }
+    std::printf("  detector terms      %zu (%u to %u per cluster, mean %.2f)\n",
+                asset.detector_terms.size(), least, most,
+                double(asset.detector_terms.size()) / double(asset.clusters.size()));
+  }
+  if (asset.detector_form == tetseg::format::DetectorForm::kBones) {
+    // Escaped (names come from the input's skin), the first 64 (--json lists all).
+    std::printf("  bones               %zu:", asset.bone_names.size());
+    for (std::size_t b = 0; b < asset.bone_names.size() && b < 64; ++b)
+      std::printf(" %zu=\"%s\"", b, tetseg::format::json_escape(asset.bone_names[b]).c_str());
+    std::printf("%s\n", asset.bone_names.size() > 64 ? " ..." : "");
+  }
   std::printf("  %-8s %10s %14s %15s %-12s  %s\n", "cluster", "triangles", "rest_positive",
               "boundary_edges", "culling", "detector");
   for (std::size_t c = 0; c < asset.clusters.size(); ++c) {
@@ -131,10 +151,10 @@ void print_summary(const std::string& path, const std::string& version, const As
     const bool overlap_only = (cluster.flags & tetseg::format::kClusterOverlapOnly) != 0;
     std::printf("  %-8zu %10u %14.4f %15u %-12s  %s", c, cluster.triangle_count,
                 cluster.rest_positive_fraction, edges[c], overlap_only ? "overlap-only" : "rvbc",
-                tetseg::tools::detector_text(cluster).c_str());
-    if (!asset.rest_positions.empty()) {
-      const auto p =
-          tetseg::format::detector_position(cluster.detector, asset.rest_positions.front().data());
+                tetseg::tools::detector_text(asset, cluster).c_str());
+    if (!asset.rest_positions.empty() ||
+        asset.detector_form != tetseg::format::DetectorForm::kTetPoint) {
+      const auto p = tetseg::format::rest_detector_position(asset, cluster);
       std::printf(" at (%.6g, %.6g, %.6g)", p[0], p[1], p[2]);
     }
     std::printf("\n");
@@ -147,6 +167,13 @@ void print_json(const std::string& version, const Asset& asset) {
   std::ostringstream out;
   out.precision(9);
   out << "{\n  \"format_version\": \"" << version << "\",\n";
+  out << "  \"body\": \"" << tetseg::format::body_kind_name(asset.body_kind) << "\",\n";
+  out << "  \"detector_form\": \"" << tetseg::format::detector_form_name(asset.detector_form)
+      << "\",\n";
+  out << "  \"bone_names\": [";
+  for (std::size_t b = 0; b < asset.bone_names.size(); ++b)
+    out << (b ? ", \"" : "\"") << json_escape(asset.bone_names[b]) << '"';
+  out << "],\n";
   out << "  \"nodes\": " << asset.node_count << ",\n";
   out << "  \"rest_positions\": " << (asset.rest_positions.empty() ? "false" : "true") << ",\n";
   out << "  \"surface_triangles\": " << asset.triangles.size() << ",\n";

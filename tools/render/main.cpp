@@ -46,8 +46,7 @@ RenderMesh mesh_from_asset(const std::string& path, bool boundaries, bool detect
     // Detector points (inside tets or at nodes) are appended as extra positions.
     for (const auto& c : asset.clusters) {
       mesh.points.push_back(static_cast<std::uint32_t>(mesh.positions.size()));
-      mesh.positions.push_back(
-          tetseg::format::detector_position(c.detector, asset.rest_positions.front().data()));
+      mesh.positions.push_back(tetseg::format::rest_detector_position(asset, c));
     }
     mesh.points_on_top = true;
   }

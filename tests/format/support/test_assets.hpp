@@ -145,8 +145,7 @@ inline double dot(const Vec3& a, const Vec3& b) {
 /// Rest position of a cluster's detector (kTetPoint: evaluated from the rest positions; other
 /// forms: `detector_rest`).
 inline Vec3 detector_position(const Asset& a, const Cluster& c) {
-  if (a.detector_form != DetectorForm::kTetPoint) return c.detector_rest;
-  return format::detector_position(c.detector, a.rest_positions.front().data());
+  return format::rest_detector_position(a, c);
 }
 
 /// Share of the cluster's triangles whose outward normal faces away from the detector.

@@ -210,4 +210,11 @@ struct Asset {
   std::vector<std::string> bone_names;
 };
 
+/// A cluster's detector at rest, as tools draw and print it: kTetPoint: `detector_position` of
+/// the rest positions (which must be present); other forms: `detector_rest`.
+inline std::array<double, 3> rest_detector_position(const Asset& asset, const Cluster& cluster) {
+  if (asset.detector_form != DetectorForm::kTetPoint) return cluster.detector_rest;
+  return detector_position(cluster.detector, asset.rest_positions.front().data());
+}
+
 }  // namespace tetseg::format

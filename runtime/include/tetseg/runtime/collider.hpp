@@ -1,9 +1,9 @@
 #pragma once
 /// \file
-/// Per-frame continuous self-collision queries for the surface of one deformable tetrahedral
-/// object (paper section V; docs/runtime.md). A `Collider` is built once from an `Asset`,
-/// allocates all of its scratch memory in the constructor, and then answers queries for each
-/// step `x(t) = (1-t) x0 + t x1`, t in [0,1], without allocating.
+/// Per-frame continuous self-collision queries for the surface of one deformable object, a
+/// tet body or a surface body (asset format 1.2) (paper section V; docs/runtime.md). A `Collider`
+/// is built once from an `Asset`, allocates all of its scratch memory in the constructor, and then
+/// answers queries for each step `x(t) = (1-t) x0 + t x1`, t in [0,1], without allocating.
 ///
 /// Usage per step: `step(x0, x1)`, then any of `any_collision(hit)`, `earliest_toi(e)`,
 /// `contacts(buffer, capacity, r)`, each returning a status. Queries do only the work they
@@ -188,7 +188,10 @@ class Collider {
   /// whole step, i.e. at t = 0, which the previous step or `check_rest_intersection` reports); so
   /// still clusters, pairs of still clusters and a step where nothing moved cost no traversal.
   /// Rejects NaN/inf positions of the nodes it reads (surface and detector nodes; no other node is
-  /// read).
+  /// read). Detectors of a kSurfaceWeights asset are evaluated from x0 and x1; those of a kBones
+  /// asset are read from the arrays given to `set_detector_positions` by every kRvbc step
+  /// (kNullInput when never given, kNonFinite for NaN/inf in a classified cluster's entries;
+  /// other modes classify nothing and do not read them).
   ColliderStatus step(const double* x0, const double* x1, std::size_t value_count) noexcept;
   /// Same with value_count = node_count * 3 assumed.
   ColliderStatus step(const double* x0, const double* x1) noexcept;
@@ -210,6 +213,17 @@ class Collider {
   /// a buffer (the list is not stored); a count-only call after a full traversal reuses it.
   [[nodiscard]] ColliderStatus contacts(Contact* buffer, std::size_t capacity,
                                         ContactsResult& out) noexcept;
+
+  /// Detector positions of a kBones asset (bones carry the detectors; the application poses
+  /// its skeleton, e.g. with `format::skinned_detector_positions`): `d0`, `d1` = cluster_count
+  /// * 3 doubles (xyz per cluster at the start and end of the step; entries of overlap-only
+  /// clusters are not read), `value_count` must be cluster_count * 3. The collider keeps the
+  /// pointers (like `step`'s) and reads them at every following `step`: update the arrays
+  /// before each step. Any positions are correct, even wrong ones (a detector far from its
+  /// part only culls less; docs/runtime.md). kInvalidArgument for an asset of another form,
+  /// kSizeMismatch for a wrong count.
+  ColliderStatus set_detector_positions(const double* d0, const double* d1,
+                                        std::size_t value_count) noexcept;
 
   /// Statistics of the current step.
   const ColliderStats& stats() const noexcept;

@@ -1,12 +1,12 @@
 #pragma once
 /// \file
 /// Continuous collision queries over several bodies in one runtime (docs/runtime.md, "Scenes").
-/// Bodies: a tet body from an asset (radial-view culling inside it), a surface-only body (a
-/// triangle mesh with no asset: obstacles, cloth, shells, soups; overlap culling only); any
-/// body may be still. Per step: the self-collision of each body plus every pair of bodies
-/// whose swept boxes overlap, culled hierarchically (body boxes, then BVH against BVH); a pair
-/// of still bodies costs nothing. Same guarantees as `Collider`: scratch allocated when bodies
-/// are added, no allocation per step, no exceptions, every query returns a status.
+/// Bodies: a tet or surface body from an asset (radial-view culling inside it), a surface-only body
+/// (a triangle mesh with no asset: obstacles, cloth, shells, soups; overlap culling only); any body
+/// may be still. Per step: the self-collision of each body plus every pair of bodies whose swept
+/// boxes overlap, culled hierarchically (body boxes, then BVH against BVH); a pair of still bodies
+/// costs nothing. Same guarantees as `Collider`: scratch allocated when bodies are added, no
+/// allocation per step, no exceptions, every query returns a status.
 ///
 /// Thread safety: one `Scene` per thread; shapes (`BodyShape`) may be shared across scenes.
 
@@ -102,6 +102,11 @@ class Scene {
   /// queries answer kNoStep until the next `step`.
   ColliderStatus set_positions(std::uint32_t body, const double* x0, const double* x1,
                                std::size_t value_count) noexcept;
+
+  /// Detector positions of a body over a kBones asset, as `Collider::set_detector_positions`
+  /// (kept and read at every step; kInvalidArgument for an unknown body or another form).
+  ColliderStatus set_detector_positions(std::uint32_t body, const double* d0, const double* d1,
+                                        std::size_t value_count) noexcept;
 
   /// Starts a step `x(t) = (1-t) x0 + t x1` of every body: `x0`/`x1`/`value_count` are the
   /// global arrays read by the bodies with a `global_offset` (may be null when there are
