@@ -25,6 +25,7 @@
 #include <CLI/CLI.hpp>
 
 #include "scene_table.hpp"
+#include "surface_frames.hpp"
 #include "tetseg/runtime/asset.hpp"
 #include "tetseg/runtime/collider.hpp"
 #include "tetseg/runtime/frames.hpp"
@@ -474,9 +475,23 @@ int main(int argc, char** argv) {
                "Skip brute force and the comparison (timings only)");
   sc->add_flag("--expect-clean", scene_options.expect_clean,
                "Exit 1 when a frame intersects or brute force finds a contact in a step");
+  CLI::App* sf = app.add_subcommand(
+      "surface",
+      "A tet scene as a surface body: its rest surface as OFF (surface nodes in ascending id) "
+      "and frame files restricted to those nodes");
+  std::string surface_asset, surface_off;
+  std::vector<std::string> surface_frame_pairs;
+  sf->add_option("asset", surface_asset, "Tet asset (with rest positions)")->required();
+  sf->add_option("surface", surface_off, "OFF file to write")->required();
+  sf->add_option("frames", surface_frame_pairs, "FRAMES OUT_FRAMES, repeated")->expected(0, -1);
   try {
     app.parse(argc, argv);
     if (c->parsed()) return check(check_asset, check_frames);
+    if (sf->parsed()) {
+      if (surface_frame_pairs.size() % 2 != 0)
+        throw Failure{kExitUsage, "surface: frame files come in pairs (FRAMES OUT_FRAMES)"};
+      return tetseg::bench::surface_frames(surface_asset, surface_off, surface_frame_pairs);
+    }
     if (sc->parsed()) return tetseg::bench::scene_table(scene_options);
     plan.earliest = query == "earliest";
     return table(scenes, modes, plan, openmp, json, !no_truth);

@@ -337,7 +337,7 @@ struct PositionEqual {
   }
 };
 
-TriangleMesh read_with_cgal(const std::string& path, const std::string& ext) {
+TriangleMesh read_with_cgal(const std::string& path, const std::string& ext, bool keep_vertices) {
   const std::string text = detail::read_file_text(path);
   if (text.empty()) throw InputError(path, "empty file");
   if (ext == ".ply") check_ply_layout(path, text);
@@ -373,8 +373,16 @@ TriangleMesh read_with_cgal(const std::string& path, const std::string& ext) {
       triangulate_polygon(points, polygon, triangles);
     }
   }
-  // Vertices are merged by exact position (STL repeats corners), numbered in order of first use.
   TriangleMesh mesh;
+  if (keep_vertices) {  // the file's vertices, all of them, in their order
+    mesh.vertices.reserve(points.size());
+    for (const Point& p : points) mesh.vertices.push_back(detail::cgal::to_vec3(p));
+    for (const auto& t : triangles)
+      mesh.triangles.push_back({static_cast<std::uint32_t>(t[0]), static_cast<std::uint32_t>(t[1]),
+                                static_cast<std::uint32_t>(t[2])});
+    return mesh;
+  }
+  // Vertices are merged by exact position (STL repeats corners), numbered in order of first use.
   std::unordered_map<Vec3, std::uint32_t, PositionHash, PositionEqual> index_of;
   index_of.reserve(points.size());
   for (const auto& t : triangles) {
@@ -393,7 +401,9 @@ TriangleMesh read_with_cgal(const std::string& path, const std::string& ext) {
 
 }  // namespace
 
-TriangleMesh read_triangle_mesh(const std::string& path) {
+namespace {
+
+TriangleMesh read_triangle_mesh(const std::string& path, bool keep_vertices) {
   {
     std::ifstream probe(path, std::ios::binary);
     if (!probe) throw InputError(path, "cannot open file");
@@ -404,7 +414,8 @@ TriangleMesh read_triangle_mesh(const std::string& path) {
   // The third-party readers may throw anything (allocation failures on hostile sizes, CGAL
   // precondition failures); every one becomes an InputError naming the file.
   try {
-    mesh = cgal ? read_with_cgal(path, ext) : detail::read_triangle_mesh_assimp(path);
+    mesh = cgal ? read_with_cgal(path, ext, keep_vertices && ext != ".stl")
+                : detail::read_triangle_mesh_assimp(path);
   } catch (const InputError&) {
     throw;
   } catch (const std::bad_alloc&) {
@@ -414,6 +425,16 @@ TriangleMesh read_triangle_mesh(const std::string& path) {
   }
   if (mesh.triangles.empty()) throw InputError(path, "no triangles in file");
   return mesh;
+}
+
+}  // namespace
+
+TriangleMesh read_triangle_mesh(const std::string& path) {
+  return read_triangle_mesh(path, false);
+}
+
+TriangleMesh read_triangle_mesh_keeping_vertices(const std::string& path) {
+  return read_triangle_mesh(path, true);
 }
 
 }  // namespace tetseg::preprocess

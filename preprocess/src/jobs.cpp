@@ -264,7 +264,10 @@ BuildJobResult build_asset_from_file(const std::string& path, const BuildJobOpti
   return run_build(
       [&](std::string& summary) {
         if (is_tet_mesh_path(path)) return read_tet_mesh_input(read_tet_mesh(path), summary);
-        BuildInput input = read_surface_input(read_triangle_mesh(path), summary);
+        BuildInput input = read_surface_input(options.build.body == format::BodyKind::kSurface
+                                                  ? read_triangle_mesh_keeping_vertices(path)
+                                                  : read_triangle_mesh(path),
+                                              summary);
         if (detector_form_of(options.build) == format::DetectorForm::kBones) {
           input.skin = read_skin(path);
           summary += ", skin of " + count_text(input.skin->bone_names.size(), "bones");

@@ -36,7 +36,8 @@ constexpr std::uint32_t kUnset = 0xffffffffu;
 /// smallest triangle id, and whether each is closed (every edge shared by two triangles).
 struct SurfaceComponents {
   std::vector<std::vector<std::uint32_t>> triangles;  ///< per component, ascending ids
-  std::vector<bool> closed;
+  std::vector<bool> closed;  ///< closed and wound outward (check_closed_components)
+  std::size_t inward = 0;    ///< closed components wound inward (overlap-only)
 };
 
 std::string triangle_name(const TriangleMesh& mesh, std::size_t t) {
@@ -126,27 +127,31 @@ SurfaceComponents check_triangles(const TriangleMesh& mesh, const std::string& f
 }
 
 /// The closed components' own checks: validate_closed_surface (vertex-manifold, no
-/// self-intersection), outward orientation and no nesting.
-void check_closed_components(const TriangleMesh& mesh, const SurfaceComponents& components,
+/// self-intersection) and no nesting among the outward ones. A closed component wound inward
+/// (a shell whose solid is outside, e.g. a container) is valid but has no inside to put
+/// detectors in: it is marked open (overlap-only) here.
+void check_closed_components(const TriangleMesh& mesh, SurfaceComponents& components,
                              const std::string& file) {
-  TriangleMesh closed;
+  TriangleMesh closed, outward;
   closed.vertices = mesh.vertices;
+  outward.vertices = mesh.vertices;
   for (std::size_t c = 0; c < components.triangles.size(); ++c) {
     if (!components.closed[c]) continue;
     std::vector<Tri> own;
     for (std::uint32_t t : components.triangles[c]) own.push_back(mesh.triangles[t]);
-    if (!(enclosed_volume(mesh.vertices, own) > 0.0))
-      throw InputError(file, "closed component " + std::to_string(c) + " (first triangle " +
-                                 triangle_name(mesh, components.triangles[c].front()) +
-                                 ") is wound inward (enclosed volume <= 0); a surface body "
-                                 "keeps the input's triangles: flip its winding");
     closed.triangles.insert(closed.triangles.end(), own.begin(), own.end());
+    if (enclosed_volume(mesh.vertices, own) > 0.0) {
+      outward.triangles.insert(outward.triangles.end(), own.begin(), own.end());
+    } else {
+      components.closed[c] = false;
+      components.inward += 1;
+    }
   }
   if (closed.triangles.empty()) return;
   detail::SurfaceCheck check;
   check.allow_components = true;
   detail::validate_closed_surface(closed, file, check, nullptr);
-  detail::check_surface_not_nested(closed, file);
+  if (!outward.triangles.empty()) detail::check_surface_not_nested(outward, file);
 }
 
 /// Inside test for one closed, outward component: the winding number along the +z ray from a
@@ -464,25 +469,15 @@ std::vector<format::DetectorTerm> detector_terms(const std::vector<Vec3>& points
   }
 }
 
-/// `sum weight * x[index]` in term order, as format's evaluation of kSurfaceWeights detectors.
-Vec3 weighted_position(const std::vector<Vec3>& points,
-                       const std::vector<format::DetectorTerm>& terms) {
-  Vec3 out{0.0, 0.0, 0.0};
-  for (const format::DetectorTerm& term : terms)
-    for (int k = 0; k < 3; ++k) out[k] += term.weight * points[term.index][k];
-  return out;
-}
-
 }  // namespace
 
 format::Asset build_surface_asset(const TriangleMesh& input, const std::string& source,
                                   const BuildOptions& options, BuildReport& report,
                                   const std::function<void(const StageReport&)>& on_stage) {
   if (detector_form_of(options) != format::DetectorForm::kSurfaceWeights)
-    throw std::invalid_argument(std::string("a surface body takes --detectors weights") +
-                                (detector_form_of(options) == format::DetectorForm::kBones
-                                     ? " (skin is not built yet)"
-                                     : ""));
+    throw std::invalid_argument(
+        "build_surface_asset builds detectors by weights (skin: carry_detectors_by_bones on "
+        "its asset)");
   StageTimer timer(report, on_stage);
   const std::vector<Vec3>& points = input.vertices;
   const std::size_t vertex_count = points.size();
@@ -541,8 +536,9 @@ format::Asset build_surface_asset(const TriangleMesh& input, const std::string& 
     }
     summary = std::to_string(input.triangles.size()) + " triangles, " +
               std::to_string(components.triangles.size()) + " components (" +
-              std::to_string(overlap_only_components.size()) + " overlap-only), " +
-              std::to_string(candidates) + " interior candidates";
+              std::to_string(overlap_only_components.size()) + " overlap-only, " +
+              std::to_string(components.inward) + " closed inward), " + std::to_string(candidates) +
+              " interior candidates";
     return 0;
   });
   report.components = static_cast<std::uint32_t>(components.triangles.size());
@@ -616,7 +612,8 @@ format::Asset build_surface_asset(const TriangleMesh& input, const std::string& 
           terms[c] = detector_terms(points, rings, seed, chosen.position);
         }
         if (!terms[c].empty()) {
-          d.position = weighted_position(points, terms[c]);
+          d.position = format::weighted_detector_position(
+              terms[c].data(), static_cast<std::uint32_t>(terms[c].size()), points.front().data());
           d.positive_triangles =
               count_positive_triangles(points, input.triangles, members[c], d.position);
           d.rest_positive_fraction =
@@ -660,6 +657,9 @@ format::Asset build_surface_asset(const TriangleMesh& input, const std::string& 
   detail::set_provenance(asset, source, used, report);
   for (const DetectorChoice& detector : detectors)
     report.rest_positive_fraction.push_back(detector.rest_positive_fraction);
+  std::string detail;
+  if (format::validate(asset, &detail) != format::Status::kOk)
+    throw std::runtime_error("internal error: built surface asset does not validate: " + detail);
   return asset;
 }
 

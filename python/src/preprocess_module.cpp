@@ -169,9 +169,14 @@ py::tuple build(const py::object& mesh, const py::object& source, const std::str
                 double cell_size, double facet_size, double facet_distance, bool optimize,
                 int threads, const std::string& repair, double wrap_alpha, double wrap_offset,
                 double wrap_sheet_offset, bool keep_largest_component, double max_deviation,
-                double time_limit, bool rest_positions, const py::object& on_stage) {
+                double time_limit, bool rest_positions, const std::string& body,
+                const py::object& detectors, const py::object& on_stage) {
   BuildJobOptions job;
   BuildOptions& options = job.build;
+  options.body = enum_from_name<format::BodyKind>("body", body);
+  if (!detectors.is_none())
+    options.detectors =
+        enum_from_name<format::DetectorForm>("detectors", detectors.cast<std::string>());
   options.clusters = enum_from_name<ClusterMethod>("clusters", clusters);
   options.refinement.min_visibility = refine_visibility;
   options.refinement.max_clusters = refine_max_clusters;
@@ -362,7 +367,9 @@ PYBIND11_MODULE(preprocess, m) {
         py::arg("keep_largest_component") = meshing.keep_largest_component,
         py::arg("max_deviation") = meshing.max_deviation,
         py::arg("time_limit") = BuildJobOptions{}.time_limit,
-        py::arg("rest_positions") = b.keep_rest_positions, py::arg("on_stage") = py::none(),
+        py::arg("rest_positions") = b.keep_rest_positions,
+        py::arg("body") = std::string(name_of(b.body)), py::arg("detectors") = py::none(),
+        py::arg("on_stage") = py::none(),
         "Returns (asset bytes, report dict). "
         "Runs the whole pipeline as `tetseg build` does. mesh: a tet mesh file (.mesh, "
         ".node/.ele, .msh), a closed surface file (.obj, .ply, .stl, .off, ...; tetrahedralised "
@@ -373,6 +380,9 @@ PYBIND11_MODULE(preprocess, m) {
         "recorded in the asset's provenance and used in messages (default: the path, or "
         "'arrays'). Every other option is the `tetseg build` option of the same name "
         "(--no-optimize is optimize=False, --no-rest-positions is rest_positions=False). "
+        "body='surface' builds a surface body from a surface (file or arrays) as it is: its "
+        "vertices and triangles in their order, no tets; detectors: None (the body's own form: "
+        "'weights' for a surface body) or 'weights'. "
         "on_stage(name, seconds, summary) is called after each stage. The report dict is "
         "`tetseg build --report` (the same writer; no 'output') plus 'stages'. Load the bytes with "
         "tetseg.load_asset. Raises InputError for a bad mesh or a build past time_limit seconds "

@@ -99,6 +99,34 @@ def test_build_from_closed_surface_equals_cli(pp, bin_dir, sphere_mesh, tmp_path
     assert report["counts"] == expected_report["counts"]
 
 
+def test_surface_body_build_equals_cli_and_keeps_the_arrays(pp, bin_dir, sphere_mesh, tmp_path):
+    import tetseg
+    asset = tetseg.load_asset(pp.build(sphere_mesh, clusters="single")[0])
+    used, triangles = np.unique(asset.triangles, return_inverse=True)
+    triangles = triangles.reshape(-1, 3)[::-1].copy()  # another triangle order, kept as given
+    points = asset.rest_positions[used]
+    off = tmp_path / "sphere.off"
+    with open(off, "w") as out:
+        out.write(f"OFF\n{len(points)} {len(triangles)} 0\n")
+        out.writelines(f"{x!r} {y!r} {z!r}\n" for x, y, z in points.tolist())
+        out.writelines(f"3 {a} {b} {c}\n" for a, b, c in triangles.tolist())
+    expected, expected_report = cli_build(bin_dir, off, tmp_path, "--body", "surface")
+    data, report = pp.build(off, body="surface", detectors="weights")
+    assert data == expected
+    assert report["body"] == expected_report["body"] == "surface"
+    assert report["detectors"] == "weights"
+    assert report["options"]["body"] == "surface"
+    assert "tetrahedralize" not in [s[0] for s in report["stages"]]
+    from_arrays, _ = pp.build((points, triangles), body="surface")
+    built = tetseg.load_asset(from_arrays)
+    assert np.array_equal(built.rest_positions, points)
+    assert np.array_equal(built.triangles, triangles)
+    with pytest.raises(ValueError, match="needs --body surface"):
+        pp.build(off, detectors="weights")
+    with pytest.raises(ValueError, match="body: unknown value"):
+        pp.build(off, body="shell")
+
+
 CUBE_OFF = """OFF
 8 7 0
 0 0 0

@@ -25,7 +25,7 @@ def build(mesh: _Mesh, *, source: Optional[str] = ..., clusters: str = ...,
           wrap_sheet_offset: float = ...,
           keep_largest_component: bool = ..., max_deviation: float = ...,
           time_limit: float = ...,
-          rest_positions: bool = ...,
+          rest_positions: bool = ..., body: str = ..., detectors: Optional[str] = ...,
           on_stage: Optional[Callable[[str, float, str], Any]] = ...) -> Tuple[bytes, dict]: ...
 def charge(mesh: _Mesh, *, source: Optional[str] = ..., solver: str = ...,
            tolerance: float = ..., max_iterations: int = ..., theta: float = ...,

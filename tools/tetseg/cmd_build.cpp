@@ -37,6 +37,14 @@ void print_visibility_note(const format::Asset& asset, double min_visibility) {
       worst = c;
   }
   if (poor == 0) return;
+  if (asset.body_kind == format::BodyKind::kSurface) {
+    std::fprintf(stderr,
+                 "tetseg: note: %zu of %zu clusters are seen less than %.0f%% positive at rest "
+                 "from their detector point; %zu are overlap-only (open components, or below "
+                 "--min-visibility %g): culled by BVH overlap only\n",
+                 poor, asset.clusters.size(), 100.0 * kPoorVisibility, flagged, min_visibility);
+    return;
+  }
   std::fprintf(stderr,
                "tetseg: note: %zu of %zu clusters are seen less than %.0f%% positive at rest "
                "from their detector point (lowest: cluster %zu, %.1f%%); %zu flagged "

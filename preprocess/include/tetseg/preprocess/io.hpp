@@ -52,4 +52,11 @@ void write_gmsh41_binary(const std::string& path, const TetMesh& mesh);
 /// validate_closed_surface.
 TriangleMesh read_triangle_mesh(const std::string& path);
 
+/// read_triangle_mesh for a surface body (`tetseg build --body surface`): OFF, PLY and OBJ
+/// keep the file's vertices as they are, all of them in their order (none merged or dropped),
+/// so that frames of the same simulation apply unchanged; polygons are triangulated as there.
+/// STL (corners repeated per facet) and the assimp formats are read as read_triangle_mesh
+/// reads them (their vertex order is the reader's).
+TriangleMesh read_triangle_mesh_keeping_vertices(const std::string& path);
+
 }  // namespace tetseg::preprocess

@@ -48,7 +48,8 @@ struct BuildOptions {
   /// provenance key "body" when kSurface.
   format::BodyKind body = format::BodyKind::kTet;
   /// The detector form; unset: the body's own (kTet: kTetPoint, kSurface: kSurfaceWeights).
-  /// A kTet body takes only kTetPoint; kBones (from the input's skin) is not built yet.
+  /// A kTet body takes only kTetPoint; kBones: the surface body's detectors carried by the
+  /// input's skin (the build job, skin.hpp).
   /// Recorded as provenance key "detectors" with a surface body.
   std::optional<format::DetectorForm> detectors;
   /// Set when the tet mesh was made from the source surface by tetrahedralize with these
@@ -160,12 +161,13 @@ format::DetectorForm detector_form_of(const BuildOptions& options);
 /// both in the input's order (format::BodyKind::kSurface). Validation (InputError naming the
 /// first defect): finite coordinates, indices in range, no zero-area triangle, no edge of
 /// more than two triangles, consistent orientation; closed components must also be
-/// vertex-manifold, free of self-intersection, outward and not nested. Closed components are
+/// vertex-manifold, free of self-intersection and (the outward ones) not nested. Closed
+/// outward components are
 /// charged, segmented and refined like a tet mesh's surface, with interior points sampled
 /// inside them as detector candidates (used only as candidates); each detector is then written
 /// as non-negative weights (sum 1) of at most kSurfaceDetectorTerms surface vertices around it
-/// (kSurfaceWeights). Open components, and clusters no candidate sees well at rest, are
-/// overlap-only clusters (one per open component). Deterministic.
+/// (kSurfaceWeights). Open components and closed ones wound inward (one cluster each), and
+/// clusters no candidate sees well at rest, are overlap-only clusters. Deterministic.
 format::Asset build_surface_asset(const TriangleMesh& surface, const std::string& source,
                                   const BuildOptions& options, BuildReport& report,
                                   const std::function<void(const StageReport&)>& on_stage = {});
