@@ -68,7 +68,8 @@ tetseg::test::Scene tube_scene(const SkinnedTube& tube, DetectorForm form) {
       for (std::uint32_t v : ring)
         for (int k = 0; k < 3; ++k) c.detector_rest[k] += s.verts[v][k] / ring.size();
     }
-    c.detector_term_count = static_cast<std::uint32_t>(a.detector_terms.size()) - c.detector_term_offset;
+    c.detector_term_count =
+        static_cast<std::uint32_t>(a.detector_terms.size()) - c.detector_term_offset;
     a.clusters.push_back(c);
   }
   if (form == DetectorForm::kBones) a.bone_names = tube.bone_names;
