@@ -62,6 +62,19 @@ for asset in "$weights" "$bones"; do
 done
 echo "frames --asset: $(wc -l < asset.txt) of $(wc -l < soup.txt) soup contacts, earliest '$first' found"
 
+# tetseg-run over the same step as a frame sequence: both surface assets give brute force's
+# earliest contact; the bones asset runs with its detectors at rest (said on stderr).
+"$bin/tetseg-frames" step.tsf t0.ply t1.ply 2>/dev/null
+"$bin/tetseg-run" "$weights" step.tsf --mode brute --json > brute.json
+earliest=$(grep -o '"earliest_toi": [0-9.e-]*' brute.json)
+[ -n "$earliest" ] || fail "tetseg-run brute: no contact: $(cat brute.json)"
+for asset in "$weights" "$bones"; do
+  "$bin/tetseg-run" "$asset" step.tsf --json > run.json 2> run.err
+  grep -qF "$earliest" run.json || fail "tetseg-run ($asset): not brute force's $earliest: $(cat run.json)"
+done
+grep -q "detectors carried by bones stay at their rest positions" run.err ||
+  fail "tetseg-run: no note on the bones asset: $(cat run.err)"
+
 # Frames that are not the asset's: refused with the reason, exit 3.
 ply six.ply 0 0 1 "${faces[@]}"
 sed -i 's/^element vertex 7$/element vertex 6/; /^3 3 3$/d' six.ply
