@@ -30,6 +30,9 @@ grep -q '"detector": {"form": "bones", "terms": \[\[1, 0.75\], \[2, 0.25\]\], "p
   fail "dump --json: detector: $(cat b.json)"
 "$bin/tetseg-dump" "$weights" --vtu w.vtu --ply w.ply > /dev/null
 grep -q "<VTKFile" w.vtu || fail "dump --vtu of a surface asset"
+grep -q "^ply" w.ply || fail "dump --ply of a surface asset"
+"$bin/tetseg-render" "$bones" -o b.png --width 64 --height 48 --detectors
+[ "$(head -c 4 b.png | tail -c 3)" = "PNG" ] || fail "tetseg-render of a surface asset: no PNG"
 
 # The golden octahedron's frames: its 7 vertices (the 7th used by no face) and 8 triangles;
 # the top vertex 4 falls through the lower half, past the detector of the upper cluster.
