@@ -519,7 +519,8 @@ PYBIND11_MODULE(_runtime, m) {
             return clusters[py::str("detector_nodes")];
           },
           "(C, 4) uint32: the four tet-mesh nodes of each cluster's detector point (a detector "
-          "at a node: that node four times; weights in clusters['detector_weights']).")
+          "at a node: that node four times; weights in clusters['detector_weights']). "
+          "detector_form 'tet-point' only; the other forms' detectors are detector_terms.")
       .def_property_readonly(
           "body_kind",
           [](const PyAsset& a) { return format::body_kind_name(a.asset->data().body_kind); },
