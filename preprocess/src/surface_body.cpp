@@ -126,20 +126,18 @@ SurfaceComponents check_triangles(const TriangleMesh& mesh, const std::string& f
   return out;
 }
 
-/// The closed components' own checks: validate_closed_surface (vertex-manifold, no
-/// self-intersection) and no nesting among the outward ones. A closed component wound inward
-/// (a shell whose solid is outside, e.g. a container) is valid but has no inside to put
-/// detectors in: it is marked open (overlap-only) here.
+/// The closed components' own checks. A closed component wound inward (a shell whose solid is
+/// outside, e.g. a container) has no inside to put detectors in: it is marked open here
+/// (overlap-only, checked as open components are). The outward ones pass
+/// validate_closed_surface (vertex-manifold, no self-intersection) and are not nested.
 void check_closed_components(const TriangleMesh& mesh, SurfaceComponents& components,
                              const std::string& file) {
-  TriangleMesh closed, outward;
-  closed.vertices = mesh.vertices;
+  TriangleMesh outward;
   outward.vertices = mesh.vertices;
   for (std::size_t c = 0; c < components.triangles.size(); ++c) {
     if (!components.closed[c]) continue;
     std::vector<Tri> own;
     for (std::uint32_t t : components.triangles[c]) own.push_back(mesh.triangles[t]);
-    closed.triangles.insert(closed.triangles.end(), own.begin(), own.end());
     if (enclosed_volume(mesh.vertices, own) > 0.0) {
       outward.triangles.insert(outward.triangles.end(), own.begin(), own.end());
     } else {
@@ -147,11 +145,11 @@ void check_closed_components(const TriangleMesh& mesh, SurfaceComponents& compon
       components.inward += 1;
     }
   }
-  if (closed.triangles.empty()) return;
+  if (outward.triangles.empty()) return;
   detail::SurfaceCheck check;
   check.allow_components = true;
-  detail::validate_closed_surface(closed, file, check, nullptr);
-  if (!outward.triangles.empty()) detail::check_surface_not_nested(outward, file);
+  detail::validate_closed_surface(outward, file, check, nullptr);
+  detail::check_surface_not_nested(outward, file);
 }
 
 /// Inside test for one closed, outward component: the winding number along the +z ray from a
@@ -242,9 +240,15 @@ std::vector<Vec3> interior_candidates(const std::vector<Vec3>& points,
   std::vector<Vec3> out;
   const double volume = enclosed_volume(points, triangles);
   const double spacing = std::cbrt(volume / kGridCandidates);
+  // At most kMaxGridPoints points tested (a thin component lying diagonally in its box).
+  constexpr double kMaxGridPoints = double(1 << 21);
   int count[3];
-  for (int k = 0; k < 3; ++k)
-    count[k] = std::clamp(static_cast<int>((test.hi()[k] - test.lo()[k]) / spacing), 1, 256);
+  double size = spacing;
+  do {
+    for (int k = 0; k < 3; ++k)
+      count[k] = std::clamp(static_cast<int>((test.hi()[k] - test.lo()[k]) / size), 1, 256);
+    size *= 1.25;
+  } while (double(count[0]) * count[1] * count[2] > kMaxGridPoints);
   for (int i = 0; i < count[0]; ++i)
     for (int j = 0; j < count[1]; ++j)
       for (int l = 0; l < count[2]; ++l) {
@@ -408,9 +412,9 @@ VertexRings vertex_rings(std::size_t vertex_count, const std::vector<Tri>& trian
 
 /// A detector at `p` as weights of at most kSurfaceDetectorTerms surface vertices, chosen from
 /// the cluster's vertices (`seed`) and, when p is not inside their hull, rings of vertices
-/// around them (grown until it is, or the component is exhausted): per fixed direction from p
-/// the vertex best aligned with it (nearer on ties), then spread_weights. Empty when none is
-/// found. Terms sorted by vertex id.
+/// around them (1, 2, 4, ... more rings until it is, or the component is exhausted): per fixed
+/// direction from p the vertex best aligned with it (nearer on ties), then spread_weights. Empty
+/// when none is found. Terms sorted by vertex id.
 std::vector<format::DetectorTerm> detector_terms(const std::vector<Vec3>& points,
                                                  const VertexRings& rings,
                                                  std::vector<std::uint32_t> seed, const Vec3& p) {
@@ -419,6 +423,7 @@ std::vector<format::DetectorTerm> detector_terms(const std::vector<Vec3>& points
   for (std::uint32_t v : seed) taken[v] = 1;
   std::vector<std::uint32_t> set = seed;
   std::vector<std::uint32_t> frontier = seed;
+  std::size_t ring_count = 1;
   while (true) {
     double scale = 0.0;
     for (std::uint32_t v : set) scale = std::max(scale, distance2(points[v], p));
@@ -453,19 +458,25 @@ std::vector<format::DetectorTerm> detector_terms(const std::vector<Vec3>& points
         return terms;
       }
     }
-    // One more ring around the set.
-    std::vector<std::uint32_t> next;
-    for (std::uint32_t v : frontier)
-      for (std::uint32_t i = rings.start[v]; i < rings.start[v + 1]; ++i) {
-        const std::uint32_t w = rings.neighbours[i];
-        if (!taken[w]) {
-          taken[w] = 1;
-          next.push_back(w);
+    // As many rings again around the set as it has (doubling: a few rounds reach any part of
+    // the component).
+    const std::size_t added_before = set.size();
+    for (std::size_t ring = 0; ring < std::max<std::size_t>(1, ring_count); ++ring) {
+      std::vector<std::uint32_t> next;
+      for (std::uint32_t v : frontier)
+        for (std::uint32_t i = rings.start[v]; i < rings.start[v + 1]; ++i) {
+          const std::uint32_t w = rings.neighbours[i];
+          if (!taken[w]) {
+            taken[w] = 1;
+            next.push_back(w);
+          }
         }
-      }
-    if (next.empty()) return {};
-    set.insert(set.end(), next.begin(), next.end());
-    frontier = std::move(next);
+      if (next.empty()) break;
+      set.insert(set.end(), next.begin(), next.end());
+      frontier = std::move(next);
+    }
+    ring_count *= 2;
+    if (set.size() == added_before) return {};
   }
 }
 

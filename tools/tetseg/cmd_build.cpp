@@ -58,6 +58,11 @@ void run_build(const BuildArgs& args) {
   BuildJobOptions options = args.job;
   options.build.keep_rest_positions = !args.no_rest_positions;
   options.output_name = args.output;
+  try {  // option combinations the parser cannot see (--body with --detectors): usage errors
+    validate_options(options);
+  } catch (const std::invalid_argument& e) {
+    throw CLI::ValidationError("--detectors", e.what());
+  }
   if (!args.quiet) mesh_cli::report_meshing_progress(options.meshing);
   options.write_output = [&](const std::vector<std::uint8_t>& bytes) {
     write_file_atomic(args.output, bytes);

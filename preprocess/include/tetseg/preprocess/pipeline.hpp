@@ -160,9 +160,9 @@ format::DetectorForm detector_form_of(const BuildOptions& options);
 /// The asset's nodes are the surface's vertices and its triangles the surface's triangles,
 /// both in the input's order (format::BodyKind::kSurface). Validation (InputError naming the
 /// first defect): finite coordinates, indices in range, no zero-area triangle, no edge of
-/// more than two triangles, consistent orientation; closed components must also be
-/// vertex-manifold, free of self-intersection and (the outward ones) not nested. Closed
-/// outward components are
+/// more than two triangles, consistent orientation; closed components wound outward must
+/// also be vertex-manifold, free of self-intersection and not nested. Closed outward
+/// components are
 /// charged, segmented and refined like a tet mesh's surface, with interior points sampled
 /// inside them as detector candidates (used only as candidates); each detector is then written
 /// as non-negative weights (sum 1) of at most kSurfaceDetectorTerms surface vertices around it
