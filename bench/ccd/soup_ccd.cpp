@@ -227,8 +227,7 @@ std::vector<Contact> scene_contacts(const std::vector<std::array<double, 3>>& x0
   // Bone-carried detectors: the frames carry no pose, so they stay at rest.
   std::vector<double> rest_detectors;
   if (asset != nullptr && asset->data().detector_form == tetseg::format::DetectorForm::kBones) {
-    for (const auto& c : asset->data().clusters)
-      rest_detectors.insert(rest_detectors.end(), c.detector_rest.begin(), c.detector_rest.end());
+    rest_detectors = tetseg::format::rest_detector_positions(asset->data());
     if (scene.set_detector_positions(body, rest_detectors.data(), rest_detectors.data(),
                                      rest_detectors.size()) != ColliderStatus::kOk)
       throw std::runtime_error("cannot set the detector positions");

@@ -26,6 +26,7 @@
 
 #include "scene_table.hpp"
 #include "surface_frames.hpp"
+#include "tetseg/format/skin.hpp"
 #include "tetseg/runtime/asset.hpp"
 #include "tetseg/runtime/collider.hpp"
 #include "tetseg/runtime/frames.hpp"
@@ -86,7 +87,34 @@ struct Scene {
   std::string name;
   tetseg::Asset asset;
   tetseg::FrameSequence frames;
+  /// Bone-carried detectors (DetectorForm::kBones): per frame, every cluster's detector
+  /// position (cluster_count * 3), from the --bones file's matrices. Empty for other forms.
+  std::vector<double> detectors;
+  const double* detectors_at(std::size_t frame) const {
+    return detectors.data() + frame * 3 * asset.cluster_count();
+  }
 };
+
+/// Reads the per-frame bone matrices of `bones_path` (tetseg-character's PREFIX.bones.tsf: per
+/// frame, each bone's row-major 3x4 skinning matrix as 4 points) and poses the detectors of
+/// every frame (format::skinned_detector_positions).
+void pose_detectors(Scene& s, const std::string& bones_path) {
+  tetseg::FrameSequence bones;
+  std::string why;
+  const tetseg::FramesStatus fs = tetseg::read_frames_file(bones_path, bones, &why);
+  if (fs != tetseg::FramesStatus::kOk)
+    throw Failure{kExitBadInput, bones_path + ": " + tetseg::to_string(fs) + ": " + why};
+  const tetseg::format::Asset& a = s.asset.data();
+  if (bones.node_count != 4 * a.bone_names.size() || bones.frame_count != s.frames.frame_count)
+    throw Failure{kExitBadInput, bones_path + ": expected " + std::to_string(a.bone_names.size()) +
+                                     " bones (4 points each) in " +
+                                     std::to_string(s.frames.frame_count) + " frames"};
+  const std::size_t per_frame = 3 * a.clusters.size();
+  s.detectors.resize(per_frame * bones.frame_count);
+  for (std::size_t f = 0; f < bones.frame_count; ++f)
+    tetseg::format::skinned_detector_positions(a, bones.frame(f),
+                                               s.detectors.data() + f * per_frame);
+}
 
 void load_scene(Scene& s, const std::string& asset_path, const std::string& frames_path) {
   std::string why;
@@ -182,6 +210,12 @@ Row run_mode(const Scene& s, tetseg::ColliderMode mode, bool openmp, const Plan&
   for (std::size_t i = 0; i < steps; ++i) {
     const double* x0 = s.frames.frame(step_start(i, plan));
     const double* x1 = s.frames.frame(step_end(i, plan));
+    if (!s.detectors.empty() &&
+        collider.set_detector_positions(s.detectors_at(step_start(i, plan)),
+                                        s.detectors_at(step_end(i, plan)),
+                                        3 * s.asset.cluster_count()) != tetseg::ColliderStatus::kOk)
+      throw Failure{kExitBadInput,
+                    s.name + ": detector positions of step " + std::to_string(i) + " rejected"};
     double best_total = 1e300, best_cpu = 1e300;
     tetseg::ColliderStats best_stats;
     tetseg::ContactsResult result;
@@ -263,8 +297,8 @@ std::string fmt(const char* f, double v) {
   return buf;
 }
 
-int table(const std::vector<std::string>& scene_args, const std::string& mode_list,
-          const Plan& plan, bool openmp, bool json, bool with_truth) {
+int table(const std::vector<std::string>& scene_args, const std::vector<std::string>& bones_files,
+          const std::string& mode_list, const Plan& plan, bool openmp, bool json, bool with_truth) {
   if (scene_args.empty() || scene_args.size() % 3 != 0)
     throw Failure{kExitUsage, "scenes are given as NAME ASSET FRAMES triples"};
   std::vector<tetseg::ColliderMode> modes;
@@ -283,10 +317,16 @@ int table(const std::vector<std::string>& scene_args, const std::string& mode_li
   std::vector<Row> rows;
   std::vector<tetseg::Contact> buffer(1 << 20);
   std::map<std::string, std::vector<StepTruth>> truths;  // by frames path
+  std::size_t bones_used = 0;                            // --bones files given to scenes
   for (std::size_t i = 0; i < scene_args.size(); i += 3) {
     Scene s;
     s.name = scene_args[i];
     load_scene(s, scene_args[i + 1], scene_args[i + 2]);
+    if (s.asset.data().detector_form == tetseg::format::DetectorForm::kBones) {
+      if (bones_used == bones_files.size())
+        throw Failure{kExitUsage, s.name + ": its detectors are carried by bones: give --bones"};
+      pose_detectors(s, bones_files[bones_used++]);
+    }
     if (plan.pairs && s.frames.frame_count % 2 != 0)
       throw Failure{kExitBadInput, scene_args[i + 2] + ": --pairs needs an even frame count"};
     // A scene on the same frames as an earlier one (another asset of the same mesh, e.g.
@@ -304,6 +344,8 @@ int table(const std::vector<std::string>& scene_args, const std::string& mode_li
       }
     }
   }
+  if (bones_used != bones_files.size())
+    throw Failure{kExitUsage, "more --bones files than scenes with bone-carried detectors"};
   bool all_found = true;
   for (const Row& r : rows)
     all_found = all_found && r.missed == 0 && r.extra == 0 && r.any_mismatch == 0 &&
@@ -419,7 +461,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   CLI::App* t = app.add_subcommand(
       "table", "Table I: per-step stage times, work counts and missed contacts per mode");
-  std::vector<std::string> scenes;
+  std::vector<std::string> scenes, bones_files;
   std::string modes = "rvbc,bvh,cone,brute";
   Plan plan;
   std::string query = "all";
@@ -428,6 +470,10 @@ int main(int argc, char** argv) {
                 "NAME ASSET FRAMES, repeated per scene (scenes on the same FRAMES file share "
                 "one oracle truth)")
       ->required();
+  t->add_option("--bones", bones_files,
+                "Per-frame bone matrices (tetseg-character's PREFIX.bones.tsf) for each scene "
+                "whose detectors are carried by bones, in scene order")
+      ->allow_extra_args(false);
   t->add_option("--modes", modes, "Comma-separated modes, each compared with the scene oracle");
   t->add_option("--stride", plan.stride, "Step from frame f to f + stride (default 1)")
       ->check(CLI::Range(std::size_t(1), std::size_t(1000)));
@@ -494,7 +540,7 @@ int main(int argc, char** argv) {
     }
     if (sc->parsed()) return tetseg::bench::scene_table(scene_options);
     plan.earliest = query == "earliest";
-    return table(scenes, modes, plan, openmp, json, !no_truth);
+    return table(scenes, bones_files, modes, plan, openmp, json, !no_truth);
   } catch (const CLI::ParseError& e) {
     const int code = app.exit(e);
     return code == 0 ? 0 : kExitUsage;

@@ -76,6 +76,12 @@ inline const double* positions_of(const char* name, const py::handle& object, st
   return static_cast<const double*>(array.data());
 }
 
+/// Checks a (clusters, 3) array of detector positions (as `positions_of`) and returns its data.
+inline const double* detector_positions_of(const char* name, const py::handle& object,
+                                           std::size_t clusters) {
+  return positions_of(name, object, clusters, "the asset's cluster count");
+}
+
 /// Rows of an array that passed `positions_of`.
 inline std::size_t rows_of(const py::handle& checked) {
   return static_cast<std::size_t>(py::reinterpret_borrow<py::array>(checked).shape(0));
@@ -102,6 +108,9 @@ inline std::string step_failure_detail(ColliderStatus status) {
       return "a position of a surface or detector node is NaN or infinite (step rejected)";
     case ColliderStatus::kSizeMismatch:
       return "position count differs from node_count * 3";
+    case ColliderStatus::kNullInput:
+      return "the asset's detectors are carried by bones: call set_detector_positions(d0, d1) "
+             "first";
     default:
       return "";
   }

@@ -18,6 +18,8 @@
 #include "collider_calls.hpp"
 #include "python_errors.hpp"
 #include "runtime_binding.hpp"
+#include "tetseg/format/asset_json.hpp"
+#include "tetseg/format/skin.hpp"
 #include "tetseg/runtime/asset.hpp"
 #include "tetseg/runtime/collider.hpp"
 #include "tetseg/runtime/frames.hpp"
@@ -78,21 +80,60 @@ py::dtype cluster_dtype() {
   using format::DetectorPoint;
   static_assert(std::is_standard_layout_v<Cluster> && std::is_standard_layout_v<DetectorPoint>);
   const std::size_t det = offsetof(Cluster, detector);
-  return record_dtype({{"detector_nodes", "(4,)u4"},
-                       {"detector_weights", "(4,)f8"},
-                       {"detector_tet", "u4"},
-                       {"flags", "u4"},
-                       {"rest_positive_fraction", "f4"},
-                       {"triangle_offset", "u4"},
-                       {"triangle_count", "u4"},
-                       {"bvh_offset", "u4"},
-                       {"bvh_count", "u4"}},
-                      {det + offsetof(DetectorPoint, nodes), det + offsetof(DetectorPoint, weights),
-                       det + offsetof(DetectorPoint, tet), offsetof(Cluster, flags),
-                       offsetof(Cluster, rest_positive_fraction),
-                       offsetof(Cluster, triangle_offset), offsetof(Cluster, triangle_count),
-                       offsetof(Cluster, bvh_offset), offsetof(Cluster, bvh_count)},
-                      sizeof(Cluster));
+  return record_dtype(
+      {{"detector_nodes", "(4,)u4"},
+       {"detector_weights", "(4,)f8"},
+       {"detector_tet", "u4"},
+       {"flags", "u4"},
+       {"rest_positive_fraction", "f4"},
+       {"triangle_offset", "u4"},
+       {"triangle_count", "u4"},
+       {"bvh_offset", "u4"},
+       {"bvh_count", "u4"},
+       {"detector_term_offset", "u4"},
+       {"detector_term_count", "u4"},
+       {"detector_rest", "(3,)f8"}},
+      {det + offsetof(DetectorPoint, nodes), det + offsetof(DetectorPoint, weights),
+       det + offsetof(DetectorPoint, tet), offsetof(Cluster, flags),
+       offsetof(Cluster, rest_positive_fraction), offsetof(Cluster, triangle_offset),
+       offsetof(Cluster, triangle_count), offsetof(Cluster, bvh_offset),
+       offsetof(Cluster, bvh_count), offsetof(Cluster, detector_term_offset),
+       offsetof(Cluster, detector_term_count), offsetof(Cluster, detector_rest)},
+      sizeof(Cluster));
+}
+
+py::dtype detector_term_dtype() {
+  using format::DetectorTerm;
+  static_assert(std::is_standard_layout_v<DetectorTerm>);
+  return record_dtype({{"index", "u4"}, {"weight", "f8"}},
+                      {offsetof(DetectorTerm, index), offsetof(DetectorTerm, weight)},
+                      sizeof(DetectorTerm));
+}
+
+/// format::skinned_detector_positions over a (bones, 3, 4) float64 array of skinning matrices.
+py::array skinned_positions(const py::object& asset_object, const py::object& matrices) {
+  if (!py::isinstance<PyAsset>(asset_object))
+    throw py::type_error("skinned_detector_positions expects a tetseg.Asset");
+  const AssetPtr asset = asset_object.cast<const PyAsset&>().asset;
+  const std::size_t bones = asset->data().bone_names.size();
+  const std::string expected = "(" + std::to_string(bones) + ", 3, 4)";
+  if (!py::isinstance<py::array>(matrices))
+    throw py::type_error("bone_matrices must be a numpy.ndarray of float64 with shape " + expected);
+  const auto array = py::reinterpret_borrow<py::array>(matrices);
+  if (!array.dtype().equal(py::dtype::of<double>()))
+    throw py::type_error("bone_matrices must have dtype float64, got " +
+                         std::string(py::str(array.dtype())));
+  if (array.ndim() != 3 || array.shape(0) != static_cast<py::ssize_t>(bones) ||
+      array.shape(1) != 3 || array.shape(2) != 4)
+    throw py::value_error("bone_matrices must have shape " + expected +
+                          " (one row-major 3x4 skinning matrix per bone of the asset), got " +
+                          std::string(py::str(array.attr("shape"))));
+  const auto contiguous =
+      py::array_t<double, py::array::c_style>::ensure(matrices);  // a copy when strided
+  const auto clusters = static_cast<py::ssize_t>(asset->cluster_count());
+  py::array_t<double> out({clusters, py::ssize_t{3}});
+  format::skinned_detector_positions(asset->data(), contiguous.data(), out.mutable_data());
+  return std::move(out);
 }
 
 py::dtype bvh_node_dtype() {
@@ -214,6 +255,25 @@ class PyCollider {
                    "cannot create the collider (out of memory)");
   }
 
+  void set_detector_positions(const py::object& d0, const py::object& d1) {
+    const std::size_t clusters = m_asset->cluster_count();
+    if (m_asset->data().detector_form != format::DetectorForm::kBones)
+      raise_status(errors().collider, "set_detector_positions",
+                   to_string(ColliderStatus::kInvalidArgument),
+                   std::string("the asset's detectors are ") +
+                       format::detector_form_name(m_asset->data().detector_form) +
+                       ", not carried by bones: they need no positions");
+    const double* p0 = detector_positions_of("d0", d0, clusters);
+    const double* p1 = detector_positions_of("d1", d1, clusters);
+    Busy busy = m_queries.lock();
+    const ColliderStatus status = m_collider->set_detector_positions(p0, p1, clusters * 3);
+    if (status != ColliderStatus::kOk)
+      raise_status(errors().collider, "set_detector_positions", to_string(status), "");
+    // Read at every following step: referenced until replaced.
+    m_d0 = d0;
+    m_d1 = d1;
+  }
+
   void step(const py::object& x0, const py::object& x1) {
     const std::size_t nodes = m_asset->node_count();
     const double* p0 = positions_of("x0", x0, nodes, "the asset's node count");
@@ -291,6 +351,7 @@ class PyCollider {
   AssetPtr m_asset;
   std::unique_ptr<Collider> m_collider;             // declared after m_asset: destroyed before it
   py::object m_x0 = py::none(), m_x1 = py::none();  // arrays the collider reads this step
+  py::object m_d0 = py::none(), m_d1 = py::none();  // detector positions (kBones), every step
   StepQueries m_queries{"Collider", "step(x0, x1)"};
 };
 
@@ -448,7 +509,8 @@ PYBIND11_MODULE(_runtime, m) {
           },
           "(C,) structured: detector_nodes (4 u4), detector_weights (4 f8), detector_tet, "
           "flags (1 = overlap-only), rest_positive_fraction, triangle_offset, triangle_count, "
-          "bvh_offset, bvh_count.")
+          "bvh_offset, bvh_count, detector_term_offset, detector_term_count, detector_rest (3 "
+          "f8; format 1.2).")
       .def_property_readonly(
           "detectors",
           [](const PyAsset& a) -> py::object {
@@ -457,7 +519,37 @@ PYBIND11_MODULE(_runtime, m) {
             return clusters[py::str("detector_nodes")];
           },
           "(C, 4) uint32: the four tet-mesh nodes of each cluster's detector point (a detector "
-          "at a node: that node four times; weights in clusters['detector_weights']).")
+          "at a node: that node four times; weights in clusters['detector_weights']). "
+          "detector_form 'tet-point' only; the other forms' detectors are detector_terms.")
+      .def_property_readonly(
+          "body_kind",
+          [](const PyAsset& a) { return format::body_kind_name(a.asset->data().body_kind); },
+          "'tet' (nodes of a tet mesh) or 'surface' (the input surface's vertices, in order; "
+          "format 1.2).")
+      .def_property_readonly(
+          "detector_form",
+          [](const PyAsset& a) {
+            return format::detector_form_name(a.asset->data().detector_form);
+          },
+          "'tet-point' (clusters['detector_nodes'/'detector_weights']), 'surface-weights' "
+          "(detector_terms over node ids, evaluated per step) or 'bones' (detector_terms over "
+          "bone ids: pass positions with Collider.set_detector_positions).")
+      .def_property_readonly(
+          "detector_terms",
+          [](const PyAsset& a) {
+            return vector_view(a.asset->data().detector_terms, detector_term_dtype(), 0, a.asset);
+          },
+          "(K,) structured: index (u4: a node id, or a bone id for 'bones'), weight (f8); "
+          "cluster c's are [clusters['detector_term_offset'][c] ..+ detector_term_count].")
+      .def_property_readonly(
+          "bone_names",
+          [](const PyAsset& a) {
+            py::list names;
+            for (const std::string& name : a.asset->data().bone_names)
+              names.append(py::bytes(name).attr("decode")("utf-8", "replace"));
+            return names;
+          },
+          "list of str: the skeleton's bones of a 'bones' asset, by bone id (else empty).")
       .def_property_readonly(
           "cluster_triangles",
           [](const PyAsset& a) {
@@ -506,6 +598,15 @@ PYBIND11_MODULE(_runtime, m) {
         "Loads and validates an asset from a path (str or os.PathLike) or from bytes. Raises "
         "AssetError (with .status and .detail) when it is unreadable, corrupt or invalid.");
 
+  m.def("skinned_detector_positions", &skinned_positions, py::arg("asset"),
+        py::arg("bone_matrices"),
+        "Returns a (clusters, 3) float64 array: every cluster's detector for one pose of the "
+        "skeleton, by linear blend skinning of its rest position (format::"
+        "skinned_detector_positions). bone_matrices: (len(asset.bone_names), 3, 4) float64, "
+        "per bone the row-major 3x4 skinning matrix (world transform times inverse bind "
+        "matrix; identities give the rest pose). Clusters without terms keep their rest "
+        "position.");
+
   m.def("read_frames", &read_frames_array, py::arg("path"),
         "Returns a (frames, nodes, 3) float64 array. "
         "Reads a frame-sequence file (docs/format.md). Each frames[i] is C-contiguous and can "
@@ -551,6 +652,14 @@ PYBIND11_MODULE(_runtime, m) {
            "referenced by the collider until the next step; do not modify them in between. "
            "TypeError for a non-array or another dtype, ValueError for a wrong shape or a "
            "non-contiguous array, ColliderError ('non-finite position') for NaN/inf.")
+      .def("set_detector_positions", &PyCollider::set_detector_positions, py::arg("d0"),
+           py::arg("d1"),
+           "Detector positions of a 'bones' asset at the start and end of each step: "
+           "(cluster_count, 3) C-contiguous float64 arrays (e.g. from "
+           "skinned_detector_positions), used in place and read at every following step until "
+           "replaced: update them before each step. Entries of overlap-only clusters are not "
+           "read. Any positions give exact answers; wrong ones only cull less. ColliderError "
+           "('invalid argument') for an asset of another form.")
       .def("any_collision", &PyCollider::any_collision,
            "Whether any feature pair is in contact during the step. "
            "Raises ColliderError without a valid step.")

@@ -107,7 +107,10 @@ struct BodyRecord {
   bool still = false;
   bool global = false;
   std::size_t global_offset = 0;
+  std::uint32_t cluster_count = 0;  // of the body's asset (0 for a surface-only body)
+  bool bones = false;               // the asset's detectors are carried by bones
   py::object x0 = py::none(), x1 = py::none();
+  py::object d0 = py::none(), d1 = py::none();  // detector positions of a 'bones' asset
 };
 
 class PyScene {
@@ -152,6 +155,12 @@ class PyScene {
     record.still = still;
     record.global = !global_offset.is_none();
     record.global_offset = options.global_offset;
+    const py::object& asset = shape_object.cast<const PyBodyShape&>().asset;
+    if (!asset.is_none()) {
+      const AssetPtr& a = asset.cast<const PyAsset&>().asset;
+      record.cluster_count = static_cast<std::uint32_t>(a->cluster_count());
+      record.bones = a->data().detector_form == format::DetectorForm::kBones;
+    }
     m_bodies.push_back(std::move(record));
     return id;
   }
@@ -193,6 +202,20 @@ class PyScene {
     record.x0 = x0;
     record.x1 = x1;
     m_queries.invalidated("set_positions gave new positions: call step() first");
+  }
+
+  void set_detector_positions(std::int64_t body, const py::object& d0, const py::object& d1) {
+    Busy busy = m_queries.lock();
+    const std::uint32_t b = body_id("set_detector_positions", body);
+    BodyRecord& record = m_bodies[b];
+    const double* p0 = detector_positions_of("d0", d0, record.cluster_count);
+    const double* p1 = detector_positions_of("d1", d1, record.cluster_count);
+    check(m_scene->set_detector_positions(b, p0, p1, std::size_t(record.cluster_count) * 3),
+          "set_detector_positions",
+          "body " + std::to_string(b) + "'s detectors are not carried by bones");
+    // Read at every following step: referenced until replaced.
+    record.d0 = d0;
+    record.d1 = d1;
   }
 
   void step(const py::object& x0, const py::object& x1) {
@@ -303,6 +326,8 @@ class PyScene {
           if (r.global && !r.still && m_x1.is_none())
             return body + " is not still and reads the global x1: pass it to step";
           if (!r.global && r.x0.is_none()) return body + " has no positions: call set_positions";
+          if (r.bones && r.d0.is_none())
+            return body + "'s detectors are carried by bones: call set_detector_positions";
         }
         return "missing positions";
       case ColliderStatus::kSizeMismatch: {
@@ -421,6 +446,12 @@ void bind_scene(py::module_& m) {
            "C-contiguous float64 arrays, used in place (not copied) and referenced by the "
            "scene until replaced, for every following step; do not modify them during a step. "
            "x1 may be None only for a still body. Checked for NaN at step.")
+      .def("set_detector_positions", &PyScene::set_detector_positions, py::arg("body"),
+           py::arg("d0"), py::arg("d1"),
+           "Detector positions of a body whose asset's detectors are carried by bones, as "
+           "Collider.set_detector_positions: (cluster_count, 3) C-contiguous float64 arrays "
+           "used in place and read at every following step until replaced. ColliderError "
+           "('invalid argument') for another body.")
       .def("step", &PyScene::step, py::arg("x0") = py::none(), py::arg("x1") = py::none(),
            "Starts a step of every body: x0, x1 are the global (n, 3) C-contiguous float64 "
            "arrays read by the bodies with a global_offset (None when there are none; x1 None "

@@ -20,6 +20,7 @@ from ._runtime import (  # noqa: F401
     __version__,
     load_asset,
     read_frames,
+    skinned_detector_positions,
 )
 
 __all__ = [
@@ -36,4 +37,5 @@ __all__ = [
     "VERTEX_FACE",
     "load_asset",
     "read_frames",
+    "skinned_detector_positions",
 ]

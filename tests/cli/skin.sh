@@ -53,3 +53,20 @@ expect_exit 3 "tetseg: error: bare.gltf: .*has no bones" -- \
 [ ! -e bare.tetseg ] || fail "a refused build left an asset"
 expect_exit 2 "needs --body surface" -- \
   "$bin/tetseg" build tube.gltf --detectors skin -o tet.tetseg
+
+# tetseg-bench table poses the bone-carried detectors from the --bones file: 0 missed.
+"$bin/tetseg-bench" table tube skin.tetseg tube.tsf --bones tube.bones.tsf --modes rvbc,bvh \
+  --repeat 1 --json >table.json
+python3 - table.json <<'PY'
+import json, sys
+rows = json.load(open(sys.argv[1]))["rows"]
+assert [r["mode"] for r in rows] == ["rvbc", "bvh"], rows
+assert all(r["steps"] == 8 and r["compared"] == 8 and r["missed"] == 0 and r["extra"] == 0
+           for r in rows), rows
+PY
+expect_exit 2 "give --bones" -- "$bin/tetseg-bench" table tube skin.tetseg tube.tsf --repeat 1
+"$bin/tetseg" build tube.gltf --body surface -o weights.tetseg -q
+expect_exit 2 "more --bones files" -- "$bin/tetseg-bench" table tube weights.tetseg tube.tsf \
+  --bones tube.bones.tsf --repeat 1
+expect_exit 3 "tube.tsf: expected 4 bones" -- "$bin/tetseg-bench" table tube skin.tetseg \
+  tube.tsf --bones tube.tsf --repeat 1

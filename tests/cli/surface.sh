@@ -30,6 +30,9 @@ grep -q '"detector": {"form": "bones", "terms": \[\[1, 0.75\], \[2, 0.25\]\], "p
   fail "dump --json: detector: $(cat b.json)"
 "$bin/tetseg-dump" "$weights" --vtu w.vtu --ply w.ply > /dev/null
 grep -q "<VTKFile" w.vtu || fail "dump --vtu of a surface asset"
+grep -q "^ply" w.ply || fail "dump --ply of a surface asset"
+"$bin/tetseg-render" "$bones" -o b.png --width 64 --height 48 --detectors
+[ "$(head -c 4 b.png | tail -c 3)" = "PNG" ] || fail "tetseg-render of a surface asset: no PNG"
 
 # The golden octahedron's frames: its 7 vertices (the 7th used by no face) and 8 triangles;
 # the top vertex 4 falls through the lower half, past the detector of the upper cluster.
@@ -61,6 +64,19 @@ for asset in "$weights" "$bones"; do
   grep -q "^$first " asset.txt || fail "--asset ($asset): the earliest contact '$first' is missing: $(cat asset.txt)"
 done
 echo "frames --asset: $(wc -l < asset.txt) of $(wc -l < soup.txt) soup contacts, earliest '$first' found"
+
+# tetseg-run over the same step as a frame sequence: both surface assets give brute force's
+# earliest contact; the bones asset runs with its detectors at rest (said on stderr).
+"$bin/tetseg-frames" step.tsf t0.ply t1.ply 2>/dev/null
+"$bin/tetseg-run" "$weights" step.tsf --mode brute --json > brute.json
+earliest=$(grep -o '"earliest_toi": [0-9.e-]*' brute.json)
+[ -n "$earliest" ] || fail "tetseg-run brute: no contact: $(cat brute.json)"
+for asset in "$weights" "$bones"; do
+  "$bin/tetseg-run" "$asset" step.tsf --json > run.json 2> run.err
+  grep -qF "$earliest" run.json || fail "tetseg-run ($asset): not brute force's $earliest: $(cat run.json)"
+done
+grep -q "detectors carried by bones stay at their rest positions" run.err ||
+  fail "tetseg-run: no note on the bones asset: $(cat run.err)"
 
 # Frames that are not the asset's: refused with the reason, exit 3.
 ply six.ply 0 0 1 "${faces[@]}"

@@ -57,6 +57,17 @@ int run(const std::string& asset_path, const std::string& frames_path, const std
   tetseg::Collider collider(asset, options);
   if (collider.status() != tetseg::ColliderStatus::kOk)
     throw ToolError(kExitProcessingFailed, "", "cannot create the collider (out of memory)");
+  // Bone-carried detectors: the frames carry no pose, so they stay at rest (exact, culls less).
+  const std::vector<double> rest_detectors = tetseg::format::rest_detector_positions(asset.data());
+  if (asset.data().detector_form == tetseg::format::DetectorForm::kBones) {
+    if (collider.set_detector_positions(rest_detectors.data(), rest_detectors.data(),
+                                        rest_detectors.size()) != tetseg::ColliderStatus::kOk)
+      throw ToolError(kExitProcessingFailed, asset_path, "cannot set the detector positions");
+    std::fprintf(stderr,
+                 "tetseg-run: %s: detectors carried by bones stay at their rest positions (the "
+                 "frames carry no pose)\n",
+                 asset_path.c_str());
+  }
 
   std::vector<tetseg::Contact> buffer;  // contacts are counted, not stored
   std::vector<FrameResult> results;

@@ -217,4 +217,14 @@ inline std::array<double, 3> rest_detector_position(const Asset& asset, const Cl
   return detector_position(cluster.detector, asset.rest_positions.front().data());
 }
 
+/// Every cluster's `detector_rest` (clusters x 3 doubles): the detector positions a tool passes
+/// for a kBones asset when it has no pose (exact, culls less than a posed skeleton).
+inline std::vector<double> rest_detector_positions(const Asset& asset) {
+  std::vector<double> out;
+  out.reserve(3 * asset.clusters.size());
+  for (const Cluster& c : asset.clusters)
+    out.insert(out.end(), c.detector_rest.begin(), c.detector_rest.end());
+  return out;
+}
+
 }  // namespace tetseg::format
