@@ -505,7 +505,8 @@ format::Asset build_surface_asset(const TriangleMesh& input, const std::string& 
   timer.run("surface", [&](std::string& summary) {
     components = check_triangles(input, source);
     check_closed_components(input, components, source);
-    std::vector<std::uint32_t> local(input.triangles.size(), kUnset);
+    std::vector<char> in_part(input.triangles.size(), 0);
+    std::vector<std::uint32_t> part_components;
     std::size_t candidates = 0;
     for (std::uint32_t c = 0; c < components.triangles.size(); ++c) {
       std::vector<Tri> own;
@@ -530,21 +531,17 @@ format::Asset build_surface_asset(const TriangleMesh& input, const std::string& 
       }
       candidates += inside.size();
       parts.push_back(std::move(part));
-      for (std::uint32_t t : components.triangles[c]) local[t] = 0;
+      part_components.push_back(c);
+      for (std::uint32_t t : components.triangles[c]) in_part[t] = 1;
     }
     for (std::uint32_t t = 0; t < input.triangles.size(); ++t)
-      if (local[t] != kUnset) solid_triangles.push_back(t);
+      if (in_part[t]) solid_triangles.push_back(t);
     // Part triangle ids are positions in solid_triangles.
     std::vector<std::uint32_t> position(input.triangles.size(), kUnset);
     for (std::uint32_t i = 0; i < solid_triangles.size(); ++i) position[solid_triangles[i]] = i;
-    std::size_t p = 0;
-    for (std::uint32_t c = 0; c < components.triangles.size(); ++c) {
-      if (std::find(overlap_only_components.begin(), overlap_only_components.end(), c) !=
-          overlap_only_components.end())
-        continue;
-      for (std::uint32_t t : components.triangles[c]) parts[p].triangles.push_back(position[t]);
-      ++p;
-    }
+    for (std::size_t p = 0; p < parts.size(); ++p)
+      for (std::uint32_t t : components.triangles[part_components[p]])
+        parts[p].triangles.push_back(position[t]);
     summary = std::to_string(input.triangles.size()) + " triangles, " +
               std::to_string(components.triangles.size()) + " components (" +
               std::to_string(overlap_only_components.size()) + " overlap-only, " +
