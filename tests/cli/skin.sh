@@ -45,13 +45,12 @@ assert dump["provenance"]["options"]["detectors"] == "skin", dump["provenance"]
 assert dump["nodes"] == report["counts"]["nodes"] == 1322, dump["nodes"]
 PY
 
-# Refusals: no skin in the file (exit 3, naming it); skin without a surface body (an option
-# the build job refuses: exit 1).
+# Refusals: no skin in the file (exit 3, naming it); skin without a surface body (exit 2).
 sed 's/,"skin":0//' tube.gltf >bare.gltf
 expect_exit 3 "tetseg: error: bare.gltf: .*has no bones" -- \
   "$bin/tetseg" build bare.gltf --body surface --detectors skin -o bare.tetseg
 [ ! -e bare.tetseg ] || fail "a refused build left an asset"
-expect_exit 1 "needs --body surface" -- \
+expect_exit 2 "needs --body surface" -- \
   "$bin/tetseg" build tube.gltf --detectors skin -o tet.tetseg
 
 # tetseg-bench table poses the bone-carried detectors from the --bones file: 0 missed.
