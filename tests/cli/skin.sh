@@ -45,8 +45,7 @@ assert dump["provenance"]["options"]["detectors"] == "skin", dump["provenance"]
 assert dump["nodes"] == report["counts"]["nodes"] == 1322, dump["nodes"]
 PY
 
-# Refusals: no skin in the file (exit 3, naming it); skin without a surface body (an option
-# the build job refuses: exit 1).
+# Refusals: no skin in the file (exit 3, naming it); skin without a surface body (exit 2).
 sed 's/,"skin":0//' tube.gltf >bare.gltf
 expect_exit 3 "tetseg: error: bare.gltf: .*has no bones" -- \
   "$bin/tetseg" build bare.gltf --body surface --detectors skin -o bare.tetseg
