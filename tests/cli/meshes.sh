@@ -164,14 +164,14 @@ expect_exit 2 "wrap-alpha" -- "$bin/tetseg" build holed.off -o x.tetseg --repair
 # A flat sheet encloses nothing: wrap meshes it as a slab (2 x --wrap-sheet-offset thick) and
 # reports it (stderr, report, provenance); the option is range-checked.
 printf 'OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n' >sheet.off
-expect_exit 0 "tetseg: repaired sheet.off: .*400 sheet enclosing no volume wrapped as a slab" -- \
+expect_exit 0 "tetseg: repaired sheet.off: .*400 surface wrapped as a slab" -- \
   "$bin/tetseg" build sheet.off -o sheet.tetseg --clusters single --repair wrap \
   --wrap-sheet-offset 0.02 --report sheet.json
-grep -q '"sheet enclosing no volume wrapped as a slab this many ten thousandths of the diagonal thick": 400' sheet.json ||
+grep -q '"surface wrapped as a slab this many ten thousandths of the diagonal thick": 400' sheet.json ||
   fail "the report lacks the slab"
 "$bin/tetseg-dump" sheet.tetseg | grep -q 'meshing.wrap_sheet_offset *0.02' ||
   fail "the provenance lacks the sheet offset"
-"$bin/tetseg-dump" sheet.tetseg | grep -q 'repairs.sheet_enclosing_no_volume_wrapped_as_a_slab' ||
+"$bin/tetseg-dump" sheet.tetseg | grep -q 'repairs.surface_wrapped_as_a_slab' ||
   fail "the provenance lacks the slab repair"
 expect_exit 2 "wrap-sheet-offset" -- "$bin/tetseg" build sheet.off -o x.tetseg --repair wrap \
   --wrap-sheet-offset 2
