@@ -530,6 +530,21 @@ TEST_CASE("Auto is fix, and the wrap with the reason where fix leaves a defect",
       CHECK(count_of(notes, "wrapped as a slab") == 200);
       CHECK(std::max(notes.hausdorff_input_to_mesh, notes.hausdorff_mesh_to_input) < 0.02);
     }
+    SECTION("Fix's filled sphere after all when the wrap lies further from the input") {
+      // A slab 0.4 of the diagonal off the input deviates more than the patch (under 0.31).
+      MeshingOptions m = coarse(Repair::kAuto);
+      m.facet_size = 0.2;
+      m.wrap_sheet_offset = 0.4;
+      TetrahedralizeNotes notes;
+      const TetMesh mesh = tetrahedralize(s, m, "auto.off", &notes);
+      validate_tet_mesh(mesh, extract_surface(mesh), "auto");
+      CHECK(notes.repair_used == Repair::kFix);
+      CHECK(notes.fallback_reason.empty());
+      CHECK(count_of(notes, "holes filled") == 1);
+      CHECK(count_of(notes, "slab") == 0);
+      CHECK(notes.hausdorff_mesh_to_input < 0.31);
+      CHECK(notes.deviation_excess > 0.19);
+    }
     SECTION("Within --max-deviation 0.5: fix's filled sphere") {
       const TetrahedralizeNotes notes = auto_repaired(s, 0.2, 0.5);
       CHECK(notes.repair_used == Repair::kFix);
