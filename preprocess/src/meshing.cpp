@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
+#include <limits>
 #include <new>
 #include <stdexcept>
 #include <string>
@@ -238,14 +239,19 @@ std::size_t vertex_budget(const detail::Mesh3Criteria& criteria, double diagonal
 
 /// Runs one CGAL Mesh_3 call; whatever CGAL throws becomes an InputError naming the file and
 /// the stage.
-/// `step` names it for the time limit and progress; with sharp-edge protection the call is
-/// also bounded by kProtectedMeshingSeconds.
+/// `step` names it for the time limit and progress; the call is bounded by `bound_seconds`
+/// when > 0, and with sharp-edge protection by kProtectedMeshingSeconds; past the bound it is
+/// refused as not converging.
 TetMesh run_mesh_3_guarded(const TriangleMesh& input, detail::Mesh3Criteria criteria,
                            const std::string& file, detail::Watchdog& watchdog,
-                           const std::string& step) {
-  const bool bounded = criteria.sharp_edge_angle > 0.0;
+                           const std::string& step, double bound_seconds) {
+  const bool sharp = criteria.sharp_edge_angle > 0.0;
+  if (sharp)
+    bound_seconds = bound_seconds > 0.0 ? std::min(bound_seconds, kProtectedMeshingSeconds)
+                                        : kProtectedMeshingSeconds;
+  const bool bounded = bound_seconds > 0.0;
   if (bounded)
-    watchdog.begin_bounded(step + ", sharp edges protected", kProtectedMeshingSeconds);
+    watchdog.begin_bounded(step + (sharp ? ", sharp edges protected" : ""), bound_seconds);
   else
     watchdog.begin(step);
   struct EndBound {
@@ -256,8 +262,8 @@ TetMesh run_mesh_3_guarded(const TriangleMesh& input, detail::Mesh3Criteria crit
     }
   } end_bound{watchdog, bounded};
   criteria.stop = watchdog.stop_flag();
-  criteria.seconds_left = bounded ? std::min(watchdog.seconds_left(), kProtectedMeshingSeconds)
-                                  : watchdog.seconds_left();
+  criteria.seconds_left =
+      bounded ? std::min(watchdog.seconds_left(), bound_seconds) : watchdog.seconds_left();
   // CGAL 5.5 writes dump-bug.mesh and dump-bug.binary.cgal to the working directory when a
   // Mesh_3 assertion fails (Refine_facets_3.h, "already inserted on surface"); those it made
   // here are removed, so that a failed run leaves no file.
@@ -280,9 +286,11 @@ TetMesh run_mesh_3_guarded(const TriangleMesh& input, detail::Mesh3Criteria crit
     end_bound.bounded = false;
     if (!bounded || !watchdog.end_bounded()) throw;
     throw InputError(file, "tetrahedralize: CGAL Mesh_3 did not converge: it did not finish in " +
-                               std::to_string(static_cast<int>(kProtectedMeshingSeconds)) +
-                               " s with the sharp edges protected (corners too sharp or parts "
-                               "too thin for its feature protection); try --repair wrap");
+                               std::to_string(static_cast<int>(bound_seconds)) +
+                               (sharp ? " s with the sharp edges protected (corners too sharp or "
+                                        "parts too thin for its feature protection); try "
+                                        "--repair wrap"
+                                      : " s"));
   } catch (const detail::MeshingBudgetExceeded& e) {
     remove_new_dumps();
     throw InputError(file, std::string("tetrahedralize: CGAL Mesh_3 did not converge: ") +
@@ -314,7 +322,7 @@ std::string boundary_defect(const TetMesh& mesh, const std::string& file) {
 /// tetrahedralize; notes.optimization_used and notes.first_defect say which mesh was returned.
 TetMesh mesh_closed_surface(const TriangleMesh& input, const MeshingOptions& meshing,
                             const std::string& file, TetrahedralizeNotes& notes,
-                            detail::Watchdog& watchdog) {
+                            detail::Watchdog& watchdog, double bound_seconds) {
   const double diagonal = bounding_box_diagonal(input.vertices);
   // Criteria are checked before CGAL sees them: every size finite and positive, and not so
   // small against the surface that refinement could never end (kMaxDiagonalPerSize).
@@ -387,7 +395,8 @@ TetMesh mesh_closed_surface(const TriangleMesh& input, const MeshingOptions& mes
       const TetMesh mesh =
           run_mesh_3_guarded(input, tried, file, watchdog,
                              std::string("CGAL Mesh_3 (") + attempt.name + ", sizes x" +
-                                 std::to_string(factor).substr(0, 3) + ")");
+                                 std::to_string(factor).substr(0, 3) + ")",
+                             bound_seconds);
       if (mesh.tets.empty())
         throw InputError(file,
                          "meshing produced no tetrahedra (is the surface closed and "
@@ -448,6 +457,15 @@ constexpr std::size_t kThinProbes = 512;
 constexpr double kPi = 3.14159265358979323846;
 /// With --repair wrap, alpha is doubled at most this many times (see tetrahedralize).
 constexpr int kMaxAlphaDoublings = 6;
+/// A wrap bridges the gaps and holes narrower than alpha, so its distance from the input grows
+/// with alpha (libcgal-demo, docs/benchmarks-history.md: about 0.01-0.04 of the diagonal at
+/// alpha 0.02, 0.05-0.08 at 0.08, 0.22-0.32 at 0.32). Alpha is doubled past
+/// kAlphaPerDeviation x --max-deviation (or --wrap-alpha when larger) only when the slab
+/// (mesh_sheet_slab, within about --wrap-sheet-offset of the input) does not mesh.
+constexpr double kAlphaPerDeviation = 2.0;
+/// That slab's Mesh_3 runs are bounded (seconds; past it, the doublings): slabs mesh in 1-20 s
+/// on libcgal-demo, but b9_mesh.off's ran over 300 s.
+constexpr double kSlabMeshingSeconds = 20.0;
 
 /// The share of the probed vertices of `wrap` (closed, outward) that lie on a thin part (see
 /// kThinShare). O(kThinProbes x triangles).
@@ -505,7 +523,7 @@ TriangleMesh wrapped_surface(const TriangleMesh& surface, double alpha, double o
 /// named with a pointer to wrap.
 TetMesh validate_and_mesh(const TriangleMesh& source, const MeshingOptions& meshing,
                           const std::string& file, TetrahedralizeNotes& notes,
-                          detail::Watchdog& watchdog) {
+                          detail::Watchdog& watchdog, double bound_seconds = 0.0) {
   watchdog.begin("surface validation");
   TriangleMesh split;
   detail::SurfaceCheck check;
@@ -521,20 +539,25 @@ TetMesh validate_and_mesh(const TriangleMesh& source, const MeshingOptions& mesh
   }
   detail::check_surface_not_nested(source, file);
   return mesh_closed_surface(split.triangles.empty() ? source : split, meshing, file, notes,
-                             watchdog);
+                             watchdog, bound_seconds);
 }
 
+/// The repair kind of mesh_sheet_slab (the count: the slab's thickness, 1e-4 of the diagonal).
+constexpr const char* kSlabRepair =
+    "surface wrapped as a slab this many ten thousandths of the diagonal thick";
+
 /// An input that encloses no volume (its wrap is a thin shell even with alpha = the diagonal:
-/// a flat or open sheet) is wrapped again, with --wrap-alpha and the larger offset
+/// a flat or open sheet), or one whose wrap went through its holes (wrap_and_mesh), is wrapped
+/// again, with --wrap-alpha and the larger offset
 /// --wrap-sheet-offset, into a closed slab about 2 x that offset thick, and meshed.
 TetMesh mesh_sheet_slab(const TriangleMesh& surface, const MeshingOptions& meshing, double diagonal,
                         const std::string& file, TetrahedralizeNotes& notes,
-                        detail::Watchdog& watchdog) {
+                        detail::Watchdog& watchdog, double bound_seconds = 0.0) {
   const TriangleMesh slab = wrapped_surface(surface, meshing.wrap_alpha, meshing.wrap_sheet_offset,
                                             diagonal, file, watchdog);
   TetMesh mesh;
   try {
-    mesh = validate_and_mesh(slab, meshing, file, notes, watchdog);
+    mesh = validate_and_mesh(slab, meshing, file, notes, watchdog, bound_seconds);
   } catch (const TimeLimitExceeded&) {
     throw;
   } catch (const InputError& e) {
@@ -545,16 +568,17 @@ TetMesh mesh_sheet_slab(const TriangleMesh& surface, const MeshingOptions& meshi
   }
   notes.repairs = {
       {"surface replaced by an alpha wrap of this many triangles", slab.triangles.size()},
-      {"sheet enclosing no volume wrapped as a slab this many ten thousandths of the diagonal "
-       "thick",
-       static_cast<std::size_t>(std::lround(2.0 * meshing.wrap_sheet_offset * 1e4))}};
+      {kSlabRepair, static_cast<std::size_t>(std::lround(2.0 * meshing.wrap_sheet_offset * 1e4))}};
   return mesh;
 }
 
 /// --repair wrap: wraps and meshes; while the wrap is a thin shell (is_thin_shell) or does not
 /// mesh (thin parts), alpha is doubled (at most kMaxAlphaDoublings times, up to the whole
-/// diagonal), without running Mesh_3 on thin wraps (slow on them). A wrap still thin at the end
-/// means that the input encloses no volume: mesh_sheet_slab.
+/// diagonal), without running Mesh_3 on thin wraps (slow on them). A thin wrap whose next alpha
+/// would pass kAlphaPerDeviation x --max-deviation is first replaced by the slab
+/// (mesh_sheet_slab: the surface stays within about --wrap-sheet-offset); the doublings go on
+/// only when the slab does not mesh. A wrap still thin at the end means that the input encloses
+/// no volume: mesh_sheet_slab.
 TetMesh wrap_and_mesh(const TriangleMesh& surface, const MeshingOptions& meshing,
                       const std::string& file, TetrahedralizeNotes& notes,
                       detail::Watchdog& watchdog) {
@@ -573,6 +597,9 @@ TetMesh wrap_and_mesh(const TriangleMesh& surface, const MeshingOptions& meshing
   double alpha = meshing.wrap_alpha;
   // The wrap lies `offset` outside the input: at most a quarter of --max-deviation.
   const double offset = std::min(meshing.wrap_offset, 0.25 * meshing.max_deviation);
+  const double max_alpha_within_deviation =
+      std::max(meshing.wrap_alpha, kAlphaPerDeviation * meshing.max_deviation);
+  bool slab_tried = false;
   for (std::size_t doublings = 0;; ++doublings) {
     const bool last = doublings == kMaxAlphaDoublings || alpha >= 1.0;
     const TriangleMesh wrap = wrapped_surface(surface, alpha, offset, diagonal, file, watchdog);
@@ -593,6 +620,24 @@ TetMesh wrap_and_mesh(const TriangleMesh& surface, const MeshingOptions& meshing
         if (last)
           throw InputError(file, std::string(e.what()) + " (meshing the alpha wrap, alpha " +
                                      std::to_string(alpha) + " of the diagonal)");
+      }
+    }
+    // The wrap went through holes, wrapped a sheet or did not mesh: a larger alpha would
+    // bridge more and move the surface further than --max-deviation, so the slab around the
+    // input is tried first.
+    if (!slab_tried && 2.0 * alpha > max_alpha_within_deviation) {
+      slab_tried = true;
+      try {
+        return mesh_sheet_slab(surface, meshing, diagonal, file, notes, watchdog,
+                               kSlabMeshingSeconds);
+      } catch (const TimeLimitExceeded&) {
+        throw;
+      } catch (const InputError&) {
+        // Back to the doublings; only what the slab's meshing wrote is dropped.
+        TetrahedralizeNotes kept;
+        kept.repair_used = notes.repair_used;
+        kept.fallback_reason = notes.fallback_reason;
+        notes = kept;
       }
     }
     alpha = std::min(2.0 * alpha, 1.0);
@@ -669,6 +714,120 @@ TetMesh tetrahedralize(const TriangleMesh& surface, const MeshingOptions& meshin
 
 namespace {
 
+/// How far the surface moved (repairs, wrap and Mesh_3's re-meshing of the boundary): the
+/// distances between the input and the boundary of the tets, whatever the repair, into `notes`.
+void measure_deviation(const TriangleMesh& surface, const TetMesh& mesh,
+                       const MeshingOptions& meshing, double diagonal, TetrahedralizeNotes& notes) {
+  const Surface boundary = extract_surface(mesh);
+  const TriangleMesh meshed{mesh.nodes, boundary.triangles};
+  const auto [there, back] = detail::hausdorff_distances(surface, meshed);
+  if (there >= 0.0 && diagonal > 0.0) {
+    notes.hausdorff_input_to_mesh = there / diagonal;
+    notes.hausdorff_mesh_to_input = back / diagonal;
+    notes.diagonal = diagonal;
+    notes.deviation_excess =
+        std::max(0.0, std::max(there, back) / diagonal - meshing.max_deviation);
+  }
+}
+
+/// Hole patches making at least this share of a fixed surface's area close an open surface
+/// (a mask, a box without its lid) rather than mend a defect: --repair auto then checks them
+/// against --max-deviation (fix_or_wrap). libcgal-demo, about: the 7 holes of pig.off make 4 %,
+/// the base of head.off 8 %, open_cube.off's missing face 17 %, nefertiti.off's open back 43 %.
+constexpr double kOpenPatchShare = 0.15;
+
+/// The larger of the two notes' distances (relative); infinite when not measured.
+double larger_deviation(const TetrahedralizeNotes& notes) {
+  if (notes.hausdorff_input_to_mesh < 0.0) return std::numeric_limits<double>::infinity();
+  return std::max(notes.hausdorff_input_to_mesh, notes.hausdorff_mesh_to_input);
+}
+
+/// --repair fix's repairs of `surface` (detail::repair_soup; the repairs into `notes`).
+TriangleMesh fixed_surface(const TriangleMesh& surface, const MeshingOptions& meshing,
+                           const std::string& file, TetrahedralizeNotes& notes,
+                           detail::Watchdog& watchdog, double* patch_area = nullptr) {
+  watchdog.begin("repair");
+  TriangleMesh fixed = surface;
+  notes.repairs = detail::repair_soup(fixed, meshing.keep_largest_component, patch_area);
+  if (fixed.triangles.empty())
+    throw InputError(file, "tetrahedralize: no triangle is left after repair");
+  return fixed;
+}
+
+/// --repair auto: fix, and the wrap when what fix leaves cannot be meshed (any refusal of the
+/// surface or of Mesh_3 but the time limit, which is the user's bound on the whole), or when
+/// fix closed an open surface across: hole patches of at least kOpenPatchShare of the area
+/// lying further than --max-deviation from the input (the wrap keeps nearer, as a slab if need
+/// be). In that last case the fixed surface is meshed after all when the wrap fails or
+/// deviates more.
+TetMesh fix_or_wrap(const TriangleMesh& surface, const MeshingOptions& meshing, double diagonal,
+                    const std::string& file, TetrahedralizeNotes& notes,
+                    detail::Watchdog& watchdog) {
+  using Repair = MeshingOptions::Repair;
+  notes.repair_used = Repair::kFix;
+  TriangleMesh fixed;
+  double fix_deviation = 0.0;  // how far fix's hole patches are from the input, relative
+  double patch_share = 0.0;
+  std::string fix_error;
+  try {
+    double patch_area = 0.0;
+    fixed = fixed_surface(surface, meshing, file, notes, watchdog, &patch_area);
+    patch_share = patch_area / area_and_volume(fixed).first;
+    if (patch_share >= kOpenPatchShare && diagonal > 0.0) {
+      watchdog.begin("deviation of the hole patches");
+      const auto [there, back] = detail::hausdorff_distances(surface, fixed);
+      fix_deviation = std::max(there, back) / diagonal;
+    }
+    if (fix_deviation <= meshing.max_deviation)
+      return validate_and_mesh(fixed, meshing, file, notes, watchdog);
+  } catch (const TimeLimitExceeded&) {
+    throw;
+  } catch (const InputError& e) {
+    fix_error = e.what();
+  }
+  const bool fixed_too_far = fix_error.empty();  // else fix's result could not be meshed
+  const TetrahedralizeNotes fix_notes = notes;
+  notes = TetrahedralizeNotes{};
+  notes.repair_used = Repair::kWrap;
+  if (fixed_too_far) {
+    char reason[200];
+    std::snprintf(reason, sizeof reason,
+                  "tetrahedralize: the holes filled by fix (%.0f %% of the area) lie %.2g of "
+                  "the diagonal from the input, over --max-deviation %.2g",
+                  100.0 * patch_share, fix_deviation, meshing.max_deviation);
+    notes.fallback_reason = reason;
+  } else {
+    notes.fallback_reason = fix_error;
+  }
+  TetMesh wrapped;
+  try {
+    wrapped = wrap_and_mesh(surface, meshing, file, notes, watchdog);
+    if (!fixed_too_far) return wrapped;
+    watchdog.begin("deviation measurement");
+    measure_deviation(surface, wrapped, meshing, diagonal, notes);
+    if (larger_deviation(notes) <= fix_deviation) return wrapped;
+  } catch (const TimeLimitExceeded&) {
+    throw;
+  } catch (const InputError& wrap_error) {
+    if (!fixed_too_far)
+      throw InputError(file, std::string(wrap_error.what()) +
+                                 " (--repair auto: the wrap, after fix left: " + fix_error + ")");
+  }
+  // The wrap failed or moved the surface further than fix did: fix's surface after all, unless
+  // it does not mesh and the wrap did.
+  const TetrahedralizeNotes wrap_notes = notes;
+  notes = fix_notes;
+  try {
+    return validate_and_mesh(fixed, meshing, file, notes, watchdog);
+  } catch (const TimeLimitExceeded&) {
+    throw;
+  } catch (const InputError&) {
+    if (wrapped.tets.empty()) throw;
+    notes = wrap_notes;
+    return wrapped;
+  }
+}
+
 TetMesh tetrahedralize_in_place(const TriangleMesh& surface, const MeshingOptions& meshing,
                                 const std::string& file, TetrahedralizeNotes* notes) {
   TetrahedralizeNotes local_notes;
@@ -679,58 +838,21 @@ TetMesh tetrahedralize_in_place(const TriangleMesh& surface, const MeshingOption
     throw std::invalid_argument("max deviation must be in [1e-4, 1] (a fraction of the diagonal)");
   detail::Watchdog watchdog(meshing.time_limit, meshing.progress, file);
   using Repair = MeshingOptions::Repair;
-  const auto fix_and_mesh = [&] {
-    watchdog.begin("repair");
-    TriangleMesh fixed = surface;
-    out_notes.repairs = detail::repair_soup(fixed, meshing.keep_largest_component);
-    if (fixed.triangles.empty())
-      throw InputError(file, "tetrahedralize: no triangle is left after repair");
-    return validate_and_mesh(fixed, meshing, file, out_notes, watchdog);
-  };
+  const double diagonal = bounding_box_diagonal(surface.vertices);
   TetMesh mesh;
   out_notes.repair_used = meshing.repair;
   if (meshing.repair == Repair::kFix) {
-    mesh = fix_and_mesh();
+    mesh = validate_and_mesh(fixed_surface(surface, meshing, file, out_notes, watchdog), meshing,
+                             file, out_notes, watchdog);
   } else if (meshing.repair == Repair::kWrap) {
     mesh = wrap_and_mesh(surface, meshing, file, out_notes, watchdog);
   } else if (meshing.repair == Repair::kAuto) {
-    // fix, and the wrap when what fix leaves cannot be meshed (any refusal of the surface or
-    // of Mesh_3 but the time limit, which is the user's bound on the whole).
-    try {
-      out_notes.repair_used = Repair::kFix;
-      mesh = fix_and_mesh();
-    } catch (const TimeLimitExceeded&) {
-      throw;
-    } catch (const InputError& e) {
-      out_notes = TetrahedralizeNotes{};
-      out_notes.repair_used = Repair::kWrap;
-      out_notes.fallback_reason = e.what();
-      try {
-        mesh = wrap_and_mesh(surface, meshing, file, out_notes, watchdog);
-      } catch (const TimeLimitExceeded&) {
-        throw;
-      } catch (const InputError& wrap_error) {
-        throw InputError(file, std::string(wrap_error.what()) +
-                                   " (--repair auto: the wrap, after fix left: " + e.what() + ")");
-      }
-    }
+    mesh = fix_or_wrap(surface, meshing, diagonal, file, out_notes, watchdog);
   } else {
     mesh = validate_and_mesh(surface, meshing, file, out_notes, watchdog);
   }
   watchdog.begin("deviation measurement");
-  // How far the surface moved (repairs, wrap and Mesh_3's re-meshing of the boundary):
-  // distances between the input and the boundary of the tets, whatever the repair.
-  const Surface boundary = extract_surface(mesh);
-  const TriangleMesh meshed{mesh.nodes, boundary.triangles};
-  const double diagonal = bounding_box_diagonal(surface.vertices);
-  const auto [there, back] = detail::hausdorff_distances(surface, meshed);
-  if (there >= 0.0 && diagonal > 0.0) {
-    out_notes.hausdorff_input_to_mesh = there / diagonal;
-    out_notes.hausdorff_mesh_to_input = back / diagonal;
-    out_notes.diagonal = diagonal;
-    out_notes.deviation_excess =
-        std::max(0.0, std::max(there, back) / diagonal - meshing.max_deviation);
-  }
+  measure_deviation(surface, mesh, meshing, diagonal, out_notes);
   watchdog.check();
   return mesh;
 }

@@ -107,7 +107,8 @@ std::size_t remove_few_self_intersections(Mesh& mesh) {
   return pairs.size();
 }
 
-/// The repairs that need the oriented soup as a polygon mesh, in this order: borders stitched
+/// The repairs that need the oriented soup as a polygon mesh, in this order (the hole
+/// patches' area into `patch_area`): borders stitched
 /// (CGAL stitch_borders: border edges whose ends coincide with another border edge's, as on a
 /// seam whose vertices were duplicated), zero-area triangles removed (CGAL
 /// remove_degenerate_faces, by edge collapses and flips), small holes filled, few
@@ -115,7 +116,7 @@ std::size_t remove_few_self_intersections(Mesh& mesh) {
 /// rewritten only when something changed.
 template <class Record>
 void repair_as_mesh(std::vector<Point>& points, std::vector<Polygon>& polygons,
-                    const Record& record) {
+                    const Record& record, double& patch_area) {
   namespace pmp = CGAL::Polygon_mesh_processing;
   if (polygons.empty() || !pmp::is_polygon_soup_a_polygon_mesh(polygons)) return;
   Mesh mesh;
@@ -131,7 +132,6 @@ void repair_as_mesh(std::vector<Point>& points, std::vector<Polygon>& polygons,
     record("zero-area triangles removed", zero_area - std::min(left, zero_area));
     changed = true;
   }
-  double patch_area = 0.0;
   const std::size_t filled = fill_small_holes(mesh, patch_area);
   record("holes filled", filled);
   changed |= filled > 0;
@@ -197,7 +197,7 @@ std::size_t keep_largest_component(const std::vector<Point>& points,
 
 }  // namespace
 
-std::vector<RepairCount> repair_soup(TriangleMesh& mesh, bool keep_largest) {
+std::vector<RepairCount> repair_soup(TriangleMesh& mesh, bool keep_largest, double* patch_area) {
   namespace pmp = CGAL::Polygon_mesh_processing;
   std::vector<RepairCount> repairs;
   auto record = [&repairs](const char* kind, std::size_t count) {
@@ -241,7 +241,9 @@ std::vector<RepairCount> repair_soup(TriangleMesh& mesh, bool keep_largest) {
     for (std::size_t v : polygon) used[v] = 1;
   record("isolated vertices removed",
          static_cast<std::size_t>(std::count(used.begin(), used.end(), 0)));
-  repair_as_mesh(points, polygons, record);
+  double patches = 0.0;
+  repair_as_mesh(points, polygons, record, patches);
+  if (patch_area != nullptr) *patch_area = patches;
   if (keep_largest && !polygons.empty())
     record("smaller components removed", keep_largest_component(points, polygons));
   // Vertices no triangle uses any more are dropped (ids renumbered in order).

@@ -19,8 +19,10 @@ namespace tetseg::preprocess::detail {
 /// experimental::remove_self_intersections; kept only when none is left), with
 /// `keep_largest_component` every edge-connected component but the one of largest area
 /// removed, unused vertices dropped. Returns the repairs made (kind, count; kinds with a zero
-/// count are left out). Vertex ids are renumbered in order of first use.
-std::vector<RepairCount> repair_soup(TriangleMesh& mesh, bool keep_largest_component = false);
+/// count are left out). Vertex ids are renumbered in order of first use. When given,
+/// `patch_area` gets the area of the triangles that fill holes.
+std::vector<RepairCount> repair_soup(TriangleMesh& mesh, bool keep_largest_component = false,
+                                     double* patch_area = nullptr);
 
 /// CGAL 3D alpha wrapping of the triangle soup `soup` (any defects; at least one triangle),
 /// with absolute `alpha` and `offset` (> 0): a closed, 2-manifold, self-intersection-free

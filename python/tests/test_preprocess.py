@@ -331,8 +331,7 @@ def test_wrap_meshes_a_flat_sheet_as_a_slab(pp):
     triangles = np.array([[0, 1, 2], [0, 2, 3]])
     data, _ = pp.build((square, triangles), repair="wrap", wrap_sheet_offset=0.02,
                        clusters="single")
-    kind = "sheet enclosing no volume wrapped as a slab this many ten thousandths of the " \
-        "diagonal thick"
+    kind = "surface wrapped as a slab this many ten thousandths of the diagonal thick"
     provenance = tetseg.load_asset(data).provenance["options"]
     assert float(provenance["meshing.wrap_sheet_offset"]) == 0.02
     assert provenance["repairs." + kind.replace(" ", "_")] == "400"

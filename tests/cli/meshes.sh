@@ -116,11 +116,19 @@ grep -q '"hausdorff": {"input_to_mesh": ' dup.json || fail "the report lacks the
 "$bin/tetseg-dump" dup.tetseg | grep -q 'repairs.duplicate_triangles_removed *2' ||
   fail "the provenance lacks the repair"
 
-# A small hole: fix fills it; a tube with 2 x 80 border edges (over fix's 64): fix names it and
-# points to wrap; wrap (alpha larger than the hole) closes a hole.
+# A cube without one face: fix fills the hole; auto, by default, wraps it instead (the patch is
+# 1/6 of the area and 0.29 of the diagonal from the input, over --max-deviation 0.01), and fills
+# it within --max-deviation 0.5. A tube with 2 x 80 border edges (over fix's 64): fix names it
+# and points to wrap; wrap (alpha larger than the hole) closes a hole.
 sed -e 's/^8 6 0$/8 5 0/' -e '/^4 2 3 7 6$/d' cube.off >holed.off
 expect_exit 0 "tetseg: repaired holed.off: 1 holes filled" -- \
+  "$bin/tetseg" build holed.off -o filled.tetseg --clusters single --facet-size 0.25 --no-optimize \
+  --repair fix
+expect_exit 0 "auto wrapped the surface, as fix left: tetrahedralize: the holes filled by fix (17 % of the area) lie 0.2[89] of the diagonal" -- \
   "$bin/tetseg" build holed.off -o filled.tetseg --clusters single --facet-size 0.25 --no-optimize
+expect_exit 0 "tetseg: repaired holed.off: 1 holes filled" -- \
+  "$bin/tetseg" build holed.off -o filled.tetseg --clusters single --facet-size 0.25 --no-optimize \
+  --max-deviation 0.5
 # Two halves of the cube whose 8 seam edges have duplicated vertices (bottom, top and front
 # on vertices 0-7; right, back and left on copies 8-15): the reader merges vertices by exact
 # position, so the seam is closed as read and builds even with --repair none (stitching of
@@ -164,14 +172,14 @@ expect_exit 2 "wrap-alpha" -- "$bin/tetseg" build holed.off -o x.tetseg --repair
 # A flat sheet encloses nothing: wrap meshes it as a slab (2 x --wrap-sheet-offset thick) and
 # reports it (stderr, report, provenance); the option is range-checked.
 printf 'OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n' >sheet.off
-expect_exit 0 "tetseg: repaired sheet.off: .*400 sheet enclosing no volume wrapped as a slab" -- \
+expect_exit 0 "tetseg: repaired sheet.off: .*400 surface wrapped as a slab" -- \
   "$bin/tetseg" build sheet.off -o sheet.tetseg --clusters single --repair wrap \
   --wrap-sheet-offset 0.02 --report sheet.json
-grep -q '"sheet enclosing no volume wrapped as a slab this many ten thousandths of the diagonal thick": 400' sheet.json ||
+grep -q '"surface wrapped as a slab this many ten thousandths of the diagonal thick": 400' sheet.json ||
   fail "the report lacks the slab"
 "$bin/tetseg-dump" sheet.tetseg | grep -q 'meshing.wrap_sheet_offset *0.02' ||
   fail "the provenance lacks the sheet offset"
-"$bin/tetseg-dump" sheet.tetseg | grep -q 'repairs.sheet_enclosing_no_volume_wrapped_as_a_slab' ||
+"$bin/tetseg-dump" sheet.tetseg | grep -q 'repairs.surface_wrapped_as_a_slab' ||
   fail "the provenance lacks the slab repair"
 expect_exit 2 "wrap-sheet-offset" -- "$bin/tetseg" build sheet.off -o x.tetseg --repair wrap \
   --wrap-sheet-offset 2

@@ -313,10 +313,12 @@ namespace {
 
 /// Wraps and meshes `s` at default sizes (no optimisation, for speed); the result must pass
 /// the tet-mesh validation (closed, 2-manifold boundary, no self-intersection, ...).
-TetMesh wrapped_at_default_sizes(const TriangleMesh& s, TetrahedralizeNotes& notes) {
+TetMesh wrapped_at_default_sizes(const TriangleMesh& s, TetrahedralizeNotes& notes,
+                                 double max_deviation = MeshingOptions{}.max_deviation) {
   MeshingOptions m;
   m.optimize = false;
   m.repair = MeshingOptions::Repair::kWrap;
+  m.max_deviation = max_deviation;
   const TetMesh mesh = tetrahedralize(s, m, "sheet.off", &notes);
   validate_tet_mesh(mesh, extract_surface(mesh), "wrapped");
   return mesh;
@@ -360,8 +362,7 @@ void check_slab(const TetMesh& m, const TetrahedralizeNotes& notes, double area,
   CHECK(notes.repairs[0].kind == "surface replaced by an alpha wrap of this many triangles");
   CHECK(notes.repairs[0].count > 0);
   CHECK(notes.repairs[1].kind ==
-        "sheet enclosing no volume wrapped as a slab this many ten thousandths of the diagonal "
-        "thick");
+        "surface wrapped as a slab this many ten thousandths of the diagonal thick");
   CHECK(notes.repairs[1].count == 200);
   const double pi = std::acos(-1.0);
   const double r = 0.01 * diagonal;
@@ -396,16 +397,33 @@ TEST_CASE("Wrap builds a cube without one face, without meshing its thin wraps",
           "[meshing][repair][wrap]") {
   // The wrap at alpha 0.02 goes in through the missing face and wraps the walls on both
   // sides; so does the wrap at 0.16 in part (libcgal-demo cube-ouvert.off, on which Mesh_3
-  // does not end). Those are skipped as thin; alpha grows until the wrap closes the box.
+  // does not end). Those are not meshed.
   TriangleMesh s = cube();
   s.triangles.erase(s.triangles.begin() + 2, s.triangles.begin() + 4);  // the top face, z = 1
   TetrahedralizeNotes notes;
-  const TetMesh m = wrapped_at_default_sizes(s, notes);
-  CHECK(count_of(notes, "alpha wrap") > 0);
-  CHECK(count_of(notes, "alpha doublings") >= 3);  // 0.02 to 0.16 were thin
-  CHECK(total_tet_volume(m) == Approx(1.0).epsilon(0.05));
-  // The lid is farthest from the input at its centre: half a side, over the diagonal.
-  CHECK(notes.hausdorff_mesh_to_input == Approx(0.5 / std::sqrt(3.0)).margin(0.02));
+  SECTION("Within the default --max-deviation 0.01: a slab, not a lid across the box") {
+    // Doubling alpha to 0.04 would pass 2 x 0.01: the open box becomes a slab 0.02 of the
+    // diagonal thick (its five walls, area 5, times the thickness 0.02 sqrt 3, plus the rims
+    // and corners). Its walls lie the offset 0.01 from the input; at the rim and the corners,
+    // where the alpha ball (0.02) does not reach in, the slab's surface lies up to about
+    // offset + alpha from it.
+    const TetMesh m = wrapped_at_default_sizes(s, notes);
+    CHECK(count_of(notes, "alpha doublings") == 0);
+    CHECK(count_of(notes, "wrapped as a slab") == 200);
+    CHECK(total_tet_volume(m) == Approx(5.0 * 0.02 * std::sqrt(3.0)).epsilon(0.25));
+    CHECK(notes.hausdorff_input_to_mesh == Approx(0.01).margin(0.005));
+    CHECK(notes.hausdorff_mesh_to_input >= 0.008);
+    CHECK(notes.hausdorff_mesh_to_input <= 0.03);
+  }
+  SECTION("With --max-deviation 1: alpha grows until the wrap closes the box") {
+    const TetMesh m = wrapped_at_default_sizes(s, notes, 1.0);
+    CHECK(count_of(notes, "alpha wrap") > 0);
+    CHECK(count_of(notes, "slab") == 0);
+    CHECK(count_of(notes, "alpha doublings") >= 3);  // 0.02 to 0.16 were thin
+    CHECK(total_tet_volume(m) == Approx(1.0).epsilon(0.05));
+    // The lid is farthest from the input at its centre: half a side, over the diagonal.
+    CHECK(notes.hausdorff_mesh_to_input == Approx(0.5 / std::sqrt(3.0)).margin(0.02));
+  }
 }
 
 namespace {
@@ -431,9 +449,11 @@ TriangleMesh torus(double major, double minor, std::uint32_t n, std::uint32_t m,
 }
 
 /// `s` through --repair auto (facet size `facet`, no optimisation); the mesh must be valid.
-TetrahedralizeNotes auto_repaired(const TriangleMesh& s, double facet) {
+TetrahedralizeNotes auto_repaired(const TriangleMesh& s, double facet,
+                                  double max_deviation = MeshingOptions{}.max_deviation) {
   MeshingOptions m = coarse(MeshingOptions::Repair::kAuto);
   m.facet_size = facet;
+  m.max_deviation = max_deviation;
   TetrahedralizeNotes notes;
   const TetMesh mesh = tetrahedralize(s, m, "auto.off", &notes);
   validate_tet_mesh(mesh, extract_surface(mesh), "auto");
@@ -461,22 +481,79 @@ TEST_CASE("Auto is fix, and the wrap with the reason where fix leaves a defect",
   }
   SECTION("A sphere with a hole over the fill limit falls back to the wrap.") {
     // The cap z > 0.6 of an 11.5k-triangle unit sphere removed: a hole of about 110 border edges
-    // (radius 0.8), over fix's 64. The wrap closes it (alpha doubles until the wrap no
-    // longer enters the sphere) with a patch across the hole, whose centre is 0.8 (the hole's
-    // radius: the nearest input points are on its rim) from the input, over the diagonal
-    // 2 sqrt 3 (a little more where the patch sags inward); elsewhere it is close.
+    // (radius 0.8), over fix's 64. The wrap at alpha 0.02 enters the sphere.
     TriangleMesh s = tetseg::test::icosphere(24);
     std::vector<Tri> kept;
     for (const Tri& t : s.triangles)
       if (s.vertices[t[0]][2] <= 0.6 || s.vertices[t[1]][2] <= 0.6 || s.vertices[t[2]][2] <= 0.6)
         kept.push_back(t);
     s.triangles = kept;
-    const TetrahedralizeNotes notes = auto_repaired(s, 0.2);
-    CHECK(notes.repair_used == Repair::kWrap);
-    CHECK_THAT(notes.fallback_reason, Catch::Contains("surface is not closed ("));
-    CHECK(count_of(notes, "alpha wrap") > 0);
-    CHECK(notes.hausdorff_input_to_mesh < 0.05);
-    CHECK(notes.hausdorff_mesh_to_input == Approx(0.8 / (2.0 * std::sqrt(3.0))).margin(0.04));
+    SECTION("Within the default --max-deviation 0.01: the open sphere as a slab") {
+      // Bridging the hole would put the surface 0.8 from the input; the slab's faces lie the
+      // sheet offset, 0.01 of the diagonal, from it.
+      const TetrahedralizeNotes notes = auto_repaired(s, 0.2);
+      CHECK(notes.repair_used == Repair::kWrap);
+      CHECK_THAT(notes.fallback_reason, Catch::Contains("surface is not closed ("));
+      CHECK(count_of(notes, "wrapped as a slab") == 200);
+      CHECK(notes.hausdorff_input_to_mesh == Approx(0.01).margin(0.006));
+      CHECK(notes.hausdorff_mesh_to_input == Approx(0.01).margin(0.006));
+    }
+    SECTION("With --max-deviation 0.5: the wrap closes the hole across") {
+      // Alpha doubles until the wrap no longer enters the sphere: a patch across the hole,
+      // whose centre is 0.8 (the hole's radius: the nearest input points are on its rim) from
+      // the input, over the diagonal 2 sqrt 3 (a little more where the patch sags inward).
+      const TetrahedralizeNotes notes = auto_repaired(s, 0.2, 0.5);
+      CHECK(notes.repair_used == Repair::kWrap);
+      CHECK(count_of(notes, "alpha wrap") > 0);
+      CHECK(count_of(notes, "slab") == 0);
+      CHECK(notes.hausdorff_input_to_mesh < 0.05);
+      CHECK(notes.hausdorff_mesh_to_input == Approx(0.8 / (2.0 * std::sqrt(3.0))).margin(0.04));
+    }
+  }
+  SECTION("A hole fix fills but that makes a quarter of the surface is kept within the bound") {
+    // The cap z > 0.5 of a 720-triangle unit sphere removed: one hole under the fill limit,
+    // whose patch is about a quarter of the area (the cap's share of a sphere: (1 - 0.5) / 2).
+    // The rim (the nearest input to the patch) lies between z = 0.5 and 0.7 (kept triangles
+    // reach above 0.5), radius 0.71 to 0.87: a flat patch's centre is that radius from it,
+    // 0.2 to 0.25 of the diagonal 2 sqrt 3; a patch faired up to the pole at most 1, 0.29.
+    TriangleMesh s = tetseg::test::icosphere(6);
+    std::vector<Tri> kept;
+    for (const Tri& t : s.triangles)
+      if (s.vertices[t[0]][2] <= 0.5 || s.vertices[t[1]][2] <= 0.5 || s.vertices[t[2]][2] <= 0.5)
+        kept.push_back(t);
+    s.triangles = kept;
+    SECTION("Over the default --max-deviation: wrapped, as a slab, with the reason") {
+      const TetrahedralizeNotes notes = auto_repaired(s, 0.2);
+      CHECK(notes.repair_used == Repair::kWrap);
+      CHECK_THAT(notes.fallback_reason, Catch::Contains("the holes filled by fix ("));
+      CHECK_THAT(notes.fallback_reason, Catch::Contains("over --max-deviation 0.01"));
+      CHECK(count_of(notes, "wrapped as a slab") == 200);
+      CHECK(std::max(notes.hausdorff_input_to_mesh, notes.hausdorff_mesh_to_input) < 0.02);
+    }
+    SECTION("Fix's filled sphere after all when the wrap lies further from the input") {
+      // A slab 0.4 of the diagonal off the input deviates more than the patch (under 0.31).
+      MeshingOptions m = coarse(Repair::kAuto);
+      m.facet_size = 0.2;
+      m.wrap_sheet_offset = 0.4;
+      TetrahedralizeNotes notes;
+      const TetMesh mesh = tetrahedralize(s, m, "auto.off", &notes);
+      validate_tet_mesh(mesh, extract_surface(mesh), "auto");
+      CHECK(notes.repair_used == Repair::kFix);
+      CHECK(notes.fallback_reason.empty());
+      CHECK(count_of(notes, "holes filled") == 1);
+      CHECK(count_of(notes, "slab") == 0);
+      CHECK(notes.hausdorff_mesh_to_input < 0.31);
+      CHECK(notes.deviation_excess > 0.19);
+    }
+    SECTION("Within --max-deviation 0.5: fix's filled sphere") {
+      const TetrahedralizeNotes notes = auto_repaired(s, 0.2, 0.5);
+      CHECK(notes.repair_used == Repair::kFix);
+      CHECK(notes.fallback_reason.empty());
+      CHECK(count_of(notes, "holes filled") == 1);
+      CHECK(notes.hausdorff_input_to_mesh < 0.02);
+      CHECK(notes.hausdorff_mesh_to_input > 0.2);
+      CHECK(notes.hausdorff_mesh_to_input < 0.31);
+    }
   }
   SECTION("Two interpenetrating tori (more crossing pairs than fix removes) are wrapped.") {
     TriangleMesh s = torus(1.0, 0.3, 64, 16, {0, 0, 0});

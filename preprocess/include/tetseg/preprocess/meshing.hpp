@@ -28,7 +28,8 @@ struct MeshingOptions {
   double cell_radius_edge_ratio = 3.0;  ///< tet quality bound, >= 2
   bool optimize = true;  ///< sliver perturbation (10 degree bound) + exudation; no ODT/Lloyd
   /// Surfaces only: kFix repairs the input before validation; kWrap replaces it by its alpha
-  /// wrap; kAuto (the default) is kFix, and kWrap when what kFix leaves cannot be meshed
+  /// wrap; kAuto (the default) is kFix, and kWrap when what kFix leaves cannot be meshed or
+  /// when its hole patches (15 % of the area or more) lie further than max_deviation
   /// (tetrahedralize; TetrahedralizeNotes::repair_used and ::fallback_reason say which).
   enum class Repair { kNone, kFix, kWrap, kAuto } repair = Repair::kAuto;
   /// kWrap: alpha (the size of the gaps the wrap does not enter) and offset (its distance
@@ -53,9 +54,10 @@ struct MeshingOptions {
   /// Surfaces only: how far the asset's surface may be from the input's (the two-sided
   /// Hausdorff distance), a fraction of the bounding-box diagonal (option_ranges
   /// kMaxDeviation). A derived facet distance is at most half of it and the wrap offset at most
-  /// a quarter (the defaults are below both at 0.01); a mesh that still deviates more (a sheet
-  /// wrapped as a slab, a hole closed across) is kept, and TetrahedralizeNotes says by how
-  /// much.
+  /// a quarter (the defaults are below both at 0.01); the wrap's alpha is not doubled past
+  /// twice it before the slab is tried, and kAuto wraps hole patches further than it
+  /// (tetrahedralize). A mesh that still deviates more (a sheet wrapped as a slab, the inner
+  /// parts of a self-intersecting input) is kept, and TetrahedralizeNotes says by how much.
   double max_deviation = 0.01;
   /// Surfaces only: seconds tetrahedralize may run (0: no limit; option_ranges kTimeLimit).
   /// Mesh_3 is stopped there, and the other steps (repair, wrap, deviation) are checked
@@ -133,12 +135,17 @@ struct TetrahedralizeNotes {
 /// an error that ends by suggesting `--repair wrap`. With kWrap the surface
 /// is replaced by its CGAL alpha wrap (wrap_alpha, wrap_offset), which is closed, manifold and
 /// free of self-intersections for any soup; while that wrap is a thin shell (all over, or half
-/// of it) or does not mesh, alpha is doubled (at most 6 times); an input whose wrap is still a
-/// thin shell with alpha = the diagonal encloses no volume (a sheet) and is wrapped again with
-/// wrap_sheet_offset into a slab (a repair in `notes`). `notes` gets the Hausdorff distances
-/// between input and meshed boundary (always: how far the surface moved). The boundary is
-/// re-meshed (Mesh_3 does not keep the input triangles); Mesh_3 runs with its manifold option.
-/// Unlike validate_closed_surface, pinch points (separate fans of triangles touching at one
+/// of it) or does not mesh, alpha is doubled (at most 6 times), but before alpha passes twice
+/// max_deviation (or wrap_alpha when larger) the input is wrapped again with wrap_sheet_offset
+/// into a slab (an open surface becomes a shell; a repair in `notes`), meshed with a 20 s bound;
+/// the doublings go on only when that slab does not mesh, and an input whose wrap is still a
+/// thin shell with alpha = the diagonal (a sheet) is then wrapped as that slab, unbounded. kAuto
+/// is kFix, and kWrap when what fix leaves is refused (the reason in `notes`) or when fix's
+/// hole patches make 15 % of the area or more and lie further than max_deviation from the
+/// input (fix's surface is meshed after all when that wrap fails or lies further). `notes` gets the
+/// Hausdorff distances between input and meshed boundary (always: how far the surface moved). The
+/// boundary is re-meshed (Mesh_3 does not keep the input triangles); Mesh_3 runs with its manifold
+/// option. Unlike validate_closed_surface, pinch points (separate fans of triangles touching at one
 /// vertex position, common in modelled meshes) are accepted. The result is checked like
 /// validate_tet_mesh (closed 2-manifold boundary, ...); when the optimised mesh (sliver
 /// perturbation, then exudation) fails that check, meshing is retried with exudation only,
