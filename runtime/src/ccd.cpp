@@ -622,6 +622,43 @@ double certified_crossing_time(const FloatBernstein& p, double ta, double tb, do
   return max_nan(ta, t - std::fabs(t) * 0x1p-51);
 }
 
+/// The cubic-first descent's jump (exact contact): on a dyadic interval [ta, tb] where the
+/// coplanarity cubic p changes sign, the bisection would halve down to the leaf holding p's
+/// root, excluding on the way each half where p is one-signed. Instead, the leaf of that grid
+/// (width `leaf`, the bisection's own: a power of two) holding a float estimate of the root is
+/// taken at once, when p is proven one-signed on the rest of [ta, tb]: before the leaf
+/// (left_part) and after it (right_part), so the leaf holds every root. Its ends, and their
+/// local parameters, are grid points: exact. Returns false (the caller halves) when a proof
+/// fails: a root near a leaf end, several roots, a bound too wide.
+bool root_leaf(const FloatBernstein& p, double ta, double tb, double leaf, double& lo,
+               double& hi) noexcept {
+  const double width = tb - ta;
+  const double local_leaf = leaf / width;  // a power of two: exact
+  const double estimate = root_estimate(p, 0.25 * local_leaf);
+  const double k = std::floor(estimate / local_leaf);
+  const double lambda_lo = k * local_leaf;  // exact: k < 2^53, a power-of-two scale
+  const double lambda_hi = lambda_lo + local_leaf;
+  if (!(lambda_lo >= 0.0 && lambda_hi <= 1.0)) return false;
+  if (lambda_lo > 0.0) {
+    const FloatBernstein before = left_part(p, lambda_lo);
+    if (!proven_positive(before) && !proven_negative(before)) return false;
+  }
+  if (lambda_hi < 1.0) {
+    const FloatBernstein after = right_part(p, lambda_hi);
+    if (!proven_positive(after) && !proven_negative(after)) return false;
+  }
+  lo = ta + lambda_lo * width;  // grid points: exact
+  hi = ta + lambda_hi * width;
+  return true;
+}
+
+/// Width of the bisection's leaves below a dyadic interval of width `width`: the first halving
+/// not above tol.
+double leaf_width(double width, double tol) noexcept {
+  while (width > tol) width *= 0.5;
+  return width;
+}
+
 /// Start of the last leaf of the bisection of [0, 1] down to the tolerance: 1 - 2^-k with
 /// 2^-k the first halving not above tol.
 double last_leaf_start(double tol) noexcept {
@@ -722,6 +759,14 @@ CcdResult run_bisection(const Test& test, const CcdOptions& options) noexcept {
                (proven_positive(item.poly) || proven_negative(item.poly))) {
       outcome.excluded = true;
     } else if (item.depth == Depth::kCubicFirst && !leaf && proven_sign_change(item.poly)) {
+      // The leaf holding the cubic's only root, checked in full as the bisection would
+      // (everything else in [ta, tb] is proven contact-free); else one halving.
+      double lo = 0.0, hi = 0.0;
+      if (root_leaf(item.poly, item.ta, item.tb, leaf_width(item.tb - item.ta, tol), lo, hi)) {
+        ++result.intervals;  // the rest of [ta, tb], excluded
+        stack[top++] = {lo, hi, Depth::kFull, {}};
+        continue;
+      }
       FloatBernstein left{}, right{};
       split_half(item.poly, left, right);
       stack[top++] = {tm, item.tb, Depth::kCubicFirst, right};
