@@ -23,6 +23,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <type_traits>
 
 #include "ccd_bernstein.hpp"
 #include "ccd_interval.hpp"
@@ -297,6 +298,59 @@ bool all_finite(const Vec3d* const* points, int count) noexcept {
   return true;
 }
 
+/// Bernstein coefficients of a polynomial of degree 3 or 4 on an interval (the coplanarity
+/// cubic, or an inside condition), from its enclosed sums: the midpoints with the largest
+/// radius as error bound.
+template <int N>
+FloatBernstein float_bernstein(const Sums<Iv, N>& sums) noexcept {
+  static_assert(N == 3 || N == 4, "degrees 3 and 4");
+  constexpr double kBinomial[2][5] = {{1, 3, 3, 1, 0}, {1, 4, 6, 4, 1}};
+  FloatBernstein p{{}, N, 0.0};
+  for (int k = 0; k <= N; ++k) {
+    const Iv b = (k == 0 || k == N) ? sums.s[k] : divide(sums.s[k], kBinomial[N - 3][k]);
+    p.c[k] = b.m;
+    p.err = max_nan(p.err, b.r);
+  }
+  return p;
+}
+
+/// The cubic-first descent's jump (exact contact): on a dyadic interval [ta, tb] where the
+/// coplanarity cubic p changes sign, the bisection would halve down to the leaf holding p's
+/// root, excluding on the way each half where p is one-signed. Instead, the leaf of that grid
+/// (width `leaf`, the bisection's own: a power of two) holding a float estimate of the root is
+/// taken at once, when p is proven one-signed on the rest of [ta, tb]: before the leaf
+/// (left_part) and after it (right_part), so the leaf holds every root. Its ends, and their
+/// local parameters, are grid points: exact. Returns false (the caller halves) when a proof
+/// fails: a root near a leaf end, several roots, a bound too wide.
+bool root_leaf(const FloatBernstein& p, double ta, double tb, double leaf, double& lo,
+               double& hi) noexcept {
+  const double width = tb - ta;
+  const double local_leaf = leaf / width;  // a power of two: exact
+  const double estimate = root_estimate(p, 0.25 * local_leaf);
+  const double k = std::floor(estimate / local_leaf);
+  const double lambda_lo = k * local_leaf;  // exact: k < 2^53, a power-of-two scale
+  const double lambda_hi = lambda_lo + local_leaf;
+  if (!(lambda_lo >= 0.0 && lambda_hi <= 1.0)) return false;
+  if (lambda_lo > 0.0) {
+    const FloatBernstein before = left_part(p, lambda_lo);
+    if (!proven_positive(before) && !proven_negative(before)) return false;
+  }
+  if (lambda_hi < 1.0) {
+    const FloatBernstein after = right_part(p, lambda_hi);
+    if (!proven_positive(after) && !proven_negative(after)) return false;
+  }
+  lo = ta + lambda_lo * width;  // grid points: exact
+  hi = ta + lambda_hi * width;
+  return true;
+}
+
+/// Width of the bisection's leaves below a dyadic interval of width `width`: the first halving
+/// not above tol.
+double leaf_width(double width, double tol) noexcept {
+  while (width > tol) width *= 0.5;
+  return width;
+}
+
 /// How much of a test to run on an interval. kFilter: boxes and the coplanarity cubic (the
 /// cheap pre-filter). kFull: every exclusion test. kCoplanarOnly: boxes and the coplanarity
 /// cubic, for an interval inside one where every inside condition was proven positive (the
@@ -324,6 +378,10 @@ struct IntervalOutcome {
   /// Certified in the plane with one inside condition open: on sub-intervals, contact happens
   /// exactly where that condition is >= 0 (the others are proven positive).
   bool open_condition = false;
+  /// Exact contact, a check given a leaf width: the coplanarity cubic has its only root on the
+  /// interval in the leaf [leaf_lo, leaf_hi] (root_leaf); nothing else was checked.
+  bool to_leaf = false;
+  double leaf_lo = 0.0, leaf_hi = 0.0;
 };
 
 /// True when every Bernstein sum is proven strictly positive (the polynomial > 0 on T).
@@ -338,6 +396,16 @@ template <class I, int N>
 bool sign_change(const Sums<I, N>& raw) noexcept {
   return (upper(raw.s[0]) < 0.0 && lower(raw.s[N]) > 0.0) ||
          (lower(raw.s[0]) > 0.0 && upper(raw.s[N]) < 0.0);
+}
+
+/// The outcome sending a check to the leaf holding the coplanarity cubic's only root on
+/// [ta, tb] (root_leaf), when there is one: `to_leaf` set, else nothing decided.
+inline IntervalOutcome crossing_leaf(const Sums<Iv, 3>& f, double ta, double tb,
+                                     double leaf) noexcept {
+  IntervalOutcome out{};
+  out.to_leaf =
+      sign_change(f) && root_leaf(float_bernstein(f), ta, tb, leaf, out.leaf_lo, out.leaf_hi);
+  return out;
 }
 
 /// Positive certificate of an open interval (exact contact), from the coplanarity cubic f and
@@ -393,9 +461,11 @@ struct VertexFaceTest {
   /// The axis orthogonal to a plane the four points stay in for the whole step, or -1.
   int plane_axis = axis_plane(x0, x1);
 
+  /// `leaf` > 0 (exact contact, doubles): a crossing of the coplanarity cubic goes to its
+  /// root's leaf of that width (crossing_leaf) before the inside conditions are computed.
   template <class I>
   IntervalOutcome check(double ta, double tb, Depth depth, Sums<I, 3>* coplanarity = nullptr,
-                        Sums<I, 4>* open_condition = nullptr) const noexcept {
+                        Sums<I, 4>* open_condition = nullptr, double leaf = 0.0) const noexcept {
     Vec<I> x[4][2];
     positions_at<I>(x0, x1, ta, tb, x);
     if (boxes_disjoint<I>(x, 1, x + 1, 3, sep)) return {true, false};
@@ -409,6 +479,12 @@ struct VertexFaceTest {
     if (coplanarity != nullptr) *coplanarity = f;
     if (away_from_zero(f, sep, n2)) return {true, false};
     if (depth != Depth::kFull) return {false, depth == Depth::kCoplanarOnly};
+    if constexpr (std::is_same_v<I, Iv>) {
+      if (leaf > 0.0) {
+        const IntervalOutcome jump = crossing_leaf(f, ta, tb, leaf);
+        if (jump.to_leaf) return jump;
+      }
+    }
 
     const Slot<I> cb = difference(x[3], x[2]);
     const Slot<I> pb = difference(x[0], x[2]);
@@ -455,9 +531,11 @@ struct EdgeEdgeTest {
   /// The axis orthogonal to a plane the four points stay in for the whole step, or -1.
   int plane_axis = axis_plane(x0, x1);
 
+  /// `leaf` > 0 (exact contact, doubles): a crossing of the coplanarity cubic goes to its
+  /// root's leaf of that width (crossing_leaf) before the inside conditions are computed.
   template <class I>
   IntervalOutcome check(double ta, double tb, Depth depth, Sums<I, 3>* coplanarity = nullptr,
-                        Sums<I, 4>* open_condition = nullptr) const noexcept {
+                        Sums<I, 4>* open_condition = nullptr, double leaf = 0.0) const noexcept {
     Vec<I> x[4][2];
     positions_at<I>(x0, x1, ta, tb, x);
     if (boxes_disjoint<I>(x, 2, x + 2, 2, sep)) return {true, false};
@@ -471,6 +549,12 @@ struct EdgeEdgeTest {
     if (coplanarity != nullptr) *coplanarity = f;
     if (away_from_zero(f, sep, n2)) return {true, false};
     if (depth != Depth::kFull) return {false, depth == Depth::kCoplanarOnly};
+    if constexpr (std::is_same_v<I, Iv>) {
+      if (leaf > 0.0) {
+        const IntervalOutcome jump = crossing_leaf(f, ta, tb, leaf);
+        if (jump.to_leaf) return jump;
+      }
+    }
 
     // Planes through one edge containing the common normal n = (b-a) x (d-c): the other edge
     // strictly beyond one of them (by delta) cannot touch. With N = |n|^2:
@@ -571,22 +655,6 @@ double clamp_tolerance(double tol) noexcept {
   return min_nan(tol, 1.0);
 }
 
-/// Bernstein coefficients of a polynomial of degree 3 or 4 on an interval (the coplanarity
-/// cubic, or an inside condition), from its enclosed sums: the midpoints with the largest
-/// radius as error bound.
-template <int N>
-FloatBernstein float_bernstein(const Sums<Iv, N>& sums) noexcept {
-  static_assert(N == 3 || N == 4, "degrees 3 and 4");
-  constexpr double kBinomial[2][5] = {{1, 3, 3, 1, 0}, {1, 4, 6, 4, 1}};
-  FloatBernstein p{{}, N, 0.0};
-  for (int k = 0; k <= N; ++k) {
-    const Iv b = (k == 0 || k == N) ? sums.s[k] : divide(sums.s[k], kBinomial[N - 3][k]);
-    p.c[k] = b.m;
-    p.err = max_nan(p.err, b.r);
-  }
-  return p;
-}
-
 /// True when the coplanarity cubic f, known to vanish at t = 1, is proven nonzero on [0, 1).
 /// f = (1 - t) g with g quadratic; g's Bernstein coefficients on [0, 1] are f's sums
 /// s0, s1 / 2, s2 (from (1 - t) B_i^2 = C(2,i) / C(3,i) B_i^3), so one strict sign of those three
@@ -620,43 +688,6 @@ double certified_crossing_time(const FloatBernstein& p, double ta, double tb, do
   if (!proven_positive(left) && !proven_negative(left)) return -1.0;
   const double t = ta + lambda * width;  // two roundings: 2^-51 |t| covers them
   return max_nan(ta, t - std::fabs(t) * 0x1p-51);
-}
-
-/// The cubic-first descent's jump (exact contact): on a dyadic interval [ta, tb] where the
-/// coplanarity cubic p changes sign, the bisection would halve down to the leaf holding p's
-/// root, excluding on the way each half where p is one-signed. Instead, the leaf of that grid
-/// (width `leaf`, the bisection's own: a power of two) holding a float estimate of the root is
-/// taken at once, when p is proven one-signed on the rest of [ta, tb]: before the leaf
-/// (left_part) and after it (right_part), so the leaf holds every root. Its ends, and their
-/// local parameters, are grid points: exact. Returns false (the caller halves) when a proof
-/// fails: a root near a leaf end, several roots, a bound too wide.
-bool root_leaf(const FloatBernstein& p, double ta, double tb, double leaf, double& lo,
-               double& hi) noexcept {
-  const double width = tb - ta;
-  const double local_leaf = leaf / width;  // a power of two: exact
-  const double estimate = root_estimate(p, 0.25 * local_leaf);
-  const double k = std::floor(estimate / local_leaf);
-  const double lambda_lo = k * local_leaf;  // exact: k < 2^53, a power-of-two scale
-  const double lambda_hi = lambda_lo + local_leaf;
-  if (!(lambda_lo >= 0.0 && lambda_hi <= 1.0)) return false;
-  if (lambda_lo > 0.0) {
-    const FloatBernstein before = left_part(p, lambda_lo);
-    if (!proven_positive(before) && !proven_negative(before)) return false;
-  }
-  if (lambda_hi < 1.0) {
-    const FloatBernstein after = right_part(p, lambda_hi);
-    if (!proven_positive(after) && !proven_negative(after)) return false;
-  }
-  lo = ta + lambda_lo * width;  // grid points: exact
-  hi = ta + lambda_hi * width;
-  return true;
-}
-
-/// Width of the bisection's leaves below a dyadic interval of width `width`: the first halving
-/// not above tol.
-double leaf_width(double width, double tol) noexcept {
-  while (width > tol) width *= 0.5;
-  return width;
 }
 
 /// Start of the last leaf of the bisection of [0, 1] down to the tolerance: 1 - 2^-k with
@@ -773,8 +804,17 @@ CcdResult run_bisection(const Test& test, const CcdOptions& options) noexcept {
       stack[top++] = {item.ta, tm, Depth::kCubicFirst, left};
       continue;
     } else {
-      outcome = test.template check<Iv>(item.ta, item.tb, depth, &f, &open);
+      // The whole step first (exact contact): a crossing goes straight to its root's leaf.
+      const double leaf = exact_contact && !start_tested ? leaf_width(1.0, tol) : 0.0;
+      outcome = test.template check<Iv>(item.ta, item.tb, depth, &f, &open, leaf);
       checked = true;
+    }
+    if (outcome.to_leaf) {
+      // The cubic is proven nonzero at t = 0 (it changes sign on [0, 1]): no contact there.
+      start_tested = true;
+      certified = contact_at_end;
+      stack[top++] = {outcome.leaf_lo, outcome.leaf_hi, Depth::kFull, {}};
+      continue;
     }
     if (outcome.excluded) continue;
     if (near_degenerate && !certified && test.template check<Dd>(item.ta, item.tb, depth).excluded)
