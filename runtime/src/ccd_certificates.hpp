@@ -39,7 +39,7 @@ FloatBernstein float_bernstein(const Sums<Iv, N>& sums) noexcept {
 /// local parameters, are grid points: exact. Returns false (the caller halves) when a proof
 /// fails: a root near a leaf end, several roots, a bound too wide.
 inline bool root_leaf(const FloatBernstein& p, double ta, double tb, double leaf, double& lo,
-               double& hi) noexcept {
+                      double& hi) noexcept {
   const double width = tb - ta;
   const double local_leaf = leaf / width;  // a power of two: exact
   const double estimate = root_estimate(p, 0.25 * local_leaf);
@@ -167,7 +167,8 @@ inline bool nonzero_after_start(const Sums<Iv, 3>& f) noexcept {
 /// coefficients there, from one de Casteljau step at the estimated root, are of one sign), rounded
 /// down. Everything before ta being contact-free, t is a lower bound of the first contact. -1 when
 /// the proof fails (then the caller bisects).
-inline double certified_crossing_time(const FloatBernstein& p, double ta, double tb, double tol) noexcept {
+inline double certified_crossing_time(const FloatBernstein& p, double ta, double tb,
+                                      double tol) noexcept {
   const double width = tb - ta;
   const double local_tol = tol / width;
   const double lambda = root_estimate(p, 0.25 * local_tol) - 0.5 * local_tol;
