@@ -548,8 +548,9 @@ bool Collider::Impl::run_query(ContactSink* sink) noexcept {
   }
   Worker& w0 = workers[0];
   const bool count_skips = !stats.full_traversal && qkind == QueryKind::kFull && !rest_mode;
-  // Parallel traversal: OpenMP threads take whole tasks (a cluster with its pairs, a subtree
-  // of the whole-surface BVH, a brute force vertex or edge); merged in worker order, so counts
+  // Parallel traversal: OpenMP threads take tasks (an item of the cluster BVHs, handed over
+  // below whole clusters when a thread is idle; a subtree of the whole-surface BVH; a brute
+  // force vertex or edge), each traversed once; merged in worker order, so counts
   // and the earliest contact equal the serial ones, and a buffer keeps the smallest contacts
   // whoever finds them (ContactSink).
   const bool parallel = workers.size() > 1 && !rest_mode;
