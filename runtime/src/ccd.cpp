@@ -19,7 +19,10 @@
 // Exact contact also proves contacts (docs/ccd.md, "Exact contacts at the speed of float"):
 // certificates at an end of the step in an axis-aligned plane (ccd_plane.hpp), on intervals
 // (inside proven and the cubic changing sign; in a plane, the inside conditions), then a jump
-// to the crossing or descents in floating point with rigorous error bounds (ccd_bernstein.hpp).
+// to the crossing or descents in floating point with rigorous error bounds (ccd_bernstein.hpp);
+// a crossing of the cubic goes straight to its root's leaf (ccd_certificates.hpp). The forms
+// and their exclusion tests are in ccd_forms.hpp; this file holds the two tests and the
+// bisection.
 
 #include <algorithm>
 #include <cmath>

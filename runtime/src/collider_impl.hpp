@@ -398,8 +398,8 @@ struct Collider::Impl {
   // reserved at construction when there are several workers).
   std::vector<StackItem> frontier;
   // The same for the cluster BVHs (traverse_clusters_parallel's queue): every cluster's own
-  // item and every live pair of clusters, then items handed over on the way (capacity
-  // reserved at construction when there are several workers).
+  // item and every live pair of clusters, then items handed over on the way (sized at
+  // construction when there are several workers, empty otherwise).
   std::vector<WideTask> wide_frontier;
   // Contact closure scratch (capacity tri_count, reserved at construction).
   std::vector<std::uint32_t> closure_ring;
