@@ -19,12 +19,18 @@
 // Exact contact also proves contacts (docs/ccd.md, "Exact contacts at the speed of float"):
 // certificates at an end of the step in an axis-aligned plane (ccd_plane.hpp), on intervals
 // (inside proven and the cubic changing sign; in a plane, the inside conditions), then a jump
-// to the crossing or descents in floating point with rigorous error bounds (ccd_bernstein.hpp).
+// to the crossing or descents in floating point with rigorous error bounds (ccd_bernstein.hpp);
+// a crossing of the cubic goes straight to its root's leaf (ccd_certificates.hpp). The forms
+// and their exclusion tests are in ccd_forms.hpp; this file holds the two tests and the
+// bisection.
 
 #include <algorithm>
 #include <cmath>
+#include <type_traits>
 
 #include "ccd_bernstein.hpp"
+#include "ccd_certificates.hpp"
+#include "ccd_forms.hpp"
 #include "ccd_interval.hpp"
 #include "ccd_plane.hpp"
 #include "tetseg/runtime/ccd.hpp"
@@ -37,258 +43,6 @@ using namespace ccd_detail;
 constexpr int kStackSize = 64;
 
 constexpr double kMinTolerance = 0x1p-50;
-
-template <class I>
-Vec<I> exact_vec(const Vec3d& x) noexcept {
-  return {make<I>(x[0]), make<I>(x[1]), make<I>(x[2])};
-}
-
-/// Enclosure of x0 + t (x1 - x0) for an exact time t.
-template <class I>
-Vec<I> position(const Vec3d& x0, const Vec3d& x1, double t) noexcept {
-  if (t == 0.0) return exact_vec<I>(x0);
-  if (t == 1.0) return exact_vec<I>(x1);
-  const I tt = make<I>(t);
-  return {make<I>(x0[0]) + tt * (make<I>(x1[0]) - make<I>(x0[0])),
-          make<I>(x0[1]) + tt * (make<I>(x1[1]) - make<I>(x0[1])),
-          make<I>(x0[2]) + tt * (make<I>(x1[2]) - make<I>(x0[2]))};
-}
-
-/// A vector affine in t over the current interval: enclosures of its values at both ends.
-template <class I>
-struct Slot {
-  Vec<I> v[2];
-};
-
-template <class I>
-Slot<I> difference(const Vec<I> (&x)[2], const Vec<I> (&y)[2]) noexcept {
-  return {{x[0] - y[0], x[1] - y[1]}};
-}
-
-/// Bernstein coefficients of a polynomial of degree N on the interval, each multiplied by
-/// the binomial coefficient C(N, k) (the sums of the form over the 2^N end choices): same
-/// signs as the coefficients, no division.
-template <class I, int N>
-struct Sums {
-  I s[N + 1];
-};
-
-template <class I, int N>
-Range range_of(const Sums<I, N>& c) noexcept {
-  Range r{lower(c.s[0]), upper(c.s[0])};
-  for (int i = 1; i <= N; ++i) {
-    r.lo = min_nan(r.lo, lower(c.s[i]));
-    r.hi = max_nan(r.hi, upper(c.s[i]));
-  }
-  if (std::isnan(r.lo) || std::isnan(r.hi)) r = {-INFINITY, INFINITY};
-  return r;
-}
-
-/// Enclosure of the polynomial itself over the interval (sums divided by the binomials).
-template <class I, int N>
-Range value_range(const Sums<I, N>& c) noexcept {
-  static_assert(N >= 2 && N <= 4, "degrees 2..4");
-  constexpr double kBinomial[5][5] = {
-      {1, 0, 0, 0, 0}, {1, 1, 0, 0, 0}, {1, 2, 1, 0, 0}, {1, 3, 3, 1, 0}, {1, 4, 6, 4, 1}};
-  Sums<I, N> d = c;
-  for (int k = 1; k < N; ++k) d.s[k] = divide(c.s[k], kBinomial[N][k]);
-  return range_of(d);
-}
-
-/// w1 . w2 (degree 2).
-template <class I>
-Sums<I, 2> bilinear(const Slot<I>& w1, const Slot<I>& w2) noexcept {
-  return {{dot(w1.v[0], w2.v[0]), dot(w1.v[1], w2.v[0]) + dot(w1.v[0], w2.v[1]),
-           dot(w1.v[1], w2.v[1])}};
-}
-
-/// w1 x w2 (degree 2) as Bernstein sums of vectors: c[k] sums the cross products of the ends
-/// i + j = k. Forms that share a cross product compute it once.
-template <class I>
-struct CrossSums {
-  Vec<I> c[3];
-};
-
-template <class I>
-CrossSums<I> cross_sums(const Slot<I>& w1, const Slot<I>& w2) noexcept {
-  const Vec<I> mixed0 = cross(w1.v[0], w2.v[1]);
-  const Vec<I> mixed1 = cross(w1.v[1], w2.v[0]);
-  return {{cross(w1.v[0], w2.v[0]),
-           {mixed0.x + mixed1.x, mixed0.y + mixed1.y, mixed0.z + mixed1.z},
-           cross(w1.v[1], w2.v[1])}};
-}
-
-/// The 2D cross product of w1 and w2 on the two axes other than `axis` (degree 2).
-template <class I>
-Sums<I, 2> cross2(const Slot<I>& w1, const Slot<I>& w2, int axis) noexcept {
-  auto coord = [](const Vec<I>& v, int k) -> const I& { return k == 0 ? v.x : k == 1 ? v.y : v.z; };
-  const int i = (axis + 1) % 3;
-  const int j = (axis + 2) % 3;
-  auto cross = [&](const Vec<I>& a, const Vec<I>& b) {
-    return coord(a, i) * coord(b, j) - coord(a, j) * coord(b, i);
-  };
-  return {{cross(w1.v[0], w2.v[0]), cross(w1.v[0], w2.v[1]) + cross(w1.v[1], w2.v[0]),
-           cross(w1.v[1], w2.v[1])}};
-}
-
-/// (w1 x w2) . w3 (degree 3), with n = w1 x w2.
-template <class I>
-Sums<I, 3> trilinear(const CrossSums<I>& n, const Slot<I>& w3) noexcept {
-  return {{dot(n.c[0], w3.v[0]), dot(n.c[0], w3.v[1]) + dot(n.c[1], w3.v[0]),
-           dot(n.c[1], w3.v[1]) + dot(n.c[2], w3.v[0]), dot(n.c[2], w3.v[1])}};
-}
-
-/// (w1 x w2) . (w3 x w4) (degree 4), with l = w1 x w2 and r = w3 x w4.
-template <class I>
-Sums<I, 4> quadrilinear(const CrossSums<I>& l, const CrossSums<I>& r) noexcept {
-  return {{dot(l.c[0], r.c[0]), dot(l.c[0], r.c[1]) + dot(l.c[1], r.c[0]),
-           dot(l.c[0], r.c[2]) + dot(l.c[1], r.c[1]) + dot(l.c[2], r.c[0]),
-           dot(l.c[1], r.c[2]) + dot(l.c[2], r.c[1]), dot(l.c[2], r.c[2])}};
-}
-
-/// range_of(quadrilinear(l, r)).hi < 0 (the same sums, each proven negative), the end sums
-/// (the form's values at the interval ends) first: where they are not negative, as on most
-/// calls, the three middle sums are not computed.
-template <class I>
-bool quadrilinear_negative(const CrossSums<I>& l, const CrossSums<I>& r) noexcept {
-  if (!(upper(dot(l.c[0], r.c[0])) < 0.0) || !(upper(dot(l.c[2], r.c[2])) < 0.0)) return false;
-  return upper(dot(l.c[0], r.c[1]) + dot(l.c[1], r.c[0])) < 0.0 &&
-         upper(dot(l.c[0], r.c[2]) + dot(l.c[1], r.c[1]) + dot(l.c[2], r.c[0])) < 0.0 &&
-         upper(dot(l.c[1], r.c[2]) + dot(l.c[2], r.c[1])) < 0.0;
-}
-
-/// Mid value of an enclosure, as a double.
-inline double mid(Iv a) noexcept {
-  return a.m;
-}
-inline double mid(Dd a) noexcept {
-  return a.hi + a.lo;
-}
-
-/// True when two of the three polynomials are proven of strictly opposite signs on the whole
-/// interval.
-template <class I>
-bool opposite_signs(const Sums<I, 2>& o1, const Sums<I, 2>& o2, const Sums<I, 2>& o3) noexcept {
-  const Range r[3] = {range_of(o1), range_of(o2), range_of(o3)};
-  bool positive = false, negative = false;
-  for (const Range& x : r) {
-    positive = positive || x.lo > 0.0;
-    negative = negative || x.hi < 0.0;
-  }
-  return positive && negative;
-}
-
-/// True when e + lambda f < 0 on the whole interval for some lambda (e: an inside condition
-/// of degree 4, f: the coplanarity cubic), so that e < 0 wherever f = 0. With Bernstein sums,
-/// degree elevation of f is exact: the sums of e + lambda f are E_k + lambda (F_{k-1} + F_k).
-/// lambda cancels the change of e across the interval against that of f (any value is valid).
-template <class I>
-bool negative_where_coplanar(const Sums<I, 4>& e, const Sums<I, 3>& f) noexcept {
-  const double df = mid(f.s[3]) - mid(f.s[0]);
-  const double lambda = -(mid(e.s[4]) - mid(e.s[0])) / df;
-  if (!std::isfinite(lambda)) return false;
-  const I l = make<I>(lambda);
-  for (int k = 0; k <= 4; ++k) {
-    I g = e.s[k];
-    if (k >= 1) g = g + l * f.s[k - 1];
-    if (k <= 3) g = g + l * f.s[k];
-    if (!(upper(g) < 0.0)) return false;
-  }
-  return true;
-}
-
-/// Upper bound of |w|^2 over the interval.
-template <class I>
-double norm2_upper(const Slot<I>& w) noexcept {
-  const IvVec h = hull(w.v[0], w.v[1]);
-  return upper(dot(h, h));
-}
-
-/// Upper bound of |w1 x w2|^2 over the interval.
-template <class I>
-double cross_norm2_upper(const Slot<I>& w1, const Slot<I>& w2) noexcept {
-  const IvVec n = cross(hull(w1.v[0], w1.v[1]), hull(w2.v[0], w2.v[1]));
-  return upper(dot(n, n));
-}
-
-/// Minimum separation and its square (rounded up).
-struct Separation {
-  double delta = 0.0;
-  double delta2 = 0.0;
-  explicit Separation(double d) noexcept {
-    if (d > 0.0) {  // NaN and negative values mean 0; +inf reports everything
-      delta = d;
-      delta2 = mul_up(d, d);
-    }
-  }
-  bool zero() const noexcept { return delta == 0.0; }
-};
-
-/// True when the function is provably < 0 on the interval and, with a separation, its
-/// square > delta2 * scale2_hi (the signed distance it measures is below -delta).
-/// `raw` are the Bernstein sums (sign only); the value range is computed only when needed.
-template <class I, int N>
-bool below_minus_delta(const Sums<I, N>& raw, const Separation& s, double scale2_hi) noexcept {
-  if (s.zero()) return range_of(raw).hi < 0.0;
-  const Range r = value_range(raw);
-  return r.hi < 0.0 && mul_down(r.hi, r.hi) > mul_up(s.delta2, scale2_hi);
-}
-
-/// True when an inside condition g (degree 4) excludes the interval: g below -delta, or (exact
-/// contact) g plus a multiple of the coplanarity cubic f negative, so g < 0 wherever f = 0.
-/// Tested per condition, right after it is computed: the earliest exclusion skips the rest.
-template <class I>
-bool outside(const Sums<I, 4>& g, const Sums<I, 3>& f, const Separation& s,
-             double scale2_hi) noexcept {
-  return below_minus_delta(g, s, scale2_hi) || (s.zero() && negative_where_coplanar(g, f));
-}
-
-/// True when the function is provably > 0 on the interval (beyond delta * sqrt(scale2)).
-template <class I, int N>
-bool above_delta(const Sums<I, N>& raw, const Separation& s, double scale2_hi) noexcept {
-  if (s.zero()) return range_of(raw).lo > 0.0;
-  const Range r = value_range(raw);
-  return r.lo > 0.0 && mul_down(r.lo, r.lo) > mul_up(s.delta2, scale2_hi);
-}
-
-/// True when |function| > delta * sqrt(scale2) on the whole interval (one sign).
-template <class I, int N>
-bool away_from_zero(const Sums<I, N>& raw, const Separation& s, double scale2_hi) noexcept {
-  return above_delta(raw, s, scale2_hi) || below_minus_delta(raw, s, scale2_hi);
-}
-
-/// True when the boxes of two groups of moving points over the interval (rigorous bounds of
-/// the points at both interval ends; linear motion keeps them inside) are more than delta
-/// apart along one axis.
-template <class I>
-bool boxes_disjoint(const Vec<I> (*first)[2], int first_count, const Vec<I> (*second)[2],
-                    int second_count, const Separation& s) noexcept {
-  for (int axis = 0; axis < 3; ++axis) {
-    auto coord = [axis](const Vec<I>& v) -> I { return axis == 0 ? v.x : axis == 1 ? v.y : v.z; };
-    double a_lo = INFINITY;
-    double a_hi = -INFINITY;
-    double b_lo = INFINITY;
-    double b_hi = -INFINITY;
-    for (int k = 0; k < first_count; ++k) {
-      for (int e = 0; e < 2; ++e) {
-        a_lo = min_nan(a_lo, lower(coord(first[k][e])));
-        a_hi = max_nan(a_hi, upper(coord(first[k][e])));
-      }
-    }
-    for (int k = 0; k < second_count; ++k) {
-      for (int e = 0; e < 2; ++e) {
-        b_lo = min_nan(b_lo, lower(coord(second[k][e])));
-        b_hi = max_nan(b_hi, upper(coord(second[k][e])));
-      }
-    }
-    // Gaps rounded down; a NaN gap compares false and proves nothing.
-    const double gap1 = b_lo - a_hi;
-    const double gap2 = a_lo - b_hi;
-    if (gap1 - (std::fabs(gap1) * kRel + kTiny) > s.delta) return true;
-    if (gap2 - (std::fabs(gap2) * kRel + kTiny) > s.delta) return true;
-  }
-  return false;
-}
 
 bool all_finite(const Vec3d* const* points, int count) noexcept {
   for (int i = 0; i < count; ++i)
@@ -312,68 +66,6 @@ bool all_finite(const Vec3d* const* points, int count) noexcept {
 /// crossing is isolated first; the inside conditions are then tested once, near it).
 enum class Depth { kFilter, kFull, kCoplanarOnly, kOpenCondition, kCubicFirst };
 
-/// Outcome of one interval: excluded, or open (with `inside` when every inside condition is
-/// proven strictly positive on it, so that its sub-intervals need only kCoplanarOnly).
-/// Exact contact only, a positive certificate: `certified` when a contact certainly exists in
-/// the interval, `contact_at_start` when its start is a contact time.
-struct IntervalOutcome {
-  bool excluded = false;
-  bool inside = false;
-  bool certified = false;
-  bool contact_at_start = false;
-  /// Certified in the plane with one inside condition open: on sub-intervals, contact happens
-  /// exactly where that condition is >= 0 (the others are proven positive).
-  bool open_condition = false;
-};
-
-/// True when every Bernstein sum is proven strictly positive (the polynomial > 0 on T).
-template <class I, int N>
-bool positive(const Sums<I, N>& raw) noexcept {
-  return range_of(raw).lo > 0.0;
-}
-
-/// True when the polynomial is proven to take both signs on T: its values at the ends (the
-/// first and last Bernstein sums) are of strictly opposite signs, so it has a root in T.
-template <class I, int N>
-bool sign_change(const Sums<I, N>& raw) noexcept {
-  return (upper(raw.s[0]) < 0.0 && lower(raw.s[N]) > 0.0) ||
-         (lower(raw.s[0]) > 0.0 && upper(raw.s[N]) < 0.0);
-}
-
-/// Positive certificate of an open interval (exact contact), from the coplanarity cubic f and
-/// the inside conditions g[0..count) (vertex-face: the three edge-plane quartics; edge-edge:
-/// h1..h4), whose joint non-negativity on the plane of the four points means contact (with
-/// the triangle non-degenerate, the edges not parallel: implied below by a proven-positive
-/// condition, as A e_ab = ... and h1 + h2 = h3 + h4 = |n|^2). `in_plane`: the four points stay
-/// in one plane for the whole step (f vanishes identically).
-///  - every condition proven positive on T and f changing sign on T: contact at f's root;
-///  - in the plane, every condition positive on T: every time of T is a contact (its start);
-///  - in the plane, all conditions but one positive on T and that one positive at an end of
-///    T: contact at that end (and `open_condition`, its sums copied to *open_condition).
-template <class I, int N>
-IntervalOutcome certify(const Sums<I, 3>& f, const Sums<I, 4>* const* conditions, bool in_plane,
-                        bool inside, Sums<I, 4>* open_condition) noexcept {
-  IntervalOutcome out{false, inside, false, false};
-  if (inside) {
-    out.contact_at_start = in_plane;
-    out.certified = in_plane || sign_change(f);
-    return out;
-  }
-  if (!in_plane) return out;
-  int open = -1;
-  for (int k = 0; k < N; ++k) {
-    if (positive(*conditions[k])) continue;
-    if (open >= 0) return out;
-    open = k;
-  }
-  const Sums<I, 4>& g = *conditions[open];
-  out.contact_at_start = lower(g.s[0]) > 0.0;
-  out.certified = out.contact_at_start || lower(g.s[4]) > 0.0;
-  out.open_condition = out.certified;
-  if (out.certified && open_condition != nullptr) *open_condition = g;
-  return out;
-}
-
 /// The four points of a query at the ends of the time interval [ta, tb]: x[i][0] at ta,
 /// x[i][1] at tb.
 template <class I>
@@ -393,9 +85,11 @@ struct VertexFaceTest {
   /// The axis orthogonal to a plane the four points stay in for the whole step, or -1.
   int plane_axis = axis_plane(x0, x1);
 
+  /// `leaf` > 0 (exact contact, doubles): a crossing of the coplanarity cubic goes to its
+  /// root's leaf of that width (crossing_leaf) before the inside conditions are computed.
   template <class I>
   IntervalOutcome check(double ta, double tb, Depth depth, Sums<I, 3>* coplanarity = nullptr,
-                        Sums<I, 4>* open_condition = nullptr) const noexcept {
+                        Sums<I, 4>* open_condition = nullptr, double leaf = 0.0) const noexcept {
     Vec<I> x[4][2];
     positions_at<I>(x0, x1, ta, tb, x);
     if (boxes_disjoint<I>(x, 1, x + 1, 3, sep)) return {true, false};
@@ -409,6 +103,12 @@ struct VertexFaceTest {
     if (coplanarity != nullptr) *coplanarity = f;
     if (away_from_zero(f, sep, n2)) return {true, false};
     if (depth != Depth::kFull) return {false, depth == Depth::kCoplanarOnly};
+    if constexpr (std::is_same_v<I, Iv>) {
+      if (leaf > 0.0) {
+        const IntervalOutcome jump = crossing_leaf(f, ta, tb, leaf);
+        if (jump.to_leaf) return jump;
+      }
+    }
 
     const Slot<I> cb = difference(x[3], x[2]);
     const Slot<I> pb = difference(x[0], x[2]);
@@ -455,9 +155,11 @@ struct EdgeEdgeTest {
   /// The axis orthogonal to a plane the four points stay in for the whole step, or -1.
   int plane_axis = axis_plane(x0, x1);
 
+  /// `leaf` > 0 (exact contact, doubles): a crossing of the coplanarity cubic goes to its
+  /// root's leaf of that width (crossing_leaf) before the inside conditions are computed.
   template <class I>
   IntervalOutcome check(double ta, double tb, Depth depth, Sums<I, 3>* coplanarity = nullptr,
-                        Sums<I, 4>* open_condition = nullptr) const noexcept {
+                        Sums<I, 4>* open_condition = nullptr, double leaf = 0.0) const noexcept {
     Vec<I> x[4][2];
     positions_at<I>(x0, x1, ta, tb, x);
     if (boxes_disjoint<I>(x, 2, x + 2, 2, sep)) return {true, false};
@@ -471,6 +173,12 @@ struct EdgeEdgeTest {
     if (coplanarity != nullptr) *coplanarity = f;
     if (away_from_zero(f, sep, n2)) return {true, false};
     if (depth != Depth::kFull) return {false, depth == Depth::kCoplanarOnly};
+    if constexpr (std::is_same_v<I, Iv>) {
+      if (leaf > 0.0) {
+        const IntervalOutcome jump = crossing_leaf(f, ta, tb, leaf);
+        if (jump.to_leaf) return jump;
+      }
+    }
 
     // Planes through one edge containing the common normal n = (b-a) x (d-c): the other edge
     // strictly beyond one of them (by delta) cannot touch. With N = |n|^2:
@@ -571,65 +279,6 @@ double clamp_tolerance(double tol) noexcept {
   return min_nan(tol, 1.0);
 }
 
-/// Bernstein coefficients of a polynomial of degree 3 or 4 on an interval (the coplanarity
-/// cubic, or an inside condition), from its enclosed sums: the midpoints with the largest
-/// radius as error bound.
-template <int N>
-FloatBernstein float_bernstein(const Sums<Iv, N>& sums) noexcept {
-  static_assert(N == 3 || N == 4, "degrees 3 and 4");
-  constexpr double kBinomial[2][5] = {{1, 3, 3, 1, 0}, {1, 4, 6, 4, 1}};
-  FloatBernstein p{{}, N, 0.0};
-  for (int k = 0; k <= N; ++k) {
-    const Iv b = (k == 0 || k == N) ? sums.s[k] : divide(sums.s[k], kBinomial[N - 3][k]);
-    p.c[k] = b.m;
-    p.err = max_nan(p.err, b.r);
-  }
-  return p;
-}
-
-/// True when the coplanarity cubic f, known to vanish at t = 1, is proven nonzero on [0, 1).
-/// f = (1 - t) g with g quadratic; g's Bernstein coefficients on [0, 1] are f's sums
-/// s0, s1 / 2, s2 (from (1 - t) B_i^2 = C(2,i) / C(3,i) B_i^3), so one strict sign of those three
-/// sums makes g, hence f before t = 1, of one sign.
-bool nonzero_before_end(const Sums<Iv, 3>& f) noexcept {
-  const Sums<Iv, 2> g{{f.s[0], f.s[1], f.s[2]}};
-  const Range r = range_of(g);
-  return r.lo > 0.0 || r.hi < 0.0;
-}
-
-/// The same when f vanishes at t = 0: f = t g, g's coefficients are s1, s2 / 2, s3.
-bool nonzero_after_start(const Sums<Iv, 3>& f) noexcept {
-  const Sums<Iv, 2> g{{f.s[1], f.s[2], f.s[3]}};
-  const Range r = range_of(g);
-  return r.lo > 0.0 || r.hi < 0.0;
-}
-
-/// Time of impact for a crossing certified on [ta, tb] (exact contact: the inside proven on
-/// it, so contact happens exactly where the coplanarity cubic p vanishes; or in a plane, where
-/// the open inside condition p is >= 0, p negative at ta; p of opposite signs at the ends): a
-/// time t, about tol / 2 before p's first root, such that p is proven nonzero on [ta, t] (its
-/// coefficients there, from one de Casteljau step at the estimated root, are of one sign), rounded
-/// down. Everything before ta being contact-free, t is a lower bound of the first contact. -1 when
-/// the proof fails (then the caller bisects).
-double certified_crossing_time(const FloatBernstein& p, double ta, double tb, double tol) noexcept {
-  const double width = tb - ta;
-  const double local_tol = tol / width;
-  const double lambda = root_estimate(p, 0.25 * local_tol) - 0.5 * local_tol;
-  if (!(lambda > 0.0)) return ta;  // the root is within tol of ta
-  const FloatBernstein left = left_part(p, lambda);
-  if (!proven_positive(left) && !proven_negative(left)) return -1.0;
-  const double t = ta + lambda * width;  // two roundings: 2^-51 |t| covers them
-  return max_nan(ta, t - std::fabs(t) * 0x1p-51);
-}
-
-/// Start of the last leaf of the bisection of [0, 1] down to the tolerance: 1 - 2^-k with
-/// 2^-k the first halving not above tol.
-double last_leaf_start(double tol) noexcept {
-  double width = 1.0;
-  while (width > tol) width *= 0.5;
-  return 1.0 - width;
-}
-
 struct Item {
   double ta, tb;
   /// kFull, or kCoplanarOnly inside an interval with the inside proven. Exact contact only:
@@ -722,14 +371,31 @@ CcdResult run_bisection(const Test& test, const CcdOptions& options) noexcept {
                (proven_positive(item.poly) || proven_negative(item.poly))) {
       outcome.excluded = true;
     } else if (item.depth == Depth::kCubicFirst && !leaf && proven_sign_change(item.poly)) {
+      // The leaf holding the cubic's only root, checked in full as the bisection would
+      // (everything else in [ta, tb] is proven contact-free); else one halving.
+      double lo = 0.0, hi = 0.0;
+      if (root_leaf(item.poly, item.ta, item.tb, leaf_width(item.tb - item.ta, tol), lo, hi)) {
+        ++result.intervals;  // the rest of [ta, tb], excluded
+        stack[top++] = {lo, hi, Depth::kFull, {}};
+        continue;
+      }
       FloatBernstein left{}, right{};
       split_half(item.poly, left, right);
       stack[top++] = {tm, item.tb, Depth::kCubicFirst, right};
       stack[top++] = {item.ta, tm, Depth::kCubicFirst, left};
       continue;
     } else {
-      outcome = test.template check<Iv>(item.ta, item.tb, depth, &f, &open);
+      // The whole step first (exact contact): a crossing goes straight to its root's leaf.
+      const double jump_width = exact_contact && !start_tested ? leaf_width(1.0, tol) : 0.0;
+      outcome = test.template check<Iv>(item.ta, item.tb, depth, &f, &open, jump_width);
       checked = true;
+    }
+    if (outcome.to_leaf) {
+      // The cubic is proven nonzero at t = 0 (it changes sign on [0, 1]): no contact there.
+      start_tested = true;
+      certified = contact_at_end;
+      stack[top++] = {outcome.leaf_lo, outcome.leaf_hi, Depth::kFull, {}};
+      continue;
     }
     if (outcome.excluded) continue;
     if (near_degenerate && !certified && test.template check<Dd>(item.ta, item.tb, depth).excluded)

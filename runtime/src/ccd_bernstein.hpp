@@ -80,6 +80,21 @@ inline FloatBernstein left_part(const FloatBernstein& p, double lambda,
   return left;
 }
 
+/// The coefficients on the right part [lambda, 1] (local parameter), with their error bound:
+/// left_part of the reversed polynomial at 1 - lambda, reversed (the same bound). `lambda` must
+/// make 1 - lambda exact (a dyadic grid point, as every caller's); `bound_scale` as for
+/// split_half.
+inline FloatBernstein right_part(const FloatBernstein& p, double lambda,
+                                 double bound_scale = 1.0) noexcept {
+  const int n = p.degree;
+  FloatBernstein reversed{{}, n, p.err};
+  for (int i = 0; i <= n; ++i) reversed.c[i] = p.c[n - i];
+  const FloatBernstein part = left_part(reversed, 1.0 - lambda, bound_scale);
+  FloatBernstein right{{}, n, part.err};
+  for (int i = 0; i <= n; ++i) right.c[i] = part.c[n - i];
+  return right;
+}
+
 /// Estimate (not a proof) of the first root of the polynomial's midpoint coefficients in
 /// [0, 1], when their end values have opposite signs: regula falsi (Illinois) on the power
 /// form, stopped when the bracket is narrower than `width`. Returns the bracket's left end.

@@ -102,6 +102,10 @@ void Collider::Impl::construct(std::shared_ptr<const BodyShape> sh, const Collid
   // The whole-surface BVH's parallel traversal: 16 items per thread, with room for the
   // items expanded on the way (traverse_global_parallel).
   if (threads > 1) frontier.reserve(64 * threads + 4);
+  // The cluster traversal's queue (traverse_clusters_parallel): every cluster and pair of
+  // clusters, and room for the hand-overs.
+  if (threads > 1)
+    wide_frontier.resize(std::size_t(cluster_count()) * (cluster_count() + 1) / 2 + 64 * threads);
   const bool plane_cache = opt.mode != ColliderMode::kBrute && opt.ccd.min_separation <= 0;
   for (Worker& w : workers) {
     w.stack.resize(stack_size);

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <chrono>
 #include <cstddef>
 #include <cstdint>
@@ -112,6 +113,27 @@ struct alignas(64) WideStep {
 struct StackItem {
   std::uint32_t a;
   std::uint32_t b;  // kNone: self item of node a
+};
+
+/// An item of the 4-wide cluster BVHs with the rules of the traversal it belongs to
+/// (traverse_wide's `orient` and `seam`).
+struct WideTask {
+  StackItem item;
+  bool orient;
+  bool seam;
+};
+
+/// The cluster traversal's shared queue on the OpenMP workers (traverse_clusters_parallel):
+/// items[0, count) wait, `running` are being traversed; a worker that finds the queue empty
+/// while others run sets `hungry`, and a running traversal then moves the oldest half of its
+/// stack (the largest subtrees left) into the queue. Changed only inside the critical section
+/// tetseg_wide_queue; the atomics are read outside it as hints.
+struct WideQueue {
+  WideTask* items = nullptr;
+  std::size_t capacity = 0;
+  std::atomic<std::size_t> count{0};
+  std::atomic<std::size_t> running{0};
+  std::atomic<bool> hungry{false};
 };
 
 /// Bottom-up refit of one BVH (children after parents, so reverse order is bottom-up): node
@@ -379,6 +401,10 @@ struct Collider::Impl {
   // Items of the whole-surface BVH handed to the workers (traverse_global_parallel; capacity
   // reserved at construction when there are several workers).
   std::vector<StackItem> frontier;
+  // The same for the cluster BVHs (traverse_clusters_parallel's queue): every cluster's own
+  // item and every live pair of clusters, then items handed over on the way (sized at
+  // construction when there are several workers, empty otherwise).
+  std::vector<WideTask> wide_frontier;
   // Contact closure scratch (capacity tri_count, reserved at construction).
   std::vector<std::uint32_t> closure_ring;
   std::vector<std::uint8_t> closure_mark;
@@ -455,6 +481,11 @@ struct Collider::Impl {
   /// is expanded breadth first on worker 0 into `frontier`, whose items the workers then
   /// traverse (each item once, so counts and contacts are the serial ones).
   bool traverse_global_parallel() noexcept;
+  /// The cluster traversal (rvbc) on the OpenMP workers, split below whole clusters: each
+  /// cluster's own item and each live pair of clusters queued in `wide_frontier`, and
+  /// subtrees handed over from running traversals to idle workers (WideQueue). Each item is
+  /// traversed once: counts and contacts are the serial ones.
+  bool traverse_clusters_parallel(bool count_skips) noexcept;
   bool non_culled(std::uint32_t t1, std::uint32_t t2) const noexcept;
   /// A pair of two clusters sharing a node that non_culled accepted before the seam rule (both
   /// not still, boxes overlapping): culled only by that rule (rvbc, not the rest check).
@@ -463,8 +494,11 @@ struct Collider::Impl {
   /// process_triangle_pair of a pair known to be non-culled (not in the rest check).
   void process_non_culled_pair(Worker& w, std::uint32_t t1, std::uint32_t t2) const noexcept;
   /// Traversal of the 4-wide cluster BVHs from `first` (a self item {node, kNone} or a pair of
-  /// child slots); `orient`: cull by the sign bits (within one cluster). False on overflow.
-  bool traverse_wide(Worker& w, StackItem first, bool orient) const noexcept;
+  /// child slots); `orient`: cull by the sign bits (within one cluster); `seam`: a pair of
+  /// clusters' items (pairs sharing a node culled). With `queue` (parallel traversal), items
+  /// of the stack are handed to the queue when a worker is hungry. False on overflow.
+  bool traverse_wide(Worker& w, StackItem first, bool orient, bool seam,
+                     WideQueue* queue = nullptr) const noexcept;
   /// Refits the 4-wide cluster BVHs from tbox / tmov (wstep boxes and moving bits, wbox, wmov).
   void refit_wide() noexcept;
   /// Sign bits of triangle t from its class tcls[t] (class_sign_bits).

@@ -158,6 +158,22 @@ bool face_off_vertex_planes(Worker& w, const Collider::Impl& P, std::uint32_t p,
   return false;
 }
 
+// The elementary test `ccd` (a call returning its CcdResult), timed when the options ask, and
+// its contact recorded: `c` names the features (kind, bodies, nodes, triangle); the outcome
+// sets its time.
+template <class Ccd>
+void test_and_record(Worker& w, const ColliderOptions& opt, Ccd&& ccd, Contact c) noexcept {
+  ++w.stats.feature_tests;
+  Clock::time_point t0;
+  if (opt.time_tests) t0 = Clock::now();
+  const CcdResult r = ccd();
+  if (opt.time_tests) w.tests_seconds += std::chrono::duration<double>(Clock::now() - t0).count();
+  if (!r.hit()) return;
+  c.at_start = r.outcome == CcdOutcome::kContactAtStart;
+  c.toi = c.at_start ? 0.0 : r.toi;
+  w.record(c);
+}
+
 }  // namespace
 
 void process_vertex_face(Worker& w, const Collider::Impl& P, std::uint32_t p,
@@ -180,22 +196,19 @@ void process_vertex_face(Worker& w, const Collider::Impl& P, std::uint32_t p,
       return;
     }
   }
-  ++w.stats.feature_tests;
-  Clock::time_point t0;
-  if (opt.time_tests) t0 = Clock::now();
-  const CcdResult r =
-      vertex_face_ccd(v3(P.pos0(p)), v3(F.pos0(f[0])), v3(F.pos0(f[1])), v3(F.pos0(f[2])),
-                      v3(P.pos1(p)), v3(F.pos1(f[0])), v3(F.pos1(f[1])), v3(F.pos1(f[2])), opt.ccd);
-  if (opt.time_tests) w.tests_seconds += std::chrono::duration<double>(Clock::now() - t0).count();
-  if (!r.hit()) return;
   Contact c;
   c.kind = ContactKind::kVertexFace;
   c.bodies = {P.body_id, F.body_id};
   c.nodes = {p, f[0], f[1], f[2]};
   c.triangle = face;
-  c.at_start = r.outcome == CcdOutcome::kContactAtStart;
-  c.toi = c.at_start ? 0.0 : r.toi;
-  w.record(c);
+  test_and_record(
+      w, opt,
+      [&] {
+        return vertex_face_ccd(v3(P.pos0(p)), v3(F.pos0(f[0])), v3(F.pos0(f[1])), v3(F.pos0(f[2])),
+                               v3(P.pos1(p)), v3(F.pos1(f[0])), v3(F.pos1(f[1])), v3(F.pos1(f[2])),
+                               opt.ccd);
+      },
+      c);
 }
 
 void process_edge_edge(Worker& w, const Collider::Impl& A, std::uint32_t e1,
@@ -230,23 +243,19 @@ void process_edge_edge(Worker& w, const Collider::Impl& A, std::uint32_t e1, Box
       return;
     }
   }
-  ++w.stats.feature_tests;
-  Clock::time_point t0;
-  if (opt.time_tests) t0 = Clock::now();
-  const CcdResult r =
-      edge_edge_ccd(v3(A.pos0(a)), v3(A.pos0(b)), v3(B.pos0(c)), v3(B.pos0(d)), v3(A.pos1(a)),
-                    v3(A.pos1(b)), v3(B.pos1(c)), v3(B.pos1(d)), opt.ccd);
-  if (opt.time_tests) w.tests_seconds += std::chrono::duration<double>(Clock::now() - t0).count();
-  if (!r.hit()) return;
   Contact k;
   k.kind = ContactKind::kEdgeEdge;
   k.bodies = {A.body_id, B.body_id};
   // Edges sorted (a<b, c<d); within one body e1 < e2 in sorted edge order.
   k.nodes = {a, b, c, d};
   k.triangle = 0;
-  k.at_start = r.outcome == CcdOutcome::kContactAtStart;
-  k.toi = k.at_start ? 0.0 : r.toi;
-  w.record(k);
+  test_and_record(
+      w, opt,
+      [&] {
+        return edge_edge_ccd(v3(A.pos0(a)), v3(A.pos0(b)), v3(B.pos0(c)), v3(B.pos0(d)),
+                             v3(A.pos1(a)), v3(A.pos1(b)), v3(B.pos1(c)), v3(B.pos1(d)), opt.ccd);
+      },
+      k);
 }
 
 // Triangle-pair plane filter of triangle t1 of A and t2 of B (plane_filter.hpp; exact

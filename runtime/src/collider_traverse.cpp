@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <thread>
 
 #include "collider_impl.hpp"
 #include "plane_filter.hpp"
@@ -442,25 +443,100 @@ void Collider::Impl::brute_edge_edges(Worker& w, std::uint32_t i) const noexcept
   }
 }
 
-bool Collider::Impl::cluster_tasks(Worker& w, std::uint32_t c1, bool count_skips) const noexcept {
-  const std::uint32_t nc = cluster_count();
-  const std::uint32_t r1 = topo->wide_root[c1];
+namespace {
+
+// The items of cluster c1 of `body` (cluster_tasks' work), each to `task` (a WideTask; false
+// stops): its own item unless still or of one sign (then counted as skipped in w), then its
+// live pairs with the later clusters.
+template <typename Task>
+bool cluster_items(const Collider::Impl& body, Worker& w, std::uint32_t c1, bool count_skips,
+                   Task&& task) noexcept {
+  const std::uint32_t nc = body.cluster_count();
+  const std::uint32_t r1 = body.topo->wide_root[c1];
   if (r1 == kWideEmpty) return true;
-  const bool orient = orientation_mode();
-  const bool still = !rest_mode && wmov[r1] == 0;
-  if (still || (orient && wsign[r1] != 0)) {
+  const bool orient = body.orientation_mode();
+  const bool still = !body.rest_mode && body.wmov[r1] == 0;
+  if (still || (orient && body.wsign[r1] != 0)) {
     if (count_skips) ++w.stats.clusters_skipped;
-  } else if (!traverse_wide(w, {r1, kNone}, orient)) {
+  } else if (!task(WideTask{{r1, kNone}, orient, false})) {
     return false;
   }
   for (std::uint32_t c2 = c1 + 1; c2 < nc && !w.stop; ++c2) {
-    const std::uint32_t r2 = topo->wide_root[c2];
+    const std::uint32_t r2 = body.topo->wide_root[c2];
     if (r2 == kWideEmpty) continue;
-    if (!rest_mode && wmov[r1] == 0 && wmov[r2] == 0) continue;
-    if (!boxes_overlap(wbox[r1], wbox[r2], opt.ccd.min_separation)) continue;
-    if (!traverse_wide(w, {r1, r2}, false)) return false;
+    if (!body.rest_mode && body.wmov[r1] == 0 && body.wmov[r2] == 0) continue;
+    if (!boxes_overlap(body.wbox[r1], body.wbox[r2], body.opt.ccd.min_separation)) continue;
+    if (!task(WideTask{{r1, r2}, false, true})) return false;
   }
   return true;
+}
+
+}  // namespace
+
+bool Collider::Impl::traverse_clusters_parallel(bool count_skips) noexcept {
+  Worker& w0 = workers[0];
+  // The items of cluster_tasks, in its order (wide_frontier is sized at construction for all
+  // of them and the hand-overs).
+  std::size_t queued = 0;
+  for (std::uint32_t c = 0; c < cluster_count(); ++c)
+    cluster_items(*this, w0, c, count_skips, [&](const WideTask& task) {
+      wide_frontier[queued++] = task;
+      return true;
+    });
+  // The workers take items from the queue's end; an idle one waits for a hand-over while
+  // others run, and all are done when nothing waits and nothing runs.
+  WideQueue queue;
+  queue.items = wide_frontier.data();
+  queue.capacity = wide_frontier.size();
+  queue.count.store(queued, std::memory_order_relaxed);
+  bool overflow = false;
+#if defined(TETSEG_HAVE_OPENMP)
+#pragma omp parallel num_threads(static_cast <int>(workers.size())) reduction(|| : overflow)
+  {
+    Worker& w = workers[static_cast<std::size_t>(omp_get_thread_num())];
+    if (omp_get_thread_num() == 0)
+      stats.traversal_threads = static_cast<std::uint32_t>(omp_get_num_threads());
+    for (;;) {
+      WideTask task{};
+      bool have = false, done = false;
+#pragma omp critical(tetseg_wide_queue)
+      {
+        const std::size_t count = queue.count.load(std::memory_order_relaxed);
+        if (count > 0) {
+          task = queue.items[count - 1];
+          queue.count.store(count - 1, std::memory_order_relaxed);
+          queue.running.fetch_add(1, std::memory_order_relaxed);
+          have = true;
+        } else if (queue.running.load(std::memory_order_relaxed) == 0) {
+          done = true;
+        } else {
+          queue.hungry.store(true, std::memory_order_relaxed);
+        }
+      }
+      if (done) break;
+      if (!have) {
+        std::this_thread::yield();
+        continue;
+      }
+      if (!w.stop && !w.overflow && !traverse_wide(w, task.item, task.orient, task.seam, &queue))
+        w.overflow = overflow = true;
+#pragma omp critical(tetseg_wide_queue)
+      queue.running.fetch_sub(1, std::memory_order_relaxed);
+    }
+  }
+#else
+  for (std::size_t i = 0; i < queued && !w0.stop; ++i) {
+    const WideTask& task = wide_frontier[i];
+    if (!traverse_wide(w0, task.item, task.orient, task.seam)) overflow = true;
+  }
+#endif
+  return !overflow;
+}
+
+bool Collider::Impl::cluster_tasks(Worker& w, std::uint32_t c1, bool count_skips) const noexcept {
+  return cluster_items(*this, w, c1, count_skips, [&](const WideTask& task) {
+    return traverse_wide(w, task.item, task.orient, task.seam);
+  });
 }
 
 bool Collider::Impl::run_query(ContactSink* sink) noexcept {
@@ -472,8 +548,9 @@ bool Collider::Impl::run_query(ContactSink* sink) noexcept {
   }
   Worker& w0 = workers[0];
   const bool count_skips = !stats.full_traversal && qkind == QueryKind::kFull && !rest_mode;
-  // Parallel traversal: OpenMP threads take whole tasks (a cluster with its pairs, a subtree
-  // of the whole-surface BVH, a brute force vertex or edge); merged in worker order, so counts
+  // Parallel traversal: OpenMP threads take tasks (an item of the cluster BVHs, handed over
+  // below whole clusters when a thread is idle; a subtree of the whole-surface BVH; a brute
+  // force vertex or edge), each traversed once; merged in worker order, so counts
   // and the earliest contact equal the serial ones, and a buffer keeps the smallest contacts
   // whoever finds them (ContactSink).
   const bool parallel = workers.size() > 1 && !rest_mode;
@@ -515,22 +592,9 @@ bool Collider::Impl::run_query(ContactSink* sink) noexcept {
           brute_edge_edges(w0, static_cast<std::uint32_t>(i));
       }
     } else {
-#if defined(TETSEG_HAVE_OPENMP)
-      if (parallel) {
-#pragma omp parallel num_threads(static_cast <int>(workers.size()))
-        {
-          Worker& w = workers[static_cast<std::size_t>(omp_get_thread_num())];
-          if (omp_get_thread_num() == 0)
-            stats.traversal_threads = static_cast<std::uint32_t>(omp_get_num_threads());
-#pragma omp for schedule(dynamic, 1)
-          for (std::int64_t c = 0; c < static_cast<std::int64_t>(nc); ++c)
-            if (!w.stop && !w.overflow &&
-                !cluster_tasks(w, static_cast<std::uint32_t>(c), count_skips))
-              w.overflow = true;
-        }
-      } else
-#endif
-      {
+      if (parallel && !wide_frontier.empty()) {
+        if (!traverse_clusters_parallel(count_skips)) w0.overflow = true;
+      } else {
         for (std::uint32_t c = 0; c < nc && !w0.stop; ++c) {
           if (!cluster_tasks(w0, c, count_skips)) {
             w0.overflow = true;

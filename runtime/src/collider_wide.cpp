@@ -50,6 +50,25 @@ inline Box slot_box(const WideStep& s, int k) noexcept {
   return {{s.lo[0][k], s.lo[1][k], s.lo[2][k]}, {s.hi[0][k], s.hi[1][k], s.hi[2][k]}};
 }
 
+// Moves the oldest half of stack[0, top) (the shallowest items: the largest subtrees left)
+// into the queue for a hungry worker, as far as the queue has room; returns the new top.
+std::size_t hand_over(WideQueue& q, StackItem* stack, std::size_t top, bool orient,
+                      bool seam) noexcept {
+  std::size_t moved = 0;
+#if defined(TETSEG_HAVE_OPENMP)
+#pragma omp critical(tetseg_wide_queue)
+#endif
+  {
+    const std::size_t count = q.count.load(std::memory_order_relaxed);
+    moved = std::min(top / 2, q.capacity - count);
+    for (std::size_t k = 0; k < moved; ++k) q.items[count + k] = {stack[k], orient, seam};
+    q.count.store(count + moved, std::memory_order_relaxed);
+    q.hungry.store(false, std::memory_order_relaxed);
+  }
+  std::copy(stack + moved, stack + top, stack);
+  return top - moved;
+}
+
 }  // namespace
 
 void Collider::Impl::refit_wide() noexcept {
@@ -121,13 +140,14 @@ void Collider::Impl::sign_wide() noexcept {
 // `orient` not of one sign), so popped items are live; a live pair of two triangles is
 // processed where it is found. Its test is non_culled's (the slot boxes and bits are the
 // triangles'), so outside the rest check it is a non-culled pair.
-bool Collider::Impl::traverse_wide(Worker& w, StackItem first, bool orient) const noexcept {
+bool Collider::Impl::traverse_wide(Worker& w, StackItem first, bool orient, bool seam,
+                                   WideQueue* queue) const noexcept {
   const WideNode* nodes = topo->wide_nodes.data();
   const double ms = opt.ccd.min_separation;
   const bool use_mov = !rest_mode;
-  // Across clusters (a pair of roots) a pair sharing a node is culled too (non_culled's seam
-  // rule; its feature pairs are the seam orphans').
-  const bool seam = !rest_mode && first.b != kNone;
+  // Across clusters (`seam`: items of a pair of roots) a pair sharing a node is culled too
+  // (non_culled's seam rule; its feature pairs are the seam orphans').
+  seam = seam && !rest_mode;
   auto triangle_pair = [&](std::uint32_t t1, std::uint32_t t2) {
     if (rest_mode) {
       process_triangle_pair(w, t1, t2);
@@ -173,6 +193,8 @@ bool Collider::Impl::traverse_wide(Worker& w, StackItem first, bool orient) cons
   if (cap == 0) return false;
   stack[top++] = first;
   while (top > 0 && !w.stop) {
+    if (queue != nullptr && top >= 2 && queue->hungry.load(std::memory_order_relaxed))
+      top = hand_over(*queue, stack, top, orient, seam);
     const StackItem it = stack[--top];
     ++w.stats.node_pairs_visited;
     if (top + 16 > cap) return false;  // a pair of nodes pushes up to 4 x 4 items

@@ -120,6 +120,7 @@ TEST_CASE("Degenerate simulator contacts: none missed, none late, no false posit
   struct Counts {
     int queries = 0, hits = 0, missed = 0, late = 0, start_wrong = 0, false_positives = 0;
     int end_contacts = 0, end_contacts_decided_at_once = 0;
+    int crossings = 0, crossings_decided_quickly = 0;
   } counts[kFamilies];
   for (int i = 0; i < 28000; ++i) {
     const Family family = static_cast<Family>((i / 2) % kFamilies);
@@ -136,6 +137,12 @@ TEST_CASE("Degenerate simulator contacts: none missed, none late, no false posit
     if (family == kEndInPlane && e.hit && e.toi_lower == 1.0) {
       ++c.end_contacts;
       if (r.intervals <= 2) ++c.end_contacts_decided_at_once;
+    }
+    // A generic crossing inside the step: the cubic's root leaf is reached at once (no
+    // halving down to it), and the time of impact lands within the tolerance before the root.
+    if (family == kGenericCrossing && e.hit && e.toi_lower > 0.0 && e.toi_upper < 1.0) {
+      ++c.crossings;
+      if (r.intervals <= 10 && r.toi >= e.toi_lower - 2e-9) ++c.crossings_decided_quickly;
     }
   }
   for (int f = 0; f < kFamilies; ++f) {
@@ -158,6 +165,12 @@ TEST_CASE("Degenerate simulator contacts: none missed, none late, no false posit
                                         << " contacts at t = 1 decided in at most 2 intervals");
   CHECK(end.end_contacts > 200);
   CHECK(end.end_contacts_decided_at_once >= end.end_contacts * 9 / 10);
+  // Crossings inside the step: the jump to the root leaf (about 48 intervals when halving).
+  const Counts& generic = counts[kGenericCrossing];
+  INFO(generic.crossings_decided_quickly << " of " << generic.crossings
+                                         << " crossings decided in at most 10 intervals");
+  CHECK(generic.crossings > 200);
+  CHECK(generic.crossings_decided_quickly >= generic.crossings * 9 / 10);
 }
 
 TEST_CASE("Contacts in an axis plane are certified at their exact times", "[ccd]") {

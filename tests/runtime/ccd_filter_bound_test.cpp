@@ -172,3 +172,39 @@ TEST_CASE(
   CHECK(worst <= 1.0);
   CHECK(worst_scaled > 1.0);  // the charge per level is load-bearing
 }
+
+TEST_CASE("Float de Casteljau's right part stays within its bound, and an eighth of it does not",
+          "[ccd][filter]") {
+  // right_part at grid points lambda = k / 2^m (the root leaf's end, where 1 - lambda is exact).
+  std::mt19937_64 rng(13);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  std::uniform_int_distribution<int> exponent(-20, 20);
+  std::uniform_int_distribution<int> level(1, 40);
+  double worst = 0.0, worst_scaled = 0.0;
+  for (int trial = 0; trial < 200000; ++trial) {
+    const int n = 3 + trial % 2;
+    const double scale = std::ldexp(1.0, exponent(rng));
+    FloatBernstein p{{}, n, 0.0};
+    std::array<mpq_class, 5> w{};
+    for (int i = 0; i <= n; ++i) {
+      p.c[i] = scale * (unit(rng) + (i % 2 == 0 ? 0.5 : -0.25));
+      w[i] = p.c[i];
+    }
+    const int m = level(rng);
+    const double grid = std::ldexp(1.0, -m);
+    const double lambda = std::floor(0.5 * (unit(rng) + 1.0) / grid) * grid;
+    // Exact right part on [lambda, 1]: de Casteljau in rationals, the last coefficients.
+    std::array<mpq_class, 5> exact{};
+    exact[n] = w[n];
+    for (int r = 1; r <= n; ++r) {
+      for (int i = 0; i + r <= n; ++i) w[i] = w[i] + mpq_class(lambda) * (w[i + 1] - w[i]);
+      exact[n - r] = w[n - r];
+    }
+    worst = std::max(worst, violation(tetseg::ccd_detail::right_part(p, lambda), exact));
+    worst_scaled =
+        std::max(worst_scaled, violation(tetseg::ccd_detail::right_part(p, lambda, 0.125), exact));
+  }
+  INFO("largest error / bound: " << worst << "; with an eighth of the charge: " << worst_scaled);
+  CHECK(worst <= 1.0);
+  CHECK(worst_scaled > 1.0);  // the charge per level is load-bearing
+}

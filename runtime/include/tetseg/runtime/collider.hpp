@@ -70,7 +70,8 @@ struct ColliderOptions {
   std::uint32_t bvh_leaf_size = 4;
   /// Use OpenMP threads inside a step when built with it: refit and classification loops
   /// (large meshes), and the traversal of every query (`any_collision`, `earliest_toi`,
-  /// `contacts` with or without a buffer) in rvbc (whole clusters per task), bvh and cone
+  /// `contacts` with or without a buffer) in rvbc (items of the cluster BVHs per task, handed
+  /// from a busy thread to an idle one), bvh and cone
   /// (subtrees of the whole-surface BVH per task) and brute modes (features per task).
   /// Results are identical to serial, contact buffers included (merged in a fixed order; a
   /// buffer keeps the smallest contacts, whichever thread finds them: `contacts`). Scratch per
