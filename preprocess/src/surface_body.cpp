@@ -51,17 +51,10 @@ std::string triangle_name(const TriangleMesh& mesh, std::size_t t) {
 SurfaceComponents check_triangles(const TriangleMesh& mesh, const std::string& file) {
   if (mesh.triangles.empty()) throw InputError(file, "surface has no triangles");
   const std::size_t n = mesh.vertices.size();
-  for (std::size_t v = 0; v < n; ++v)
-    for (double x : mesh.vertices[v])
-      if (!std::isfinite(x))
-        throw InputError(file, "vertex " + std::to_string(v) + " has a non-finite coordinate");
+  detail::check_finite(mesh.vertices, file, "vertex");
+  detail::check_triangle_indices(mesh, file);
   for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
     const Tri& tri = mesh.triangles[t];
-    for (std::uint32_t v : tri)
-      if (v >= n)
-        throw InputError(file, "triangle " + std::to_string(t) + " refers to vertex " +
-                                   std::to_string(v) + " out of range (" + std::to_string(n) +
-                                   " vertices)");
     const Vec3& a = mesh.vertices[tri[0]];
     const Vec3& b = mesh.vertices[tri[1]];
     const Vec3& c = mesh.vertices[tri[2]];

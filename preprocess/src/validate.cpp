@@ -27,14 +27,6 @@ std::string plural(std::size_t n, const char* one, const char* many) {
   return std::to_string(n) + " " + (n == 1 ? one : many);
 }
 
-void check_finite(const std::vector<Vec3>& points, const std::string& file, const char* noun) {
-  for (std::size_t i = 0; i < points.size(); ++i)
-    for (double c : points[i])
-      if (!std::isfinite(c))
-        throw InputError(file, std::string(noun) + " " + std::to_string(i) +
-                                   " has a non-finite coordinate (" + std::to_string(c) + ")");
-}
-
 /// The checks shared by tet-mesh boundaries and triangle surfaces: closed, edge-manifold,
 /// consistently oriented, vertex-manifold, one component (unless allowed), no
 /// self-intersection.
@@ -239,7 +231,7 @@ detail::NodeParts detail::validate_tet_mesh(const TetMesh& mesh, const Surface& 
   if (!match.tets_checked) throw std::logic_error("validate_tet_mesh: faces matched unchecked");
   const std::size_t n = mesh.nodes.size();
   if (mesh.tets.empty()) throw InputError(file, "mesh has no tetrahedra");
-  check_finite(mesh.nodes, file, "node");
+  detail::check_finite(mesh.nodes, file, "node");
   // The per-tet checks were made while matching the faces (match_faces).
   const TetChecks& checks = match.tets;
   if (checks.first_out_of_range != SIZE_MAX)
@@ -287,19 +279,33 @@ void validate_closed_surface(const TriangleMesh& mesh, const std::string& file,
   detail::validate_closed_surface(mesh, file, check, nullptr);
 }
 
-void detail::validate_closed_surface(const TriangleMesh& mesh, const std::string& file,
-                                     const SurfaceCheck& options, TriangleMesh* split) {
+void detail::check_finite(const std::vector<Vec3>& points, const std::string& file,
+                          const char* noun) {
+  for (std::size_t i = 0; i < points.size(); ++i)
+    for (double c : points[i])
+      if (!std::isfinite(c))
+        throw InputError(file, std::string(noun) + " " + std::to_string(i) +
+                                   " has a non-finite coordinate (" + std::to_string(c) + ")");
+}
+
+void detail::check_triangle_indices(const TriangleMesh& mesh, const std::string& file) {
   const std::size_t n = mesh.vertices.size();
-  check_finite(mesh.vertices, file, "vertex");
-  std::size_t zero_area = 0;
-  std::size_t first_zero = 0;
-  for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
-    const Tri& tri = mesh.triangles[t];
-    for (std::uint32_t v : tri)
+  for (std::size_t t = 0; t < mesh.triangles.size(); ++t)
+    for (std::uint32_t v : mesh.triangles[t])
       if (v >= n)
         throw InputError(file, "triangle " + std::to_string(t) + " refers to vertex " +
                                    std::to_string(v) + " out of range (" + std::to_string(n) +
                                    " vertices)");
+}
+
+void detail::validate_closed_surface(const TriangleMesh& mesh, const std::string& file,
+                                     const SurfaceCheck& options, TriangleMesh* split) {
+  detail::check_finite(mesh.vertices, file, "vertex");
+  check_triangle_indices(mesh, file);
+  std::size_t zero_area = 0;
+  std::size_t first_zero = 0;
+  for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+    const Tri& tri = mesh.triangles[t];
     const Vec3& a = mesh.vertices[tri[0]];
     const Vec3& b = mesh.vertices[tri[1]];
     const Vec3& c = mesh.vertices[tri[2]];

@@ -70,6 +70,12 @@ Surface extract_valid_surface(const TetMesh& mesh, const std::string& file, Node
 std::vector<std::pair<std::size_t, std::size_t>> self_intersecting_pairs(
     const std::vector<Vec3>& points, const std::vector<Tri>& triangles);
 
+/// Throws InputError naming `file` and the first point (`noun` i) with a NaN or infinite
+/// coordinate.
+void check_finite(const std::vector<Vec3>& points, const std::string& file, const char* noun);
+/// Throws InputError naming `file` and the first triangle referring to a vertex out of range.
+void check_triangle_indices(const TriangleMesh& mesh, const std::string& file);
+
 /// Options of the surface checks shared by validate_closed_surface and tetrahedralize.
 struct SurfaceCheck {
   /// Accept vertices where several fans touch at one point (a "pinch", e.g. two vertices of
