@@ -212,6 +212,32 @@ inline std::vector<Affine> tube_skinning_matrices(const SkinnedTube& tube,
   return out;
 }
 
+/// The tube as a game engine's vertex buffer holds it: split at seams. Every `stride`-th vertex
+/// (from vertex 1) gets a copy appended after the original vertices, with the same position
+/// and weights, and every odd-numbered triangle that uses it uses the copy, as a UV or normal
+/// seam splits a fan. Merged by position it is the original tube; `original_vertex[v]` is the
+/// vertex copy v stands for (itself for the originals).
+struct SplitTube {
+  SkinnedTube tube;
+  std::vector<std::uint32_t> original_vertex;
+};
+inline SplitTube split_tube_vertices(const SkinnedTube& tube, std::uint32_t stride = 5) {
+  SplitTube out{tube, {}};
+  const auto n = static_cast<std::uint32_t>(tube.vertex_count());
+  for (std::uint32_t v = 0; v < n; ++v) out.original_vertex.push_back(v);
+  std::vector<std::uint32_t> copy_of(n, n);
+  for (std::uint32_t v = 1; v < n; v += stride) {
+    copy_of[v] = static_cast<std::uint32_t>(out.original_vertex.size());
+    out.original_vertex.push_back(v);
+    out.tube.rest.insert(out.tube.rest.end(), &tube.rest[3 * v], &tube.rest[3 * v] + 3);
+    out.tube.weights.push_back(tube.weights[v]);
+  }
+  for (std::size_t t = 1; t < out.tube.triangles.size(); t += 2)
+    for (std::uint32_t& v : out.tube.triangles[t])
+      if (copy_of[v] != n) v = copy_of[v];
+  return out;
+}
+
 /// Linear blend skinning of the rest vertices: per vertex `sum weight * (M_bone * rest)`, in
 /// the vertex's weight order, in double. Returns vertex_count * 3.
 inline std::vector<double> skin_tube(const SkinnedTube& tube, const std::vector<Affine>& matrices) {
