@@ -213,28 +213,34 @@ inline std::vector<Affine> tube_skinning_matrices(const SkinnedTube& tube,
 }
 
 /// The tube as a game engine's vertex buffer holds it: split at seams. Every `stride`-th vertex
-/// (from vertex 1) gets a copy appended after the original vertices, with the same position
-/// and weights, and every odd-numbered triangle that uses it uses the copy, as a UV or normal
-/// seam splits a fan. Merged by position it is the original tube; `original_vertex[v]` is the
-/// vertex copy v stands for (itself for the originals).
+/// (from vertex 1) is stored twice, the copy right after it, with the same position and
+/// weights, and every odd-numbered triangle that uses it uses the copy, as a UV or normal seam
+/// splits a fan. Merged by position it is the original tube; `original_vertex[v]` is the tube
+/// vertex that file vertex v stands for.
 struct SplitTube {
   SkinnedTube tube;
   std::vector<std::uint32_t> original_vertex;
 };
 inline SplitTube split_tube_vertices(const SkinnedTube& tube, std::uint32_t stride = 5) {
   SplitTube out{tube, {}};
+  out.tube.rest.clear();
+  out.tube.weights.clear();
   const auto n = static_cast<std::uint32_t>(tube.vertex_count());
-  for (std::uint32_t v = 0; v < n; ++v) out.original_vertex.push_back(v);
-  std::vector<std::uint32_t> copy_of(n, n);
-  for (std::uint32_t v = 1; v < n; v += stride) {
-    copy_of[v] = static_cast<std::uint32_t>(out.original_vertex.size());
+  std::vector<std::uint32_t> first(n), copy(n, UINT32_MAX);
+  auto emit = [&](std::uint32_t v) {
+    const auto id = static_cast<std::uint32_t>(out.original_vertex.size());
     out.original_vertex.push_back(v);
     out.tube.rest.insert(out.tube.rest.end(), &tube.rest[3 * v], &tube.rest[3 * v] + 3);
     out.tube.weights.push_back(tube.weights[v]);
+    return id;
+  };
+  for (std::uint32_t v = 0; v < n; ++v) {
+    first[v] = emit(v);
+    if (v % stride == 1) copy[v] = emit(v);
   }
-  for (std::size_t t = 1; t < out.tube.triangles.size(); t += 2)
+  for (std::size_t t = 0; t < out.tube.triangles.size(); ++t)
     for (std::uint32_t& v : out.tube.triangles[t])
-      if (copy_of[v] != n) v = copy_of[v];
+      v = (t % 2 == 1 && copy[v] != UINT32_MAX) ? copy[v] : first[v];
   return out;
 }
 
