@@ -90,6 +90,13 @@ sed -i 's/^element vertex 7$/element vertex 6/; /^3 3 3$/d' six.ply
 ply six1.ply 0 0 -1 "${faces[@]}"
 sed -i 's/^element vertex 7$/element vertex 6/; /^3 3 3$/d' six1.ply
 expect_exit 3 "six.ply: 6 vertices, the asset .* has 7 nodes" -- "$bin/tetseg-ccd" frames six.ply six1.ply --asset "$weights"
+# A frame over the 9 file vertices the weights golden was read from (its map): named as such.
+{
+  printf 'ply\nformat ascii 1.0\nelement vertex 9\nproperty double x\nproperty double y\nproperty double z\n'
+  printf 'element face 1\nproperty list uchar int vertex_indices\nend_header\n'
+  printf '0 0 1\n1 0 0\n-1 0 0\n0 1 0\n0 -1 0\n0 0 1\n0 0 -1\n3 3 3\n1 0 0\n3 1 2 3\n'
+} > nine.ply
+expect_exit 3 "nine.ply: 9 vertices, the asset .* has 7 nodes .*input file's vertices, which the asset merged" -- "$bin/tetseg-ccd" frames nine.ply nine.ply --asset "$weights"
 swapped=("2 0 4" "2 1 4" "1 3 4" "3 0 4" "2 0 5" "1 2 5" "3 1 5" "0 3 5")
 ply s0.ply 0 0 1 "${swapped[@]}"
 ply s1.ply 0 0 -1 "${swapped[@]}"
