@@ -483,7 +483,14 @@ TEST_CASE("A glTF split at seams: its skinned frames, in the file's order, gathe
   BuildJobOptions options;
   options.build.body = format::BodyKind::kSurface;
   const BuildJobResult result = build_asset_from_file(path, options);
+  // Bone-carried detectors: the seam copies carry equal weights, so the skin is accepted and
+  // the map is the same.
+  BuildJobOptions skin_options = options;
+  skin_options.build.detectors = format::DetectorForm::kBones;
+  const BuildJobResult skinned_result = build_asset_from_file(path, skin_options);
   std::filesystem::remove(path);
+  CHECK(skinned_result.asset.detector_form == format::DetectorForm::kBones);
+  CHECK(skinned_result.asset.source_vertex_nodes == result.asset.source_vertex_nodes);
   const format::Asset& asset = result.asset;
   REQUIRE(format::validate(asset) == format::Status::kOk);
   // The reader merged the copies: one node per position, a map entry per file vertex, and each
