@@ -209,11 +209,20 @@ tetseg::Asset load_frame_asset(const std::string& path, const io::Mesh& mesh,
     throw ToolError(kExitBadInput, path,
                     std::string(tetseg::to_string(status)) + (detail.empty() ? "" : ": " + detail));
   const tetseg::format::Asset& a = asset.data();
-  if (a.node_count != mesh.vertices.size())
+  if (a.node_count != mesh.vertices.size()) {
+    // A frame over the input file's vertices of an asset that merged them (seams, STL corners).
+    const std::string merged =
+        a.source_vertex_nodes.size() == mesh.vertices.size()
+            ? "; they are the input file's vertices, which the asset merged into its nodes: "
+              "gather them first (format::gather_node_positions) or write the frame over the "
+              "nodes (tetseg-dump --ply)"
+            : "";
     throw ToolError(kExitBadInput, frame,
                     std::to_string(mesh.vertices.size()) + " vertices, the asset " + path +
                         " has " + std::to_string(a.node_count) +
-                        " nodes (the frame's vertices must be the asset's nodes, in order)");
+                        " nodes (the frame's vertices must be the asset's nodes, in order)" +
+                        merged);
+  }
   if (a.triangles.size() != mesh.faces.size())
     throw ToolError(kExitBadInput, frame,
                     std::to_string(mesh.faces.size()) + " faces, the asset " + path + " has " +

@@ -159,7 +159,8 @@ std::uint16_t minor_version_needed(const Asset& asset) noexcept {
   // Anything 1.2 stores (also when it is invalid, so the reader refuses it rather than the
   // writer dropping it).
   if (asset.body_kind != BodyKind::kTet || asset.detector_form != DetectorForm::kTetPoint ||
-      !asset.detector_terms.empty() || !asset.bone_names.empty())
+      !asset.detector_terms.empty() || !asset.bone_names.empty() ||
+      !asset.source_vertex_nodes.empty())
     return 2;
   std::uint16_t minor = 0;
   for (const Cluster& c : asset.clusters) {

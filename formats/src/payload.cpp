@@ -181,6 +181,7 @@ std::size_t payload_bytes(const Asset& a, std::uint16_t minor) {
   std::size_t n = 1 + 4 + 8 * 11;
   if (minor >= 2) {
     n += 8 + 8 + 8 + kDetectorTermBytes * a.detector_terms.size();
+    n += 8 + 4 * a.source_vertex_nodes.size();
     for (const std::string& name : a.bone_names) n += 8 + name.size();
   }
   n += 24 * a.rest_positions.size() + 12 * a.triangles.size() + 4 * a.triangle_cluster.size();
@@ -244,6 +245,8 @@ void encode_payload(const Asset& a, std::uint16_t minor, std::vector<std::uint8_
     }
     e.count(a.bone_names.size());
     for (const std::string& name : a.bone_names) e.string(name);
+    e.count(a.source_vertex_nodes.size());
+    e.array(a.source_vertex_nodes.data(), a.source_vertex_nodes.size());
   }
   e.string(a.provenance.tool_version);
   e.string(a.provenance.source);
@@ -323,6 +326,7 @@ Status decode_payload(const std::uint8_t* data, std::size_t size, std::uint16_t 
       const std::size_t bones = d.count("bone_names", kMaxBones, 8);
       a.bone_names.resize(bones);
       for (std::string& name : a.bone_names) d.string("bone name", name);
+      decode_u32_vector(d, "source_vertex_nodes", kMaxSourceVertices, a.source_vertex_nodes);
     }
     d.string("provenance.tool_version", a.provenance.tool_version);
     d.string("provenance.source", a.provenance.source);

@@ -48,6 +48,7 @@ void check_limits(const Asset& a) {
   limit("detector_terms", a.detector_terms.size(), std::uint64_t(kMaxClusters) * kMaxDetectorTerms);
   limit("bone_names", a.bone_names.size(), kMaxBones);
   for (const std::string& name : a.bone_names) limit("bone name", name.size(), kMaxStringBytes);
+  limit("source_vertex_nodes", a.source_vertex_nodes.size(), kMaxSourceVertices);
   limit("provenance.tool_version", a.provenance.tool_version.size(), kMaxStringBytes);
   limit("provenance.source", a.provenance.source.size(), kMaxStringBytes);
   limit("provenance.options", a.provenance.options.size(), kMaxProvenanceOptions);
@@ -287,6 +288,31 @@ void check_detector_terms(const Asset& a) {
   }
 }
 
+/// source_vertex_nodes (kSurface only, optional): every entry below node_count and every node
+/// hit at least once. The hit table is sized by node_count only after node_count <= entries
+/// (which hitting every node needs), so it is bounded by bytes that were read.
+void check_source_vertex_nodes(const Asset& a) {
+  const std::vector<std::uint32_t>& map = a.source_vertex_nodes;
+  if (map.empty()) return;
+  if (a.body_kind != BodyKind::kSurface)
+    fail("source_vertex_nodes has " + std::to_string(map.size()) +
+         " entries but the body kind is not kSurface");
+  if (a.node_count > map.size())
+    fail("source_vertex_nodes has " + std::to_string(map.size()) + " entries, fewer than the " +
+         std::to_string(a.node_count) + " nodes it must all reach");
+  std::vector<bool> hit(a.node_count, false);
+  for (std::size_t i = 0; i < map.size(); ++i) {
+    if (map[i] >= a.node_count)
+      fail(at("source_vertex_nodes", i) + " is " + std::to_string(map[i]) + " >= node_count " +
+           std::to_string(a.node_count));
+    hit[map[i]] = true;
+  }
+  const auto missed = std::find(hit.begin(), hit.end(), false);
+  if (missed != hit.end())
+    fail("node " + std::to_string(missed - hit.begin()) +
+         " is no source vertex's node (source_vertex_nodes must reach every node)");
+}
+
 /// kTetPoint: node-form detectors are interior: not a vertex of any surface triangle. Searches
 /// the (few) detector ids for every triangle corner rather than sorting all surface nodes.
 void check_detectors(const Asset& a) {
@@ -442,6 +468,7 @@ Status validate(const Asset& asset, std::string* detail) noexcept {
     check_body_and_form(asset);
     check_partition(asset);
     check_detector_terms(asset);
+    check_source_vertex_nodes(asset);
     check_detectors(asset);
     check_bvhs(asset);
     check_boundaries(asset);

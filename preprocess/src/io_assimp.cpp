@@ -16,14 +16,19 @@
 namespace tetseg::preprocess::detail {
 
 /// Reads the triangles of every mesh of the scene (see read_triangle_mesh). Throws InputError.
-TriangleMesh read_triangle_mesh_assimp(const std::string& path) {
+/// `keep_vertices` (surface bodies): assimp keeps the file's vertices (no joining), every one
+/// of them becomes a vertex (merged by exact position as always, unused ones after the used
+/// ones), and `source_vertex_nodes` (if given) records each file vertex's vertex: every mesh
+/// assimp reports, in its order, each mesh's vertices in order (one mesh: the file's order).
+TriangleMesh read_triangle_mesh_assimp(const std::string& path, bool keep_vertices,
+                                       std::vector<std::uint32_t>* source_vertex_nodes) {
   Assimp::Importer importer;
   // Points and lines are dropped; everything else is flattened into world coordinates.
   importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE,
                               aiPrimitiveType_POINT | aiPrimitiveType_LINE);
-  const aiScene* scene =
-      importer.ReadFile(path, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
-                                  aiProcess_SortByPType | aiProcess_PreTransformVertices);
+  const unsigned join = keep_vertices ? 0u : unsigned(aiProcess_JoinIdenticalVertices);
+  const aiScene* scene = importer.ReadFile(
+      path, aiProcess_Triangulate | join | aiProcess_SortByPType | aiProcess_PreTransformVertices);
   if (scene == nullptr) {
     std::string reason = importer.GetErrorString();
     if (reason.empty()) reason = "unknown error";
@@ -33,6 +38,18 @@ TriangleMesh read_triangle_mesh_assimp(const std::string& path) {
   // Vertices are merged by exact position (STL and per-face normals duplicate them), numbered
   // in order of first use.
   std::map<Vec3, std::uint32_t> index_of;
+  auto position = [&](const aiVector3D& v) {
+    const Vec3 p = {static_cast<double>(v.x), static_cast<double>(v.y), static_cast<double>(v.z)};
+    if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2]))
+      throw InputError(path, "vertex coordinate is not finite");
+    return p;
+  };
+  auto node_of = [&](const Vec3& p) {
+    const auto [it, inserted] =
+        index_of.emplace(p, static_cast<std::uint32_t>(mesh.vertices.size()));
+    if (inserted) mesh.vertices.push_back(p);
+    return it->second;
+  };
   for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
     const aiMesh* am = scene->mMeshes[m];
     if (am == nullptr || am->mVertices == nullptr) continue;
@@ -44,17 +61,18 @@ TriangleMesh read_triangle_mesh_assimp(const std::string& path) {
         const unsigned vi = face.mIndices[k];
         if (vi >= am->mNumVertices)
           throw InputError(path, "face refers to vertex " + std::to_string(vi) + " out of range");
-        const aiVector3D& v = am->mVertices[vi];
-        const Vec3 p = {static_cast<double>(v.x), static_cast<double>(v.y),
-                        static_cast<double>(v.z)};
-        if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2]))
-          throw InputError(path, "vertex coordinate is not finite");
-        const auto [it, inserted] =
-            index_of.emplace(p, static_cast<std::uint32_t>(mesh.vertices.size()));
-        if (inserted) mesh.vertices.push_back(p);
-        tri[k] = it->second;
+        tri[k] = node_of(position(am->mVertices[vi]));
       }
       mesh.triangles.push_back(tri);
+    }
+  }
+  if (!keep_vertices) return mesh;
+  for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
+    const aiMesh* am = scene->mMeshes[m];
+    if (am == nullptr || am->mVertices == nullptr) continue;
+    for (unsigned v = 0; v < am->mNumVertices; ++v) {
+      const std::uint32_t node = node_of(position(am->mVertices[v]));
+      if (source_vertex_nodes) source_vertex_nodes->push_back(node);
     }
   }
   return mesh;

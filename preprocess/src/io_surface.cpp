@@ -28,7 +28,8 @@
 
 namespace tetseg::preprocess {
 namespace detail {
-TriangleMesh read_triangle_mesh_assimp(const std::string& path);
+TriangleMesh read_triangle_mesh_assimp(const std::string& path, bool keep_vertices,
+                                       std::vector<std::uint32_t>* source_vertex_nodes);
 }  // namespace detail
 
 namespace {
@@ -337,7 +338,8 @@ struct PositionEqual {
   }
 };
 
-TriangleMesh read_with_cgal(const std::string& path, const std::string& ext, bool keep_vertices) {
+TriangleMesh read_with_cgal(const std::string& path, const std::string& ext, bool keep_vertices,
+                            std::vector<std::uint32_t>* source_vertex_nodes) {
   const std::string text = detail::read_file_text(path);
   if (text.empty()) throw InputError(path, "empty file");
   if (ext == ".ply") check_ply_layout(path, text);
@@ -374,7 +376,8 @@ TriangleMesh read_with_cgal(const std::string& path, const std::string& ext, boo
     }
   }
   TriangleMesh mesh;
-  if (keep_vertices) {  // the file's vertices, all of them, in their order
+  const bool stl = ext == ".stl";
+  if (keep_vertices && !stl) {  // the file's vertices, all of them, in their order
     mesh.vertices.reserve(points.size());
     for (const Point& p : points) mesh.vertices.push_back(detail::cgal::to_vec3(p));
     for (const auto& t : triangles)
@@ -383,6 +386,10 @@ TriangleMesh read_with_cgal(const std::string& path, const std::string& ext, boo
     return mesh;
   }
   // Vertices are merged by exact position (STL repeats corners), numbered in order of first use.
+  // STL: the file's vertices are the facets' corners, three per facet in file order;
+  // source_vertex_nodes records each corner's vertex.
+  const bool record_corners = keep_vertices && stl && source_vertex_nodes != nullptr;
+  if (record_corners) source_vertex_nodes->clear();
   std::unordered_map<Vec3, std::uint32_t, PositionHash, PositionEqual> index_of;
   index_of.reserve(points.size());
   for (const auto& t : triangles) {
@@ -393,6 +400,7 @@ TriangleMesh read_with_cgal(const std::string& path, const std::string& ext, boo
           detail::cgal::to_vec3(p), static_cast<std::uint32_t>(mesh.vertices.size()));
       if (inserted) mesh.vertices.push_back(it->first);
       tri[k] = it->second;
+      if (record_corners) source_vertex_nodes->push_back(it->second);
     }
     mesh.triangles.push_back(tri);
   }
@@ -403,7 +411,8 @@ TriangleMesh read_with_cgal(const std::string& path, const std::string& ext, boo
 
 namespace {
 
-TriangleMesh read_triangle_mesh(const std::string& path, bool keep_vertices) {
+TriangleMesh read_triangle_mesh(const std::string& path, bool keep_vertices,
+                                std::vector<std::uint32_t>* source_vertex_nodes) {
   {
     std::ifstream probe(path, std::ios::binary);
     if (!probe) throw InputError(path, "cannot open file");
@@ -414,8 +423,9 @@ TriangleMesh read_triangle_mesh(const std::string& path, bool keep_vertices) {
   // The third-party readers may throw anything (allocation failures on hostile sizes, CGAL
   // precondition failures); every one becomes an InputError naming the file.
   try {
-    mesh = cgal ? read_with_cgal(path, ext, keep_vertices && ext != ".stl")
-                : detail::read_triangle_mesh_assimp(path);
+    if (source_vertex_nodes) source_vertex_nodes->clear();
+    mesh = cgal ? read_with_cgal(path, ext, keep_vertices, source_vertex_nodes)
+                : detail::read_triangle_mesh_assimp(path, keep_vertices, source_vertex_nodes);
   } catch (const InputError&) {
     throw;
   } catch (const std::bad_alloc&) {
@@ -430,11 +440,12 @@ TriangleMesh read_triangle_mesh(const std::string& path, bool keep_vertices) {
 }  // namespace
 
 TriangleMesh read_triangle_mesh(const std::string& path) {
-  return read_triangle_mesh(path, false);
+  return read_triangle_mesh(path, false, nullptr);
 }
 
-TriangleMesh read_triangle_mesh_keeping_vertices(const std::string& path) {
-  return read_triangle_mesh(path, true);
+TriangleMesh read_triangle_mesh_keeping_vertices(const std::string& path,
+                                                 std::vector<std::uint32_t>* source_vertex_nodes) {
+  return read_triangle_mesh(path, true, source_vertex_nodes);
 }
 
 }  // namespace tetseg::preprocess

@@ -41,7 +41,23 @@ struct BuildInput {
   TetMesh tet_mesh;
   TriangleMesh surface;
   std::optional<Skin> skin;  ///< --detectors skin: the input's skin
+  /// --body surface from a reader that merges vertices (STL, glTF, FBX, ...): each file
+  /// vertex's vertex (read_triangle_mesh_keeping_vertices); else empty.
+  std::vector<std::uint32_t> source_vertex_nodes;
 };
+
+/// Records in a surface asset which node each vertex of the input file became, unless the
+/// reader kept the file's vertices as they are (no map, or the identity).
+void set_source_vertex_nodes(format::Asset& asset, std::vector<std::uint32_t> map) {
+  if (map.empty()) return;
+  bool identity = map.size() == asset.node_count;
+  for (std::size_t i = 0; identity && i < map.size(); ++i) identity = map[i] == i;
+  if (identity) return;
+  asset.source_vertex_nodes = std::move(map);
+  std::string detail;
+  if (format::validate(asset, &detail) != format::Status::kOk)
+    throw std::runtime_error("internal error: the source vertex map does not validate: " + detail);
+}
 
 /// The stages after read: [tetrahedralize,] build_asset's, write.
 BuildJobResult run_build(const std::function<BuildInput(std::string& summary)>& read,
@@ -95,6 +111,7 @@ BuildJobResult run_build(const std::function<BuildInput(std::string& summary)>& 
       result.asset =
           build_surface_asset(input.surface, source, build, result.report, checked_on_stage);
     }
+    set_source_vertex_nodes(result.asset, std::move(input.source_vertex_nodes));
   } else if (input.is_surface) {
     // tetrahedralize alone judges the surface (with its own rules: pinch points accepted), so
     // that a build accepts exactly the surfaces `tetseg tetrahedralize` accepts.
@@ -264,10 +281,13 @@ BuildJobResult build_asset_from_file(const std::string& path, const BuildJobOpti
   return run_build(
       [&](std::string& summary) {
         if (is_tet_mesh_path(path)) return read_tet_mesh_input(read_tet_mesh(path), summary);
-        BuildInput input = read_surface_input(options.build.body == format::BodyKind::kSurface
-                                                  ? read_triangle_mesh_keeping_vertices(path)
-                                                  : read_triangle_mesh(path),
-                                              summary);
+        std::vector<std::uint32_t> source_vertex_nodes;
+        BuildInput input =
+            read_surface_input(options.build.body == format::BodyKind::kSurface
+                                   ? read_triangle_mesh_keeping_vertices(path, &source_vertex_nodes)
+                                   : read_triangle_mesh(path),
+                               summary);
+        input.source_vertex_nodes = std::move(source_vertex_nodes);
         if (detector_form_of(options.build) == format::DetectorForm::kBones) {
           input.skin = read_skin(path);
           summary += ", skin of " + count_text(input.skin->bone_names.size(), "bones");

@@ -20,6 +20,7 @@
 #include "runtime_binding.hpp"
 #include "tetseg/format/asset_json.hpp"
 #include "tetseg/format/skin.hpp"
+#include "tetseg/format/source_vertices.hpp"
 #include "tetseg/runtime/asset.hpp"
 #include "tetseg/runtime/collider.hpp"
 #include "tetseg/runtime/frames.hpp"
@@ -133,6 +134,34 @@ py::array skinned_positions(const py::object& asset_object, const py::object& ma
   const auto clusters = static_cast<py::ssize_t>(asset->cluster_count());
   py::array_t<double> out({clusters, py::ssize_t{3}});
   format::skinned_detector_positions(asset->data(), contiguous.data(), out.mutable_data());
+  return std::move(out);
+}
+
+/// format::gather_node_positions over an (S, 3) float64 array in the input file's vertex order.
+py::array gathered_positions(const py::object& asset_object, const py::object& positions) {
+  if (!py::isinstance<PyAsset>(asset_object))
+    throw py::type_error("gather_node_positions expects a tetseg.Asset");
+  const AssetPtr asset = asset_object.cast<const PyAsset&>().asset;
+  const std::size_t sources = format::source_vertex_count(asset->data());
+  const std::string expected = "(" + std::to_string(sources) + ", 3)";
+  if (!py::isinstance<py::array>(positions))
+    throw py::type_error("source_positions must be a numpy.ndarray of float64 with shape " +
+                         expected);
+  const auto array = py::reinterpret_borrow<py::array>(positions);
+  if (!array.dtype().equal(py::dtype::of<double>()))
+    throw py::type_error("source_positions must have dtype float64, got " +
+                         std::string(py::str(array.dtype())));
+  if (array.ndim() != 2 || array.shape(0) != static_cast<py::ssize_t>(sources) ||
+      array.shape(1) != 3)
+    throw py::value_error("source_positions must have shape " + expected +
+                          " (the input file's vertices, in its order), got " +
+                          std::string(py::str(array.attr("shape"))));
+  const auto contiguous = py::array_t<double, py::array::c_style>::ensure(positions);
+  py::array_t<double> out({static_cast<py::ssize_t>(asset->data().node_count), py::ssize_t{3}});
+  const format::GatherStatus status =
+      format::gather_node_positions(asset->data(), contiguous.data(), sources, out.mutable_data());
+  if (status != format::GatherStatus::kOk)  // shape checked above: cannot happen
+    throw py::value_error("gather_node_positions failed");
   return std::move(out);
 }
 
@@ -551,6 +580,19 @@ PYBIND11_MODULE(_runtime, m) {
           },
           "list of str: the skeleton's bones of a 'bones' asset, by bone id (else empty).")
       .def_property_readonly(
+          "source_vertex_count",
+          [](const PyAsset& a) { return format::source_vertex_count(a.asset->data()); },
+          "int: vertices of the input file (len(source_vertex_nodes), or nodes without a map).")
+      .def_property_readonly(
+          "source_vertex_nodes",
+          [](const PyAsset& a) {
+            return vector_view(a.asset->data().source_vertex_nodes, py::dtype::of<std::uint32_t>(),
+                               0, a.asset);
+          },
+          "(S,) uint32: for each vertex of the input file, in its order, the node it became "
+          "(a 'surface' body read from glTF, FBX, STL, ...: readers that merge vertices at "
+          "seams); empty when node i is vertex i. See gather_node_positions.")
+      .def_property_readonly(
           "cluster_triangles",
           [](const PyAsset& a) {
             return vector_view(a.asset->data().cluster_triangles, py::dtype::of<std::uint32_t>(), 0,
@@ -606,6 +648,14 @@ PYBIND11_MODULE(_runtime, m) {
         "per bone the row-major 3x4 skinning matrix (world transform times inverse bind "
         "matrix; identities give the rest pose). Clusters without terms keep their rest "
         "position.");
+
+  m.def("gather_node_positions", &gathered_positions, py::arg("asset"), py::arg("source_positions"),
+        "Returns a (nodes, 3) float64 array: positions given in the input file's vertex order "
+        "(an engine's skinned vertex buffer, split at seams: (asset.source_vertex_count, 3) "
+        "float64) turned into the node positions Collider.step takes (format::"
+        "gather_node_positions): node asset.source_vertex_nodes[i] takes row i (copies of "
+        "one node carry equal positions; the last wins), or a copy without a map. Raises "
+        "ValueError on another shape.");
 
   m.def("read_frames", &read_frames_array, py::arg("path"),
         "Returns a (frames, nodes, 3) float64 array. "

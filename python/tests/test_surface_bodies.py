@@ -168,3 +168,40 @@ def test_scene_bodies_over_surface_assets(weights_asset, bones_asset):
     truth = contact_set(brute.contacts())
     for body in (w, b):
         assert per_body[body] and per_body[body] <= truth
+
+
+def test_gather_node_positions_from_the_files_vertex_order(weights_asset, bones_asset):
+    # The weights golden was read from 9 file vertices (seam copies of the top and +x).
+    a = weights_asset
+    nodes = a.source_vertex_nodes
+    assert nodes.dtype == np.uint32 and nodes.tolist() == [4, 0, 1, 2, 3, 4, 5, 6, 0]
+    assert a.source_vertex_count == 9
+    # Independent truth: file vertex i sits at its node's rest position; gathering the file's
+    # vertices, moved by any map, gives the nodes moved by the same map.
+    rng = np.random.default_rng(7)
+    shift = rng.normal(size=(a.node_count, 3))
+    nodes_moved = a.rest_positions + shift
+    source = nodes_moved[nodes]
+    got = tetseg.gather_node_positions(a, source)
+    assert got.shape == (7, 3) and np.array_equal(got, nodes_moved)
+    # A strided view works the same.
+    wide = np.zeros((9, 6))
+    wide[:, ::2] = source
+    assert np.array_equal(tetseg.gather_node_positions(a, wide[:, ::2]), nodes_moved)
+    # No map: the positions are the nodes'.
+    b = bones_asset
+    assert b.source_vertex_nodes.shape == (0,) and b.source_vertex_count == 7
+    assert np.array_equal(tetseg.gather_node_positions(b, nodes_moved), nodes_moved)
+    with pytest.raises(ValueError, match=r"\(9, 3\)"):
+        tetseg.gather_node_positions(a, nodes_moved)  # 7 rows: the nodes, not the file's
+    with pytest.raises(TypeError):
+        tetseg.gather_node_positions(a, source.astype(np.float32))
+    with pytest.raises(TypeError):
+        tetseg.gather_node_positions(a, source.tolist())
+    # Stepped: gathered frames give the contacts the nodes' own frames give.
+    x0, x1 = falling_top(a)
+    c = tetseg.Collider(a)
+    c.step(tetseg.gather_node_positions(a, x0[nodes]), tetseg.gather_node_positions(a, x1[nodes]))
+    d = tetseg.Collider(a)
+    d.step(x0, x1)
+    assert contact_set(c.contacts()) == contact_set(d.contacts()) != set()

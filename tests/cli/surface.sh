@@ -20,11 +20,17 @@ grep -q "weights n0:0.125 n2:0.125 n1:0.125 n3:0.125 (+1 terms) at (0, 0, 0.5)" 
   fail "dump: cluster 0 detector: $(cat w.txt)"
 "$bin/tetseg-dump" "$bones" > b.txt
 grep -q '^  bones  *3: 0="root" 1="spine" 2="head"$' b.txt || fail "dump: bone names: $(cat b.txt)"
+# The weights golden maps 9 file vertices (seam copies) onto its 7 nodes; the bones one has no map.
+grep -q "^  source vertices  *9 mapped onto 7 nodes" w.txt || fail "dump: source vertex map: $(cat w.txt)"
+grep -q "^  source vertices  *none mapped" b.txt || fail "dump: no source vertex map: $(cat b.txt)"
+"$bin/tetseg-dump" "$weights" --json > w.json
+grep -q '"source_vertices": 9, "source_vertex_map": true' w.json || fail "dump --json: map: $(cat w.json)"
 grep -q "bones 1:0.75 2:0.25 at (0, 0, 0.5)" b.txt || fail "dump: bone detector: $(cat b.txt)"
 grep -q "overlap-only  bones none at (0, 0, -0.5)" b.txt || fail "dump: overlap-only cluster: $(cat b.txt)"
 "$bin/tetseg-dump" "$bones" --json > b.json
 grep -q '"body": "surface"' b.json || fail "dump --json: body: $(cat b.json)"
 grep -q '"detector_form": "bones"' b.json || fail "dump --json: form: $(cat b.json)"
+grep -q '"source_vertices": 7, "source_vertex_map": false' b.json || fail "dump --json: no map: $(cat b.json)"
 grep -q '"bone_names": \["root", "spine", "head"\]' b.json || fail "dump --json: bones: $(cat b.json)"
 grep -q '"detector": {"form": "bones", "terms": \[\[1, 0.75\], \[2, 0.25\]\], "position": \[0, 0, 0.5\]}' b.json ||
   fail "dump --json: detector: $(cat b.json)"
@@ -84,6 +90,13 @@ sed -i 's/^element vertex 7$/element vertex 6/; /^3 3 3$/d' six.ply
 ply six1.ply 0 0 -1 "${faces[@]}"
 sed -i 's/^element vertex 7$/element vertex 6/; /^3 3 3$/d' six1.ply
 expect_exit 3 "six.ply: 6 vertices, the asset .* has 7 nodes" -- "$bin/tetseg-ccd" frames six.ply six1.ply --asset "$weights"
+# A frame over the 9 file vertices the weights golden was read from (its map): named as such.
+{
+  printf 'ply\nformat ascii 1.0\nelement vertex 9\nproperty double x\nproperty double y\nproperty double z\n'
+  printf 'element face 1\nproperty list uchar int vertex_indices\nend_header\n'
+  printf '0 0 1\n1 0 0\n-1 0 0\n0 1 0\n0 -1 0\n0 0 1\n0 0 -1\n3 3 3\n1 0 0\n3 1 2 3\n'
+} > nine.ply
+expect_exit 3 "nine.ply: 9 vertices, the asset .* has 7 nodes .*input file's vertices, which the asset merged" -- "$bin/tetseg-ccd" frames nine.ply nine.ply --asset "$weights"
 swapped=("2 0 4" "2 1 4" "1 3 4" "3 0 4" "2 0 5" "1 2 5" "3 1 5" "0 3 5")
 ply s0.ply 0 0 1 "${swapped[@]}"
 ply s1.ply 0 0 -1 "${swapped[@]}"

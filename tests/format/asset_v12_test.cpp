@@ -214,6 +214,44 @@ const std::vector<Rule>& rules() {
          a.bone_names.resize(kMaxBones + 1);
          return a;
        }},
+      // source_vertex_nodes (the weights golden maps 9 file vertices onto the 7 nodes).
+      {"a source vertex map on a tet body", "the body kind is not kSurface",
+       [] {
+         Asset a = make_octahedron_asset();
+         a.source_vertex_nodes = {0, 1, 2, 3, 4, 5, 6, 7};
+         return a;
+       }},
+      {"a source vertex on node_count", "source_vertex_nodes[8] is 7 >= node_count 7",
+       [] {
+         Asset a = weights_asset();
+         a.source_vertex_nodes[8] = 7;
+         return a;
+       }},
+      {"a huge source vertex node", "source_vertex_nodes[0] is 4294967295 >= node_count",
+       [] {
+         Asset a = weights_asset();
+         a.source_vertex_nodes[0] = 0xFFFFFFFFu;
+         return a;
+       }},
+      {"a node no source vertex reaches", "node 6 is no source vertex's node",
+       [] {
+         Asset a = weights_asset();
+         a.source_vertex_nodes[7] = 5;
+         return a;
+       }},
+      {"fewer source vertices than nodes", "fewer than the 7 nodes",
+       [] {
+         Asset a = weights_asset();
+         a.source_vertex_nodes = {0, 1, 2, 3, 4, 5};
+         return a;
+       }},
+      {"a source vertex map that cannot reach a huge node_count", "fewer than the",
+       [] {
+         Asset a = weights_asset();
+         a.rest_positions.clear();  // else their count fails first
+         a.node_count = kMaxNodes;  // the hit table must not be sized by this
+         return a;
+       }},
   };
   return table;
 }
@@ -293,6 +331,18 @@ TEST_CASE("Format 1.2: validation accepts the legitimate variations", "[format][
     a = bones_asset();
     a.bone_names = {"", "", "head", "tail"};
   }
+  SECTION("No source vertex map (node i is file vertex i), or one that only renumbers.") {
+    SECTION("none") {
+      a.source_vertex_nodes.clear();
+    }
+    SECTION("a permutation") {
+      a.source_vertex_nodes = {6, 5, 4, 3, 2, 1, 0};
+    }
+  }
+  SECTION("A bone asset may map source vertices too.") {
+    a = bones_asset();
+    a.source_vertex_nodes = {0, 0, 1, 2, 3, 4, 5, 6, 6};
+  }
   std::string why;
   CHECK(validate(a, &why) == Status::kOk);
   INFO(why);
@@ -347,12 +397,17 @@ TEST_CASE("Format 1.2: the new fields sit where docs/format.md puts them", "[for
     CHECK(same_bits(w, a.detector_terms[i].weight));
   }
   CHECK(get_le(bytes, tag_at("bone_names"), 8) == a.bone_names.size());
-  CHECK(tag_at("provenance.tool_version") ==
-        tag_at("bone_names") + 8 + 8 * a.bone_names.size() + [&] {
-          std::size_t n = 0;
-          for (const auto& s : a.bone_names) n += s.size();
-          return n;
-        }());
+  // The source vertex map (u32 per file vertex) right after the bone names.
+  const std::size_t map = tag_at("source_vertex_nodes");
+  CHECK(map == tag_at("bone_names") + 8 + 8 * a.bone_names.size() + [&] {
+    std::size_t n = 0;
+    for (const auto& s : a.bone_names) n += s.size();
+    return n;
+  }());
+  REQUIRE(get_le(bytes, map, 8) == a.source_vertex_nodes.size());
+  for (std::size_t i = 0; i < a.source_vertex_nodes.size(); ++i)
+    CHECK(get_le(bytes, map + 8 + 4 * i, 4) == a.source_vertex_nodes[i]);
+  CHECK(tag_at("provenance.tool_version") == map + 8 + 4 * a.source_vertex_nodes.size());
   CHECK(tags.back().second == bytes.size() - kHeaderBytes);
 }
 
@@ -408,7 +463,7 @@ TEST_CASE("Format 1.2: tet assets are still written as 1.0 and 1.1, byte for byt
   CHECK(write_asset(make_octahedron_asset_v11()) == read_file(golden_path(1)));
   SECTION("Any one 1.2 field set needs 1.2.") {
     Asset a = make_octahedron_asset();
-    const int which = GENERATE(range(0, 6));
+    const int which = GENERATE(range(0, 7));
     CAPTURE(which);
     if (which == 0) a.body_kind = BodyKind::kSurface;
     if (which == 1) a.detector_form = DetectorForm::kBones;
@@ -416,6 +471,7 @@ TEST_CASE("Format 1.2: tet assets are still written as 1.0 and 1.1, byte for byt
     if (which == 3) a.bone_names.push_back("b");
     if (which == 4) a.clusters[1].detector_term_offset = 1;
     if (which == 5) a.clusters[0].detector_rest[1] = 1.0;
+    if (which == 6) a.source_vertex_nodes.push_back(0);
     CHECK(minor_version_needed(a) == 2);
   }
 }

@@ -2,22 +2,30 @@
 // exactly, detectors as valid weights of surface vertices, open components overlap-only,
 // refusals with their reasons.
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <functional>
+#include <map>
+#include <numeric>
 #include <set>
 #include <string>
 #include <vector>
 
 #include "tetseg/format/asset.hpp"
 #include "tetseg/format/asset_io.hpp"
+#include "tetseg/format/source_vertices.hpp"
 #include "tetseg/preprocess/jobs.hpp"
 #include "tetseg/preprocess/pipeline.hpp"
 #include "tetseg/runtime/asset.hpp"
 #include "tetseg/runtime/collider.hpp"
 #include "tetseg/testing/charge_shapes.hpp"
 #include "tetseg/testing/scene_oracle.hpp"
+#include "tetseg/testing/skinned_tube.hpp"
 #include "tetseg/testing/test_data.hpp"
 
 using namespace tetseg::preprocess;
@@ -435,4 +443,151 @@ TEST_CASE("The runtime on a surface body finds what brute force finds while it b
     }));
   }
   compare_with_brute_force(asset, waves);
+}
+
+namespace {
+
+/// `asset`'s rest positions flattened (x, y, z per node).
+std::vector<double> flat_rest(const format::Asset& asset) {
+  std::vector<double> x;
+  for (const auto& p : asset.rest_positions) x.insert(x.end(), p.begin(), p.end());
+  return x;
+}
+
+/// Node positions gathered from positions in the file's vertex order; REQUIREs kOk.
+std::vector<double> gathered(const format::Asset& asset, const std::vector<double>& source) {
+  std::vector<double> out(3 * std::size_t(asset.node_count), -1.0);
+  REQUIRE(format::gather_node_positions(asset, source.data(), source.size() / 3, out.data()) ==
+          format::GatherStatus::kOk);
+  return out;
+}
+
+std::string temp_file(const std::string& name, const std::string& text) {
+  const std::filesystem::path path =
+      std::filesystem::temp_directory_path() /
+      ("tetseg_surface_body_test_" + std::to_string(::getpid()) + "_" + name);
+  std::ofstream(path, std::ios::binary) << text;
+  return path.string();
+}
+
+}  // namespace
+
+TEST_CASE("A glTF split at seams: its skinned frames, in the file's order, gathered and stepped",
+          "[surface-body][skin][source-vertices]") {
+  const tetseg::test::SkinnedTube tube =
+      tetseg::test::make_skinned_tube({4, 1.0, 0.25, 16, 6, 3, 0.35});
+  const tetseg::test::SplitTube split = tetseg::test::split_tube_vertices(tube);
+  const tetseg::test::SkinnedTube& file = split.tube;
+  REQUIRE(file.vertex_count() > tube.vertex_count());
+  const std::string path = temp_file("split.gltf", tetseg::test::tube_gltf(file));
+  BuildJobOptions options;
+  options.build.body = format::BodyKind::kSurface;
+  const BuildJobResult result = build_asset_from_file(path, options);
+  // Bone-carried detectors: the seam copies carry equal weights, so the skin is accepted and
+  // the map is the same.
+  BuildJobOptions skin_options = options;
+  skin_options.build.detectors = format::DetectorForm::kBones;
+  const BuildJobResult skinned_result = build_asset_from_file(path, skin_options);
+  std::filesystem::remove(path);
+  CHECK(skinned_result.asset.detector_form == format::DetectorForm::kBones);
+  CHECK(skinned_result.asset.source_vertex_nodes == result.asset.source_vertex_nodes);
+  const format::Asset& asset = result.asset;
+  REQUIRE(format::validate(asset) == format::Status::kOk);
+  // The reader merged the copies: one node per position, a map entry per file vertex, and each
+  // copy on its original's node.
+  CHECK(asset.node_count == tube.vertex_count());
+  REQUIRE(asset.source_vertex_nodes.size() == file.vertex_count());
+  REQUIRE(format::source_vertex_count(asset) == file.vertex_count());
+  std::map<std::uint32_t, std::uint32_t> node_of_original;
+  for (std::size_t v = 0; v < file.vertex_count(); ++v) {
+    const auto it =
+        node_of_original.emplace(split.original_vertex[v], asset.source_vertex_nodes[v]).first;
+    CHECK(it->second == asset.source_vertex_nodes[v]);
+  }
+  CHECK(node_of_original.size() == tube.vertex_count());
+  // ... and the file's order is not the nodes' (the copies sit between the originals).
+  std::vector<std::uint32_t> identity(asset.node_count);
+  std::iota(identity.begin(), identity.end(), 0u);
+  CHECK_FALSE(std::equal(identity.begin(), identity.end(), asset.source_vertex_nodes.begin()));
+  // The file's rest vertices gathered are the asset's rest positions.
+  CHECK(gathered(asset, file.rest) == flat_rest(asset));
+  // The round trip keeps the map.
+  const std::vector<std::uint8_t> bytes = format::write_asset(asset);
+  format::Asset loaded;
+  REQUIRE(format::read_asset(bytes.data(), bytes.size(), loaded) == format::Status::kOk);
+  CHECK(loaded.source_vertex_nodes == asset.source_vertex_nodes);
+
+  // Frames as an engine skins the file's vertex buffer, gathered, up to the first contact.
+  const auto poses = tetseg::test::tube_bend_sequence(file, 25, M_PI / 2, 0.15);
+  std::vector<std::vector<double>> frames;
+  for (const auto& pose : poses) {
+    const std::vector<double> skinned = tetseg::test::skin_tube(file, pose);
+    frames.push_back(gathered(asset, skinned));
+    // Independent of the map: node n is where every file vertex at its rest position went.
+    for (std::size_t v = 0; v < file.vertex_count(); ++v) {
+      const std::uint32_t n = asset.source_vertex_nodes[v];
+      for (int k = 0; k < 3; ++k) REQUIRE(frames.back()[3 * n + k] == skinned[3 * v + k]);
+    }
+    if (frames.size() < 2) continue;
+    tetseg::test::OracleBody body;
+    body.tris = asset.triangles.data();
+    body.triangle_count = asset.triangles.size();
+    body.x0 = frames[frames.size() - 2].data();
+    body.x1 = frames.back().data();
+    if (!tetseg::test::scene_brute_contacts({body}).empty()) break;
+  }
+  REQUIRE(frames.size() < poses.size());  // the tube touched itself
+  CHECK(compare_with_brute_force(asset, frames) > 0);
+
+  SECTION("wrong sizes and null pointers are refused, the output untouched") {
+    const std::vector<double> skinned = tetseg::test::skin_tube(file, poses.back());
+    std::vector<double> out(3 * std::size_t(asset.node_count), 7.0);
+    const std::vector<double> before = out;
+    const std::size_t n = file.vertex_count();
+    CHECK(format::gather_node_positions(asset, skinned.data(), n - 1, out.data()) ==
+          format::GatherStatus::kSizeMismatch);
+    CHECK(format::gather_node_positions(asset, skinned.data(), asset.node_count, out.data()) ==
+          format::GatherStatus::kSizeMismatch);
+    CHECK(format::gather_node_positions(asset, nullptr, n, out.data()) ==
+          format::GatherStatus::kNullInput);
+    CHECK(format::gather_node_positions(asset, skinned.data(), n, nullptr) ==
+          format::GatherStatus::kNullInput);
+    CHECK(out == before);
+  }
+}
+
+TEST_CASE("A surface body from STL maps every facet corner to its node",
+          "[surface-body][source-vertices]") {
+  const TriangleMesh dumbbell = tetseg::test::dumbbell(0.08);
+  std::string stl = "solid dumbbell\n";
+  char line[256];
+  std::vector<double> corners;
+  for (const Tri& t : dumbbell.triangles) {
+    stl += "facet normal 0 0 0\nouter loop\n";
+    for (std::uint32_t v : t) {
+      // STL stores float32: the corners are float values, printed exactly (%.17g), so a reader
+      // parsing floats or doubles gets them.
+      const Vec3& p = dumbbell.vertices[v];
+      std::snprintf(line, sizeof line, "vertex %.17g %.17g %.17g\n", double(float(p[0])),
+                    double(float(p[1])), double(float(p[2])));
+      stl += line;
+      for (int k = 0; k < 3; ++k) corners.push_back(double(float(p[k])));
+    }
+    stl += "endloop\nendfacet\n";
+  }
+  stl += "endsolid dumbbell\n";
+  const std::string path = temp_file("dumbbell.stl", stl);
+  BuildJobOptions options;
+  options.build.body = format::BodyKind::kSurface;
+  const BuildJobResult result = build_asset_from_file(path, options);
+  std::filesystem::remove(path);
+  const format::Asset& asset = result.asset;
+  REQUIRE(format::validate(asset) == format::Status::kOk);
+  CHECK(asset.node_count == dumbbell.vertices.size());
+  REQUIRE(asset.source_vertex_nodes.size() == 3 * dumbbell.triangles.size());
+  // Corner c of facet t is a corner of asset triangle t (the input's order is kept).
+  for (std::size_t t = 0; t < dumbbell.triangles.size(); ++t)
+    for (int k = 0; k < 3; ++k)
+      CHECK(asset.source_vertex_nodes[3 * t + k] == asset.triangles[t][k]);
+  CHECK(gathered(asset, corners) == flat_rest(asset));
 }

@@ -15,6 +15,7 @@
 
 #include "mesh_output.hpp"
 #include "tetseg/format/asset_json.hpp"
+#include "tetseg/format/source_vertices.hpp"
 #include "tetseg/runtime/asset.hpp"
 #include "tool_support.hpp"
 
@@ -144,6 +145,15 @@ void print_summary(const std::string& path, const std::string& version, const As
       std::printf(" %zu=\"%s\"", b, tetseg::format::json_escape(asset.bone_names[b]).c_str());
     std::printf("%s\n", asset.bone_names.size() > 64 ? " ..." : "");
   }
+  if (asset.body_kind == tetseg::format::BodyKind::kSurface) {
+    if (asset.source_vertex_nodes.empty())
+      std::printf("  source vertices     none mapped (node i is vertex i of the input file)\n");
+    else
+      std::printf(
+          "  source vertices     %zu mapped onto %u nodes (frames in the file's vertex "
+          "order: gather_node_positions)\n",
+          asset.source_vertex_nodes.size(), asset.node_count);
+  }
   std::printf("  %-8s %10s %14s %15s %-12s  %s\n", "cluster", "triangles", "rest_positive",
               "boundary_edges", "culling", "detector");
   for (std::size_t c = 0; c < asset.clusters.size(); ++c) {
@@ -175,6 +185,9 @@ void print_json(const std::string& version, const Asset& asset) {
     out << (b ? ", \"" : "\"") << json_escape(asset.bone_names[b]) << '"';
   out << "],\n";
   out << "  \"nodes\": " << asset.node_count << ",\n";
+  out << "  \"source_vertices\": " << tetseg::format::source_vertex_count(asset)
+      << ", \"source_vertex_map\": " << (asset.source_vertex_nodes.empty() ? "false" : "true")
+      << ",\n";
   out << "  \"rest_positions\": " << (asset.rest_positions.empty() ? "false" : "true") << ",\n";
   out << "  \"surface_triangles\": " << asset.triangles.size() << ",\n";
   out << "  \"components\": " << surface_components(asset) << ",\n";

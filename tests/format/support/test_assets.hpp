@@ -99,6 +99,7 @@ inline std::vector<std::pair<std::string, std::size_t>> payload_size_tags(const 
     tags.emplace_back("bone_names", at);
     at += 8;
     for (const std::string& name : a.bone_names) tag("bone name", name.size(), 1);
+    tag("source_vertex_nodes", a.source_vertex_nodes.size(), 4);
   }
   tag("provenance.tool_version", a.provenance.tool_version.size(), 1);
   tag("provenance.source", a.provenance.source.size(), 1);
@@ -251,6 +252,8 @@ inline void set_detector_terms(Asset& a, std::size_t c, const std::vector<Detect
 /// of the top, the lower one from (0, 0, -0.5) = 1/4 of +x and -x + 1/2 of the bottom.
 /// kBones: bones "root", "spine", "head"; the upper detector at (0, 0, 0.5) carried 3/4 by
 /// "spine" and 1/4 by "head"; the lower cluster overlap-only without terms, at (0, 0, -0.5).
+/// The weights asset was read from a file of 9 vertices split at seams (source_vertex_nodes:
+/// the top and +x stored twice, the file's order not the nodes'); the bones one has no map.
 inline Asset make_surface_octahedron_v12(DetectorForm form) {
   Asset a = make_octahedron(DetectorPoint::at_node(0), DetectorPoint::at_node(0));
   a.rest_positions.resize(6);
@@ -267,6 +270,7 @@ inline Asset make_surface_octahedron_v12(DetectorForm form) {
     set_detector_terms(a, 0, {{0, 0.125}, {2, 0.125}, {1, 0.125}, {3, 0.125}, {4, 0.5}},
                        {0, 0, 0.5});
     set_detector_terms(a, 1, {{5, 0.5}, {0, 0.25}, {1, 0.25}}, {0, 0, -0.5});
+    a.source_vertex_nodes = {4, 0, 1, 2, 3, 4, 5, 6, 0};
   }
   a.provenance.source = "octahedron.obj";
   a.provenance.options = {{"body", "surface"},
@@ -372,7 +376,8 @@ inline bool assets_equal(const Asset& a, const Asset& b) {
       if (!same_bits(x.detector_rest[k], y.detector_rest[k])) return false;
   }
   if (a.body_kind != b.body_kind || a.detector_form != b.detector_form ||
-      a.bone_names != b.bone_names || a.detector_terms.size() != b.detector_terms.size())
+      a.bone_names != b.bone_names || a.detector_terms.size() != b.detector_terms.size() ||
+      a.source_vertex_nodes != b.source_vertex_nodes)
     return false;
   for (std::size_t i = 0; i < a.detector_terms.size(); ++i) {
     if (a.detector_terms[i].index != b.detector_terms[i].index ||

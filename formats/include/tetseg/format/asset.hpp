@@ -36,6 +36,8 @@ inline constexpr std::uint32_t kMaxBvhNodes = 2 * kMaxTriangles;  ///< all clust
 inline constexpr std::uint32_t kMaxBoundaryNodes = 3 * kMaxTriangles;  ///< all loops' node ids
 inline constexpr std::uint32_t kMaxDetectorTerms = 256;  ///< terms of one cluster's detector (1.2)
 inline constexpr std::uint32_t kMaxBones = 1u << 16;     ///< bones of a kBones asset (1.2)
+/// Entries of `source_vertex_nodes` (1.2): three corners per triangle, as an STL file has.
+inline constexpr std::uint32_t kMaxSourceVertices = 3 * kMaxTriangles;
 
 using Triangle = std::array<std::uint32_t, 3>;  ///< tet-mesh node ids, wound outward
 
@@ -102,7 +104,9 @@ enum class BodyKind : std::uint32_t {
   kTet = 0,
   /// A surface body, built with no tets behind it (`tetseg build --body surface`): node i is
   /// vertex i of the input surface, in the input's order, and `triangles` are the input's
-  /// triangles in the input's order, so frames of the same simulation apply unchanged.
+  /// triangles in the input's order, so frames of the same simulation apply unchanged. When
+  /// the reader merged vertices (glTF/FBX seams, STL corners), `Asset::source_vertex_nodes`
+  /// maps the file's vertices to nodes (`gather_node_positions`).
   kSurface = 1,
 };
 
@@ -208,6 +212,12 @@ struct Asset {
   /// kBones: the skeleton's bone names (from the input's skin), indexed by bone id; the
   /// application maps its bones to these. Empty for other forms.
   std::vector<std::string> bone_names;
+  /// kSurface, optional: for each vertex of the input file, in the file's order, the node it
+  /// became, written only when the reader merged or renumbered vertices (glTF and FBX split
+  /// vertices at UV and normal seams, STL repeats every corner). Every entry is below
+  /// node_count and every node appears at least once. Empty: node i is vertex i of the file.
+  /// `gather_node_positions` turns positions in the file's vertex order into node positions.
+  std::vector<std::uint32_t> source_vertex_nodes;
 };
 
 /// A cluster's detector at rest, as tools draw and print it: kTetPoint: `detector_position` of

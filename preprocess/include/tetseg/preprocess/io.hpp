@@ -55,8 +55,14 @@ TriangleMesh read_triangle_mesh(const std::string& path);
 /// read_triangle_mesh for a surface body (`tetseg build --body surface`): OFF, PLY and OBJ
 /// keep the file's vertices as they are, all of them in their order (none merged or dropped),
 /// so that frames of the same simulation apply unchanged; polygons are triangulated as there.
-/// STL (corners repeated per facet) and the assimp formats are read as read_triangle_mesh
-/// reads them (their vertex order is the reader's).
-TriangleMesh read_triangle_mesh_keeping_vertices(const std::string& path);
+/// STL (corners repeated per facet) and the assimp formats merge vertices by exact position
+/// (numbered in order of first use) and, when `source_vertex_nodes` is given, set it to the
+/// vertex each vertex of the file became (format::Asset::source_vertex_nodes): STL's file
+/// vertices are the facets' corners, three per facet in file order; an assimp format's are
+/// assimp's meshes' vertices in order, unjoined (a glTF with one mesh: its POSITION
+/// accessor's order, split at seams), and unused ones become vertices too. OFF, PLY and OBJ
+/// leave it empty (vertex i is the file's vertex i).
+TriangleMesh read_triangle_mesh_keeping_vertices(
+    const std::string& path, std::vector<std::uint32_t>* source_vertex_nodes = nullptr);
 
 }  // namespace tetseg::preprocess

@@ -212,6 +212,38 @@ inline std::vector<Affine> tube_skinning_matrices(const SkinnedTube& tube,
   return out;
 }
 
+/// The tube as a game engine's vertex buffer holds it: split at seams. Every `stride`-th vertex
+/// (from vertex 1) is stored twice, the copy right after it, with the same position and
+/// weights, and every odd-numbered triangle that uses it uses the copy, as a UV or normal seam
+/// splits a fan. Merged by position it is the original tube; `original_vertex[v]` is the tube
+/// vertex that file vertex v stands for.
+struct SplitTube {
+  SkinnedTube tube;
+  std::vector<std::uint32_t> original_vertex;
+};
+inline SplitTube split_tube_vertices(const SkinnedTube& tube, std::uint32_t stride = 5) {
+  SplitTube out{tube, {}};
+  out.tube.rest.clear();
+  out.tube.weights.clear();
+  const auto n = static_cast<std::uint32_t>(tube.vertex_count());
+  std::vector<std::uint32_t> first(n), copy(n, UINT32_MAX);
+  auto emit = [&](std::uint32_t v) {
+    const auto id = static_cast<std::uint32_t>(out.original_vertex.size());
+    out.original_vertex.push_back(v);
+    out.tube.rest.insert(out.tube.rest.end(), &tube.rest[3 * v], &tube.rest[3 * v] + 3);
+    out.tube.weights.push_back(tube.weights[v]);
+    return id;
+  };
+  for (std::uint32_t v = 0; v < n; ++v) {
+    first[v] = emit(v);
+    if (v % stride == 1) copy[v] = emit(v);
+  }
+  for (std::size_t t = 0; t < out.tube.triangles.size(); ++t)
+    for (std::uint32_t& v : out.tube.triangles[t])
+      v = (t % 2 == 1 && copy[v] != UINT32_MAX) ? copy[v] : first[v];
+  return out;
+}
+
 /// Linear blend skinning of the rest vertices: per vertex `sum weight * (M_bone * rest)`, in
 /// the vertex's weight order, in double. Returns vertex_count * 3.
 inline std::vector<double> skin_tube(const SkinnedTube& tube, const std::vector<Affine>& matrices) {
