@@ -24,12 +24,7 @@ TEST_CASE("Radial-view culling matches brute force on deformed real meshes",
   REQUIRE(closed_and_consistent(s));
   orient_outward(s);
   const Scene scene = slab_scene(s, 5);
-  double lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300};
-  for (const P3& p : s.verts)
-    for (int a = 0; a < 3; ++a) lo[a] = std::min(lo[a], p[a]), hi[a] = std::max(hi[a], p[a]);
-  const double size =
-      std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
-                (hi[2] - lo[2]) * (hi[2] - lo[2]));
+  const double size = bounding_diagonal(s);
   std::mt19937 rng(seed);
   auto u = [&] { return (rng() / 4294967296.0) * 2 - 1; };
   std::vector<std::array<double, 7>> waves;

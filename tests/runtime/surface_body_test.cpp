@@ -265,12 +265,7 @@ TEST_CASE("Surface bodies on deformed real meshes match brute force",
   REQUIRE(closed_and_consistent(s));
   orient_outward(s);
   const Scene scene = as_weighted_surface_body(slab_scene(s, 5), 5);
-  double lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300};
-  for (const P3& p : s.verts)
-    for (int a = 0; a < 3; ++a) lo[a] = std::min(lo[a], p[a]), hi[a] = std::max(hi[a], p[a]);
-  const double size =
-      std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
-                (hi[2] - lo[2]) * (hi[2] - lo[2]));
+  const double size = bounding_diagonal(s);
   Waves waves(11, 0.2 * size, 6.0 / size);
   const SequenceReport rep = compare_with_oracle(scene, make_frames(scene, 10, waves));
   CHECK(rep.contact_frames == 1);

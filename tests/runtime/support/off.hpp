@@ -1,6 +1,8 @@
 #pragma once
 // A minimal OFF reader for tests (triangle meshes only) and a closedness check.
 
+#include <algorithm>
+#include <cmath>
 #include <fstream>
 #include <map>
 #include <string>
@@ -45,12 +47,26 @@ inline bool closed_and_consistent(const Surface& s) {
   return true;
 }
 
+/// The axis-aligned bounding box of the surface's vertices, into `lo` and `hi`.
+inline void bounding_box(const Surface& s, double lo[3], double hi[3]) {
+  for (int a = 0; a < 3; ++a) lo[a] = 1e300, hi[a] = -1e300;
+  for (const P3& p : s.verts)
+    for (int a = 0; a < 3; ++a) lo[a] = std::min(lo[a], p[a]), hi[a] = std::max(hi[a], p[a]);
+}
+
+/// The length of the bounding box's diagonal.
+inline double bounding_diagonal(const Surface& s) {
+  double lo[3], hi[3];
+  bounding_box(s, lo, hi);
+  return std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                   (hi[2] - lo[2]) * (hi[2] - lo[2]));
+}
+
 /// `k` clusters as slabs of equal triangle count along the longest axis (by centroid); each
 /// detector is the mean of its slab's centroids (any point off the surface is sound).
 inline Scene slab_scene(const Surface& s, std::uint32_t k) {
-  double lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300};
-  for (const P3& p : s.verts)
-    for (int a = 0; a < 3; ++a) lo[a] = std::min(lo[a], p[a]), hi[a] = std::max(hi[a], p[a]);
+  double lo[3], hi[3];
+  bounding_box(s, lo, hi);
   int axis = 0;
   for (int a = 1; a < 3; ++a)
     if (hi[a] - lo[a] > hi[axis] - lo[axis]) axis = a;
