@@ -33,6 +33,7 @@
 #include "ccd_forms.hpp"
 #include "ccd_interval.hpp"
 #include "ccd_plane.hpp"
+#include "orientation_terms.hpp"
 #include "tetseg/runtime/ccd.hpp"
 
 namespace tetseg {
@@ -64,7 +65,10 @@ bool all_finite(const Vec3d* const* points, int count) noexcept {
 /// the subdivided cubic excludes sub-intervals, and a sub-interval it cannot exclude is given
 /// the full check only once the cubic no longer changes sign on it or it is a leaf (the
 /// crossing is isolated first; the inside conditions are then tested once, near it).
-enum class Depth { kFilter, kFull, kCoplanarOnly, kOpenCondition, kCubicFirst };
+/// kLeaf (exact contact): the leaf holding the only root of the coplanarity cubic on an
+/// interval (root_leaf): kFull, unless a coarser enclosure of the inside conditions over the
+/// whole leaf decides it first (leaf_outcome).
+enum class Depth { kFilter, kFull, kCoplanarOnly, kOpenCondition, kCubicFirst, kLeaf };
 
 /// The four points of a query at the ends of the time interval [ta, tb]: x[i][0] at ta,
 /// x[i][1] at tb.
@@ -114,6 +118,7 @@ struct VertexFaceTest {
     const Slot<I> pb = difference(x[0], x[2]);
     const Slot<I> ac = difference(x[1], x[3]);
     const Slot<I> pc = difference(x[0], x[3]);
+
     // In an axis-aligned plane for the whole step (exact contact): p is in the closed
     // triangle only if no two of its 2D orientations against the edges have strictly
     // opposite signs (inside a proper triangle they share the triangle's sign; on a
@@ -144,6 +149,24 @@ struct VertexFaceTest {
     const Vec3d* const* x = at_end ? x1 : x0;
     const int axis = shared_axis(x);
     return axis < 0 ? PlaneContact::kUnknown : vertex_triangle_2d(*x[0], *x[1], *x[2], *x[3], axis);
+  }
+
+  /// A crossing's leaf [ta, tb] decided from one enclosure of each edge-plane condition over
+  /// it (leaf_outcome): n . ((b-a) x (p-a)), n . ((c-b) x (p-b)), n . ((a-c) x (p-c)) with
+  /// n = (b-a) x (c-a). Not tried in an axis plane (they vanish with the triangle's area).
+  LeafOutcome leaf(double ta, double tb) const noexcept {
+    if (plane_axis >= 0) return LeafOutcome::kUndecided;
+    const Iv t = hull(exact(ta), exact(tb));
+    auto d = [&](int i, int j) { return difference_over(*x0[i], *x1[i], *x0[j], *x1[j], t); };
+    const IvVec u = d(2, 1), n = cross(u, d(3, 1));
+    return leaf_outcome({dot(n, cross(u, d(0, 1))), dot(n, cross(d(3, 2), d(0, 2))),
+                         dot(n, cross(d(1, 3), d(0, 3)))});
+  }
+
+  /// The coplanarity cubic on [0, 1] in doubles: det[p-a, b-a, c-a] = det[b-a, c-a, p-a].
+  BernsteinCubic step_cubic_terms() const noexcept {
+    return orientation_detail::cubic(x0[1]->data(), x0[0]->data(), x0[2]->data(), x0[3]->data(),
+                                     x1[1]->data(), x1[0]->data(), x1[2]->data(), x1[3]->data());
   }
 };
 
@@ -272,6 +295,24 @@ struct EdgeEdgeTest {
     const int axis = shared_axis(x);
     return axis < 0 ? PlaneContact::kUnknown : segments_2d(*x[0], *x[1], *x[2], *x[3], axis);
   }
+
+  /// A crossing's leaf [ta, tb] decided from one enclosure of each of h1..h4 (check) over it
+  /// (leaf_outcome): ((c-a) x (d-c)).n, ((b-c) x (d-c)).n, ((c-a) x (b-a)).n,
+  /// ((b-a) x (d-a)).n with n = (b-a) x (d-c). Not tried in an axis plane (n vanishes there).
+  LeafOutcome leaf(double ta, double tb) const noexcept {
+    if (plane_axis >= 0) return LeafOutcome::kUndecided;
+    const Iv t = hull(exact(ta), exact(tb));
+    auto d = [&](int i, int j) { return difference_over(*x0[i], *x1[i], *x0[j], *x1[j], t); };
+    const IvVec ba = d(1, 0), dc = d(3, 2), ca = d(2, 0), n = cross(ba, dc);
+    return leaf_outcome({dot(cross(ca, dc), n), dot(cross(d(1, 2), dc), n), dot(cross(ca, ba), n),
+                         dot(cross(ba, d(3, 0)), n)});
+  }
+
+  /// The coplanarity cubic on [0, 1] in doubles: det[b-a, d-a, c-a] = det[b-a, d-c, c-a].
+  BernsteinCubic step_cubic_terms() const noexcept {
+    return orientation_detail::cubic(x0[0]->data(), x0[1]->data(), x0[3]->data(), x0[2]->data(),
+                                     x1[0]->data(), x1[1]->data(), x1[3]->data(), x1[2]->data());
+  }
 };
 
 double clamp_tolerance(double tol) noexcept {
@@ -346,6 +387,26 @@ CcdResult run_bisection(const Test& test, const CcdOptions& options) noexcept {
     if (at_start == PlaneContact::kApart && nonzero_after_start(f)) return result;
   }
   const bool contact_at_end = at_end == PlaneContact::kTouching;
+  // The whole step in plain doubles first (exact contact): the coplanarity cubic with a
+  // rigorous error bound (step_cubic). Of one sign, there is no contact; changing sign with its
+  // only root in one leaf (root_leaf), that leaf is all there is to check, as the interval
+  // check of [0, 1] would decide (crossing_leaf) at a fraction of its cost. Otherwise that
+  // interval check runs as before.
+  if (exact_contact) {
+    const FloatBernstein cubic = step_cubic(test.step_cubic_terms());
+    if (proven_positive(cubic) || proven_negative(cubic)) {
+      result.intervals = 1;
+      return result;
+    }
+    double lo = 0.0, hi = 0.0;
+    if (proven_sign_change(cubic) && root_leaf(cubic, 0.0, 1.0, leaf_width(1.0, tol), lo, hi)) {
+      result.intervals = 1;  // [0, 1]: the cubic is nonzero at t = 0, no contact there
+      start_tested = true;
+      certified = contact_at_end;
+      top = 0;
+      stack[top++] = {lo, hi, Depth::kLeaf, {}};
+    }
+  }
   while (top > 0) {
     const Item item = stack[--top];
     ++result.intervals;
@@ -356,6 +417,7 @@ CcdResult run_bisection(const Test& test, const CcdOptions& options) noexcept {
     Sums<Iv, 4> open{};
     IntervalOutcome outcome{};
     bool checked = false;  // outcome from the interval check on [ta, tb]
+    LeafOutcome leaf_decision = LeafOutcome::kUndecided;
     // The check this interval gets when it is not decided by a subdivided polynomial alone,
     // and the one the double-double stage repeats.
     const Depth depth = item.depth == Depth::kCoplanarOnly ? Depth::kCoplanarOnly : Depth::kFull;
@@ -376,7 +438,7 @@ CcdResult run_bisection(const Test& test, const CcdOptions& options) noexcept {
       double lo = 0.0, hi = 0.0;
       if (root_leaf(item.poly, item.ta, item.tb, leaf_width(item.tb - item.ta, tol), lo, hi)) {
         ++result.intervals;  // the rest of [ta, tb], excluded
-        stack[top++] = {lo, hi, Depth::kFull, {}};
+        stack[top++] = {lo, hi, Depth::kLeaf, {}};
         continue;
       }
       FloatBernstein left{}, right{};
@@ -384,6 +446,13 @@ CcdResult run_bisection(const Test& test, const CcdOptions& options) noexcept {
       stack[top++] = {tm, item.tb, Depth::kCubicFirst, right};
       stack[top++] = {item.ta, tm, Depth::kCubicFirst, left};
       continue;
+    } else if (item.depth == Depth::kLeaf &&
+               (leaf_decision = test.leaf(item.ta, item.tb)) != LeafOutcome::kUndecided) {
+      // The coplanarity cubic has a root in the leaf (root_leaf proved it of opposite signs
+      // before and after): with the inside proven there, that root is a contact, and
+      // everything before the leaf is contact-free.
+      if (leaf_decision == LeafOutcome::kContact) return report(CcdOutcome::kContact, item.ta);
+      outcome.excluded = true;
     } else {
       // The whole step first (exact contact): a crossing goes straight to its root's leaf.
       const double jump_width = exact_contact && !start_tested ? leaf_width(1.0, tol) : 0.0;
@@ -394,7 +463,7 @@ CcdResult run_bisection(const Test& test, const CcdOptions& options) noexcept {
       // The cubic is proven nonzero at t = 0 (it changes sign on [0, 1]): no contact there.
       start_tested = true;
       certified = contact_at_end;
-      stack[top++] = {outcome.leaf_lo, outcome.leaf_hi, Depth::kFull, {}};
+      stack[top++] = {outcome.leaf_lo, outcome.leaf_hi, Depth::kLeaf, {}};
       continue;
     }
     if (outcome.excluded) continue;

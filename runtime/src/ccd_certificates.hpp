@@ -11,6 +11,7 @@
 
 #include "ccd_bernstein.hpp"
 #include "ccd_forms.hpp"
+#include "tetseg/runtime/classify.hpp"
 
 namespace tetseg::ccd_detail {
 // Internal linkage: ccd.cpp is the only translation unit, and GCC then inlines these as it
@@ -62,6 +63,23 @@ inline bool root_leaf(const FloatBernstein& p, double ta, double tb, double leaf
   lo = ta + lambda_lo * width;  // grid points: exact
   hi = ta + lambda_hi * width;
   return true;
+}
+
+/// The coplanarity cubic's Bernstein coefficients on the whole step [0, 1] in plain doubles,
+/// from the runtime's floating-point orientation cubic (`orientation_bernstein`, classify.hpp:
+/// coefficients k with forward error bounds err, k1 and k2 scaled by 3), with one error bound
+/// for all four: k0 and k3 as they are; k1 / 3 and k2 / 3 rounded once (at most 2^-53 of the
+/// result, charged 2^-52) with their bound not divided (a third of it would do). The bound is
+/// rounded upwards (kBoundRoundUp, kBoundFloor). `bound_scale` scales it (tests only; 1 in
+/// production): tests/runtime/ccd_filter_bound_test.cpp checks it against GMP, and that a
+/// fraction of it is violated.
+inline FloatBernstein step_cubic(const BernsteinCubic& k, double bound_scale = 1.0) noexcept {
+  FloatBernstein p{{k.k[0], k.k[1] / 3.0, k.k[2] / 3.0, k.k[3], 0.0}, 3, 0.0};
+  const double e1 = k.err[1] + 0x1p-52 * std::fabs(p.c[1]);
+  const double e2 = k.err[2] + 0x1p-52 * std::fabs(p.c[2]);
+  p.err = bound_scale * max_nan(max_nan(k.err[0], k.err[3]), max_nan(e1, e2)) * kBoundRoundUp +
+          kBoundFloor;
+  return p;
 }
 
 /// Width of the bisection's leaves below a dyadic interval of width `width`: the first halving
@@ -145,6 +163,23 @@ IntervalOutcome certify(const Sums<I, 3>& f, const Sums<I, 4>* const* conditions
   out.open_condition = out.certified;
   if (out.certified && open_condition != nullptr) *open_condition = g;
   return out;
+}
+
+/// A leaf holding a root of the coplanarity cubic, decided from the inside conditions alone.
+enum class LeafOutcome { kApart, kContact, kUndecided };
+
+/// `conditions`: enclosures of the inside conditions over the whole leaf (vertex-face: the
+/// three edge planes; edge-edge: h1..h4; their joint positivity where the cubic vanishes means
+/// contact, as in `certify`). One proven negative: apart. All proven positive: the cubic's root
+/// in the leaf is a contact. Otherwise undecided (the full check runs).
+template <int N>
+LeafOutcome leaf_outcome(const Iv (&conditions)[N]) noexcept {
+  bool inside = true;
+  for (const Iv& g : conditions) {
+    if (upper(g) < 0.0) return LeafOutcome::kApart;
+    inside = inside && lower(g) > 0.0;
+  }
+  return inside ? LeafOutcome::kContact : LeafOutcome::kUndecided;
 }
 
 /// True when the coplanarity cubic f, known to vanish at t = 1, is proven nonzero on [0, 1).

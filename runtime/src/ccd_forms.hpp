@@ -32,6 +32,18 @@ Vec<I> position(const Vec3d& x0, const Vec3d& x1, double t) noexcept {
           make<I>(x0[2]) + tt * (make<I>(x1[2]) - make<I>(x0[2]))};
 }
 
+/// Enclosure of (xi - xj)(t) for every t in the enclosure `t` (xi and xj moving linearly over
+/// the step, exact input ends): d0 + t (d1 - d0) with d0, d1 the differences at 0 and 1, in
+/// interval arithmetic (the value at each t of the enclosure is inside).
+inline IvVec difference_over(const Vec3d& xi0, const Vec3d& xi1, const Vec3d& xj0, const Vec3d& xj1,
+                             Iv t) noexcept {
+  auto coord = [&](int k) {
+    const Iv d0 = exact(xi0[k]) - exact(xj0[k]);
+    return d0 + t * ((exact(xi1[k]) - exact(xj1[k])) - d0);
+  };
+  return {coord(0), coord(1), coord(2)};
+}
+
 /// A vector affine in t over the current interval: enclosures of its values at both ends.
 template <class I>
 struct Slot {

@@ -1,8 +1,9 @@
 // The floating-point fast paths of the elementary CCD tests against exact rational arithmetic
-// (GMP): the filtered 2D orientation of the plane certificates (runtime/src/ccd_plane.hpp) and
-// the float Bernstein subdivision with its running error bound (runtime/src/ccd_bernstein.hpp).
-// Each must never claim what exact arithmetic contradicts, and each bound is load-bearing:
-// scaled down (an eighth of it), the same inputs produce wrong claims.
+// (GMP): the filtered 2D orientation of the plane certificates (runtime/src/ccd_plane.hpp), the
+// float Bernstein subdivision with its running error bound (runtime/src/ccd_bernstein.hpp) and
+// the coplanarity cubic of the whole step in doubles (step_cubic,
+// runtime/src/ccd_certificates.hpp). Each must never claim what exact arithmetic contradicts, and
+// each bound is load-bearing: scaled down (an eighth of it), the same inputs produce wrong claims.
 
 #include <array>
 #include <cmath>
@@ -12,7 +13,9 @@
 #include <catch2/catch.hpp>
 
 #include "../../runtime/src/ccd_bernstein.hpp"
+#include "../../runtime/src/ccd_certificates.hpp"
 #include "../../runtime/src/ccd_plane.hpp"
+#include "../../runtime/src/orientation_terms.hpp"
 
 namespace {
 
@@ -207,4 +210,72 @@ TEST_CASE("Float de Casteljau's right part stays within its bound, and an eighth
   INFO("largest error / bound: " << worst << "; with an eighth of the charge: " << worst_scaled);
   CHECK(worst <= 1.0);
   CHECK(worst_scaled > 1.0);  // the charge per level is load-bearing
+}
+
+namespace {
+
+using Moving = std::array<Point3, 8>;  // o, a, b, c at t = 0, then at t = 1
+
+/// Exact Bernstein coefficients on [0, 1] of det[a(t) - o(t), b(t) - o(t), c(t) - o(t)].
+std::array<mpq_class, 5> exact_step_cubic(const Moving& x) {
+  using Q3 = std::array<mpq_class, 3>;
+  auto diff = [&](int i, int end) {
+    Q3 d;
+    for (int k = 0; k < 3; ++k) d[k] = mpq_class(x[4 * end + i][k]) - x[4 * end][k];
+    return d;
+  };
+  auto det = [](const Q3& u, const Q3& v, const Q3& w) {
+    return mpq_class(u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0]) +
+                     u[2] * (v[0] * w[1] - v[1] * w[0]));
+  };
+  const Q3 u[2] = {diff(1, 0), diff(1, 1)}, v[2] = {diff(2, 0), diff(2, 1)},
+           w[2] = {diff(3, 0), diff(3, 1)};
+  std::array<mpq_class, 5> c{};
+  c[0] = det(u[0], v[0], w[0]);
+  c[1] = (det(u[1], v[0], w[0]) + det(u[0], v[1], w[0]) + det(u[0], v[0], w[1])) / 3;
+  c[2] = (det(u[0], v[1], w[1]) + det(u[1], v[0], w[1]) + det(u[1], v[1], w[0])) / 3;
+  c[3] = det(u[1], v[1], w[1]);
+  return c;
+}
+
+}  // namespace
+
+TEST_CASE(
+    "The whole step's coplanarity cubic in doubles stays within its bound, and a fraction "
+    "of it does not",
+    "[ccd][filter]") {
+  // Four points nearly coplanar at both ends (c on the plane of o, a, b, nudged by a few ulps),
+  // over many scales and far from the origin: the cancellations that come closest to the bound.
+  std::mt19937_64 rng(17);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  std::uniform_int_distribution<int> exponent(-20, 20);
+  std::uniform_int_distribution<int> ulps(-4, 4);
+  double worst = 0.0, worst_scaled = 0.0;
+  for (int trial = 0; trial < 100000; ++trial) {
+    const double scale = std::ldexp(1.0, exponent(rng));
+    const double offset = trial % 2 == 0 ? 0.0 : scale * std::ldexp(1.0, exponent(rng) / 2 + 10);
+    Moving x;
+    for (int end = 0; end < 2; ++end) {
+      for (int i = 0; i < 3; ++i)
+        for (int k = 0; k < 3; ++k) x[4 * end + i][k] = offset + scale * unit(rng);
+      const double s = 2.0 * unit(rng), r = 2.0 * unit(rng);
+      for (int k = 0; k < 3; ++k) {
+        const Point3 &o = x[4 * end], &a = x[4 * end + 1], &b = x[4 * end + 2];
+        double c = o[k] + s * (a[k] - o[k]) + r * (b[k] - o[k]);
+        for (int n = ulps(rng); n != 0; n += n > 0 ? -1 : 1)
+          c = std::nextafter(c, n > 0 ? INFINITY : -INFINITY);
+        x[4 * end + 3][k] = c;
+      }
+    }
+    const tetseg::BernsteinCubic k =
+        tetseg::orientation_detail::cubic(x[0].data(), x[1].data(), x[2].data(), x[3].data(),
+                                          x[4].data(), x[5].data(), x[6].data(), x[7].data());
+    const auto exact = exact_step_cubic(x);
+    worst = std::max(worst, violation(tetseg::ccd_detail::step_cubic(k), exact));
+    worst_scaled =
+        std::max(worst_scaled, violation(tetseg::ccd_detail::step_cubic(k, 0.125), exact));
+  }
+  INFO("largest error / bound: " << worst << "; with an eighth of the bound: " << worst_scaled);
+  CHECK(worst <= 1.0);
+  CHECK(worst_scaled > 1.0);  // the bound is load-bearing
 }
