@@ -394,7 +394,7 @@ CcdResult run_bisection(const Test& test, const CcdOptions& options) noexcept {
   // interval check runs as before.
   if (exact_contact) {
     const FloatBernstein cubic = step_cubic(test.step_cubic_terms());
-    if (proven_positive(cubic) || proven_negative(cubic)) {
+    if (proven_positive(cubic) || proven_negative(cubic) || one_signed_by_halving(cubic, 3)) {
       result.intervals = 1;
       return result;
     }

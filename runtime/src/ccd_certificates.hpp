@@ -82,6 +82,16 @@ inline FloatBernstein step_cubic(const BernsteinCubic& k, double bound_scale = 1
   return p;
 }
 
+/// True when halving p up to `levels` times proves it of one strict sign on every piece (so
+/// it has no root: the pieces share their ends).
+inline bool one_signed_by_halving(const FloatBernstein& p, int levels) noexcept {
+  if (proven_positive(p) || proven_negative(p)) return true;
+  if (levels == 0 || proven_sign_change(p)) return false;
+  FloatBernstein left{}, right{};
+  split_half(p, left, right);
+  return one_signed_by_halving(left, levels - 1) && one_signed_by_halving(right, levels - 1);
+}
+
 /// Width of the bisection's leaves below a dyadic interval of width `width`: the first halving
 /// not above tol.
 inline double leaf_width(double width, double tol) noexcept {
