@@ -67,7 +67,7 @@ bool all_finite(const Vec3d* const* points, int count) noexcept {
 /// crossing is isolated first; the inside conditions are then tested once, near it).
 /// kLeaf (exact contact): the leaf holding the only root of the coplanarity cubic on an
 /// interval (root_leaf): kFull, unless a coarser enclosure of the inside conditions over the
-/// whole leaf decides it first (leaf_outcome).
+/// whole leaf decides it first (LeafConditions).
 enum class Depth { kFilter, kFull, kCoplanarOnly, kOpenCondition, kCubicFirst, kLeaf };
 
 /// The four points of a query at the ends of the time interval [ta, tb]: x[i][0] at ta,
@@ -152,15 +152,18 @@ struct VertexFaceTest {
   }
 
   /// A crossing's leaf [ta, tb] decided from one enclosure of each edge-plane condition over
-  /// it (leaf_outcome): n . ((b-a) x (p-a)), n . ((c-b) x (p-b)), n . ((a-c) x (p-c)) with
-  /// n = (b-a) x (c-a). Not tried in an axis plane (they vanish with the triangle's area).
+  /// it, in turn (LeafConditions): n . ((b-a) x (p-a)), n . ((c-b) x (p-b)), n . ((a-c) x (p-c))
+  /// with n = (b-a) x (c-a). Not tried in an axis plane (they vanish with the triangle's area).
   LeafOutcome leaf(double ta, double tb) const noexcept {
     if (plane_axis >= 0) return LeafOutcome::kUndecided;
     const Iv t = hull(exact(ta), exact(tb));
     auto d = [&](int i, int j) { return difference_over(*x0[i], *x1[i], *x0[j], *x1[j], t); };
     const IvVec u = d(2, 1), n = cross(u, d(3, 1));
-    return leaf_outcome({dot(n, cross(u, d(0, 1))), dot(n, cross(d(3, 2), d(0, 2))),
-                         dot(n, cross(d(1, 3), d(0, 3)))});
+    LeafConditions c;
+    if (c.apart(dot(n, cross(u, d(0, 1)))) || c.apart(dot(n, cross(d(3, 2), d(0, 2)))) ||
+        c.apart(dot(n, cross(d(1, 3), d(0, 3)))))
+      return LeafOutcome::kApart;
+    return c.outcome();
   }
 
   /// The coplanarity cubic on [0, 1] in doubles: det[p-a, b-a, c-a] = det[b-a, c-a, p-a].
@@ -297,15 +300,18 @@ struct EdgeEdgeTest {
   }
 
   /// A crossing's leaf [ta, tb] decided from one enclosure of each of h1..h4 (check) over it
-  /// (leaf_outcome): ((c-a) x (d-c)).n, ((b-c) x (d-c)).n, ((c-a) x (b-a)).n,
+  /// in turn (LeafConditions): ((c-a) x (d-c)).n, ((b-c) x (d-c)).n, ((c-a) x (b-a)).n,
   /// ((b-a) x (d-a)).n with n = (b-a) x (d-c). Not tried in an axis plane (n vanishes there).
   LeafOutcome leaf(double ta, double tb) const noexcept {
     if (plane_axis >= 0) return LeafOutcome::kUndecided;
     const Iv t = hull(exact(ta), exact(tb));
     auto d = [&](int i, int j) { return difference_over(*x0[i], *x1[i], *x0[j], *x1[j], t); };
     const IvVec ba = d(1, 0), dc = d(3, 2), ca = d(2, 0), n = cross(ba, dc);
-    return leaf_outcome({dot(cross(ca, dc), n), dot(cross(d(1, 2), dc), n), dot(cross(ca, ba), n),
-                         dot(cross(ba, d(3, 0)), n)});
+    LeafConditions c;
+    if (c.apart(dot(cross(ca, dc), n)) || c.apart(dot(cross(d(1, 2), dc), n)) ||
+        c.apart(dot(cross(ca, ba), n)) || c.apart(dot(cross(ba, d(3, 0)), n)))
+      return LeafOutcome::kApart;
+    return c.outcome();
   }
 
   /// The coplanarity cubic on [0, 1] in doubles: det[b-a, d-a, c-a] = det[b-a, d-c, c-a].

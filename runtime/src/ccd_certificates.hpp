@@ -178,19 +178,26 @@ IntervalOutcome certify(const Sums<I, 3>& f, const Sums<I, 4>* const* conditions
 /// A leaf holding a root of the coplanarity cubic, decided from the inside conditions alone.
 enum class LeafOutcome { kApart, kContact, kUndecided };
 
-/// `conditions`: enclosures of the inside conditions over the whole leaf (vertex-face: the
-/// three edge planes; edge-edge: h1..h4; their joint positivity where the cubic vanishes means
-/// contact, as in `certify`). One proven negative: apart. All proven positive: the cubic's root
-/// in the leaf is a contact. Otherwise undecided (the full check runs).
-template <int N>
-LeafOutcome leaf_outcome(const Iv (&conditions)[N]) noexcept {
-  bool inside = true;
-  for (const Iv& g : conditions) {
-    if (upper(g) < 0.0) return LeafOutcome::kApart;
-    inside = inside && lower(g) > 0.0;
+/// The inside conditions of a leaf (vertex-face: the three edge planes; edge-edge: h1..h4;
+/// their joint positivity where the cubic vanishes means contact, as in `certify`), given in
+/// turn as enclosures over the whole leaf: one proven negative, apart (the rest need not be
+/// computed); all proven positive, the cubic's root in the leaf is a contact; otherwise
+/// undecided (the full check runs).
+class LeafConditions {
+ public:
+  /// Adds condition g; true when it is proven negative (the leaf is apart).
+  bool apart(Iv g) noexcept {
+    inside_ = inside_ && lower(g) > 0.0;
+    return upper(g) < 0.0;
   }
-  return inside ? LeafOutcome::kContact : LeafOutcome::kUndecided;
-}
+  /// The outcome once every condition was added and none was apart.
+  LeafOutcome outcome() const noexcept {
+    return inside_ ? LeafOutcome::kContact : LeafOutcome::kUndecided;
+  }
+
+ private:
+  bool inside_ = true;
+};
 
 /// True when the coplanarity cubic f, known to vanish at t = 1, is proven nonzero on [0, 1).
 /// f = (1 - t) g with g quadratic; g's Bernstein coefficients on [0, 1] are f's sums
