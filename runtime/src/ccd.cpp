@@ -394,10 +394,13 @@ CcdResult run_bisection(const Test& test, const CcdOptions& options) noexcept {
   }
   const bool contact_at_end = at_end == PlaneContact::kTouching;
   // The whole step in plain doubles first (exact contact): the coplanarity cubic with a
-  // rigorous error bound (step_cubic). Of one sign, there is no contact; changing sign with its
-  // only root in one leaf (root_leaf), that leaf is all there is to check, as the interval
-  // check of [0, 1] would decide (crossing_leaf) at a fraction of its cost. Otherwise that
-  // interval check runs as before.
+  // rigorous error bound (step_cubic). Of one sign (on [0, 1] or on every piece of a few
+  // halvings), there is no contact; changing sign with its only root in one leaf (root_leaf),
+  // that leaf is all there is to check, as the interval check of [0, 1] would decide
+  // (crossing_leaf) at a fraction of its cost. Otherwise, proven nonzero at t = 0 (no contact
+  // there), its halves are examined as below an interval where the cubic changes sign
+  // (kCubicFirst: excluded by its sign, or straight to a root's leaf, or checked in full). Only
+  // when even that fails does the interval check of [0, 1] run as before.
   if (exact_contact) {
     const FloatBernstein cubic = step_cubic(test.step_cubic_terms());
     if (proven_positive(cubic) || proven_negative(cubic) || one_signed_by_halving(cubic, 3)) {
@@ -411,6 +414,15 @@ CcdResult run_bisection(const Test& test, const CcdOptions& options) noexcept {
       certified = contact_at_end;
       top = 0;
       stack[top++] = {lo, hi, Depth::kLeaf, {}};
+    } else if (std::fabs(cubic.c[0]) > cubic.err) {
+      result.intervals = 1;
+      start_tested = true;
+      certified = contact_at_end;
+      top = 0;
+      FloatBernstein left{}, right{};
+      split_half(cubic, left, right);
+      stack[top++] = {0.5, 1.0, Depth::kCubicFirst, right};
+      stack[top++] = {0.0, 0.5, Depth::kCubicFirst, left};
     }
   }
   while (top > 0) {
