@@ -458,8 +458,10 @@ int check(const std::string& asset_path, const std::string& frames_path) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"tetseg-bench: benchmarks of the runtime collider (docs/benchmarks.md)",
+  CLI::App app{"tetseg-bench " TETSEG_VERSION
+               ": benchmarks of the runtime collider (docs/benchmarks.md)",
                "tetseg-bench"};
+  app.set_version_flag("--version", "tetseg-bench " TETSEG_VERSION);
   app.require_subcommand(1);
   CLI::App* t = app.add_subcommand(
       "table", "Table I: per-step stage times, work counts and missed contacts per mode");
