@@ -5,6 +5,7 @@
 # non-conservative fast-cubic baseline), then on whole scalable-CCD frames.
 # Usage: scripts/bench-ccd.sh [build-dir]   (default build-bench-ccd; data from ../shared)
 set -euo pipefail
+source "$(dirname "${BASH_SOURCE[0]}")/lib/bench-common.sh"
 cd "$(dirname "$0")/.."
 build=${1:-build-bench-ccd}
 data=${TETSEG_SHARED_DIR:-$PWD/../shared}/data/ccd-queries
@@ -14,7 +15,7 @@ cmake --build "$build" --target tetseg-ccd -j 2 >/dev/null
 tool="$build/tools/tetseg-ccd"
 [ -d "$data/sample-queries" ] || { echo "reference data not found under $data" >&2; exit 1; }
 
-echo "== machine: $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | xargs)"
+echo "== $(bench_machine "$build")"
 for method in conservative fast-cubic; do
   echo "== reference queries, --method $method (3 runs; mean CPU time of the test calls per query)"
   for run in 1 2 3; do

@@ -7,6 +7,7 @@
 # Usage: scripts/bench-charge-real.sh [build-dir] [mesh names]
 #        (default build-bench-charge and 16 meshes; e.g. `build elephant dino femur`)
 set -euo pipefail
+source "$(dirname "${BASH_SOURCE[0]}")/lib/bench-common.sh"
 cd "$(dirname "$0")/.."
 build=${1:-build-bench-charge}
 shift || true
@@ -25,10 +26,7 @@ if [ ! -d "$meshes" ]; then
   mkdir -p "$build/bench-data"
   tar xzf /usr/share/doc/libcgal-dev/data.tar.gz -C "$build/bench-data" data/meshes
 fi
-echo "== machine: $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | xargs)," \
-  "load average $(cut -d' ' -f1-3 /proc/loadavg), $(date -u '+%Y-%m-%d %H:%M UTC')," \
-  "commit $(git -C "$(sed -n 's/^CMAKE_HOME_DIRECTORY:INTERNAL=//p' "$build/CMakeCache.txt")" \
-    rev-parse --short HEAD)"
+echo "== $(bench_machine "$build")"
 echo "| mesh | N | iterations | residual | exact residual | solve s | total s | CPU s |"
 echo "|---|---|---|---|---|---|---|---|"
 for name in $names; do

@@ -11,6 +11,7 @@
 #        solver specs name[/jacobi|block|near|two][@tolerance|@auto][:order[:theta]];
 #        `--repeat N` keeps the fastest of N runs)
 set -euo pipefail
+source "$(dirname "${BASH_SOURCE[0]}")/lib/bench-common.sh"
 cd "$(dirname "$0")/.."
 build=${1:-build-bench-charge}
 shift || true
@@ -21,6 +22,5 @@ if [ ! -f "$meshes/elephant.off" ] && [ -f /usr/share/doc/libcgal-dev/data.tar.g
   mkdir -p "$build/bench-data"
   tar xzf /usr/share/doc/libcgal-dev/data.tar.gz -C "$build/bench-data" data/meshes/elephant.off
 fi
-echo "== machine: $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | xargs)," \
-  "load average $(cut -d' ' -f1-3 /proc/loadavg)"
+echo "== $(bench_machine "$build")"
 "$build/tools/tetseg-bench-charge" --mesh-dir "$meshes" "$@"

@@ -19,6 +19,7 @@
 # To compare with an older build, run the script once per build in the same minutes (a build
 # whose tetseg-bench reports no medians prints n/a for them).
 set -euo pipefail
+source "$(dirname "${BASH_SOURCE[0]}")/lib/bench-common.sh"
 repo=$(cd "$(dirname "$0")/.." && pwd)
 [ $# -ge 2 ] || { echo "usage: $0 BUILD_DIR SCENES_DIR [DATA_DIR]" >&2; exit 2; }
 build=$(cd "$1" && pwd)
@@ -26,18 +27,15 @@ scenes=$(cd "$2" && pwd)
 data=${3:-$repo/../shared/data/ccd-queries}
 bench=$build/tools/tetseg-bench
 ccd=$build/tools/tetseg-ccd
-for t in "$bench" "$ccd"; do
-  [ -x "$t" ] || { echo "bench-contact-rich: $t missing: build it first" >&2; exit 1; }
-done
+bench_require_tools "$build" tetseg-bench tetseg-ccd
 names=(armadillo pawn elephant dino dumbbell)
 for s in "${names[@]}"; do
-  for f in "$scenes/$s.tetseg" "$scenes/$s.queries.tsf"; do
-    [ -f "$f" ] || { echo "bench-contact-rich: $f missing: run scripts/make-scenes.sh" >&2; exit 1; }
-  done
+  bench_require_scenes "$scenes/$s.tetseg" "$scenes/$s.queries.tsf"
 done
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 
+echo "== $(bench_machine "$build")"
 echo "## Recorded steps ($build, $(date -u +%F))"
 echo
 for s in "${names[@]}"; do

@@ -17,6 +17,7 @@
 #   --jobs      meshes run at once (default 1: the timings are then comparable)
 #   --smallest  only the N smallest files (by bytes), for a quick subset
 set -euo pipefail
+source "$(dirname "${BASH_SOURCE[0]}")/lib/bench-common.sh"
 
 usage() {
   sed -n '/^# Usage:/,/^#   --smallest/p' "$0" | sed 's/^# \{0,1\}//' >&2
@@ -46,7 +47,7 @@ while [ $# -gt 0 ]; do
 done
 [ -n "$build" ] || usage
 tetseg="$(cd "$build" && pwd)/tools/tetseg"
-[ -x "$tetseg" ] || { echo "bench-corpus.sh: $tetseg not found (build the tetseg target)" >&2; exit 1; }
+bench_require_tools "$build" tetseg
 mesh_dir=${mesh_dir:-$build/test-data/cgal/data/meshes}
 [ -d "$mesh_dir" ] || { echo "bench-corpus.sh: no mesh folder $mesh_dir" >&2; exit 1; }
 
@@ -119,7 +120,7 @@ export work limit tetseg
 mkdir -p "$work/rows"
 
 echo "# tetseg build over $(wc -l <"$work/list") meshes of $mesh_dir; modes $modes; limit ${limit}s; jobs $jobs"
-echo "# machine: $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | xargs); $(date -u +%F)"
+echo "# $(bench_machine "$build")"
 printf 'mode\tmesh\texit\tfailed stage\tmessage\trepairs\tdeviation (in->mesh/mesh->in, of diagonal)\ttriangles\tclusters\tseconds\n'
 for mode in ${modes//,/ }; do
   awk -v m="$mode" '{ printf "%s %d %s\n", m, NR, $0 }' "$work/list"

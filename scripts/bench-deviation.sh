@@ -12,6 +12,7 @@
 #   MESH...       surface files (default: elephant.off, fandisk.off and cow.off of libcgal-demo:
 #                 organic, sharp CAD, self-intersecting so wrapped by --repair auto)
 set -euo pipefail
+source "$(dirname "${BASH_SOURCE[0]}")/lib/bench-common.sh"
 
 usage() {
   sed -n '/^# Usage:/,/^#                 organic/p' "$0" | sed 's/^# \{0,1\}//' >&2
@@ -31,9 +32,7 @@ while [ $# -gt 0 ]; do
 done
 [ -n "$build" ] || usage
 tools="$(cd "$build" && pwd)/tools"
-for tool in tetseg tetseg-sim tetseg-run; do
-  [ -x "$tools/$tool" ] || { echo "bench-deviation.sh: $tools/$tool not found (build it)" >&2; exit 1; }
-done
+bench_require_tools "$build" tetseg tetseg-sim tetseg-run
 if [ ${#meshes[@]} -eq 0 ]; then
   data="$build/test-data/cgal/data/meshes"
   meshes=("$data/elephant.off" "$data/fandisk.off" "$data/cow.off")
@@ -43,7 +42,8 @@ work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 
 echo "# tetseg build --max-deviation D (other options default), then a 20-frame tetseg-sim drop and"
-echo "# tetseg-run (rvbc, all contacts) on its asset; machine: $(nproc) cores, $(date -u +%F)"
+echo "# tetseg-run (rvbc, all contacts) on its asset"
+echo "# $(bench_machine "$build")"
 echo "| mesh | D | repair | deviation in->mesh | mesh->in | excess | surface triangles | build s | step ms (mean) |"
 echo "| --- | --- | --- | --- | --- | --- | --- | --- | --- |"
 for mesh in "${meshes[@]}"; do

@@ -6,6 +6,7 @@
 # (read + validate), the charge and the whole run (the rest is mostly writing the CSV).
 # Usage: scripts/bench-read-off.sh [tetseg binary ...]   (default build/tools/tetseg)
 set -euo pipefail
+source "$(dirname "${BASH_SOURCE[0]}")/lib/bench-common.sh"
 cd "$(dirname "$0")/.."
 binaries=("$@")
 [ ${#binaries[@]} -gt 0 ] || binaries=(build/tools/tetseg)
@@ -31,8 +32,7 @@ with open(sys.argv[1], "w") as f:
             f.write(f"3 {a} {b} {c}\n3 {a} {c} {d}\n")
 PY
 fi
-echo "== machine: $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | xargs)," \
-  "load average $(cut -d' ' -f1-3 /proc/loadavg), $(date -u '+%Y-%m-%d %H:%M UTC')"
+echo "== $(bench_machine)"
 echo "| binary | read + validate s | charge s | whole run s |"
 echo "|---|---|---|---|"
 for round in 1 2; do

@@ -8,16 +8,18 @@
 #
 # Needs the scenes of scripts/make-scenes.sh (NAME.mesh and NAME.tsf). About a minute.
 set -euo pipefail
+source "$(dirname "${BASH_SOURCE[0]}")/lib/bench-common.sh"
 repo=$(cd "$(dirname "$0")/.." && pwd)
 build=$(cd "${1:-$repo/build}" && pwd)
 scenes=${2:-$build/scenes}
-for t in tetseg tetseg-bench; do [ -x "$build/tools/$t" ] || { echo "bench-refine-grid: build $t first: cmake --build $build --target $t" >&2; exit 1; }; done
+bench_require_tools "$build" tetseg tetseg-bench
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
+echo "== $(bench_machine "$build")"
 gains="0.25 0.5 1 2"
 visibilities="0.97 0.98 0.99"
 for s in pawn dumbbell elephant armadillo dino; do
-  [ -f "$scenes/$s.tsf" ] || { echo "bench-refine-grid: $scenes/$s.tsf missing: run scripts/make-scenes.sh" >&2; exit 1; }
+  bench_require_scenes "$scenes/$s.tsf"
   args=()
   for g in $gains; do
     for v in $visibilities; do

@@ -9,6 +9,7 @@
 # whole sequence of scenes over 10k triangles (minutes).
 # Usage: scripts/bench-runtime.sh [build-dir]   (default build-bench-runtime)
 set -euo pipefail
+source "$(dirname "${BASH_SOURCE[0]}")/lib/bench-common.sh"
 cd "$(dirname "$0")/.."
 build=${1:-build-bench-runtime}
 cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DTETSEG_BUILD_TESTS=OFF >/dev/null
@@ -25,6 +26,7 @@ scenes=(
   "pawn-8k pawn twist 64 64 24"
   "pawn-waves-8k pawn waves 64 64 24"
 )
+echo "== $(bench_machine "$build")"
 echo "| scene | triangles | steps | mode | refit ms | classify ms | traversal ms | tests ms | total ms |"
 echo "| --- | --- | --- | --- | --- | --- | --- | --- | --- |"
 for entry in "${scenes[@]}"; do

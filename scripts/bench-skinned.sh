@@ -11,6 +11,7 @@
 # Builds the three tools it needs in BUILD_DIR. Single thread; every step is run 3 times and
 # its fastest run kept.
 set -euo pipefail
+source "$(dirname "${BASH_SOURCE[0]}")/lib/bench-common.sh"
 repo=$(cd "$(dirname "$0")/.." && pwd)
 build=$(cd "${1:?usage: scripts/bench-skinned.sh BUILD_DIR [OUT_DIR]}" && pwd)
 cmake --build "$build" -j 2 --target tetseg tetseg-character tetseg-bench >/dev/null
@@ -43,6 +44,7 @@ for entry in "${characters[@]}"; do
     "$name-weights" "$out/$name-weights.tetseg" "$out/$name.tsf" \
     --bones "$out/$name.bones.tsf" --modes rvbc,bvh --repeat 3 --json >"$out/$name.json"
 done
+echo "== $(bench_machine "$build")"
 # One table: per step, mean and median over steps of the kept run's CPU and wall time.
 python3 - "$out" "${characters[@]%%:*}" <<'PY'
 import json, sys

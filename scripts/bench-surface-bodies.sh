@@ -21,6 +21,7 @@
 #     and without `--asset` (thread CPU s, PLY reading excluded, fastest of 3) and the pairs
 #     each reports against the frame's exact truth (boxes + mma_bool).
 set -euo pipefail
+source "$(dirname "${BASH_SOURCE[0]}")/lib/bench-common.sh"
 repo=$(cd "$(dirname "$0")/.." && pwd)
 [ $# -ge 2 ] || { echo "usage: $0 BUILD_DIR SCENES_DIR [DATA_DIR]" >&2; exit 2; }
 build=$(cd "$1" && pwd)
@@ -29,18 +30,15 @@ data=${3:-$repo/../shared/data/ccd-queries}
 tetseg=$build/tools/tetseg
 bench=$build/tools/tetseg-bench
 ccd=$build/tools/tetseg-ccd
-for t in "$tetseg" "$bench" "$ccd"; do
-  [ -x "$t" ] || { echo "bench-surface-bodies: $t missing: build it first" >&2; exit 1; }
-done
+bench_require_tools "$build" tetseg tetseg-bench tetseg-ccd
 names=(armadillo elephant)
 for s in "${names[@]}"; do
-  for f in "$scenes/$s.tetseg" "$scenes/$s.tsf" "$scenes/$s.queries.tsf"; do
-    [ -f "$f" ] || { echo "bench-surface-bodies: $f missing: run scripts/make-scenes.sh" >&2; exit 1; }
-  done
+  bench_require_scenes "$scenes/$s.tetseg" "$scenes/$s.tsf" "$scenes/$s.queries.tsf"
 done
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 
+echo "== $(bench_machine "$build")"
 echo "## Surface bodies against tet assets ($build, $(date -u +%F), $(nproc) cores)"
 echo
 for s in "${names[@]}"; do

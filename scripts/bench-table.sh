@@ -9,16 +9,16 @@
 # Every step is run 3 times and its fastest run kept; brute force is the truth (slow: about
 # a minute for the pawn).
 set -euo pipefail
+source "$(dirname "${BASH_SOURCE[0]}")/lib/bench-common.sh"
 repo=$(cd "$(dirname "$0")/.." && pwd)
 build=$(cd "${1:-$repo/build}" && pwd)
 scenes=${2:-$build/scenes}
-for t in tetseg tetseg-bench; do [ -x "$build/tools/$t" ] || { echo "bench-table: build $t first: cmake --build $build --target $t" >&2; exit 1; }; done
+bench_require_tools "$build" tetseg tetseg-bench
 bench=$build/tools/tetseg-bench
 tetseg=$build/tools/tetseg
-for s in pawn dumbbell elephant; do
-  [ -f "$scenes/$s.tsf" ] || { echo "bench-table: $scenes/$s.tsf missing: run scripts/make-scenes.sh" >&2; exit 1; }
-done
+bench_require_scenes "$scenes"/{pawn,dumbbell,elephant}.tsf
 
+echo "== $(bench_machine "$build")"
 echo "## Table I (tetseg-bench table, $(date -u +%F))"
 echo
 "$bench" table pawn "$scenes/pawn.tetseg" "$scenes/pawn.tsf" \
@@ -28,9 +28,7 @@ echo
 echo
 echo "## Cluster methods (rvbc, single thread; brute force is the truth)"
 echo
-for s in armadillo dino; do
-  [ -f "$scenes/$s.tsf" ] || { echo "bench-table: $scenes/$s.tsf missing: run scripts/make-scenes.sh" >&2; exit 1; }
-done
+bench_require_scenes "$scenes"/{armadillo,dino}.tsf
 args=()
 for s in pawn dumbbell elephant armadillo dino; do
   for c in refined charge single; do

@@ -11,12 +11,12 @@
 # Needs tetseg, tetseg-dump, tetseg-sim and tetseg-bench built in BUILD_DIR (Release). About
 # 10 minutes of CPU on 2 cores (the twisted mat is most of it).
 set -euo pipefail
+source "$(dirname "${BASH_SOURCE[0]}")/lib/bench-common.sh"
 repo=$(cd "$(dirname "$0")/.." && pwd)
 build=$(cd "${1:-$repo/build}" && pwd)
 out=${2:-$build/scenes}
-for t in tetseg tetseg-dump tetseg-sim tetseg-bench; do
-  [ -x "$build/tools/$t" ] || { echo "bench-thin: build $t first" >&2; exit 1; }
-done
+bench_require_tools "$build" tetseg tetseg-dump tetseg-sim tetseg-bench
+echo "== $(bench_machine "$build")"
 TETSEG_SCENES=thin "$repo/scripts/make-scenes.sh" "$build" "$out"
 cd "$out"
 echo "| shape | nodes | interior nodes | surface triangles | components | build s | clusters | detectors inside tets | overlap-only | lowest rest visibility |"

@@ -24,12 +24,13 @@
 # docs/benchmarks.md, about 3 minutes more).
 # Needs tetseg and tetseg-sim built in BUILD_DIR (Release). A few minutes on 2 cores.
 set -euo pipefail
+source "$(dirname "${BASH_SOURCE[0]}")/lib/bench-common.sh"
 repo=$(cd "$(dirname "$0")/.." && pwd)
 build=$(cd "${1:-$repo/build}" && pwd)
 out=${2:-$build/scenes}
 mkdir -p "$out"
 out=$(cd "$out" && pwd)
-for t in tetseg tetseg-sim; do [ -x "$build/tools/$t" ] || { echo "make-scenes: build it first: cmake --build $build --target tetseg tetseg-sim" >&2; exit 1; }; done
+bench_require_tools "$build" tetseg tetseg-sim
 tetseg=$build/tools/tetseg
 sim=$build/tools/tetseg-sim
 cd "$out"

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <cstring>
 #include <iostream>
+#include <new>
 
 #include <unistd.h>
 
@@ -84,6 +85,31 @@ std::string json_escape(const std::string& text) {
 
 int parse_error_exit(const CLI::App& app, const CLI::ParseError& error) {
   return app.exit(error) == 0 ? kExitOk : kExitUsage;
+}
+
+int run_tool(const std::string& tool, CLI::App& app, int argc, const char* const* argv,
+             const std::function<int()>& body, const std::string& file_of_other_errors,
+             const std::function<void()>& rethrow_as_tool_error) {
+  try {
+    app.parse(argc, argv);
+    return body();
+  } catch (const CLI::ParseError& e) {
+    return parse_error_exit(app, e);  // help, version or usage error
+  } catch (...) {
+    try {
+      if (rethrow_as_tool_error) rethrow_as_tool_error();
+      throw;
+    } catch (const ToolError& e) {
+      print_error(tool, e.file(), e.what());
+      return e.code();
+    } catch (const std::bad_alloc&) {
+      print_error(tool, file_of_other_errors, "out of memory");
+      return kExitProcessingFailed;
+    } catch (const std::exception& e) {
+      print_error(tool, file_of_other_errors, e.what());
+      return kExitProcessingFailed;
+    }
+  }
 }
 
 }  // namespace tetseg::tools

@@ -62,6 +62,19 @@ inline void write_file_atomic(const std::string& path, const std::vector<std::ui
 /// returns the tool's exit code (kExitOk for --help / --version, else kExitUsage).
 int parse_error_exit(const CLI::App& app, const CLI::ParseError& error);
 
+/// A tool's whole `main`, the tools' one mapping of errors to messages and exit codes
+/// (docs/cli.md): parses `argv` with `app` (running any subcommand callbacks), then returns
+/// `body()`. Help, --version and usage errors end as parse_error_exit says; a ToolError prints
+/// `<tool>: error: <file>: <message>` and returns its code; std::bad_alloc prints "out of
+/// memory" and any other std::exception its message, both kExitProcessingFailed and naming
+/// `file_of_other_errors` (read when the error is reported, so it may be an option's variable;
+/// "" names none). `rethrow_as_tool_error`, when given, is called in the handler of any
+/// exception but a parse error: it rethrows it (`throw;`) and turns the tool's own exception
+/// types into ToolErrors.
+int run_tool(const std::string& tool, CLI::App& app, int argc, const char* const* argv,
+             const std::function<int()>& body, const std::string& file_of_other_errors = "",
+             const std::function<void()>& rethrow_as_tool_error = nullptr);
+
 /// File name without directories ("a/b/c.mesh" -> "c.mesh").
 std::string base_name(const std::string& path);
 

@@ -415,12 +415,7 @@ int main(int argc, char** argv) {
   truth->add_option("bools", bools_path, "mma_bool/<a>{vf,ee}_mma_bool.json")->required();
   truth->add_option("--kind", kind, "vf or ee")->required()->check(CLI::IsMember({"vf", "ee"}));
 
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    return parse_error_exit(app, e);  // help, version or usage error
-  }
-  try {
+  return run_tool(kTool, app, argc, argv, [&] {
     if (queries->parsed()) return command_queries(dir, json, method, options);
     if (frames->parsed())
       return command_frames(ply0, ply1, json, options,
@@ -430,11 +425,5 @@ int main(int argc, char** argv) {
                             skip_still ? soup::StillPairs::kSkip : soup::StillPairs::kInclude,
                             asset_path);
     return command_truth(truth_ply, boxes_path, bools_path, kind);
-  } catch (const ToolError& e) {
-    print_error(kTool, e.file(), e.what());
-    return e.code();
-  } catch (const std::exception& e) {
-    print_error(kTool, "", e.what());
-    return kExitProcessingFailed;
-  }
+  });
 }

@@ -94,19 +94,5 @@ int main(int argc, char** argv) {
   app.add_option("--wobble", a.wobble,
                  "Out-of-plane swing of the joints at mid-sequence, degrees (default 10)")
       ->check(CLI::Range(-90.0, 90.0));
-  try {
-    app.parse(argc, argv);
-    return run(a);
-  } catch (const CLI::ParseError& e) {
-    return parse_error_exit(app, e);
-  } catch (const ToolError& e) {
-    print_error(kTool, e.file(), e.what());
-    return e.code();
-  } catch (const std::bad_alloc&) {
-    print_error(kTool, "", "out of memory");
-    return kExitProcessingFailed;
-  } catch (const std::exception& e) {
-    print_error(kTool, "", e.what());
-    return kExitProcessingFailed;
-  }
+  return run_tool(kTool, app, argc, argv, [&] { return run(a); });
 }

@@ -68,8 +68,7 @@ int main(int argc, char** argv) {
   app.add_option("--rings", rings, "Rings along the axis (>= 2)")->check(CLI::Range(2, 4096));
   app.add_option("--frames", frame_count, "Frames (>= 2)")->check(CLI::Range(2, 100000));
   app.add_option("--obj-dir", obj_dir, "Also write frame_<i>.obj files (all nodes) here");
-  try {
-    app.parse(argc, argv);
+  return run_tool("tetseg-scene", app, argc, argv, [&] {
     Surface s;
     Scene scene;
     if (shape == "sphere") {
@@ -109,13 +108,5 @@ int main(int argc, char** argv) {
               << scene.asset.triangle_count() << " triangles, " << scene.asset.cluster_count()
               << " clusters, " << frames.size() << " frames\n";
     return kExitOk;
-  } catch (const CLI::ParseError& e) {
-    return parse_error_exit(app, e);  // help, version or usage error
-  } catch (const ToolError& e) {
-    print_error("tetseg-scene", e.file(), e.what());
-    return e.code();
-  } catch (const std::exception& e) {
-    print_error("tetseg-scene", "", e.what());
-    return kExitProcessingFailed;
-  }
+  });
 }

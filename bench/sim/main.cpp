@@ -26,6 +26,18 @@ namespace {
 using namespace tetseg::tools;
 constexpr const char* kTool = "tetseg-sim";
 
+/// The preprocess library's errors as the exit codes of docs/cli.md, naming the file without
+/// its directories (run_tool's hook).
+void rethrow_preprocess_error_as_tool_error() {
+  try {
+    throw;
+  } catch (const tetseg::preprocess::InputError& e) {
+    throw ToolError(kExitBadInput, base_name(e.file()), e.what());
+  } catch (const tetseg::preprocess::OutputError& e) {
+    throw ToolError(kExitOutputFailed, base_name(e.file()), e.what());
+  }
+}
+
 struct Args {
   std::string mesh, asset, output, scene_out, queries_out, mode = "rvbc";
   std::uint32_t record_every = 1;
@@ -310,25 +322,7 @@ int main(int argc, char** argv) {
                  "Share of the body's length held at each end (default 0.05)")
       ->check(CLI::Range(0.001, 0.499));
   app.add_flag("--json", a.json, "Print the counters as JSON on stdout");
-  try {
-    app.parse(argc, argv);
-    return run(a, opt);
-  } catch (const CLI::ParseError& e) {
-    return parse_error_exit(app, e);  // help, version or usage error
-  } catch (const ToolError& e) {
-    print_error(kTool, e.file(), e.what());
-    return e.code();
-  } catch (const tetseg::preprocess::InputError& e) {
-    print_error(kTool, base_name(e.file()), e.what());
-    return kExitBadInput;
-  } catch (const tetseg::preprocess::OutputError& e) {
-    print_error(kTool, base_name(e.file()), e.what());
-    return kExitOutputFailed;
-  } catch (const std::bad_alloc&) {
-    print_error(kTool, "", "out of memory");
-    return kExitProcessingFailed;
-  } catch (const std::exception& e) {
-    print_error(kTool, "", e.what());
-    return kExitProcessingFailed;
-  }
+  return run_tool(
+      kTool, app, argc, argv, [&] { return run(a, opt); }, "",
+      rethrow_preprocess_error_as_tool_error);
 }

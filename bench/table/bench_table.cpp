@@ -31,6 +31,7 @@
 #include "tetseg/runtime/collider.hpp"
 #include "tetseg/runtime/frames.hpp"
 #include "tetseg/testing/scene_oracle.hpp"
+#include "tool_support.hpp"
 
 namespace {
 
@@ -44,12 +45,10 @@ double process_cpu_ms() {
   return double(ts.tv_sec) * 1e3 + double(ts.tv_nsec) * 1e-6;
 }
 
-constexpr int kExitUsage = 2, kExitBadInput = 3, kExitFailed = 1;
-
-struct Failure {
-  int code;
-  std::string message;
-};
+using tetseg::tools::kExitBadInput;
+using tetseg::tools::kExitProcessingFailed;
+using tetseg::tools::kExitUsage;
+using tetseg::tools::ToolError;
 
 using Key = std::array<std::uint32_t, 5>;  // kind, nodes
 
@@ -103,12 +102,13 @@ void pose_detectors(Scene& s, const std::string& bones_path) {
   std::string why;
   const tetseg::FramesStatus fs = tetseg::read_frames_file(bones_path, bones, &why);
   if (fs != tetseg::FramesStatus::kOk)
-    throw Failure{kExitBadInput, bones_path + ": " + tetseg::to_string(fs) + ": " + why};
+    throw ToolError(kExitBadInput, "", bones_path + ": " + tetseg::to_string(fs) + ": " + why);
   const tetseg::format::Asset& a = s.asset.data();
   if (bones.node_count != 4 * a.bone_names.size() || bones.frame_count != s.frames.frame_count)
-    throw Failure{kExitBadInput, bones_path + ": expected " + std::to_string(a.bone_names.size()) +
-                                     " bones (4 points each) in " +
-                                     std::to_string(s.frames.frame_count) + " frames"};
+    throw ToolError(kExitBadInput, "",
+                    bones_path + ": expected " + std::to_string(a.bone_names.size()) +
+                        " bones (4 points each) in " + std::to_string(s.frames.frame_count) +
+                        " frames");
   const std::size_t per_frame = 3 * a.clusters.size();
   s.detectors.resize(per_frame * bones.frame_count);
   for (std::size_t f = 0; f < bones.frame_count; ++f)
@@ -120,12 +120,12 @@ void load_scene(Scene& s, const std::string& asset_path, const std::string& fram
   std::string why;
   const tetseg::Status st = tetseg::load_asset_file(asset_path, s.asset, &why);
   if (st != tetseg::Status::kOk)
-    throw Failure{kExitBadInput, asset_path + ": " + tetseg::to_string(st) + ": " + why};
+    throw ToolError(kExitBadInput, "", asset_path + ": " + tetseg::to_string(st) + ": " + why);
   const tetseg::FramesStatus fs = tetseg::read_frames_file(frames_path, s.frames, &why);
   if (fs != tetseg::FramesStatus::kOk)
-    throw Failure{kExitBadInput, frames_path + ": " + tetseg::to_string(fs) + ": " + why};
+    throw ToolError(kExitBadInput, "", frames_path + ": " + tetseg::to_string(fs) + ": " + why);
   if (s.frames.node_count != s.asset.node_count())
-    throw Failure{kExitBadInput, frames_path + ": node count differs from the asset's"};
+    throw ToolError(kExitBadInput, "", frames_path + ": node count differs from the asset's");
 }
 
 /// Median of `v` (mean of the two middle values for an even count; 0 when empty).
@@ -164,7 +164,7 @@ std::size_t step_end(std::size_t i, const Plan& plan) {
 std::vector<StepTruth> oracle_truth(const Scene& s, const Plan& plan) {
   tetseg::Collider collider(s.asset);
   if (collider.status() != tetseg::ColliderStatus::kOk)
-    throw Failure{kExitFailed, "cannot create the collider"};
+    throw ToolError(kExitProcessingFailed, "", "cannot create the collider");
   const auto& triangles = s.asset.data().triangles;
   std::vector<StepTruth> truth(step_count(s.frames, plan));
   for (std::size_t i = 0; i < truth.size(); ++i) {
@@ -197,7 +197,7 @@ Row run_mode(const Scene& s, tetseg::ColliderMode mode, bool openmp, const Plan&
   opt.time_tests = plan.time_tests;
   tetseg::Collider collider(s.asset, opt);
   if (collider.status() != tetseg::ColliderStatus::kOk)
-    throw Failure{kExitFailed, "cannot create the collider"};
+    throw ToolError(kExitProcessingFailed, "", "cannot create the collider");
   Row row;
   row.scene = s.name;
   row.mode = tetseg::to_string(mode);
@@ -214,8 +214,8 @@ Row run_mode(const Scene& s, tetseg::ColliderMode mode, bool openmp, const Plan&
         collider.set_detector_positions(s.detectors_at(step_start(i, plan)),
                                         s.detectors_at(step_end(i, plan)),
                                         3 * s.asset.cluster_count()) != tetseg::ColliderStatus::kOk)
-      throw Failure{kExitBadInput,
-                    s.name + ": detector positions of step " + std::to_string(i) + " rejected"};
+      throw ToolError(kExitBadInput, "",
+                      s.name + ": detector positions of step " + std::to_string(i) + " rejected");
     double best_total = 1e300, best_cpu = 1e300;
     tetseg::ColliderStats best_stats;
     tetseg::ContactsResult result;
@@ -224,13 +224,14 @@ Row run_mode(const Scene& s, tetseg::ColliderMode mode, bool openmp, const Plan&
       const double c0 = process_cpu_ms();
       const auto t0 = Clock::now();
       if (collider.step(x0, x1) != tetseg::ColliderStatus::kOk)
-        throw Failure{kExitBadInput, s.name + ": step " + std::to_string(i) + " rejected"};
+        throw ToolError(kExitBadInput, "", s.name + ": step " + std::to_string(i) + " rejected");
       const tetseg::ColliderStatus st =
           plan.earliest ? collider.earliest_toi(e)
                         : collider.contacts(buffer.data(), buffer.size(), result);
       const double ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
       best_cpu = std::min(best_cpu, process_cpu_ms() - c0);
-      if (st != tetseg::ColliderStatus::kOk) throw Failure{kExitFailed, s.name + ": query failed"};
+      if (st != tetseg::ColliderStatus::kOk)
+        throw ToolError(kExitProcessingFailed, "", s.name + ": query failed");
       if (ms < best_total) {
         best_total = ms;
         best_stats = collider.stats();
@@ -239,7 +240,7 @@ Row run_mode(const Scene& s, tetseg::ColliderMode mode, bool openmp, const Plan&
     // Untimed: the other query, for the counts and the comparison.
     if ((plan.earliest ? collider.contacts(buffer.data(), buffer.size(), result)
                        : collider.earliest_toi(e)) != tetseg::ColliderStatus::kOk)
-      throw Failure{kExitFailed, s.name + ": query failed"};
+      throw ToolError(kExitProcessingFailed, "", s.name + ": query failed");
     row.total += best_total;
     row.cpu += best_cpu;
     step_total.push_back(best_total);
@@ -300,7 +301,7 @@ std::string fmt(const char* f, double v) {
 int table(const std::vector<std::string>& scene_args, const std::vector<std::string>& bones_files,
           const std::string& mode_list, const Plan& plan, bool openmp, bool json, bool with_truth) {
   if (scene_args.empty() || scene_args.size() % 3 != 0)
-    throw Failure{kExitUsage, "scenes are given as NAME ASSET FRAMES triples"};
+    throw ToolError(kExitUsage, "", "scenes are given as NAME ASSET FRAMES triples");
   std::vector<tetseg::ColliderMode> modes;
   {
     std::size_t p = 0;
@@ -309,7 +310,7 @@ int table(const std::vector<std::string>& scene_args, const std::vector<std::str
       const std::string name = mode_list.substr(p, q - p);
       tetseg::ColliderMode m;
       if (!tetseg::parse_collider_mode(name.c_str(), m))
-        throw Failure{kExitUsage, "unknown mode '" + name + "'"};
+        throw ToolError(kExitUsage, "", "unknown mode '" + name + "'");
       modes.push_back(m);
       p = q + 1;
     }
@@ -324,11 +325,12 @@ int table(const std::vector<std::string>& scene_args, const std::vector<std::str
     load_scene(s, scene_args[i + 1], scene_args[i + 2]);
     if (s.asset.data().detector_form == tetseg::format::DetectorForm::kBones) {
       if (bones_used == bones_files.size())
-        throw Failure{kExitUsage, s.name + ": its detectors are carried by bones: give --bones"};
+        throw ToolError(kExitUsage, "",
+                        s.name + ": its detectors are carried by bones: give --bones");
       pose_detectors(s, bones_files[bones_used++]);
     }
     if (plan.pairs && s.frames.frame_count % 2 != 0)
-      throw Failure{kExitBadInput, scene_args[i + 2] + ": --pairs needs an even frame count"};
+      throw ToolError(kExitBadInput, "", scene_args[i + 2] + ": --pairs needs an even frame count");
     // A scene on the same frames as an earlier one (another asset of the same mesh, e.g.
     // another cluster method) reuses that scene's oracle truth.
     std::vector<StepTruth>& truth = truths[scene_args[i + 2]];
@@ -345,7 +347,7 @@ int table(const std::vector<std::string>& scene_args, const std::vector<std::str
     }
   }
   if (bones_used != bones_files.size())
-    throw Failure{kExitUsage, "more --bones files than scenes with bone-carried detectors"};
+    throw ToolError(kExitUsage, "", "more --bones files than scenes with bone-carried detectors");
   bool all_found = true;
   for (const Row& r : rows)
     all_found = all_found && r.missed == 0 && r.extra == 0 && r.any_mismatch == 0 &&
@@ -413,7 +415,7 @@ int table(const std::vector<std::string>& scene_args, const std::vector<std::str
                               : "NO")
               << "\n";
   }
-  return all_found ? 0 : kExitFailed;
+  return all_found ? 0 : kExitProcessingFailed;
 }
 
 /// `check`: every frame free of static self-intersection, every step free of contacts (the
@@ -424,7 +426,7 @@ int check(const std::string& asset_path, const std::string& frames_path) {
   load_scene(s, asset_path, frames_path);
   tetseg::Collider collider(s.asset);
   if (collider.status() != tetseg::ColliderStatus::kOk)
-    throw Failure{kExitFailed, "cannot create the collider"};
+    throw ToolError(kExitProcessingFailed, "", "cannot create the collider");
   const auto& triangles = s.asset.data().triangles;
   const std::size_t values = std::size_t(s.frames.node_count) * 3;
   std::size_t bad_frames = 0, bad_steps = 0, contacts = 0;
@@ -450,14 +452,16 @@ int check(const std::string& asset_path, const std::string& frames_path) {
   }
   std::printf("frames %u, self-intersecting frames %zu, steps with contacts %zu (%zu contacts)\n",
               s.frames.frame_count, bad_frames, bad_steps, contacts);
-  return bad_frames == 0 && bad_steps == 0 ? 0 : kExitFailed;
+  return bad_frames == 0 && bad_steps == 0 ? 0 : kExitProcessingFailed;
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"tetseg-bench: benchmarks of the runtime collider (docs/benchmarks.md)",
+  CLI::App app{"tetseg-bench " TETSEG_VERSION
+               ": benchmarks of the runtime collider (docs/benchmarks.md)",
                "tetseg-bench"};
+  app.set_version_flag("--version", "tetseg-bench " TETSEG_VERSION);
   app.require_subcommand(1);
   CLI::App* t = app.add_subcommand(
       "table", "Table I: per-step stage times, work counts and missed contacts per mode");
@@ -530,25 +534,15 @@ int main(int argc, char** argv) {
   sf->add_option("asset", surface_asset, "Tet asset (with rest positions)")->required();
   sf->add_option("surface", surface_off, "OFF file to write")->required();
   sf->add_option("frames", surface_frame_pairs, "FRAMES OUT_FRAMES, repeated")->expected(0, -1);
-  try {
-    app.parse(argc, argv);
+  return tetseg::tools::run_tool("tetseg-bench", app, argc, argv, [&] {
     if (c->parsed()) return check(check_asset, check_frames);
     if (sf->parsed()) {
       if (surface_frame_pairs.size() % 2 != 0)
-        throw Failure{kExitUsage, "surface: frame files come in pairs (FRAMES OUT_FRAMES)"};
+        throw ToolError(kExitUsage, "", "surface: frame files come in pairs (FRAMES OUT_FRAMES)");
       return tetseg::bench::surface_frames(surface_asset, surface_off, surface_frame_pairs);
     }
     if (sc->parsed()) return tetseg::bench::scene_table(scene_options);
     plan.earliest = query == "earliest";
     return table(scenes, bones_files, modes, plan, openmp, json, !no_truth);
-  } catch (const CLI::ParseError& e) {
-    const int code = app.exit(e);
-    return code == 0 ? 0 : kExitUsage;
-  } catch (const Failure& f) {
-    std::fprintf(stderr, "tetseg-bench: error: %s\n", f.message.c_str());
-    return f.code;
-  } catch (const std::bad_alloc&) {
-    std::fprintf(stderr, "tetseg-bench: error: out of memory\n");
-    return kExitFailed;
-  }
+  });
 }

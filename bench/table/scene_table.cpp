@@ -17,15 +17,17 @@
 #include "tetseg/runtime/frames.hpp"
 #include "tetseg/runtime/scene.hpp"
 #include "tetseg/testing/scene_oracle.hpp"
+#include "tool_support.hpp"
 
 namespace tetseg::bench {
 namespace {
 
 using Clock = std::chrono::steady_clock;
 
-struct BadInput {
-  std::string message;
-};
+/// A scene description or a file it names that cannot be used: exit 3 with `message`.
+tools::ToolError bad_input(const std::string& message) {
+  return tools::ToolError(tools::kExitBadInput, "", message);
+}
 
 /// One body of a scene description, with its node range in the frames' global array.
 struct DescribedBody {
@@ -46,7 +48,7 @@ struct DescribedScene {
 /// Reads a scene description (docs/format.md, "Scene descriptions") and its frames.
 DescribedScene read_scene(const std::string& name, const std::string& path) {
   std::ifstream in(path);
-  if (!in) throw BadInput{path + ": cannot be read"};
+  if (!in) throw bad_input(path + ": cannot be read");
   const std::filesystem::path dir = std::filesystem::path(path).parent_path();
   auto resolve = [&](const std::string& p) {
     const std::filesystem::path q(p);
@@ -57,7 +59,7 @@ DescribedScene read_scene(const std::string& name, const std::string& path) {
   std::string line, frames_path;
   std::size_t line_no = 0, offset = 0;
   auto fail = [&](const std::string& what) {
-    return BadInput{path + ": line " + std::to_string(line_no) + ": " + what};
+    return bad_input(path + ": line " + std::to_string(line_no) + ": " + what);
   };
   auto next = [&](std::istringstream& words) {
     if (!std::getline(in, line)) return false;
@@ -85,7 +87,7 @@ DescribedScene read_scene(const std::string& name, const std::string& path) {
       std::string why;
       const Status st = load_asset_file(resolve(asset_path), *b.asset, &why);
       if (st != Status::kOk)
-        throw BadInput{resolve(asset_path) + ": " + to_string(st) + ": " + why};
+        throw bad_input(resolve(asset_path) + ": " + to_string(st) + ": " + why);
       if (b.asset->node_count() != nodes) throw fail("node count differs from the asset's");
       b.triangles.assign(b.asset->data().triangles.begin(), b.asset->data().triangles.end());
       b.shape = BodyShape::from_asset(*b.asset);
@@ -112,15 +114,15 @@ DescribedScene read_scene(const std::string& name, const std::string& path) {
     offset += nodes;
     s.bodies.push_back(std::move(b));
   }
-  if (frames_path.empty()) throw BadInput{path + ": no 'frames' entry"};
-  if (s.bodies.empty()) throw BadInput{path + ": no bodies"};
+  if (frames_path.empty()) throw bad_input(path + ": no 'frames' entry");
+  if (s.bodies.empty()) throw bad_input(path + ": no bodies");
   std::string why;
   const FramesStatus fs = read_frames_file(resolve(frames_path), s.frames, &why);
   if (fs != FramesStatus::kOk)
-    throw BadInput{resolve(frames_path) + ": " + to_string(fs) + ": " + why};
+    throw bad_input(resolve(frames_path) + ": " + to_string(fs) + ": " + why);
   if (s.frames.node_count != offset)
-    throw BadInput{resolve(frames_path) + ": " + std::to_string(s.frames.node_count) +
-                   " nodes, the description's bodies have " + std::to_string(offset)};
+    throw bad_input(resolve(frames_path) + ": " + std::to_string(s.frames.node_count) +
+                    " nodes, the description's bodies have " + std::to_string(offset));
   // Obstacles are still: the same positions in every frame.
   for (const DescribedBody& b : s.bodies) {
     if (b.tet) continue;
@@ -128,13 +130,13 @@ DescribedScene read_scene(const std::string& name, const std::string& path) {
       if (!std::equal(s.frames.frame(0) + b.offset * 3,
                       s.frames.frame(0) + (b.offset + b.node_count) * 3,
                       s.frames.frame(f) + b.offset * 3))
-        throw BadInput{resolve(frames_path) + ": an obstacle moves in frame " + std::to_string(f)};
+        throw bad_input(resolve(frames_path) + ": an obstacle moves in frame " + std::to_string(f));
   }
   return s;
 }
 
 void require_ok(ColliderStatus st, const std::string& what) {
-  if (st != ColliderStatus::kOk) throw BadInput{what + ": " + to_string(st)};
+  if (st != ColliderStatus::kOk) throw bad_input(what + ": " + to_string(st));
 }
 
 struct Row {
@@ -176,7 +178,7 @@ Row run_scene(const DescribedScene& s, const SceneTableOptions& o) {
       for (const auto& t : b.triangles)
         for (std::uint32_t n : t) flat.push_back(static_cast<std::uint32_t>(b.offset + n));
     const auto shape = BodyShape::from_triangles(flat.data(), flat.size() / 3, s.frames.node_count);
-    if (!shape) throw BadInput{s.name + ": cannot merge the surfaces"};
+    if (!shape) throw bad_input(s.name + ": cannot merge the surfaces");
     BodyOptions bo;
     bo.mode = ColliderMode::kBvh;
     bo.global_offset = 0;
@@ -276,16 +278,10 @@ int scene_table(const SceneTableOptions& o) {
     return 2;
   }
   std::vector<Row> rows;
-  try {
-    for (std::size_t i = 0; i < o.scenes.size(); i += 2) {
-      const DescribedScene s = read_scene(o.scenes[i], o.scenes[i + 1]);
-      rows.push_back(run_scene(s, o));
-      std::fprintf(stderr, "tetseg-bench: %s done (%zu steps)\n", s.name.c_str(),
-                   rows.back().steps);
-    }
-  } catch (const BadInput& e) {
-    std::fprintf(stderr, "tetseg-bench: error: %s\n", e.message.c_str());
-    return 3;
+  for (std::size_t i = 0; i < o.scenes.size(); i += 2) {
+    const DescribedScene s = read_scene(o.scenes[i], o.scenes[i + 1]);
+    rows.push_back(run_scene(s, o));
+    std::fprintf(stderr, "tetseg-bench: %s done (%zu steps)\n", s.name.c_str(), rows.back().steps);
   }
   std::printf(
       "| scene | bodies | steps | refit ms | classify ms | self ms | pairs ms | total ms | "

@@ -23,8 +23,8 @@ struct SceneTableOptions {
 };
 
 /// Prints the Markdown table on stdout. Returns 0; 1 when a contact was missed or invented
-/// (or, with `expect_clean`, a frame or step is not clean); 3 on a bad input (message on
-/// stderr naming the file).
+/// (or, with `expect_clean`, a frame or step is not clean). A bad input throws
+/// tools::ToolError(kExitBadInput) naming the file in its message.
 int scene_table(const SceneTableOptions& options);
 
 }  // namespace tetseg::bench

@@ -73,6 +73,15 @@ bool contact_less(const Contact& a, const Contact& b) noexcept {
   return a.triangle < b.triangle;
 }
 
+std::size_t worker_count([[maybe_unused]] bool use_openmp,
+                         [[maybe_unused]] std::uint32_t threads) noexcept {
+#if defined(TETSEG_HAVE_OPENMP)
+  if (use_openmp)
+    return threads > 0 ? threads : static_cast<std::size_t>(std::max(1, omp_get_max_threads()));
+#endif
+  return 1;
+}
+
 void Collider::Impl::construct(std::shared_ptr<const BodyShape> sh, const ColliderOptions& o) {
   shape = std::move(sh);
   topo = &shape->data();
@@ -92,12 +101,7 @@ void Collider::Impl::construct(std::shared_ptr<const BodyShape> sh, const Collid
           ? opt.traversal_stack
           : std::max(4 * (std::size_t(std::max<std::uint32_t>(topo->max_depth, 64)) + 4),
                      16 * (2 * std::size_t(topo->wide_depth) + 2));
-  std::size_t threads = 1;
-#if defined(TETSEG_HAVE_OPENMP)
-  if (opt.use_openmp)
-    threads = opt.threads > 0 ? opt.threads
-                              : static_cast<std::size_t>(std::max(1, omp_get_max_threads()));
-#endif
+  const std::size_t threads = worker_count(opt.use_openmp, opt.threads);
   workers.resize(threads);
   // The whole-surface BVH's parallel traversal: 16 items per thread, with room for the
   // items expanded on the way (traverse_global_parallel).

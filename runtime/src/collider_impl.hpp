@@ -252,6 +252,10 @@ struct Worker {
   }
 };
 
+/// How many Workers a collider or a scene allocates: `threads` (0: OpenMP's default) when
+/// `use_openmp` in an OpenMP build, else 1. Defined in collider.cpp.
+std::size_t worker_count(bool use_openmp, std::uint32_t threads) noexcept;
+
 /// Per-step answers shared by the queries of a Collider or a Scene (reset by `step`).
 struct QueryCache {
   bool any_known = false, any_value = false;

@@ -213,7 +213,9 @@ bool Collider::Impl::traverse_wide(Worker& w, StackItem first, bool orient, bool
             stack[top++] = {c, kNone};
           }
         }
-        child_against_children(it.a, k, it.a, ~((bit << 1) - 1));  // the later siblings
+        // The later siblings (none after the last occupied slot: no overlap test then).
+        if (k < 3 && nd.child[k + 1] != kWideEmpty)
+          child_against_children(it.a, k, it.a, ~((bit << 1) - 1));
       }
       continue;
     }

@@ -92,13 +92,7 @@ Scene::Scene(const SceneOptions& options) noexcept {
   try {
     m_impl = std::make_unique<Impl>();
     m_impl->opt = options;
-    std::size_t threads = 1;
-#if defined(TETSEG_HAVE_OPENMP)
-    if (options.use_openmp)
-      threads = options.threads > 0 ? options.threads
-                                    : static_cast<std::size_t>(std::max(1, omp_get_max_threads()));
-#endif
-    m_impl->workers.resize(threads);
+    m_impl->workers.resize(worker_count(options.use_openmp, options.threads));
     for (Worker& w : m_impl->workers)
       w.stack.resize(options.traversal_stack > 0 ? options.traversal_stack : kSceneInitialStack);
   } catch (...) {

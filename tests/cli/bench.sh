@@ -10,6 +10,7 @@
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/common.bash"
 
+expect_exit 0 "tetseg-bench 0.1" -- "$bin/tetseg-bench" --version
 "$bin/tetseg-scene" dumbbell d.tetseg d.tsf --segments 16 --rings 20 --frames 12 2>/dev/null
 "$bin/tetseg" generate dumbbell --size 0.4 -o s.mesh 2>/dev/null
 "$bin/tetseg" build s.mesh -o s.tetseg -q

@@ -11,6 +11,9 @@ source "$(dirname "${BASH_SOURCE[0]}")/common.bash"  # $bin, $work, fail, expect
 "$bin/tetseg" generate sphere -o sphere.mesh --size 0.6 2>/dev/null
 "$bin/tetseg" build sphere.mesh -o sphere.tetseg --clusters single -q
 "$bin/tetseg-bench" surface sphere.tetseg sphere.off
+# An unwritable output is refused with the file named (exit 4), not a crash.
+expect_exit 4 "tetseg-bench: error: no-such-dir/s.off: cannot write" -- \
+  "$bin/tetseg-bench" surface sphere.tetseg no-such-dir/s.off
 # The same surface with its vertices in reverse order and one unused vertex at the end.
 python3 - <<'PY'
 lines = open("sphere.off").read().split("\n")

@@ -7,7 +7,6 @@
 
 #include "runtime/support/compare.hpp"
 #include "runtime/support/off.hpp"
-#include "tetseg/testing/test_data.hpp"
 
 using namespace tetseg;
 using namespace tetseg::test;
@@ -18,11 +17,7 @@ TEST_CASE("Radial-view culling matches brute force on deformed real meshes",
   const unsigned seed = GENERATE(11u, 12u);
   CAPTURE(name, seed);
   Surface s;
-  const std::string path = std::string(TETSEG_CGAL_MESH_DIR) + "/" + name + ".off";
-  if (!have_test_data(path, "CGAL demo mesh")) return;
-  REQUIRE(read_off(path, s));
-  REQUIRE(closed_and_consistent(s));
-  orient_outward(s);
+  if (!read_demo_surface(name, s)) return;
   const Scene scene = slab_scene(s, 5);
   const double size = bounding_diagonal(s);
   std::mt19937 rng(seed);

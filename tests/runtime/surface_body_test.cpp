@@ -17,7 +17,6 @@
 #include "tetseg/runtime/scene.hpp"
 #include "tetseg/testing/allocation_probe.hpp"
 #include "tetseg/testing/surface_bodies.hpp"
-#include "tetseg/testing/test_data.hpp"
 
 // Not `using namespace tetseg`: `Scene` is the test scene here (the runtime's is tetseg::Scene).
 using namespace tetseg::test;
@@ -259,11 +258,7 @@ TEST_CASE("Surface bodies on deformed real meshes match brute force",
   const std::string name = GENERATE(as<std::string>{}, "eight", "joint");
   CAPTURE(name);
   Surface s;
-  const std::string path = std::string(TETSEG_CGAL_MESH_DIR) + "/" + name + ".off";
-  if (!have_test_data(path, "CGAL demo mesh")) return;
-  REQUIRE(read_off(path, s));
-  REQUIRE(closed_and_consistent(s));
-  orient_outward(s);
+  if (!read_demo_surface(name, s)) return;
   const Scene scene = as_weighted_surface_body(slab_scene(s, 5), 5);
   const double size = bounding_diagonal(s);
   Waves waves(11, 0.2 * size, 6.0 / size);

@@ -232,12 +232,7 @@ int main(int argc, char** argv) {
   app.add_option("--ply", ply_path,
                  "Also write the surface with cluster colours and boundary "
                  "edges as .ply (needs rest positions)");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    return parse_error_exit(app, e);  // help, version or usage error
-  }
-  try {
+  auto dump = [&] {
     tetseg::Asset asset;
     std::string detail;
     const std::vector<std::uint8_t> bytes = read_bytes(path);
@@ -256,11 +251,6 @@ int main(int argc, char** argv) {
       print_summary(path, version, asset.data());
     }
     return kExitOk;
-  } catch (const ToolError& e) {
-    print_error("tetseg-dump", e.file(), e.what());
-    return e.code();
-  } catch (const std::exception& e) {
-    print_error("tetseg-dump", path, e.what());
-    return kExitProcessingFailed;
-  }
+  };
+  return run_tool("tetseg-dump", app, argc, argv, dump, path);
 }

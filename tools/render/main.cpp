@@ -87,12 +87,7 @@ int main(int argc, char** argv) {
   app.add_option("--scalar", scalar,
                  "PLY: colour faces by this face property (rescaled to [min,max]) instead of "
                  "their colours, e.g. --scalar charge");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    return parse_error_exit(app, e);  // help, version or usage error
-  }
-  try {
+  auto render = [&] {
     const bool ply = extension_of(input) == ".ply";
     if (!ply && !scalar.empty())
       throw ToolError(kExitUsage, "", "--scalar applies to .ply input only");
@@ -108,11 +103,6 @@ int main(int argc, char** argv) {
     const std::vector<std::uint8_t> rgb = render_rgb(mesh, options);
     write_file_atomic(output, encode_png(rgb, width, height, !stored));
     return kExitOk;
-  } catch (const ToolError& e) {
-    print_error("tetseg-render", e.file(), e.what());
-    return e.code();
-  } catch (const std::exception& e) {
-    print_error("tetseg-render", input, e.what());
-    return kExitProcessingFailed;
-  }
+  };
+  return run_tool("tetseg-render", app, argc, argv, render, input);
 }

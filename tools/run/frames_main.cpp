@@ -21,8 +21,7 @@ int main(int argc, char** argv) {
   std::vector<std::string> inputs;
   app.add_option("output", out, "Frame-sequence file to write")->required();
   app.add_option("inputs", inputs, "One mesh per frame, in order")->required();
-  try {
-    app.parse(argc, argv);
+  return run_tool("tetseg-frames", app, argc, argv, [&] {
     tetseg::FrameSequence frames;
     for (const std::string& path : inputs) {
       std::vector<double> xyz;
@@ -41,13 +40,5 @@ int main(int argc, char** argv) {
     std::cerr << "tetseg-frames: " << frames.frame_count << " frames of " << frames.node_count
               << " nodes -> " << out << '\n';
     return kExitOk;
-  } catch (const CLI::ParseError& e) {
-    return parse_error_exit(app, e);  // help, version or usage error
-  } catch (const ToolError& e) {
-    print_error("tetseg-frames", e.file(), e.what());
-    return e.code();
-  } catch (const std::exception& e) {
-    print_error("tetseg-frames", "", e.what());
-    return kExitProcessingFailed;
-  }
+  });
 }

@@ -176,19 +176,7 @@ int main(int argc, char** argv) {
   bool openmp = false;
   app.add_flag("--openmp", openmp,
                "Use OpenMP threads inside each step (ColliderOptions::use_openmp)");
-  try {
-    app.parse(argc, argv);
+  return run_tool(kTool, app, argc, argv, [&] {
     return run(asset_path, frames_path, mode, query, json, stop_at_contact, openmp);
-  } catch (const CLI::ParseError& e) {
-    return parse_error_exit(app, e);  // help, version or usage error
-  } catch (const ToolError& e) {
-    print_error(kTool, e.file(), e.what());
-    return e.code();
-  } catch (const std::bad_alloc&) {
-    print_error(kTool, "", "out of memory");
-    return kExitProcessingFailed;
-  } catch (const std::exception& e) {
-    print_error(kTool, "", e.what());
-    return kExitProcessingFailed;
-  }
+  });
 }

@@ -1,13 +1,27 @@
 // tetseg: the offline tool. Reads a tet mesh (or tetrahedralises a surface), computes the
 // segmentation and writes the runtime asset. Exit codes: docs/cli.md.
 
-#include <exception>
-#include <iostream>
-#include <new>
-
 #include "commands.hpp"
 #include "tetseg/preprocess/mesh.hpp"
 #include "tool_support.hpp"
+
+namespace {
+
+/// The preprocess library's errors as the exit codes of docs/cli.md (run_tool's hook).
+void rethrow_preprocess_error_as_tool_error() {
+  using namespace tetseg::tools;
+  try {
+    throw;
+  } catch (const tetseg::preprocess::TimeLimitExceeded& e) {
+    throw ToolError(kExitTimeLimit, e.file(), e.what());
+  } catch (const tetseg::preprocess::InputError& e) {
+    throw ToolError(kExitBadInput, e.file(), e.what());
+  } catch (const tetseg::preprocess::OutputError& e) {
+    throw ToolError(kExitOutputFailed, e.file(), e.what());
+  }
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   using namespace tetseg::tools;
@@ -20,28 +34,8 @@ int main(int argc, char** argv) {
   add_tetrahedralize_command(app);
   add_charge_command(app);
   add_build_command(app);
-  try {
-    app.parse(argc, argv);
-    return kExitOk;
-  } catch (const CLI::ParseError& e) {
-    return parse_error_exit(app, e);  // help, version or usage error
-  } catch (const ToolError& e) {
-    print_error("tetseg", e.file(), e.what());
-    return e.code();
-  } catch (const tetseg::preprocess::TimeLimitExceeded& e) {
-    print_error("tetseg", e.file(), e.what());
-    return kExitTimeLimit;
-  } catch (const tetseg::preprocess::InputError& e) {
-    print_error("tetseg", e.file(), e.what());
-    return kExitBadInput;
-  } catch (const tetseg::preprocess::OutputError& e) {
-    print_error("tetseg", e.file(), e.what());
-    return kExitOutputFailed;
-  } catch (const std::bad_alloc&) {
-    print_error("tetseg", "", "out of memory");
-    return kExitProcessingFailed;
-  } catch (const std::exception& e) {
-    print_error("tetseg", "", e.what());
-    return kExitProcessingFailed;
-  }
+  // The subcommands run as parse callbacks.
+  return run_tool(
+      "tetseg", app, argc, argv, [] { return kExitOk; }, "",
+      rethrow_preprocess_error_as_tool_error);
 }

@@ -1,5 +1,8 @@
 #pragma once
-// A minimal OFF reader for tests (triangle meshes only) and a closedness check.
+// A minimal OFF reader for tests (triangle meshes only), a closedness check and the
+// libcgal-demo surfaces.
+
+#include <catch2/catch.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -9,6 +12,7 @@
 #include <utility>
 
 #include "tetseg/testing/synthetic_scenes.hpp"
+#include "tetseg/testing/test_data.hpp"
 
 namespace tetseg::test {
 
@@ -44,6 +48,18 @@ inline bool closed_and_consistent(const Surface& s) {
     const auto it = directed.find({e.second, e.first});
     if (it == directed.end() || it->second != 1) return false;
   }
+  return true;
+}
+
+/// The libcgal-demo mesh `name`.off (TETSEG_CGAL_MESH_DIR) into `out`, required closed and
+/// consistent, oriented outward. False when the demo meshes are missing (have_test_data has
+/// failed the test case or recorded the skip): the caller returns.
+inline bool read_demo_surface(const std::string& name, Surface& out) {
+  const std::string path = std::string(TETSEG_CGAL_MESH_DIR) + "/" + name + ".off";
+  if (!have_test_data(path, "CGAL demo mesh")) return false;
+  REQUIRE(read_off(path, out));
+  REQUIRE(closed_and_consistent(out));
+  orient_outward(out);
   return true;
 }
 
