@@ -1,7 +1,8 @@
 // Shape-keeping repairs of a triangle soup before meshing (`--repair fix`): degenerate and
 // duplicate triangles, isolated vertices, orientation (CGAL polygon-soup processing), border
-// stitching, zero-area triangles, small holes (CGAL hole filling with fairing, which needs
-// Eigen) and few self-intersections (CGAL local remeshing).
+// stitching, zero-area triangles, holes (CGAL hole filling with fairing, which needs
+// Eigen) and local self-intersections (CGAL local remeshing), each kept only where it keeps the
+// shape.
 
 #define CGAL_EIGEN3_ENABLED 1
 #include <CGAL/Polygon_mesh_processing/bbox.h>
@@ -237,7 +238,7 @@ std::size_t remove_local_self_intersections(Mesh& mesh) {
 /// patches' area into `patch_area`): borders stitched
 /// (CGAL stitch_borders: border edges whose ends coincide with another border edge's, as on a
 /// seam whose vertices were duplicated), zero-area triangles removed (CGAL
-/// remove_degenerate_faces, by edge collapses and flips), small holes filled, few
+/// remove_degenerate_faces, by edge collapses and flips), holes filled, local
 /// self-intersections removed on a closed surface. Each count goes to `record`; the soup is
 /// rewritten only when something changed.
 template <class Record>

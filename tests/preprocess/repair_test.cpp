@@ -9,9 +9,11 @@
 #include <utility>
 #include <vector>
 
+#include "tetseg/preprocess/io.hpp"
 #include "tetseg/preprocess/meshing.hpp"
 #include "tetseg/preprocess/surface.hpp"
 #include "tetseg/testing/charge_shapes.hpp"
+#include "tetseg/testing/test_data.hpp"
 
 using namespace tetseg::preprocess;
 
@@ -259,6 +261,21 @@ TEST_CASE("Fix fills a hole over 64 border edges near the shape it cuts", "[mesh
   CHECK(notes.hausdorff_mesh_to_input > std::sqrt(1.0 - z_top * z_top) / diagonal + 0.005);
   CHECK(notes.hausdorff_mesh_to_input < std::sqrt(2.0 - 2.0 * z_top) / diagonal + 0.005);
   CHECK(notes.hausdorff_input_to_mesh < 0.01);
+}
+
+TEST_CASE("Fix leaves open a large hole whose patch would fold", "[meshing][repair][cgal-data]") {
+  // libcgal-demo elephant-with-holes.off: 26 holes, all but one under 64 border edges; the
+  // 78-edge one is a long slit whose faired patch turns back onto the surface (a fold of more
+  // than 120 degrees against a neighbour), so it stays open and is named.
+  const std::string path = std::string(TETSEG_CGAL_MESH_DIR) + "/elephant-with-holes.off";
+  if (!tetseg::test::have_test_data(path, "CGAL demo mesh elephant-with-holes.off")) return;
+  try {
+    tetrahedralize(read_triangle_mesh(path), coarse(MeshingOptions::Repair::kFix),
+                   "elephant-with-holes.off");
+    FAIL("the folding patch was kept");
+  } catch (const InputError& e) {
+    CHECK_THAT(e.what(), Catch::Contains("surface is not closed (78 border edges"));
+  }
 }
 
 TEST_CASE("Wrap closes holes, open surfaces and self-intersections", "[meshing][repair][wrap]") {
