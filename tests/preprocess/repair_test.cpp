@@ -263,10 +263,13 @@ TEST_CASE("Fix fills a hole over 64 border edges near the shape it cuts", "[mesh
   CHECK(notes.hausdorff_input_to_mesh < 0.01);
 }
 
-TEST_CASE("Fix leaves open a large hole whose patch would fold", "[meshing][repair][cgal-data]") {
-  // libcgal-demo elephant-with-holes.off: 26 holes, all but one under 64 border edges; the
+TEST_CASE("Fix leaves open a large hole whose patch would fold and cross the surface",
+          "[meshing][repair][cgal-data]") {
+  // libcgal-demo elephant-with-holes.off: all holes but one under 64 border edges; the
   // 78-edge one is a long slit whose faired patch turns back onto the surface (a fold of more
-  // than 120 degrees against a neighbour), so it stays open and is named.
+  // than 120 degrees against a neighbour) and crosses it, so it stays open and is named
+  // (either rule alone refuses it; without both the patch is kept and leaves a zero-area
+  // triangle).
   const std::string path = std::string(TETSEG_CGAL_MESH_DIR) + "/elephant-with-holes.off";
   if (!tetseg::test::have_test_data(path, "CGAL demo mesh elephant-with-holes.off")) return;
   try {
