@@ -1,10 +1,13 @@
 // Shape-keeping repairs of a triangle soup before meshing (`--repair fix`): degenerate and
 // duplicate triangles, isolated vertices, orientation (CGAL polygon-soup processing), border
-// stitching, zero-area triangles, small holes (CGAL hole filling with fairing, which needs
-// Eigen) and few self-intersections (CGAL local remeshing).
+// stitching, zero-area triangles, holes (CGAL hole filling with fairing, which needs
+// Eigen) and local self-intersections (CGAL local remeshing), each kept only where it keeps the
+// shape.
 
 #define CGAL_EIGEN3_ENABLED 1
+#include <CGAL/Polygon_mesh_processing/bbox.h>
 #include <CGAL/Polygon_mesh_processing/border.h>
+#include <CGAL/Polygon_mesh_processing/compute_normal.h>
 #include <CGAL/Polygon_mesh_processing/measure.h>
 #include <CGAL/Polygon_mesh_processing/orient_polygon_soup.h>
 #include <CGAL/Polygon_mesh_processing/polygon_mesh_to_polygon_soup.h>
@@ -19,10 +22,12 @@
 
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <exception>
 #include <string>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -36,11 +41,31 @@ namespace {
 using cgal::Point;
 using Polygon = std::array<std::size_t, 3>;
 
-/// Holes with at most this many border edges are filled (docs/cli.md).
-constexpr std::size_t kMaxHoleBorderEdges = 64;
+/// Holes with at most this many border edges are filled (docs/cli.md) when the patch keeps the
+/// shape (fill_holes); over kMaxSmallHoleBorderEdges, with a bounded search.
+constexpr std::size_t kMaxHoleBorderEdges = 1000;
+constexpr std::size_t kMaxSmallHoleBorderEdges = 64;
+/// A bound on the work of large holes: the border edges of all holes over
+/// kMaxSmallHoleBorderEdges that are tried (the rest are left open).
+constexpr std::size_t kMaxLargeHoleWork = 4000;
+/// A hole's patch may have at most this many times the area of a flat disk of the hole's
+/// perimeter (a hemisphere: 2).
+constexpr double kMaxPatchAreaOverDisk = 2.5;
+/// A patch triangle turning by more than this against a neighbour is a fold.
+constexpr double kMaxPatchTurnDegrees = 120.0;
+constexpr double kPi = 3.14159265358979323846;
 /// Self-intersections are removed locally only up to this many intersecting pairs of
 /// triangles (docs/cli.md); more is not a local defect.
-constexpr std::size_t kMaxLocalSelfIntersections = 64;
+constexpr std::size_t kMaxLocalSelfIntersections = 4096;
+/// The bound on CGAL's self-intersection removal (libcgal-demo: diplodocus.off, 177 pairs,
+/// removed in about 2 s; mannequin-devil.off, 1643 pairs, ends in 3 s; man.off, 848 pairs,
+/// gives up after 10 s or more).
+constexpr double kSelfIntersectionRemovalSeconds = 10.0;
+/// Self-intersection removal is kept only when the surface moved at most this much (two-sided
+/// Hausdorff distance, of the bounding-box diagonal; the default --max-deviation). A folded fan
+/// on a sphere (tests): 0.007; diplodocus.off 0.003; mannequin-devil.off 0.012 and bones.off
+/// 0.07, refused.
+constexpr double kMaxRemovalDeviation = 0.01;
 /// A surface after self-intersection removal must enclose at least this volume over its area
 /// to the power 3/2 (a ball: 0.094; a 1 x 1 x 0.01 plate: 0.0035).
 constexpr double kMinVolumeOverArea = 1e-3;
@@ -49,28 +74,106 @@ constexpr double kMaxPatchAreaForRemoval = 0.25;
 
 using Mesh = cgal::SurfaceMesh;
 
-/// Fills every hole of `mesh` with at most kMaxHoleBorderEdges border edges (triangulated,
-/// refined, faired: CGAL triangulate_refine_and_fair_hole; when fairing fails the refined
-/// patch is kept). Returns the number of holes filled; adds the patches' area to `patch_area`.
-std::size_t fill_small_holes(Mesh& mesh, double& patch_area) {
+/// Whether the border cycle of `border` visits each of its vertices once (a simple loop);
+/// its number of edges (counting stops past kMaxHoleBorderEdges) and length into `edges` and
+/// `perimeter`.
+bool is_simple_border(const Mesh& mesh, Mesh::Halfedge_index border, std::size_t& edges,
+                      double& perimeter) {
+  std::vector<Mesh::Vertex_index> corners;
+  perimeter = 0.0;
+  for (const Mesh::Halfedge_index h : CGAL::halfedges_around_face(border, mesh)) {
+    corners.push_back(mesh.target(h));
+    perimeter +=
+        std::sqrt(CGAL::squared_distance(mesh.point(mesh.source(h)), mesh.point(mesh.target(h))));
+    if (corners.size() > kMaxHoleBorderEdges) break;
+  }
+  edges = corners.size();
+  std::sort(corners.begin(), corners.end());
+  return std::adjacent_find(corners.begin(), corners.end()) == corners.end();
+}
+
+/// Whether the patch `faces` folds: a patch triangle turns by more than kMaxPatchTurnDegrees
+/// against a neighbour (in the patch or around the hole).
+bool patch_folds(const Mesh& mesh, const std::vector<Mesh::Face_index>& faces) {
+  namespace pmp = CGAL::Polygon_mesh_processing;
+  const double min_cosine = std::cos(kMaxPatchTurnDegrees * kPi / 180.0);
+  for (const Mesh::Face_index f : faces) {
+    const auto normal = pmp::compute_face_normal(f, mesh);
+    for (const Mesh::Halfedge_index h : CGAL::halfedges_around_face(mesh.halfedge(f), mesh)) {
+      const Mesh::Face_index g = mesh.face(mesh.opposite(h));
+      if (g == Mesh::null_face()) continue;
+      if (normal * pmp::compute_face_normal(g, mesh) < min_cosine) return true;
+    }
+  }
+  return false;
+}
+
+/// Fills the holes of `mesh` that are simple loops of at most kMaxHoleBorderEdges border edges
+/// (triangulated, refined, faired: CGAL triangulate_refine_and_fair_hole; over
+/// kMaxSmallHoleBorderEdges edges the cubic-time search is not used and fairing must succeed).
+/// A patch is kept when it keeps the shape: no fold (patch_folds), an area of at most
+/// kMaxPatchAreaOverDisk times that of a flat disk of the hole's perimeter, and no
+/// intersection with the rest of the surface (then removed, the hole left open). Returns the
+/// number of holes filled; adds the kept patches' area to `patch_area`.
+std::size_t fill_holes(Mesh& mesh, double& patch_area) {
   namespace pmp = CGAL::Polygon_mesh_processing;
   std::vector<Mesh::Halfedge_index> borders;
   pmp::extract_boundary_cycles(mesh, std::back_inserter(borders));
+  std::vector<std::vector<Mesh::Face_index>> patches;
+  const auto remove_patch = [&mesh](const std::vector<Mesh::Face_index>& faces) {
+    for (const Mesh::Face_index f : faces) CGAL::Euler::remove_face(mesh.halfedge(f), mesh);
+  };
   std::size_t filled = 0;
+  std::size_t work = 0;  // border edges of the large holes tried
   for (const Mesh::Halfedge_index h : borders) {
     std::size_t edges = 0;
-    for (Mesh::Halfedge_index e : CGAL::halfedges_around_face(h, mesh)) {
-      (void)e;
-      if (++edges > kMaxHoleBorderEdges) break;
-    }
-    if (edges > kMaxHoleBorderEdges) continue;
+    double perimeter = 0.0;
+    if (!is_simple_border(mesh, h, edges, perimeter) || edges > kMaxHoleBorderEdges) continue;
+    const bool large = edges > kMaxSmallHoleBorderEdges;
+    if (large && (work += edges) > kMaxLargeHoleWork) continue;
     std::vector<Mesh::Face_index> patch;
     std::vector<Mesh::Vertex_index> added;
-    pmp::triangulate_refine_and_fair_hole(mesh, h, std::back_inserter(patch),
-                                          std::back_inserter(added));
-    if (!patch.empty()) ++filled;
-    for (const Mesh::Face_index f : patch) patch_area += pmp::face_area(f, mesh);
+    const bool faired = std::get<0>(pmp::triangulate_refine_and_fair_hole(
+        mesh, h, std::back_inserter(patch), std::back_inserter(added),
+        CGAL::parameters::do_not_use_cubic_algorithm(large)));
+    if (patch.empty()) continue;
+    double area = 0.0;
+    for (const Mesh::Face_index f : patch) area += pmp::face_area(f, mesh);
+    const double disk_area = perimeter * perimeter / (4.0 * kPi);
+    if (large &&
+        (!faired || !(area <= kMaxPatchAreaOverDisk * disk_area) || patch_folds(mesh, patch))) {
+      remove_patch(patch);
+      continue;
+    }
+    if (large) {
+      patches.push_back(std::move(patch));
+    } else {
+      ++filled;
+      patch_area += area;
+    }
   }
+  if (patches.empty()) return filled;
+  // Patches crossing the rest of the surface (or each other) are removed.
+  std::vector<std::size_t> patch_of(mesh.number_of_faces() + mesh.number_of_removed_faces(),
+                                    SIZE_MAX);
+  for (std::size_t p = 0; p < patches.size(); ++p)
+    for (const Mesh::Face_index f : patches[p]) patch_of[f] = p;
+  std::vector<std::pair<Mesh::Face_index, Mesh::Face_index>> pairs;
+  pmp::self_intersections(mesh, std::back_inserter(pairs));
+  std::vector<char> crossing(patches.size(), 0);
+  for (const auto& [f, g] : pairs) {
+    if (patch_of[f] != SIZE_MAX) crossing[patch_of[f]] = 1;
+    if (patch_of[g] != SIZE_MAX) crossing[patch_of[g]] = 1;
+  }
+  for (std::size_t p = 0; p < patches.size(); ++p) {
+    if (crossing[p]) {
+      remove_patch(patches[p]);
+      continue;
+    }
+    ++filled;
+    for (const Mesh::Face_index f : patches[p]) patch_area += pmp::face_area(f, mesh);
+  }
+  mesh.collect_garbage();
   return filled;
 }
 
@@ -81,19 +184,35 @@ std::size_t count_zero_area_faces(const Mesh& mesh) {
   return count;
 }
 
-/// Removes the self-intersections of `mesh` when they are few (at most
+/// Stops CGAL's self-intersection removal (checked between its steps and components) once
+/// kSelfIntersectionRemovalSeconds have passed: a bound on a step whose work grows with the
+/// pairs and how tangled they are.
+struct RemovalDeadline
+    : CGAL::Polygon_mesh_processing::experimental::Remove_self_intersection_default_visitor<
+          cgal::SurfaceMesh> {
+  std::chrono::steady_clock::time_point end;
+  bool stop() const { return std::chrono::steady_clock::now() > end; }
+};
+
+/// Removes the self-intersections of `mesh` when they are local (at most
 /// kMaxLocalSelfIntersections pairs of triangles): CGAL's local remeshing
-/// (experimental::remove_self_intersections). The result is kept only if no intersection is
-/// left; returns the number of intersecting pairs removed (0: none, too many, or CGAL could
+/// (experimental::remove_self_intersections, within kSelfIntersectionRemovalSeconds). The
+/// result is kept only if it is closed, no intersection is left and it still encloses a
+/// volume; returns the number of intersecting pairs removed (0: none, too many, or CGAL could
 /// not remove them all, and `mesh` is unchanged).
-std::size_t remove_few_self_intersections(Mesh& mesh) {
+std::size_t remove_local_self_intersections(Mesh& mesh) {
   namespace pmp = CGAL::Polygon_mesh_processing;
   std::vector<std::pair<Mesh::Face_index, Mesh::Face_index>> pairs;
   pmp::self_intersections(mesh, std::back_inserter(pairs));
   if (pairs.empty() || pairs.size() > kMaxLocalSelfIntersections) return 0;
   Mesh attempt = mesh;
+  RemovalDeadline deadline;
+  deadline.end = std::chrono::steady_clock::now() +
+                 std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                     std::chrono::duration<double>(kSelfIntersectionRemovalSeconds));
   try {
-    if (!pmp::experimental::remove_self_intersections(attempt)) return 0;
+    if (!pmp::experimental::remove_self_intersections(attempt, CGAL::parameters::visitor(deadline)))
+      return 0;
   } catch (const std::exception&) {
     return 0;  // CGAL gave up on this input; the intersections are reported by validation
   }
@@ -103,6 +222,15 @@ std::size_t remove_few_self_intersections(Mesh& mesh) {
   const double area = pmp::area(attempt);
   if (!(std::abs(pmp::volume(attempt)) >= kMinVolumeOverArea * area * std::sqrt(area))) return 0;
   attempt.collect_garbage();
+  // Local remeshing may also cut off a part it could not mend (a thin limb): refused when the
+  // surface moved further than kMaxRemovalDeviation.
+  const CGAL::Bbox_3 box = pmp::bbox(mesh);
+  const double diagonal =
+      std::sqrt(CGAL::square(box.xmax() - box.xmin()) + CGAL::square(box.ymax() - box.ymin()) +
+                CGAL::square(box.zmax() - box.zmin()));
+  const auto [there, back] =
+      hausdorff_distances(cgal::to_triangle_mesh(mesh), cgal::to_triangle_mesh(attempt));
+  if (!(std::max(there, back) <= kMaxRemovalDeviation * diagonal)) return 0;
   mesh = std::move(attempt);
   return pairs.size();
 }
@@ -111,7 +239,7 @@ std::size_t remove_few_self_intersections(Mesh& mesh) {
 /// patches' area into `patch_area`): borders stitched
 /// (CGAL stitch_borders: border edges whose ends coincide with another border edge's, as on a
 /// seam whose vertices were duplicated), zero-area triangles removed (CGAL
-/// remove_degenerate_faces, by edge collapses and flips), small holes filled, few
+/// remove_degenerate_faces, by edge collapses and flips), holes filled, local
 /// self-intersections removed on a closed surface. Each count goes to `record`; the soup is
 /// rewritten only when something changed.
 template <class Record>
@@ -132,7 +260,7 @@ void repair_as_mesh(std::vector<Point>& points, std::vector<Polygon>& polygons,
     record("zero-area triangles removed", zero_area - std::min(left, zero_area));
     changed = true;
   }
-  const std::size_t filled = fill_small_holes(mesh, patch_area);
+  const std::size_t filled = fill_holes(mesh, patch_area);
   record("holes filled", filled);
   changed |= filled > 0;
   // Self-intersections made by the hole filling of a mostly open surface (a sheet closed onto
@@ -140,7 +268,7 @@ void repair_as_mesh(std::vector<Point>& points, std::vector<Polygon>& polygons,
   // which Mesh_3 never ended. So removal is tried only when the filled patches are under
   // kMaxPatchAreaForRemoval of the area.
   if (CGAL::is_closed(mesh) && patch_area <= kMaxPatchAreaForRemoval * pmp::area(mesh)) {
-    const std::size_t removed = remove_few_self_intersections(mesh);
+    const std::size_t removed = remove_local_self_intersections(mesh);
     record("self-intersecting triangle pairs removed by local remeshing", removed);
     changed |= removed > 0;
   }

@@ -14,9 +14,11 @@ namespace tetseg::preprocess::detail {
 /// duplicate triangles (same three vertices, either orientation) merged, orientation made
 /// consistent (CGAL orient_polygon_soup: triangles flipped, non-manifold vertices
 /// duplicated), borders stitched where two border edges coincide (CGAL stitch_borders),
-/// zero-area triangles removed (CGAL remove_degenerate_faces), small holes filled, on a
-/// closed surface a few self-intersections removed by local remeshing (CGAL
-/// experimental::remove_self_intersections; kept only when none is left), with
+/// zero-area triangles removed (CGAL remove_degenerate_faces), holes filled (all up to 64
+/// border edges; up to 1000 when the patch keeps the shape), on a closed surface
+/// self-intersections removed by local remeshing (CGAL
+/// experimental::remove_self_intersections, bounded in pairs and time; kept only when none is
+/// left and the surface moved little), with
 /// `keep_largest_component` every edge-connected component but the one of largest area
 /// removed, unused vertices dropped. Returns the repairs made (kind, count; kinds with a zero
 /// count are left out). Vertex ids are renumbered in order of first use. When given,

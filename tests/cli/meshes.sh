@@ -118,8 +118,10 @@ grep -q '"hausdorff": {"input_to_mesh": ' dup.json || fail "the report lacks the
 
 # A cube without one face: fix fills the hole; auto, by default, wraps it instead (the patch is
 # 1/6 of the area and 0.29 of the diagonal from the input, over --max-deviation 0.01), and fills
-# it within --max-deviation 0.5. A tube with 2 x 80 border edges (over fix's 64): fix names it
-# and points to wrap; wrap (alpha larger than the hole) closes a hole.
+# it within --max-deviation 0.5. A tube with 2 x 1001 border edges (over fix's 1000): fix names
+# it and points to wrap. A tube with 2 x 80: fix fills its ends, but auto wraps it (the patches
+# are 20 % of the area, 0.2 of the diagonal from the input). Wrap (alpha larger than the hole)
+# closes a hole.
 sed -e 's/^8 6 0$/8 5 0/' -e '/^4 2 3 7 6$/d' cube.off >holed.off
 expect_exit 0 "tetseg: repaired holed.off: 1 holes filled" -- \
   "$bin/tetseg" build holed.off -o filled.tetseg --clusters single --facet-size 0.25 --no-optimize \
@@ -137,9 +139,10 @@ expect_exit 0 "tetseg: repaired holed.off: 1 holes filled" -- \
   printf '4 0 3 2 1\n4 4 5 6 7\n4 0 1 5 4\n4 9 10 14 13\n4 10 11 15 14\n4 11 8 12 15\n'; } >halves.off
 expect_exit 0 "tetseg: read .* 8 vertices, 12 triangles" -- \
   "$bin/tetseg" build halves.off -o halves.tetseg --clusters single --repair none
-python3 -c '
-import math
-n = 80
+tube() {
+  python3 -c '
+import math, sys
+n = int(sys.argv[1])
 print("OFF\n%d %d 0" % (2 * n, 2 * n))
 for z in (0, 2):
     for i in range(n):
@@ -147,19 +150,23 @@ for z in (0, 2):
 for i in range(n):
     j = (i + 1) % n
     print(3, i, j, j + n)
-    print(3, i, j + n, i + n)' >tube.off
-expect_exit 3 "tetseg: error: tube.off: surface is not closed (160 border edges.*left after --repair fix; --repair wrap" -- \
-  "$bin/tetseg" build tube.off -o tube.tetseg --clusters single --repair fix
-[ ! -e tube.tetseg ] || fail "a refused surface left an asset"
+    print(3, i, j + n, i + n)' "$1"
+}
+tube 1001 >wide.off
+expect_exit 3 "tetseg: error: wide.off: surface is not closed (2002 border edges.*left after --repair fix; --repair wrap" -- \
+  "$bin/tetseg" build wide.off -o wide.tetseg --clusters single --repair fix
+[ ! -e wide.tetseg ] || fail "a refused surface left an asset"
+tube 80 >tube.off
 # --repair auto (the default) wraps what fix leaves and says why: stderr, report, provenance;
 # the deviation is in the provenance of every build.
-expect_exit 0 "tetseg: note: tube.off: --repair auto wrapped the surface, as fix left: .*surface is not closed (160 border edges" -- \
+expect_exit 0 "tetseg: note: tube.off: --repair auto wrapped the surface, as fix left: .*the holes filled by fix (20 % of the area)" -- \
   "$bin/tetseg" build tube.off -o tube.tetseg --clusters single --report tube.json
 grep -q '"repair_used": "wrap"' tube.json || fail "the report lacks the repair used"
-grep -q '"fallback_reason": ".*surface is not closed' tube.json || fail "the report lacks the reason"
+grep -q '"fallback_reason": ".*the holes filled by fix' tube.json || fail "the report lacks the reason"
 "$bin/tetseg-dump" tube.tetseg >tube.txt
 grep -q 'meshing.repair_used *wrap' tube.txt || fail "the provenance lacks the repair used"
-grep -q 'meshing.fallback_reason *.*not closed' tube.txt || fail "the provenance lacks the reason"
+grep -q 'meshing.fallback_reason *.*the holes filled by fix' tube.txt ||
+  fail "the provenance lacks the reason"
 grep -q 'deviation.asset_to_input_absolute' tube.txt || fail "the provenance lacks the deviation"
 expect_exit 0 "tetseg: repaired holed.off: [0-9]* surface replaced by an alpha wrap" -- \
   "$bin/tetseg" build holed.off -o holed.tetseg --clusters single --repair wrap --wrap-alpha 0.5 \

@@ -9,9 +9,11 @@
 #include <utility>
 #include <vector>
 
+#include "tetseg/preprocess/io.hpp"
 #include "tetseg/preprocess/meshing.hpp"
 #include "tetseg/preprocess/surface.hpp"
 #include "tetseg/testing/charge_shapes.hpp"
+#include "tetseg/testing/test_data.hpp"
 
 using namespace tetseg::preprocess;
 
@@ -216,15 +218,66 @@ TEST_CASE("Fix fills small holes, names what it cannot repair and points to wrap
     CHECK(notes.hausdorff_mesh_to_input ==
           Approx((2.0 - std::sqrt(2.0)) / 2.0 / std::sqrt(3.0)).margin(0.015));
   }
-  SECTION("Two holes of 80 border edges, over the limit of 64, are left and named.") {
+  SECTION("Two holes of 1001 border edges, over the limit of 1000, are left and named.") {
     try {
-      tetrahedralize(open_cylinder(80), coarse(MeshingOptions::Repair::kFix), "tube.off");
+      tetrahedralize(open_cylinder(1001), coarse(MeshingOptions::Repair::kFix), "tube.off");
       FAIL("an open tube was meshed by fix");
     } catch (const InputError& e) {
-      CHECK_THAT(e.what(), Catch::Contains("not closed (160 border edges, first between vertices"));
+      CHECK_THAT(e.what(),
+                 Catch::Contains("not closed (2002 border edges, first between vertices"));
       CHECK_THAT(e.what(), Catch::Contains("--repair wrap"));
       CHECK(e.file() == "tube.off");
     }
+  }
+}
+
+TEST_CASE("Fix fills a hole over 64 border edges near the shape it cuts", "[meshing][repair]") {
+  // The cap z > 0.6 of an 11.5k-triangle unit sphere removed: a hole of about 110 border
+  // edges whose rim reaches z_top = 0.64 (triangles below 0.6 kept whole). The faired patch
+  // follows the sphere: the ball's volume 4 pi / 3 within Mesh_3's error (2 % at this size),
+  // where a flat patch would lack the cap, pi 0.4^2 (3 - 0.4) / 3 = 0.44 (10 % of the ball);
+  // its farthest point from the input, the pole, lies sqrt(2 - 2 z_top) from the top of the
+  // rim (0.245 of the diagonal), where a flat patch's centre lies the rim's radius
+  // sqrt(1 - z_top^2) from it (0.222).
+  TriangleMesh s = tetseg::test::icosphere(24);
+  std::vector<Tri> kept;
+  double z_top = 0.0;
+  for (const Tri& t : s.triangles)
+    if (s.vertices[t[0]][2] <= 0.6 || s.vertices[t[1]][2] <= 0.6 || s.vertices[t[2]][2] <= 0.6) {
+      kept.push_back(t);
+      for (const std::uint32_t v : t) z_top = std::max(z_top, s.vertices[v][2]);
+    }
+  s.triangles = kept;
+  const double diagonal = 2.0 * std::sqrt(3.0);
+  REQUIRE(std::sqrt(2.0 - 2.0 * z_top) - std::sqrt(1.0 - z_top * z_top) > 0.05);
+  MeshingOptions m = coarse(MeshingOptions::Repair::kFix);
+  m.facet_size = 0.1;
+  TetrahedralizeNotes notes;
+  const TetMesh mesh = tetrahedralize(s, m, "capless.off", &notes);
+  validate_tet_mesh(mesh, extract_surface(mesh), "capless");
+  CHECK(count_of(notes, "holes filled") == 1);
+  CHECK(total_tet_volume(mesh) == Approx(4.0 * std::acos(-1.0) / 3.0).epsilon(0.04));
+  // Faired up towards the pole (to z ~ 0.9 at these sizes), above where a flat patch lies.
+  CHECK(notes.hausdorff_mesh_to_input > std::sqrt(1.0 - z_top * z_top) / diagonal + 0.005);
+  CHECK(notes.hausdorff_mesh_to_input < std::sqrt(2.0 - 2.0 * z_top) / diagonal + 0.005);
+  CHECK(notes.hausdorff_input_to_mesh < 0.01);
+}
+
+TEST_CASE("Fix leaves open a large hole whose patch would fold and cross the surface",
+          "[meshing][repair][cgal-data]") {
+  // libcgal-demo elephant-with-holes.off: all holes but one under 64 border edges; the
+  // 78-edge one is a long slit whose faired patch turns back onto the surface (a fold of more
+  // than 120 degrees against a neighbour) and crosses it, so it stays open and is named
+  // (either rule alone refuses it; without both the patch is kept and leaves a zero-area
+  // triangle).
+  const std::string path = std::string(TETSEG_CGAL_MESH_DIR) + "/elephant-with-holes.off";
+  if (!tetseg::test::have_test_data(path, "CGAL demo mesh elephant-with-holes.off")) return;
+  try {
+    tetrahedralize(read_triangle_mesh(path), coarse(MeshingOptions::Repair::kFix),
+                   "elephant-with-holes.off");
+    FAIL("the folding patch was kept");
+  } catch (const InputError& e) {
+    CHECK_THAT(e.what(), Catch::Contains("surface is not closed (78 border edges"));
   }
 }
 
@@ -479,35 +532,33 @@ TEST_CASE("Auto is fix, and the wrap with the reason where fix leaves a defect",
     CHECK(notes.repair_used == Repair::kFix);
     CHECK(count_of(notes, "holes filled") == 1);
   }
-  SECTION("A sphere with a hole over the fill limit falls back to the wrap.") {
+  SECTION("A sphere with a large hole: fix fills it, auto checks the patch's deviation") {
     // The cap z > 0.6 of an 11.5k-triangle unit sphere removed: a hole of about 110 border edges
-    // (radius 0.8), over fix's 64. The wrap at alpha 0.02 enters the sphere.
+    // (radius 0.8), a fifth of the area once filled: fix's faired patch reaches the pole, 0.81
+    // from the top of the rim (the test above), 0.23 of the diagonal 2 sqrt 3.
     TriangleMesh s = tetseg::test::icosphere(24);
     std::vector<Tri> kept;
     for (const Tri& t : s.triangles)
       if (s.vertices[t[0]][2] <= 0.6 || s.vertices[t[1]][2] <= 0.6 || s.vertices[t[2]][2] <= 0.6)
         kept.push_back(t);
     s.triangles = kept;
-    SECTION("Within the default --max-deviation 0.01: the open sphere as a slab") {
-      // Bridging the hole would put the surface 0.8 from the input; the slab's faces lie the
-      // sheet offset, 0.01 of the diagonal, from it.
+    SECTION("Over the default --max-deviation 0.01: the open sphere as a slab, with the reason") {
+      // The slab's faces lie the sheet offset, 0.01 of the diagonal, from the input.
       const TetrahedralizeNotes notes = auto_repaired(s, 0.2);
       CHECK(notes.repair_used == Repair::kWrap);
-      CHECK_THAT(notes.fallback_reason, Catch::Contains("surface is not closed ("));
+      CHECK_THAT(notes.fallback_reason, Catch::Contains("the holes filled by fix ("));
+      CHECK_THAT(notes.fallback_reason, Catch::Contains("over --max-deviation 0.01"));
       CHECK(count_of(notes, "wrapped as a slab") == 200);
       CHECK(notes.hausdorff_input_to_mesh == Approx(0.01).margin(0.006));
       CHECK(notes.hausdorff_mesh_to_input == Approx(0.01).margin(0.006));
     }
-    SECTION("With --max-deviation 0.5: the wrap closes the hole across") {
-      // Alpha doubles until the wrap no longer enters the sphere: a patch across the hole,
-      // whose centre is 0.8 (the hole's radius: the nearest input points are on its rim) from
-      // the input, over the diagonal 2 sqrt 3 (a little more where the patch sags inward).
+    SECTION("Within --max-deviation 0.5: fix's filled sphere") {
       const TetrahedralizeNotes notes = auto_repaired(s, 0.2, 0.5);
-      CHECK(notes.repair_used == Repair::kWrap);
-      CHECK(count_of(notes, "alpha wrap") > 0);
-      CHECK(count_of(notes, "slab") == 0);
-      CHECK(notes.hausdorff_input_to_mesh < 0.05);
-      CHECK(notes.hausdorff_mesh_to_input == Approx(0.8 / (2.0 * std::sqrt(3.0))).margin(0.04));
+      CHECK(notes.repair_used == Repair::kFix);
+      CHECK(notes.fallback_reason.empty());
+      CHECK(count_of(notes, "holes filled") == 1);
+      CHECK(notes.hausdorff_input_to_mesh < 0.02);
+      CHECK(notes.hausdorff_mesh_to_input == Approx(0.82 / (2.0 * std::sqrt(3.0))).margin(0.01));
     }
   }
   SECTION("A hole fix fills but that makes a quarter of the surface is kept within the bound") {

@@ -130,8 +130,9 @@ struct TetrahedralizeNotes {
 /// `meshing.repair == kFix` the surface is first repaired without changing its shape:
 /// triangles with a repeated corner removed, duplicate triangles merged, orientation made
 /// consistent (flips; non-manifold vertices duplicated), borders stitched, zero-area triangles
-/// collapsed, holes of at most 64 border edges filled, at most 64 self-intersecting pairs
-/// remeshed locally (docs/cli.md); the repairs go to `notes->repairs`. What is left makes
+/// collapsed, holes filled (up to 64 border edges, and up to 1000 when the patch keeps the
+/// shape), up to 4096 self-intersecting pairs remeshed locally when the surface moves at most
+/// 0.01 of the diagonal (docs/cli.md); the repairs go to `notes->repairs`. What is left makes
 /// an error that ends by suggesting `--repair wrap`. With kWrap the surface
 /// is replaced by its CGAL alpha wrap (wrap_alpha, wrap_offset), which is closed, manifold and
 /// free of self-intersections for any soup; while that wrap is a thin shell (all over, or half
