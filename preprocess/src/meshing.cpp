@@ -5,8 +5,10 @@
 // mesh3_polyhedral.cpp.
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <filesystem>
 #include <new>
 #include <stdexcept>
@@ -18,6 +20,7 @@
 #include "components.hpp"
 #include "mesh3_driver.hpp"
 #include "meshing_internal.hpp"
+#include "repair_internal.hpp"
 #include "tetseg/preprocess/surface.hpp"
 #include "validate_internal.hpp"
 #include "vec3_math.hpp"
@@ -65,6 +68,24 @@ constexpr double kMinProtectedDihedralDegrees = 5.0;
 /// When no optimisation gives a valid boundary, meshing is retried with every size (facet,
 /// cell, facet distance) times these factors in turn (the first is the asked size).
 constexpr double kRetrySizeFactors[] = {1.0, 0.7, 0.5};
+/// When the meshed boundary lies further than the asked distance from the surface it meshes
+/// (--max-deviation), meshing is retried at most kMaxDeviationRetries times, each with the
+/// facet distance times kDeviationRetryMargin x asked / measured distance (clamped to
+/// [kMinRetryShrink, kMaxRetryShrink]) and the facet size times its square root (cell sizes
+/// unchanged), with sharp edges protected once the input's sharp edges lie further than asked
+/// from the mesh (Mesh_3 rounds them off unprotected: fandisk). Mesh_3's facet distance bounds
+/// the distance of its facets' centres from the surface, not the Hausdorff distance: elephant
+/// deviates about twice its facet distance, fandisk three times (docs/benchmarks.md).
+constexpr int kMaxDeviationRetries = 2;
+constexpr double kDeviationRetryMargin = 0.7;
+constexpr double kMinRetryShrink = 0.25;
+constexpr double kMaxRetryShrink = 0.7;
+/// Each retry's Mesh_3 runs are bounded by kRetryTimeFactor x the first meshing's seconds,
+/// within [kMinRetrySeconds, kMaxRetrySeconds] and at most half of the time limit left; past
+/// the bound, the nearest mesh so far is kept. The vertex budget stays the first meshing's.
+constexpr double kRetryTimeFactor = 8.0;
+constexpr double kMinRetrySeconds = 10.0;
+constexpr double kMaxRetrySeconds = 60.0;
 
 }  // namespace
 
@@ -165,6 +186,8 @@ struct SharpEdges {
   /// The largest angle between the normals of a sharp edge's two triangles, degrees: 180
   /// minus it is the edge's smallest (wedge or slit) dihedral angle.
   double max_normal_degrees = 0.0;
+  /// The sharp edges, as pairs of vertex ids.
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> edges;
 };
 
 SharpEdges sharp_edges(const TriangleMesh& s, double degrees) {
@@ -195,11 +218,12 @@ SharpEdges sharp_edges(const TriangleMesh& s, double degrees) {
       const double c = std::clamp(detail::dot(n, m), -1.0, 1.0);
       out.max_normal_degrees = std::max(out.max_normal_degrees, std::acos(c) * 180.0 / M_PI);
       const auto [a, b] = edges[i].first;
+      out.edges.push_back({a, b});
       sharp.push_back({a, b});
       sharp.push_back({b, a});
     }
   }
-  out.count = sharp.size() / 2;
+  out.count = out.edges.size();
   std::sort(sharp.begin(), sharp.end());
   sharp.erase(std::unique(sharp.begin(), sharp.end()), sharp.end());
   for (std::size_t i = 0; i < sharp.size();) {
@@ -321,11 +345,20 @@ std::string boundary_defect(const TetMesh& mesh, const std::string& file) {
   return "";
 }
 
+/// How a deviation retry changes the sizes mesh_closed_surface derives from the options.
+struct RetrySizes {
+  double facet_distance = 1.0;       ///< factor
+  double facet_size = 1.0;           ///< factor (the cell size stays)
+  bool protect_sharp_edges = false;  ///< whatever the input's edge lengths
+  std::size_t max_vertices = 0;      ///< > 0: this vertex budget instead of the sizes'
+};
+
 /// Mesh_3 on a closed surface (pinch points allowed), checked, with the retries of
 /// tetrahedralize; notes.optimization_used and notes.first_defect say which mesh was returned.
 TetMesh mesh_closed_surface(const TriangleMesh& input, const MeshingOptions& meshing,
                             const std::string& file, TetrahedralizeNotes& notes,
-                            detail::Watchdog& watchdog, double bound_seconds) {
+                            detail::Watchdog& watchdog, double bound_seconds,
+                            const RetrySizes& retry = {}) {
   const double diagonal = detail::bounding_box_diagonal(input.vertices);
   // Criteria are checked before CGAL sees them: every size finite and positive, and not so
   // small against the surface that refinement could never end (kMaxDiagonalPerSize).
@@ -336,6 +369,8 @@ TetMesh mesh_closed_surface(const TriangleMesh& input, const MeshingOptions& mes
   if (meshing.facet_distance == 0.0)
     criteria.facet_distance =
         std::min(criteria.facet_distance, 0.5 * meshing.max_deviation * diagonal);
+  criteria.facet_distance *= retry.facet_distance;
+  criteria.facet_size *= retry.facet_size;
   for (const double size : {criteria.facet_size, criteria.cell_size, criteria.facet_distance})
     if (!(size * kMaxDiagonalPerSize >= diagonal))
       throw InputError(file, "tetrahedralize: a meshing size is below 1/" +
@@ -369,8 +404,10 @@ TetMesh mesh_closed_surface(const TriangleMesh& input, const MeshingOptions& mes
     sized.facet_size *= factor;
     sized.cell_size *= factor;
     sized.facet_distance *= factor;
-    sized.max_vertices = vertex_budget(sized, diagonal);
-    if (sharp && median_edge >= kProtectEdgeFacets * sized.facet_size) {
+    sized.max_vertices =
+        retry.max_vertices > 0 ? retry.max_vertices : vertex_budget(sized, diagonal);
+    if (sharp &&
+        (retry.protect_sharp_edges || median_edge >= kProtectEdgeFacets * sized.facet_size)) {
       sized.sharp_edge_angle = kSharpEdgeDegrees;
       if (sharp_features.min_corner_degrees < kMinProtectedCornerDegrees)
         throw InputError(
@@ -425,11 +462,111 @@ TetMesh mesh_closed_surface(const TriangleMesh& input, const MeshingOptions& mes
                              "need a smaller --facet-size");
 }
 
+/// The larger of the two (approximate) Hausdorff distances between `surface` and the boundary
+/// of `mesh`, absolute; -1 when not measurable.
+double boundary_distance(const TriangleMesh& surface, const TetMesh& mesh) {
+  const TriangleMesh boundary{mesh.nodes, extract_surface(mesh).triangles};
+  const auto [there, back] = detail::hausdorff_distances(surface, boundary);
+  return std::max(there, back);
+}
+
+/// Points along the sharp edges of `surface` (each edge's ends and its quarter points; at most
+/// about kMaxSharpEdgeSamples points, every k-th edge beyond).
+std::vector<Vec3> sharp_edge_samples(const TriangleMesh& surface, const SharpEdges& sharp) {
+  constexpr std::size_t kMaxSharpEdgeSamples = 20000;
+  constexpr int kPerEdge = 4;
+  std::vector<Vec3> points;
+  const std::size_t stride =
+      std::max<std::size_t>(1, kPerEdge * sharp.edges.size() / kMaxSharpEdgeSamples + 1);
+  for (std::size_t e = 0; e < sharp.edges.size(); e += stride) {
+    const Vec3& a = surface.vertices[sharp.edges[e].first];
+    const Vec3& b = surface.vertices[sharp.edges[e].second];
+    for (int k = 0; k < kPerEdge; ++k) {
+      const double t = static_cast<double>(k) / kPerEdge;
+      points.push_back(
+          {a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1]), a[2] + t * (b[2] - a[2])});
+    }
+  }
+  return points;
+}
+
+/// The deviation retries (kMaxDeviationRetries): while the boundary of `mesh` lies further than
+/// `max_distance` (absolute, > 0) from `surface`, meshing is repeated at smaller sizes, and the
+/// nearest mesh is returned, with its notes; notes.deviation_retries counts the meshings
+/// repeated. `first_seconds`: how long the first meshing took.
+TetMesh keep_within_distance(const TriangleMesh& surface, TetMesh best, double max_distance,
+                             double first_seconds, const MeshingOptions& meshing,
+                             const std::string& file, TetrahedralizeNotes& notes,
+                             detail::Watchdog& watchdog) {
+  watchdog.begin("deviation of the meshed boundary");
+  double distance = boundary_distance(surface, best);
+  if (!(distance > max_distance)) return best;
+  const TetrahedralizeNotes notes_before = notes;
+  const double diagonal = detail::bounding_box_diagonal(surface.vertices);
+  const SharpEdges sharp = sharp_edges(surface, kSharpEdgeDegrees);
+  const std::vector<Vec3> sharp_samples = sharp_edge_samples(surface, sharp);
+  RetrySizes sizes;
+  sizes.max_vertices =
+      vertex_budget(resolve(meshing, default_facet_size_for_diagonal(diagonal)), diagonal);
+  double best_distance = distance;
+  std::string best_sizes;
+  std::size_t retries = 0;
+  TetMesh last;  // the last retry's mesh (the best one is moved to `best`)
+  const TetMesh* latest = &best;
+  for (int retry = 1; retry <= kMaxDeviationRetries; ++retry) {
+    const double shrink = std::clamp(kDeviationRetryMargin * max_distance / distance,
+                                     kMinRetryShrink, kMaxRetryShrink);
+    sizes.facet_distance *= shrink;
+    sizes.facet_size *= std::sqrt(shrink);
+    if (!sizes.protect_sharp_edges && !sharp_samples.empty()) {
+      const TriangleMesh boundary{latest->nodes, extract_surface(*latest).triangles};
+      sizes.protect_sharp_edges =
+          detail::max_distance_to_surface(sharp_samples, boundary) > max_distance;
+    }
+    const double bound =
+        std::min(std::clamp(kRetryTimeFactor * first_seconds, kMinRetrySeconds, kMaxRetrySeconds),
+                 0.5 * watchdog.seconds_left());
+    if (!(bound > 1.0)) break;
+    TetrahedralizeNotes tried_notes = notes_before;
+    TetMesh tried;
+    try {
+      tried = mesh_closed_surface(surface, meshing, file, tried_notes, watchdog, bound, sizes);
+    } catch (const TimeLimitExceeded&) {
+      throw;
+    } catch (const InputError&) {
+      ++retries;
+      break;  // over its bound or refused: the nearest mesh so far is kept
+    }
+    ++retries;
+    watchdog.begin("deviation of the meshed boundary");
+    distance = boundary_distance(surface, tried);
+    if (distance >= 0.0 && distance < best_distance) {
+      char text[120];
+      std::snprintf(text, sizeof text, "facet distance x%.2g, facet size x%.2g%s",
+                    sizes.facet_distance, sizes.facet_size,
+                    sizes.protect_sharp_edges ? ", sharp edges protected" : "");
+      best_distance = distance;
+      best_sizes = text;
+      notes = tried_notes;
+      best = std::move(tried);
+      latest = &best;
+    } else {
+      last = std::move(tried);
+      latest = &last;
+    }
+    if (distance <= max_distance) break;
+  }
+  notes.deviation_retries = retries;
+  notes.deviation_retry_sizes = best_sizes;
+  return best;
+}
+
 }  // namespace
 
 TetMesh detail::validate_and_mesh(const TriangleMesh& source, const MeshingOptions& meshing,
                                   const std::string& file, TetrahedralizeNotes& notes,
-                                  detail::Watchdog& watchdog, double bound_seconds) {
+                                  detail::Watchdog& watchdog, double bound_seconds,
+                                  double max_distance) {
   watchdog.begin("surface validation");
   TriangleMesh split;
   detail::SurfaceCheck check;
@@ -444,8 +581,14 @@ TetMesh detail::validate_and_mesh(const TriangleMesh& source, const MeshingOptio
                                "of any input (docs/cli.md)");
   }
   detail::check_surface_not_nested(source, file);
-  return mesh_closed_surface(split.triangles.empty() ? source : split, meshing, file, notes,
-                             watchdog, bound_seconds);
+  const TriangleMesh& meshed = split.triangles.empty() ? source : split;
+  const auto started = std::chrono::steady_clock::now();
+  TetMesh mesh = mesh_closed_surface(meshed, meshing, file, notes, watchdog, bound_seconds);
+  if (!(max_distance > 0.0)) return mesh;
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  return keep_within_distance(meshed, std::move(mesh), max_distance, seconds, meshing, file, notes,
+                              watchdog);
 }
 
 }  // namespace tetseg::preprocess

@@ -134,7 +134,10 @@ TetMesh mesh_sheet_slab(const TriangleMesh& surface, const MeshingOptions& meshi
                                             diagonal, file, watchdog);
   TetMesh mesh;
   try {
-    mesh = detail::validate_and_mesh(slab, meshing, file, notes, watchdog, bound_seconds);
+    // Retries only when the slab's offset leaves room within --max-deviation.
+    mesh =
+        detail::validate_and_mesh(slab, meshing, file, notes, watchdog, bound_seconds,
+                                  (meshing.max_deviation - meshing.wrap_sheet_offset) * diagonal);
   } catch (const TimeLimitExceeded&) {
     throw;
   } catch (const InputError& e) {
@@ -184,7 +187,9 @@ TetMesh wrap_and_mesh(const TriangleMesh& surface, const MeshingOptions& meshing
     if (last && thin) return mesh_sheet_slab(surface, meshing, diagonal, file, notes, watchdog);
     if (!thin) {
       try {
-        TetMesh mesh = detail::validate_and_mesh(wrap, meshing, file, notes, watchdog);
+        // Mesh_3 may move the surface what --max-deviation leaves beside the wrap's offset.
+        TetMesh mesh = detail::validate_and_mesh(wrap, meshing, file, notes, watchdog, 0.0,
+                                                 (meshing.max_deviation - offset) * diagonal);
         notes.repairs = {
             {"surface replaced by an alpha wrap of this many triangles", wrap.triangles.size()}};
         if (doublings > 0)
@@ -356,7 +361,8 @@ TetMesh fix_or_wrap(const TriangleMesh& surface, const MeshingOptions& meshing, 
       fix_deviation = std::max(there, back) / diagonal;
     }
     if (fix_deviation <= meshing.max_deviation)
-      return detail::validate_and_mesh(fixed, meshing, file, notes, watchdog);
+      return detail::validate_and_mesh(fixed, meshing, file, notes, watchdog, 0.0,
+                                       meshing.max_deviation * diagonal);
   } catch (const TimeLimitExceeded&) {
     throw;
   } catch (const InputError& e) {
@@ -395,7 +401,8 @@ TetMesh fix_or_wrap(const TriangleMesh& surface, const MeshingOptions& meshing, 
   const TetrahedralizeNotes wrap_notes = notes;
   notes = fix_notes;
   try {
-    return detail::validate_and_mesh(fixed, meshing, file, notes, watchdog);
+    return detail::validate_and_mesh(fixed, meshing, file, notes, watchdog, 0.0,
+                                     meshing.max_deviation * diagonal);
   } catch (const TimeLimitExceeded&) {
     throw;
   } catch (const InputError&) {
@@ -420,13 +427,15 @@ TetMesh tetrahedralize_in_place(const TriangleMesh& surface, const MeshingOption
   out_notes.repair_used = meshing.repair;
   if (meshing.repair == Repair::kFix) {
     mesh = detail::validate_and_mesh(fixed_surface(surface, meshing, file, out_notes, watchdog),
-                                     meshing, file, out_notes, watchdog);
+                                     meshing, file, out_notes, watchdog, 0.0,
+                                     meshing.max_deviation * diagonal);
   } else if (meshing.repair == Repair::kWrap) {
     mesh = wrap_and_mesh(surface, meshing, file, out_notes, watchdog);
   } else if (meshing.repair == Repair::kAuto) {
     mesh = fix_or_wrap(surface, meshing, diagonal, file, out_notes, watchdog);
   } else {
-    mesh = detail::validate_and_mesh(surface, meshing, file, out_notes, watchdog);
+    mesh = detail::validate_and_mesh(surface, meshing, file, out_notes, watchdog, 0.0,
+                                     meshing.max_deviation * diagonal);
   }
   watchdog.begin("deviation measurement");
   measure_deviation(surface, mesh, meshing, diagonal, out_notes);

@@ -171,12 +171,12 @@ void print_repairs(const std::string& file, const preprocess::TetrahedralizeNote
   if (notes.deviation_excess > 0.0)
     std::fprintf(stderr,
                  "tetseg: note: %s: the meshed surface deviates %.3g of the bounding-box diagonal "
-                 "from the input, %.3g over --max-deviation (a sheet wrapped as a slab, a hole "
-                 "closed across, sharp corners Mesh_3 rounds, or sizes too coarse: a smaller "
-                 "--facet-distance)\n",
+                 "from the input, %.3g over --max-deviation after %zu meshing retries at smaller "
+                 "sizes (a sheet wrapped as a slab, a hole closed across, the inner parts of a "
+                 "self-intersecting input, or sizes too coarse: a smaller --facet-distance)\n",
                  base_name(file).c_str(),
                  std::max(notes.hausdorff_input_to_mesh, notes.hausdorff_mesh_to_input),
-                 notes.deviation_excess);
+                 notes.deviation_excess, notes.deviation_retries);
   if (notes.repairs.empty()) return;
   std::string list;
   for (const preprocess::RepairCount& r : notes.repairs)
