@@ -513,14 +513,18 @@ TetMesh keep_within_distance(const TriangleMesh& surface, TetMesh best, double m
   std::size_t retries = 0;
   TetMesh last;  // the last retry's mesh (the best one is moved to `best`)
   const TetMesh* latest = &best;
+  bool protection_failed = false;
   for (int retry = 1; retry <= kMaxDeviationRetries; ++retry) {
     const double shrink = std::clamp(kDeviationRetryMargin * max_distance / distance,
                                      kMinRetryShrink, kMaxRetryShrink);
-    sizes.facet_distance *= shrink;
-    sizes.facet_size *= std::sqrt(shrink);
-    if (!sizes.protect_sharp_edges && !sharp_samples.empty()) {
+    RetrySizes tried_sizes = sizes;
+    tried_sizes.facet_distance *= shrink;
+    tried_sizes.facet_size *= std::sqrt(shrink);
+    if (protection_failed) {
+      tried_sizes.protect_sharp_edges = false;
+    } else if (!tried_sizes.protect_sharp_edges && !sharp_samples.empty()) {
       const TriangleMesh boundary{latest->nodes, extract_surface(*latest).triangles};
-      sizes.protect_sharp_edges =
+      tried_sizes.protect_sharp_edges =
           detail::max_distance_to_surface(sharp_samples, boundary) > max_distance;
     }
     const double bound =
@@ -530,14 +534,21 @@ TetMesh keep_within_distance(const TriangleMesh& surface, TetMesh best, double m
     TetrahedralizeNotes tried_notes = notes_before;
     TetMesh tried;
     try {
-      tried = mesh_closed_surface(surface, meshing, file, tried_notes, watchdog, bound, sizes);
+      tried =
+          mesh_closed_surface(surface, meshing, file, tried_notes, watchdog, bound, tried_sizes);
     } catch (const TimeLimitExceeded&) {
       throw;
     } catch (const InputError&) {
+      // Over its bound or refused: with sharp edges protected (slow on finely tessellated
+      // inputs, whose sharp edges are mostly noise), the next retry takes the same sizes
+      // unprotected; else the nearest mesh so far is kept.
       ++retries;
-      break;  // over its bound or refused: the nearest mesh so far is kept
+      if (!tried_sizes.protect_sharp_edges) break;
+      protection_failed = true;
+      continue;
     }
     ++retries;
+    sizes = tried_sizes;
     watchdog.begin("deviation of the meshed boundary");
     distance = boundary_distance(surface, tried);
     if (distance >= 0.0 && distance < best_distance) {

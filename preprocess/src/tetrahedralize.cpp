@@ -119,6 +119,12 @@ TriangleMesh wrapped_surface(const TriangleMesh& surface, double alpha, double o
   }
 }
 
+/// The slab's alpha is at most this many times --wrap-sheet-offset (and at most --wrap-alpha):
+/// where the slab bridges a concave part of the input, its surface lies up to about alpha
+/// further out than the offset (libcgal-demo, the default offset 0.01: open_cube.off and
+/// patch-01.off 0.022-0.023 from their input at alpha 0.02, 0.016 at 0.01; docs/benchmarks.md).
+constexpr double kSlabAlphaPerOffset = 1.0;
+
 /// The repair kind of mesh_sheet_slab (the count: the slab's thickness, 1e-4 of the diagonal).
 constexpr const char* kSlabRepair =
     "surface wrapped as a slab this many ten thousandths of the diagonal thick";
@@ -130,8 +136,9 @@ constexpr const char* kSlabRepair =
 TetMesh mesh_sheet_slab(const TriangleMesh& surface, const MeshingOptions& meshing, double diagonal,
                         const std::string& file, TetrahedralizeNotes& notes,
                         detail::Watchdog& watchdog, double bound_seconds = 0.0) {
-  const TriangleMesh slab = wrapped_surface(surface, meshing.wrap_alpha, meshing.wrap_sheet_offset,
-                                            diagonal, file, watchdog);
+  const TriangleMesh slab = wrapped_surface(
+      surface, std::min(meshing.wrap_alpha, kSlabAlphaPerOffset * meshing.wrap_sheet_offset),
+      meshing.wrap_sheet_offset, diagonal, file, watchdog);
   TetMesh mesh;
   try {
     // Retries only when the slab's offset leaves room within --max-deviation.
