@@ -139,7 +139,8 @@ void add_repair_option(CLI::App& cmd, preprocess::MeshingOptions& m) {
   cmd.add_option("--max-deviation", m.max_deviation,
                  "Surface input: how far the asset's surface may be from the input (two-sided "
                  "Hausdorff distance), a fraction of the bounding-box diagonal: bounds the "
-                 "derived facet distance (half) and the wrap offset (a quarter); a mesh still "
+                 "derived facet distance (half) and the wrap offset (a quarter); Mesh_3 is rerun "
+                 "at smaller sizes (at most twice) while its surface is farther; a mesh still "
                  "farther is reported (report deviation_excess)")
       ->check(range_check(preprocess::option_ranges::kMaxDeviation))
       ->capture_default_str();

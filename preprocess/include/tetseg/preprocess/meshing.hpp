@@ -56,8 +56,12 @@ struct MeshingOptions {
   /// kMaxDeviation). A derived facet distance is at most half of it and the wrap offset at most
   /// a quarter (the defaults are below both at 0.01); the wrap's alpha is not doubled past
   /// twice it before the slab is tried, and kAuto wraps hole patches further than it
-  /// (tetrahedralize). A mesh that still deviates more (a sheet wrapped as a slab, the inner
-  /// parts of a self-intersecting input) is kept, and TetrahedralizeNotes says by how much.
+  /// (tetrahedralize). When Mesh_3's surface lies further than it allows from the surface
+  /// meshed, Mesh_3 is rerun at most twice at smaller sizes (sharp edges protected where they
+  /// were rounded off), bounded in time and vertices, and the nearest mesh is kept
+  /// (TetrahedralizeNotes::deviation_retries). A mesh that still deviates more (a sheet wrapped
+  /// as a slab, the inner parts of a self-intersecting input) is kept, and TetrahedralizeNotes
+  /// says by how much.
   double max_deviation = 0.01;
   /// Surfaces only: seconds tetrahedralize may run (0: no limit; option_ranges kTimeLimit).
   /// Mesh_3 is stopped there, and the other steps (repair, wrap, deviation) are checked
