@@ -80,12 +80,12 @@ constexpr int kMaxDeviationRetries = 2;
 constexpr double kDeviationRetryMargin = 0.7;
 constexpr double kMinRetryShrink = 0.25;
 constexpr double kMaxRetryShrink = 0.7;
-/// Each retry's Mesh_3 runs are bounded by kRetryTimeFactor x the first meshing's seconds,
+/// Each retry's Mesh_3 runs together are bounded by kRetryTimeFactor x the first meshing's seconds,
 /// within [kMinRetrySeconds, kMaxRetrySeconds] and at most half of the time limit left; past
 /// the bound, the nearest mesh so far is kept. The vertex budget stays the first meshing's.
-constexpr double kRetryTimeFactor = 8.0;
+constexpr double kRetryTimeFactor = 4.0;
 constexpr double kMinRetrySeconds = 10.0;
-constexpr double kMaxRetrySeconds = 60.0;
+constexpr double kMaxRetrySeconds = 30.0;
 
 }  // namespace
 
@@ -351,6 +351,9 @@ struct RetrySizes {
   double facet_size = 1.0;           ///< factor (the cell size stays)
   bool protect_sharp_edges = false;  ///< whatever the input's edge lengths
   std::size_t max_vertices = 0;      ///< > 0: this vertex budget instead of the sizes'
+  /// > 0: every Mesh_3 run of the call together stops after this many seconds (refused as
+  /// not converging), whatever runs the boundary retries add.
+  double total_seconds = 0.0;
 };
 
 /// Mesh_3 on a closed surface (pinch points allowed), checked, with the retries of
@@ -399,6 +402,7 @@ TetMesh mesh_closed_surface(const TriangleMesh& input, const MeshingOptions& mes
                     {{"exudation only", true, false}, {"no optimisation", false, false}});
   std::string first_defect;
   std::string defects;
+  const auto started = std::chrono::steady_clock::now();
   for (const double factor : kRetrySizeFactors) {
     detail::Mesh3Criteria sized = criteria;
     sized.facet_size *= factor;
@@ -432,11 +436,21 @@ TetMesh mesh_closed_surface(const TriangleMesh& input, const MeshingOptions& mes
       detail::Mesh3Criteria tried = sized;
       tried.optimize = attempt.optimize;
       tried.perturb = attempt.perturb;
+      double run_bound = bound_seconds;
+      if (retry.total_seconds > 0.0) {
+        const double left =
+            retry.total_seconds -
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+        if (left < 1.0)
+          throw InputError(file, "tetrahedralize: CGAL Mesh_3 did not converge within " +
+                                     std::to_string(static_cast<int>(retry.total_seconds)) + " s");
+        run_bound = run_bound > 0.0 ? std::min(run_bound, left) : left;
+      }
       const TetMesh mesh =
           run_mesh_3_guarded(input, tried, file, watchdog,
                              std::string("CGAL Mesh_3 (") + attempt.name + ", sizes x" +
                                  std::to_string(factor).substr(0, 3) + ")",
-                             bound_seconds);
+                             run_bound);
       if (mesh.tets.empty())
         throw InputError(file,
                          "meshing produced no tetrahedra (is the surface closed and "
@@ -531,11 +545,11 @@ TetMesh keep_within_distance(const TriangleMesh& surface, TetMesh best, double m
         std::min(std::clamp(kRetryTimeFactor * first_seconds, kMinRetrySeconds, kMaxRetrySeconds),
                  0.5 * watchdog.seconds_left());
     if (!(bound > 1.0)) break;
+    tried_sizes.total_seconds = bound;
     TetrahedralizeNotes tried_notes = notes_before;
     TetMesh tried;
     try {
-      tried =
-          mesh_closed_surface(surface, meshing, file, tried_notes, watchdog, bound, tried_sizes);
+      tried = mesh_closed_surface(surface, meshing, file, tried_notes, watchdog, 0.0, tried_sizes);
     } catch (const TimeLimitExceeded&) {
       throw;
     } catch (const InputError&) {
