@@ -147,9 +147,12 @@ BuildJobResult run_build(const std::function<BuildInput(std::string& summary)>& 
       build.fallback_reason = notes.fallback_reason;
     }
     if (notes.hausdorff_input_to_mesh >= 0.0)
-      result.deviation = {notes.hausdorff_input_to_mesh, notes.hausdorff_mesh_to_input,
+      result.deviation = {notes.hausdorff_input_to_mesh,
+                          notes.hausdorff_mesh_to_input,
                           notes.hausdorff_input_to_mesh * notes.diagonal,
-                          notes.hausdorff_mesh_to_input * notes.diagonal};
+                          notes.hausdorff_mesh_to_input * notes.diagonal,
+                          notes.deviation_excess,
+                          static_cast<int>(notes.deviation_retries)};
   }
   build.deviation = result.deviation;  // a tet-mesh input: 0, its boundary is the surface
   if (build.body == format::BodyKind::kTet)
@@ -398,6 +401,11 @@ std::string build_report_json(const BuildJobResult& result, const std::string& i
     out << "  \"repair_used\": \"" << name_of(notes.repair_used) << "\",\n";
     // Over --max-deviation (options: meshing.max_deviation) by this much; 0 within it.
     out << "  \"deviation_excess\": " << notes.deviation_excess << ",\n";
+    // Mesh_3 runs repeated at smaller sizes to stay within it, and the sizes kept.
+    out << "  \"deviation_retries\": " << notes.deviation_retries << ",\n";
+    if (!notes.deviation_retry_sizes.empty())
+      out << "  \"deviation_retry_sizes\": \"" << json_escape(notes.deviation_retry_sizes)
+          << "\",\n";
     if (!notes.fallback_reason.empty())
       out << "  \"fallback_reason\": \"" << json_escape(notes.fallback_reason) << "\",\n";
     if (!notes.optimization_used.empty())

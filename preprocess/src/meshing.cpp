@@ -1,12 +1,15 @@
-// Meshing options, size rules and entry points. No CGAL here: the Mesh_3 work is in
-// mesh3_implicit.cpp and mesh3_polyhedral.cpp.
+// Driving CGAL Mesh_3 on a surface: option checks, the default sizes, the vertex budget,
+// sharp-edge protection, the time bound and the retries when the meshed boundary is not a
+// closed 2-manifold. Which surface it meshes (fix, wrap, slab; --repair auto) is decided in
+// tetrahedralize.cpp. No CGAL here: the Mesh_3 work is in mesh3_implicit.cpp and
+// mesh3_polyhedral.cpp.
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
-#include <limits>
 #include <new>
 #include <stdexcept>
 #include <string>
@@ -15,6 +18,7 @@
 #include <vector>
 
 #include "components.hpp"
+#include "mesh3_driver.hpp"
 #include "meshing_internal.hpp"
 #include "repair_internal.hpp"
 #include "tetseg/preprocess/surface.hpp"
@@ -64,10 +68,28 @@ constexpr double kMinProtectedDihedralDegrees = 5.0;
 /// When no optimisation gives a valid boundary, meshing is retried with every size (facet,
 /// cell, facet distance) times these factors in turn (the first is the asked size).
 constexpr double kRetrySizeFactors[] = {1.0, 0.7, 0.5};
-/// The smallest --wrap-alpha and --wrap-offset, as fractions of the diagonal.
-constexpr double kMinWrapFraction = 1e-4;
+/// When the meshed boundary lies further than the asked distance from the surface it meshes
+/// (--max-deviation), meshing is retried at most kMaxDeviationRetries times, each with the
+/// facet distance times kDeviationRetryMargin x asked / measured distance (clamped to
+/// [kMinRetryShrink, kMaxRetryShrink]) and the facet size times its square root (cell sizes
+/// unchanged), with sharp edges protected once the input's sharp edges lie further than asked
+/// from the mesh (Mesh_3 rounds them off unprotected: fandisk). Mesh_3's facet distance bounds
+/// the distance of its facets' centres from the surface, not the Hausdorff distance: elephant
+/// deviates about twice its facet distance, fandisk three times (docs/benchmarks.md).
+constexpr int kMaxDeviationRetries = 2;
+constexpr double kDeviationRetryMargin = 0.7;
+constexpr double kMinRetryShrink = 0.25;
+constexpr double kMaxRetryShrink = 0.7;
+/// Each retry's Mesh_3 runs together are bounded by kRetryTimeFactor x the first meshing's seconds,
+/// within [kMinRetrySeconds, kMaxRetrySeconds] and at most half of the time limit left; past
+/// the bound, the nearest mesh so far is kept. The vertex budget stays the first meshing's.
+constexpr double kRetryTimeFactor = 4.0;
+constexpr double kMinRetrySeconds = 10.0;
+constexpr double kMaxRetrySeconds = 30.0;
 
-double bounding_box_diagonal(const std::vector<Vec3>& points) {
+}  // namespace
+
+double detail::bounding_box_diagonal(const std::vector<Vec3>& points) {
   if (points.empty()) return 0.0;
   Vec3 lo = points.front();
   Vec3 hi = lo;
@@ -78,6 +100,8 @@ double bounding_box_diagonal(const std::vector<Vec3>& points) {
     }
   return std::hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
 }
+
+namespace {
 
 void require_positive(double value, const char* name) {
   if (!std::isfinite(value) || value <= 0.0)
@@ -162,6 +186,8 @@ struct SharpEdges {
   /// The largest angle between the normals of a sharp edge's two triangles, degrees: 180
   /// minus it is the edge's smallest (wedge or slit) dihedral angle.
   double max_normal_degrees = 0.0;
+  /// The sharp edges, as pairs of vertex ids.
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> edges;
 };
 
 SharpEdges sharp_edges(const TriangleMesh& s, double degrees) {
@@ -192,11 +218,12 @@ SharpEdges sharp_edges(const TriangleMesh& s, double degrees) {
       const double c = std::clamp(detail::dot(n, m), -1.0, 1.0);
       out.max_normal_degrees = std::max(out.max_normal_degrees, std::acos(c) * 180.0 / M_PI);
       const auto [a, b] = edges[i].first;
+      out.edges.push_back({a, b});
       sharp.push_back({a, b});
       sharp.push_back({b, a});
     }
   }
-  out.count = sharp.size() / 2;
+  out.count = out.edges.size();
   std::sort(sharp.begin(), sharp.end());
   sharp.erase(std::unique(sharp.begin(), sharp.end()), sharp.end());
   for (std::size_t i = 0; i < sharp.size();) {
@@ -318,12 +345,24 @@ std::string boundary_defect(const TetMesh& mesh, const std::string& file) {
   return "";
 }
 
+/// How a deviation retry changes the sizes mesh_closed_surface derives from the options.
+struct RetrySizes {
+  double facet_distance = 1.0;       ///< factor
+  double facet_size = 1.0;           ///< factor (the cell size stays)
+  bool protect_sharp_edges = false;  ///< whatever the input's edge lengths
+  std::size_t max_vertices = 0;      ///< > 0: this vertex budget instead of the sizes'
+  /// > 0: every Mesh_3 run of the call together stops after this many seconds (refused as
+  /// not converging), whatever runs the boundary retries add.
+  double total_seconds = 0.0;
+};
+
 /// Mesh_3 on a closed surface (pinch points allowed), checked, with the retries of
 /// tetrahedralize; notes.optimization_used and notes.first_defect say which mesh was returned.
 TetMesh mesh_closed_surface(const TriangleMesh& input, const MeshingOptions& meshing,
                             const std::string& file, TetrahedralizeNotes& notes,
-                            detail::Watchdog& watchdog, double bound_seconds) {
-  const double diagonal = bounding_box_diagonal(input.vertices);
+                            detail::Watchdog& watchdog, double bound_seconds,
+                            const RetrySizes& retry = {}) {
+  const double diagonal = detail::bounding_box_diagonal(input.vertices);
   // Criteria are checked before CGAL sees them: every size finite and positive, and not so
   // small against the surface that refinement could never end (kMaxDiagonalPerSize).
   detail::Mesh3Criteria criteria = resolve(meshing, default_facet_size_for_diagonal(diagonal));
@@ -333,6 +372,8 @@ TetMesh mesh_closed_surface(const TriangleMesh& input, const MeshingOptions& mes
   if (meshing.facet_distance == 0.0)
     criteria.facet_distance =
         std::min(criteria.facet_distance, 0.5 * meshing.max_deviation * diagonal);
+  criteria.facet_distance *= retry.facet_distance;
+  criteria.facet_size *= retry.facet_size;
   for (const double size : {criteria.facet_size, criteria.cell_size, criteria.facet_distance})
     if (!(size * kMaxDiagonalPerSize >= diagonal))
       throw InputError(file, "tetrahedralize: a meshing size is below 1/" +
@@ -361,13 +402,16 @@ TetMesh mesh_closed_surface(const TriangleMesh& input, const MeshingOptions& mes
                     {{"exudation only", true, false}, {"no optimisation", false, false}});
   std::string first_defect;
   std::string defects;
+  const auto started = std::chrono::steady_clock::now();
   for (const double factor : kRetrySizeFactors) {
     detail::Mesh3Criteria sized = criteria;
     sized.facet_size *= factor;
     sized.cell_size *= factor;
     sized.facet_distance *= factor;
-    sized.max_vertices = vertex_budget(sized, diagonal);
-    if (sharp && median_edge >= kProtectEdgeFacets * sized.facet_size) {
+    sized.max_vertices =
+        retry.max_vertices > 0 ? retry.max_vertices : vertex_budget(sized, diagonal);
+    if (sharp &&
+        (retry.protect_sharp_edges || median_edge >= kProtectEdgeFacets * sized.facet_size)) {
       sized.sharp_edge_angle = kSharpEdgeDegrees;
       if (sharp_features.min_corner_degrees < kMinProtectedCornerDegrees)
         throw InputError(
@@ -392,11 +436,21 @@ TetMesh mesh_closed_surface(const TriangleMesh& input, const MeshingOptions& mes
       detail::Mesh3Criteria tried = sized;
       tried.optimize = attempt.optimize;
       tried.perturb = attempt.perturb;
+      double run_bound = bound_seconds;
+      if (retry.total_seconds > 0.0) {
+        const double left =
+            retry.total_seconds -
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+        if (left < 1.0)
+          throw InputError(file, "tetrahedralize: CGAL Mesh_3 did not converge within " +
+                                     std::to_string(static_cast<int>(retry.total_seconds)) + " s");
+        run_bound = run_bound > 0.0 ? std::min(run_bound, left) : left;
+      }
       const TetMesh mesh =
           run_mesh_3_guarded(input, tried, file, watchdog,
                              std::string("CGAL Mesh_3 (") + attempt.name + ", sizes x" +
                                  std::to_string(factor).substr(0, 3) + ")",
-                             bound_seconds);
+                             run_bound);
       if (mesh.tets.empty())
         throw InputError(file,
                          "meshing produced no tetrahedra (is the surface closed and "
@@ -422,108 +476,122 @@ TetMesh mesh_closed_surface(const TriangleMesh& input, const MeshingOptions& mes
                              "need a smaller --facet-size");
 }
 
+/// The larger of the two (approximate) Hausdorff distances between `surface` and the boundary
+/// of `mesh`, absolute; -1 when not measurable.
+double boundary_distance(const TriangleMesh& surface, const TetMesh& mesh) {
+  const TriangleMesh boundary{mesh.nodes, extract_surface(mesh).triangles};
+  const auto [there, back] = detail::hausdorff_distances(surface, boundary);
+  return std::max(there, back);
+}
+
+/// Points along the sharp edges of `surface` (each edge's ends and its quarter points; at most
+/// about kMaxSharpEdgeSamples points, every k-th edge beyond).
+std::vector<Vec3> sharp_edge_samples(const TriangleMesh& surface, const SharpEdges& sharp) {
+  constexpr std::size_t kMaxSharpEdgeSamples = 20000;
+  constexpr int kPerEdge = 4;
+  std::vector<Vec3> points;
+  const std::size_t stride =
+      std::max<std::size_t>(1, kPerEdge * sharp.edges.size() / kMaxSharpEdgeSamples + 1);
+  for (std::size_t e = 0; e < sharp.edges.size(); e += stride) {
+    const Vec3& a = surface.vertices[sharp.edges[e].first];
+    const Vec3& b = surface.vertices[sharp.edges[e].second];
+    for (int k = 0; k < kPerEdge; ++k) {
+      const double t = static_cast<double>(k) / kPerEdge;
+      points.push_back(
+          {a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1]), a[2] + t * (b[2] - a[2])});
+    }
+  }
+  return points;
+}
+
+/// The deviation retries (kMaxDeviationRetries): while the boundary of `mesh` lies further than
+/// `max_distance` (absolute, > 0) from `surface`, meshing is repeated at smaller sizes, and the
+/// nearest mesh is returned, with its notes; notes.deviation_retries counts the meshings
+/// repeated. `first_seconds`: how long the first meshing took.
+TetMesh keep_within_distance(const TriangleMesh& surface, TetMesh best, double max_distance,
+                             double first_seconds, const MeshingOptions& meshing,
+                             const std::string& file, TetrahedralizeNotes& notes,
+                             detail::Watchdog& watchdog) {
+  watchdog.begin("deviation of the meshed boundary");
+  double distance = boundary_distance(surface, best);
+  if (!(distance > max_distance)) return best;
+  const TetrahedralizeNotes notes_before = notes;
+  const double diagonal = detail::bounding_box_diagonal(surface.vertices);
+  const SharpEdges sharp = sharp_edges(surface, kSharpEdgeDegrees);
+  const std::vector<Vec3> sharp_samples = sharp_edge_samples(surface, sharp);
+  RetrySizes sizes;
+  sizes.max_vertices =
+      vertex_budget(resolve(meshing, default_facet_size_for_diagonal(diagonal)), diagonal);
+  double best_distance = distance;
+  std::string best_sizes;
+  std::size_t retries = 0;
+  TetMesh last;  // the last retry's mesh (the best one is moved to `best`)
+  const TetMesh* latest = &best;
+  bool protection_failed = false;
+  for (int retry = 1; retry <= kMaxDeviationRetries; ++retry) {
+    const double shrink = std::clamp(kDeviationRetryMargin * max_distance / distance,
+                                     kMinRetryShrink, kMaxRetryShrink);
+    RetrySizes tried_sizes = sizes;
+    tried_sizes.facet_distance *= shrink;
+    tried_sizes.facet_size *= std::sqrt(shrink);
+    if (protection_failed) {
+      tried_sizes.protect_sharp_edges = false;
+    } else if (!tried_sizes.protect_sharp_edges && !sharp_samples.empty()) {
+      const TriangleMesh boundary{latest->nodes, extract_surface(*latest).triangles};
+      tried_sizes.protect_sharp_edges =
+          detail::max_distance_to_surface(sharp_samples, boundary) > max_distance;
+    }
+    const double bound =
+        std::min(std::clamp(kRetryTimeFactor * first_seconds, kMinRetrySeconds, kMaxRetrySeconds),
+                 0.5 * watchdog.seconds_left());
+    if (!(bound > 1.0)) break;
+    tried_sizes.total_seconds = bound;
+    TetrahedralizeNotes tried_notes = notes_before;
+    TetMesh tried;
+    try {
+      tried = mesh_closed_surface(surface, meshing, file, tried_notes, watchdog, 0.0, tried_sizes);
+    } catch (const TimeLimitExceeded&) {
+      throw;
+    } catch (const InputError&) {
+      // Over its bound or refused: with sharp edges protected (slow on finely tessellated
+      // inputs, whose sharp edges are mostly noise), the next retry takes the same sizes
+      // unprotected; else the nearest mesh so far is kept.
+      ++retries;
+      if (!tried_sizes.protect_sharp_edges) break;
+      protection_failed = true;
+      continue;
+    }
+    ++retries;
+    sizes = tried_sizes;
+    watchdog.begin("deviation of the meshed boundary");
+    distance = boundary_distance(surface, tried);
+    if (distance >= 0.0 && distance < best_distance) {
+      char text[120];
+      std::snprintf(text, sizeof text, "facet distance x%.2g, facet size x%.2g%s",
+                    sizes.facet_distance, sizes.facet_size,
+                    sizes.protect_sharp_edges ? ", sharp edges protected" : "");
+      best_distance = distance;
+      best_sizes = text;
+      notes = tried_notes;
+      best = std::move(tried);
+      latest = &best;
+    } else {
+      last = std::move(tried);
+      latest = &last;
+    }
+    if (distance <= max_distance) break;
+  }
+  notes.deviation_retries = retries;
+  notes.deviation_retry_sizes = best_sizes;
+  return best;
+}
+
 }  // namespace
 
-namespace {
-
-/// Area and enclosed volume (divergence theorem; for a closed, outward surface) of `s`.
-std::pair<double, double> area_and_volume(const TriangleMesh& s) {
-  double area = 0.0, volume = 0.0;
-  for (const Tri& t : s.triangles) {
-    const Vec3& a = s.vertices[t[0]];
-    const Vec3 n =
-        detail::cross(detail::sub(s.vertices[t[1]], a), detail::sub(s.vertices[t[2]], a));
-    area += 0.5 * detail::norm(n);
-    volume += detail::dot(a, n) / 6.0;
-  }
-  return {area, volume};
-}
-
-/// A wrap is a thin shell where it went through a hole wider than alpha and wrapped both
-/// sides of the input: there it is about 2 x offset thick, and Mesh_3 cannot fill it (it fails,
-/// or on cube-ouvert.off does not end). Two tests, either one makes a wrap thin:
-/// - its volume is below kThinShell x offset x area (a wrap that is a thin shell all over has
-///   a volume of about offset x area; a solid's is far more);
-/// - at least kThinShare of kThinProbes vertices (every k-th) are on a thin part: the point
-///   kThinProbeDepth x offset inside along the vertex normal is outside the wrap (generalised
-///   winding number below 1/2). On libcgal-demo (docs/benchmarks-history.md, "Real meshes") the
-///   wraps of closed solids have shares 0-0.09; cube-ouvert's partly entered wrap (alpha
-///   0.16), which the volume test lets through, 0.61. Wraps of open surfaces that Mesh_3 did
-///   mesh reach 0.66, so no threshold is exact: three of them now take one more doubling.
-constexpr double kThinShell = 4.0;
-constexpr double kThinShare = 0.55;
-constexpr double kThinProbeDepth = 3.0;
-constexpr std::size_t kThinProbes = 512;
-constexpr double kPi = 3.14159265358979323846;
-/// With --repair wrap, alpha is doubled at most this many times (see tetrahedralize).
-constexpr int kMaxAlphaDoublings = 6;
-/// A wrap bridges the gaps and holes narrower than alpha, so its distance from the input grows
-/// with alpha (libcgal-demo, docs/benchmarks-history.md: about 0.01-0.04 of the diagonal at
-/// alpha 0.02, 0.05-0.08 at 0.08, 0.22-0.32 at 0.32). Alpha is doubled past
-/// kAlphaPerDeviation x --max-deviation (or --wrap-alpha when larger) only when the slab
-/// (mesh_sheet_slab, within about --wrap-sheet-offset of the input) does not mesh.
-constexpr double kAlphaPerDeviation = 2.0;
-/// That slab's Mesh_3 runs are bounded (seconds; past it, the doublings): slabs mesh in 1-20 s
-/// on libcgal-demo, but b9_mesh.off's ran over 300 s.
-constexpr double kSlabMeshingSeconds = 20.0;
-
-/// The share of the probed vertices of `wrap` (closed, outward) that lie on a thin part (see
-/// kThinShare). O(kThinProbes x triangles).
-double thin_share(const TriangleMesh& wrap, double offset) {
-  std::vector<Vec3> normal(wrap.vertices.size(), Vec3{0.0, 0.0, 0.0});
-  for (const Tri& t : wrap.triangles) {
-    const Vec3& a = wrap.vertices[t[0]];
-    const Vec3 n =
-        detail::cross(detail::sub(wrap.vertices[t[1]], a), detail::sub(wrap.vertices[t[2]], a));
-    for (const std::uint32_t v : t)
-      for (int k = 0; k < 3; ++k) normal[v][k] += n[k];
-  }
-  const std::size_t stride = std::max<std::size_t>(1, wrap.vertices.size() / kThinProbes);
-  std::size_t probed = 0, thin = 0;
-  for (std::size_t v = 0; v < wrap.vertices.size(); v += stride) {
-    const double length = detail::norm(normal[v]);
-    if (!(length > 0.0)) continue;
-    Vec3 probe;
-    for (int k = 0; k < 3; ++k)
-      probe[k] = wrap.vertices[v][k] - kThinProbeDepth * offset * normal[v][k] / length;
-    double angle = 0.0;
-    for (const Tri& t : wrap.triangles)
-      angle +=
-          detail::solid_angle(probe, wrap.vertices[t[0]], wrap.vertices[t[1]], wrap.vertices[t[2]]);
-    ++probed;
-    if (angle < 2.0 * kPi) ++thin;  // winding number below 1/2: outside
-  }
-  return probed == 0 ? 1.0 : static_cast<double>(thin) / static_cast<double>(probed);
-}
-
-bool is_thin_shell(const TriangleMesh& wrap, double offset) {
-  const auto [area, volume] = area_and_volume(wrap);
-  return volume < kThinShell * offset * area || thin_share(wrap, offset) >= kThinShare;
-}
-
-/// The alpha wrap of `surface` (`--repair wrap`) with alpha `alpha` and offset `offset`, both
-/// fractions of the bounding-box diagonal `diagonal`.
-TriangleMesh wrapped_surface(const TriangleMesh& surface, double alpha, double offset,
-                             double diagonal, const std::string& file, detail::Watchdog& watchdog) {
-  watchdog.begin("CGAL alpha wrap (alpha " + std::to_string(alpha) + ", offset " +
-                 std::to_string(offset) + ")");
-  try {
-    return detail::alpha_wrap(surface, alpha * diagonal, offset * diagonal);
-  } catch (const std::bad_alloc&) {
-    throw InputError(file,
-                     "tetrahedralize: out of memory in CGAL alpha wrapping (is --wrap-alpha "
-                     "much smaller than the surface?)");
-  } catch (const std::exception& e) {
-    throw InputError(file, std::string("tetrahedralize: CGAL alpha wrapping failed: ") + e.what());
-  }
-}
-
-/// Validation (pinch points accepted: the domain only needs inside/outside queries, and the
-/// output is validated strictly) and Mesh_3 of a surface; after --repair fix, what is left is
-/// named with a pointer to wrap.
-TetMesh validate_and_mesh(const TriangleMesh& source, const MeshingOptions& meshing,
-                          const std::string& file, TetrahedralizeNotes& notes,
-                          detail::Watchdog& watchdog, double bound_seconds = 0.0) {
+TetMesh detail::validate_and_mesh(const TriangleMesh& source, const MeshingOptions& meshing,
+                                  const std::string& file, TetrahedralizeNotes& notes,
+                                  detail::Watchdog& watchdog, double bound_seconds,
+                                  double max_distance) {
   watchdog.begin("surface validation");
   TriangleMesh split;
   detail::SurfaceCheck check;
@@ -538,325 +606,14 @@ TetMesh validate_and_mesh(const TriangleMesh& source, const MeshingOptions& mesh
                                "of any input (docs/cli.md)");
   }
   detail::check_surface_not_nested(source, file);
-  return mesh_closed_surface(split.triangles.empty() ? source : split, meshing, file, notes,
-                             watchdog, bound_seconds);
+  const TriangleMesh& meshed = split.triangles.empty() ? source : split;
+  const auto started = std::chrono::steady_clock::now();
+  TetMesh mesh = mesh_closed_surface(meshed, meshing, file, notes, watchdog, bound_seconds);
+  if (!(max_distance > 0.0)) return mesh;
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  return keep_within_distance(meshed, std::move(mesh), max_distance, seconds, meshing, file, notes,
+                              watchdog);
 }
-
-/// The repair kind of mesh_sheet_slab (the count: the slab's thickness, 1e-4 of the diagonal).
-constexpr const char* kSlabRepair =
-    "surface wrapped as a slab this many ten thousandths of the diagonal thick";
-
-/// An input that encloses no volume (its wrap is a thin shell even with alpha = the diagonal:
-/// a flat or open sheet), or one whose wrap went through its holes (wrap_and_mesh), is wrapped
-/// again, with --wrap-alpha and the larger offset
-/// --wrap-sheet-offset, into a closed slab about 2 x that offset thick, and meshed.
-TetMesh mesh_sheet_slab(const TriangleMesh& surface, const MeshingOptions& meshing, double diagonal,
-                        const std::string& file, TetrahedralizeNotes& notes,
-                        detail::Watchdog& watchdog, double bound_seconds = 0.0) {
-  const TriangleMesh slab = wrapped_surface(surface, meshing.wrap_alpha, meshing.wrap_sheet_offset,
-                                            diagonal, file, watchdog);
-  TetMesh mesh;
-  try {
-    mesh = validate_and_mesh(slab, meshing, file, notes, watchdog, bound_seconds);
-  } catch (const TimeLimitExceeded&) {
-    throw;
-  } catch (const InputError& e) {
-    throw InputError(file, std::string(e.what()) +
-                               " (meshing the slab wrapped around an input that encloses no "
-                               "volume, --wrap-sheet-offset " +
-                               std::to_string(meshing.wrap_sheet_offset) + ")");
-  }
-  notes.repairs = {
-      {"surface replaced by an alpha wrap of this many triangles", slab.triangles.size()},
-      {kSlabRepair, static_cast<std::size_t>(std::lround(2.0 * meshing.wrap_sheet_offset * 1e4))}};
-  return mesh;
-}
-
-/// --repair wrap: wraps and meshes; while the wrap is a thin shell (is_thin_shell) or does not
-/// mesh (thin parts), alpha is doubled (at most kMaxAlphaDoublings times, up to the whole
-/// diagonal), without running Mesh_3 on thin wraps (slow on them). A thin wrap whose next alpha
-/// would pass kAlphaPerDeviation x --max-deviation is first replaced by the slab
-/// (mesh_sheet_slab: the surface stays within about --wrap-sheet-offset); the doublings go on
-/// only when the slab does not mesh. A wrap still thin at the end means that the input encloses
-/// no volume: mesh_sheet_slab.
-TetMesh wrap_and_mesh(const TriangleMesh& surface, const MeshingOptions& meshing,
-                      const std::string& file, TetrahedralizeNotes& notes,
-                      detail::Watchdog& watchdog) {
-  const auto check_fraction = [](double value, const char* what) {
-    if (!(value >= kMinWrapFraction && value <= 1.0))
-      throw std::invalid_argument(std::string(what) +
-                                  " must be in [1e-4, 1] (a fraction of the diagonal)");
-  };
-  check_fraction(meshing.wrap_alpha, "wrap alpha");
-  check_fraction(meshing.wrap_offset, "wrap offset");
-  check_fraction(meshing.wrap_sheet_offset, "wrap sheet offset");
-  if (surface.triangles.empty()) throw InputError(file, "tetrahedralize: surface has no triangles");
-  const double diagonal = bounding_box_diagonal(surface.vertices);
-  if (!(diagonal > 0.0) || !std::isfinite(diagonal))
-    throw InputError(file, "tetrahedralize: the surface has no extent");
-  double alpha = meshing.wrap_alpha;
-  // The wrap lies `offset` outside the input: at most a quarter of --max-deviation.
-  const double offset = std::min(meshing.wrap_offset, 0.25 * meshing.max_deviation);
-  const double max_alpha_within_deviation =
-      std::max(meshing.wrap_alpha, kAlphaPerDeviation * meshing.max_deviation);
-  bool slab_tried = false;
-  for (std::size_t doublings = 0;; ++doublings) {
-    const bool last = doublings == kMaxAlphaDoublings || alpha >= 1.0;
-    const TriangleMesh wrap = wrapped_surface(surface, alpha, offset, diagonal, file, watchdog);
-    const bool thin = is_thin_shell(wrap, offset * diagonal);
-    if (last && thin) return mesh_sheet_slab(surface, meshing, diagonal, file, notes, watchdog);
-    if (!thin) {
-      try {
-        TetMesh mesh = validate_and_mesh(wrap, meshing, file, notes, watchdog);
-        notes.repairs = {
-            {"surface replaced by an alpha wrap of this many triangles", wrap.triangles.size()}};
-        if (doublings > 0)
-          notes.repairs.push_back(
-              {"alpha doublings as the wrap was a thin shell or did not mesh", doublings});
-        return mesh;
-      } catch (const TimeLimitExceeded&) {
-        throw;
-      } catch (const InputError& e) {
-        if (last)
-          throw InputError(file, std::string(e.what()) + " (meshing the alpha wrap, alpha " +
-                                     std::to_string(alpha) + " of the diagonal)");
-      }
-    }
-    // The wrap went through holes, wrapped a sheet or did not mesh: a larger alpha would
-    // bridge more and move the surface further than --max-deviation, so the slab around the
-    // input is tried first.
-    if (!slab_tried && 2.0 * alpha > max_alpha_within_deviation) {
-      slab_tried = true;
-      try {
-        return mesh_sheet_slab(surface, meshing, diagonal, file, notes, watchdog,
-                               kSlabMeshingSeconds);
-      } catch (const TimeLimitExceeded&) {
-        throw;
-      } catch (const InputError&) {
-        // Back to the doublings; only what the slab's meshing wrote is dropped.
-        TetrahedralizeNotes kept;
-        kept.repair_used = notes.repair_used;
-        kept.fallback_reason = notes.fallback_reason;
-        notes = kept;
-      }
-    }
-    alpha = std::min(2.0 * alpha, 1.0);
-  }
-}
-
-}  // namespace
-
-std::string deviation_summary(const TetrahedralizeNotes& notes) {
-  if (notes.hausdorff_input_to_mesh < 0.0) return "deviation not measured";
-  char text[160];
-  std::snprintf(text, sizeof text,
-                "deviation %.2g / %.2g of the diagonal (input to mesh / mesh to input)",
-                notes.hausdorff_input_to_mesh, notes.hausdorff_mesh_to_input);
-  return text;
-}
-
-namespace {
-
-/// tetrahedralize in the surface's own coordinates (below).
-TetMesh tetrahedralize_in_place(const TriangleMesh& surface, const MeshingOptions& meshing,
-                                const std::string& file, TetrahedralizeNotes* notes);
-
-/// Where a surface is meshed: far from the origin against its size, or very large or small,
-/// it is moved to the origin and scaled by a power of two to a diagonal in [1, 2) (Mesh_3's
-/// constructions lose precision there: a tetrahedron of side 1e11 at 1e12 sent its exuder into
-/// exact arithmetic for minutes); other surfaces are meshed where they are (`moved` false).
-struct MeshingFrame {
-  bool moved = false;
-  Vec3 centre{0.0, 0.0, 0.0};
-  double scale = 1.0;  ///< a power of two
-};
-
-MeshingFrame meshing_frame(const TriangleMesh& s) {
-  MeshingFrame frame;
-  if (s.vertices.empty()) return frame;
-  Vec3 lo = s.vertices.front(), hi = lo;
-  for (const Vec3& p : s.vertices)
-    for (int k = 0; k < 3; ++k) {
-      lo[k] = std::min(lo[k], p[k]);
-      hi[k] = std::max(hi[k], p[k]);
-    }
-  const double diagonal = std::hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
-  if (!(diagonal > 0.0) || !std::isfinite(diagonal)) return frame;
-  double far = 0.0;
-  for (int k = 0; k < 3; ++k) far = std::max(far, std::fabs(0.5 * (lo[k] + hi[k])));
-  frame.moved = diagonal < 1e-3 || diagonal > 1e6 || far > 1e3 * diagonal;
-  if (!frame.moved) return frame;
-  for (int k = 0; k < 3; ++k) frame.centre[k] = 0.5 * (lo[k] + hi[k]);
-  frame.scale = std::ldexp(1.0, -std::ilogb(diagonal));
-  return frame;
-}
-
-}  // namespace
-
-TetMesh tetrahedralize(const TriangleMesh& surface, const MeshingOptions& meshing,
-                       const std::string& file, TetrahedralizeNotes* notes) {
-  const MeshingFrame frame = meshing_frame(surface);
-  if (!frame.moved) return tetrahedralize_in_place(surface, meshing, file, notes);
-  TriangleMesh moved = surface;
-  for (Vec3& p : moved.vertices)
-    for (int k = 0; k < 3; ++k) p[k] = (p[k] - frame.centre[k]) * frame.scale;
-  MeshingOptions scaled = meshing;
-  for (double* size : {&scaled.cell_size, &scaled.facet_size, &scaled.facet_distance})
-    *size *= frame.scale;
-  TetrahedralizeNotes local_notes;
-  TetrahedralizeNotes& out_notes = notes != nullptr ? *notes : local_notes;
-  TetMesh mesh = tetrahedralize_in_place(moved, scaled, file, &out_notes);
-  for (Vec3& p : mesh.nodes)
-    for (int k = 0; k < 3; ++k) p[k] = p[k] / frame.scale + frame.centre[k];
-  out_notes.diagonal /= frame.scale;  // the relative distances do not change
-  return mesh;
-}
-
-namespace {
-
-/// How far the surface moved (repairs, wrap and Mesh_3's re-meshing of the boundary): the
-/// distances between the input and the boundary of the tets, whatever the repair, into `notes`.
-void measure_deviation(const TriangleMesh& surface, const TetMesh& mesh,
-                       const MeshingOptions& meshing, double diagonal, TetrahedralizeNotes& notes) {
-  const Surface boundary = extract_surface(mesh);
-  const TriangleMesh meshed{mesh.nodes, boundary.triangles};
-  const auto [there, back] = detail::hausdorff_distances(surface, meshed);
-  if (there >= 0.0 && diagonal > 0.0) {
-    notes.hausdorff_input_to_mesh = there / diagonal;
-    notes.hausdorff_mesh_to_input = back / diagonal;
-    notes.diagonal = diagonal;
-    notes.deviation_excess =
-        std::max(0.0, std::max(there, back) / diagonal - meshing.max_deviation);
-  }
-}
-
-/// Hole patches making at least this share of a fixed surface's area close an open surface
-/// (a mask, a box without its lid) rather than mend a defect: --repair auto then checks them
-/// against --max-deviation (fix_or_wrap). libcgal-demo, about: the 7 holes of pig.off make 4 %,
-/// the base of head.off 8 %, open_cube.off's missing face 17 %, nefertiti.off's open back 43 %.
-constexpr double kOpenPatchShare = 0.15;
-
-/// The larger of the two notes' distances (relative); infinite when not measured.
-double larger_deviation(const TetrahedralizeNotes& notes) {
-  if (notes.hausdorff_input_to_mesh < 0.0) return std::numeric_limits<double>::infinity();
-  return std::max(notes.hausdorff_input_to_mesh, notes.hausdorff_mesh_to_input);
-}
-
-/// --repair fix's repairs of `surface` (detail::repair_soup; the repairs into `notes`).
-TriangleMesh fixed_surface(const TriangleMesh& surface, const MeshingOptions& meshing,
-                           const std::string& file, TetrahedralizeNotes& notes,
-                           detail::Watchdog& watchdog, double* patch_area = nullptr) {
-  watchdog.begin("repair");
-  TriangleMesh fixed = surface;
-  notes.repairs = detail::repair_soup(fixed, meshing.keep_largest_component, patch_area);
-  if (fixed.triangles.empty())
-    throw InputError(file, "tetrahedralize: no triangle is left after repair");
-  return fixed;
-}
-
-/// --repair auto: fix, and the wrap when what fix leaves cannot be meshed (any refusal of the
-/// surface or of Mesh_3 but the time limit, which is the user's bound on the whole), or when
-/// fix closed an open surface across: hole patches of at least kOpenPatchShare of the area
-/// lying further than --max-deviation from the input (the wrap keeps nearer, as a slab if need
-/// be). In that last case the fixed surface is meshed after all when the wrap fails or
-/// deviates more.
-TetMesh fix_or_wrap(const TriangleMesh& surface, const MeshingOptions& meshing, double diagonal,
-                    const std::string& file, TetrahedralizeNotes& notes,
-                    detail::Watchdog& watchdog) {
-  using Repair = MeshingOptions::Repair;
-  notes.repair_used = Repair::kFix;
-  TriangleMesh fixed;
-  double fix_deviation = 0.0;  // how far fix's hole patches are from the input, relative
-  double patch_share = 0.0;
-  std::string fix_error;
-  try {
-    double patch_area = 0.0;
-    fixed = fixed_surface(surface, meshing, file, notes, watchdog, &patch_area);
-    patch_share = patch_area / area_and_volume(fixed).first;
-    if (patch_share >= kOpenPatchShare && diagonal > 0.0) {
-      watchdog.begin("deviation of the hole patches");
-      const auto [there, back] = detail::hausdorff_distances(surface, fixed);
-      fix_deviation = std::max(there, back) / diagonal;
-    }
-    if (fix_deviation <= meshing.max_deviation)
-      return validate_and_mesh(fixed, meshing, file, notes, watchdog);
-  } catch (const TimeLimitExceeded&) {
-    throw;
-  } catch (const InputError& e) {
-    fix_error = e.what();
-  }
-  const bool fixed_too_far = fix_error.empty();  // else fix's result could not be meshed
-  const TetrahedralizeNotes fix_notes = notes;
-  notes = TetrahedralizeNotes{};
-  notes.repair_used = Repair::kWrap;
-  if (fixed_too_far) {
-    char reason[200];
-    std::snprintf(reason, sizeof reason,
-                  "tetrahedralize: the holes filled by fix (%.0f %% of the area) lie %.2g of "
-                  "the diagonal from the input, over --max-deviation %.2g",
-                  100.0 * patch_share, fix_deviation, meshing.max_deviation);
-    notes.fallback_reason = reason;
-  } else {
-    notes.fallback_reason = fix_error;
-  }
-  TetMesh wrapped;
-  try {
-    wrapped = wrap_and_mesh(surface, meshing, file, notes, watchdog);
-    if (!fixed_too_far) return wrapped;
-    watchdog.begin("deviation measurement");
-    measure_deviation(surface, wrapped, meshing, diagonal, notes);
-    if (larger_deviation(notes) <= fix_deviation) return wrapped;
-  } catch (const TimeLimitExceeded&) {
-    throw;
-  } catch (const InputError& wrap_error) {
-    if (!fixed_too_far)
-      throw InputError(file, std::string(wrap_error.what()) +
-                                 " (--repair auto: the wrap, after fix left: " + fix_error + ")");
-  }
-  // The wrap failed or moved the surface further than fix did: fix's surface after all, unless
-  // it does not mesh and the wrap did.
-  const TetrahedralizeNotes wrap_notes = notes;
-  notes = fix_notes;
-  try {
-    return validate_and_mesh(fixed, meshing, file, notes, watchdog);
-  } catch (const TimeLimitExceeded&) {
-    throw;
-  } catch (const InputError&) {
-    if (wrapped.tets.empty()) throw;
-    notes = wrap_notes;
-    return wrapped;
-  }
-}
-
-TetMesh tetrahedralize_in_place(const TriangleMesh& surface, const MeshingOptions& meshing,
-                                const std::string& file, TetrahedralizeNotes* notes) {
-  TetrahedralizeNotes local_notes;
-  TetrahedralizeNotes& out_notes = notes != nullptr ? *notes : local_notes;
-  if (!(meshing.time_limit >= 0.0))
-    throw std::invalid_argument("time limit must be zero (none) or a positive number of seconds");
-  if (!(meshing.max_deviation >= 1e-4 && meshing.max_deviation <= 1.0))
-    throw std::invalid_argument("max deviation must be in [1e-4, 1] (a fraction of the diagonal)");
-  detail::Watchdog watchdog(meshing.time_limit, meshing.progress, file);
-  using Repair = MeshingOptions::Repair;
-  const double diagonal = bounding_box_diagonal(surface.vertices);
-  TetMesh mesh;
-  out_notes.repair_used = meshing.repair;
-  if (meshing.repair == Repair::kFix) {
-    mesh = validate_and_mesh(fixed_surface(surface, meshing, file, out_notes, watchdog), meshing,
-                             file, out_notes, watchdog);
-  } else if (meshing.repair == Repair::kWrap) {
-    mesh = wrap_and_mesh(surface, meshing, file, out_notes, watchdog);
-  } else if (meshing.repair == Repair::kAuto) {
-    mesh = fix_or_wrap(surface, meshing, diagonal, file, out_notes, watchdog);
-  } else {
-    mesh = validate_and_mesh(surface, meshing, file, out_notes, watchdog);
-  }
-  watchdog.begin("deviation measurement");
-  measure_deviation(surface, mesh, meshing, diagonal, out_notes);
-  watchdog.check();
-  return mesh;
-}
-
-}  // namespace
 
 }  // namespace tetseg::preprocess

@@ -89,6 +89,9 @@ format::DetectorForm& detectors_of(BuildOptions& o) {
 bool deviation_known(const BuildOptions& o) {
   return o.deviation.has_value();
 }
+bool surface_deviation_known(const BuildOptions& o) {  // a surface input, tetrahedralised
+  return o.deviation.has_value() && o.meshing.has_value();
+}
 
 bool parse_double(const std::string& text, double& value) {
   if (text.empty()) return false;
@@ -271,6 +274,10 @@ const std::vector<ProvenanceField>& provenance_fields() {
                      [](O& o) -> double& { return deviation_of(o).input_to_asset_absolute; }),
       number<double>("deviation.asset_to_input_absolute", deviation_known,
                      [](O& o) -> double& { return deviation_of(o).asset_to_input_absolute; }),
+      number<double>("deviation.excess", surface_deviation_known,
+                     [](O& o) -> double& { return deviation_of(o).excess; }),
+      number<int>("deviation.meshing_retries", surface_deviation_known,
+                  [](O& o) -> int& { return deviation_of(o).meshing_retries; }),
   };
   return fields;
 }

@@ -36,4 +36,8 @@ TriangleMesh alpha_wrap(const TriangleMesh& soup, double alpha, double offset);
 /// soups may have any defects; {-1, -1} when either has no usable triangle.
 std::pair<double, double> hausdorff_distances(const TriangleMesh& a, const TriangleMesh& b);
 
+/// The largest distance from `points` to the triangles of `surface` (exact per point, CGAL
+/// max_distance_to_triangle_mesh), absolute; -1 without points or usable triangles.
+double max_distance_to_surface(const std::vector<Vec3>& points, const TriangleMesh& surface);
+
 }  // namespace tetseg::preprocess::detail

@@ -54,4 +54,11 @@ std::pair<double, double> hausdorff_distances(const TriangleMesh& a, const Trian
       pmp::approximate_Hausdorff_distance<CGAL::Sequential_tag>(mesh_b, mesh_a, sampling(mesh_b))};
 }
 
+double max_distance_to_surface(const std::vector<Vec3>& points, const TriangleMesh& surface) {
+  namespace pmp = CGAL::Polygon_mesh_processing;
+  const Mesh mesh = as_polygon_mesh(surface);
+  if (points.empty() || mesh.is_empty()) return -1.0;
+  return pmp::max_distance_to_triangle_mesh<CGAL::Sequential_tag>(cgal::to_points(points), mesh);
+}
+
 }  // namespace tetseg::preprocess::detail

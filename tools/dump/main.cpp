@@ -124,6 +124,11 @@ void print_summary(const std::string& path, const std::string& version, const As
         recorded("deviation.input_to_asset").c_str(), recorded("deviation.asset_to_input").c_str(),
         recorded("deviation.input_to_asset_absolute").c_str(),
         recorded("deviation.asset_to_input_absolute").c_str());
+  if (!recorded("deviation.excess").empty())
+    std::printf(
+        "  deviation excess    %s of the diagonal over --max-deviation, after %s meshing "
+        "retries\n",
+        recorded("deviation.excess").c_str(), recorded("deviation.meshing_retries").c_str());
   std::size_t flagged = 0;
   for (const auto& cluster : asset.clusters)
     flagged += (cluster.flags & tetseg::format::kClusterOverlapOnly) ? 1 : 0;

@@ -139,7 +139,8 @@ void add_repair_option(CLI::App& cmd, preprocess::MeshingOptions& m) {
   cmd.add_option("--max-deviation", m.max_deviation,
                  "Surface input: how far the asset's surface may be from the input (two-sided "
                  "Hausdorff distance), a fraction of the bounding-box diagonal: bounds the "
-                 "derived facet distance (half) and the wrap offset (a quarter); a mesh still "
+                 "derived facet distance (half) and the wrap offset (a quarter); Mesh_3 is rerun "
+                 "at smaller sizes (at most twice) while its surface is farther; a mesh still "
                  "farther is reported (report deviation_excess)")
       ->check(range_check(preprocess::option_ranges::kMaxDeviation))
       ->capture_default_str();
@@ -171,12 +172,12 @@ void print_repairs(const std::string& file, const preprocess::TetrahedralizeNote
   if (notes.deviation_excess > 0.0)
     std::fprintf(stderr,
                  "tetseg: note: %s: the meshed surface deviates %.3g of the bounding-box diagonal "
-                 "from the input, %.3g over --max-deviation (a sheet wrapped as a slab, a hole "
-                 "closed across, sharp corners Mesh_3 rounds, or sizes too coarse: a smaller "
-                 "--facet-distance)\n",
+                 "from the input, %.3g over --max-deviation after %zu meshing retries at smaller "
+                 "sizes (a sheet wrapped as a slab, a hole closed across, the inner parts of a "
+                 "self-intersecting input, or sizes too coarse: a smaller --facet-distance)\n",
                  base_name(file).c_str(),
                  std::max(notes.hausdorff_input_to_mesh, notes.hausdorff_mesh_to_input),
-                 notes.deviation_excess);
+                 notes.deviation_excess, notes.deviation_retries);
   if (notes.repairs.empty()) return;
   std::string list;
   for (const preprocess::RepairCount& r : notes.repairs)

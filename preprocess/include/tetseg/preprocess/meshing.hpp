@@ -56,8 +56,12 @@ struct MeshingOptions {
   /// kMaxDeviation). A derived facet distance is at most half of it and the wrap offset at most
   /// a quarter (the defaults are below both at 0.01); the wrap's alpha is not doubled past
   /// twice it before the slab is tried, and kAuto wraps hole patches further than it
-  /// (tetrahedralize). A mesh that still deviates more (a sheet wrapped as a slab, the inner
-  /// parts of a self-intersecting input) is kept, and TetrahedralizeNotes says by how much.
+  /// (tetrahedralize). When Mesh_3's surface lies further than it allows from the surface
+  /// meshed, Mesh_3 is rerun at most twice at smaller sizes (sharp edges protected where they
+  /// were rounded off), bounded in time and vertices, and the nearest mesh is kept
+  /// (TetrahedralizeNotes::deviation_retries). A mesh that still deviates more (a sheet wrapped
+  /// as a slab, the inner parts of a self-intersecting input) is kept, and TetrahedralizeNotes
+  /// says by how much.
   double max_deviation = 0.01;
   /// Surfaces only: seconds tetrahedralize may run (0: no limit; option_ranges kTimeLimit).
   /// Mesh_3 is stopped there, and the other steps (repair, wrap, deviation) are checked
@@ -124,6 +128,12 @@ struct TetrahedralizeNotes {
   /// How much the larger of the two distances exceeds MeshingOptions::max_deviation (relative
   /// to the diagonal); 0 when within it.
   double deviation_excess = 0.0;
+  /// Mesh_3 runs repeated at smaller sizes (at most 2) because the meshed boundary lay further
+  /// than max_deviation allows from the surface meshed; 0: none. The nearest mesh is returned:
+  /// deviation_retry_sizes says with which sizes ("facet distance x0.35, facet size x0.59,
+  /// sharp edges protected"), "" when the first mesh stayed the nearest.
+  std::size_t deviation_retries = 0;
+  std::string deviation_retry_sizes;
 };
 
 /// Tetrahedralises a closed, manifold surface (interior nodes included). With

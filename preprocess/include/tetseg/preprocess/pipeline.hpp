@@ -33,6 +33,10 @@ struct SurfaceDeviation {
   double asset_to_input = 0.0;  ///< relative to the diagonal
   double input_to_asset_absolute = 0.0;
   double asset_to_input_absolute = 0.0;
+  /// A surface input: how far the larger distance is over --max-deviation (relative; 0 within
+  /// it) and the Mesh_3 runs repeated to stay within it (TetrahedralizeNotes).
+  double excess = 0.0;
+  int meshing_retries = 0;
 };
 
 struct BuildOptions {
