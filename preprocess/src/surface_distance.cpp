@@ -5,6 +5,7 @@
 #include <CGAL/Polygon_mesh_processing/orient_polygon_soup.h>
 #include <CGAL/Polygon_mesh_processing/polygon_soup_to_polygon_mesh.h>
 #include <CGAL/Polygon_mesh_processing/repair_polygon_soup.h>
+#include <CGAL/Random.h>
 
 #include <algorithm>
 #include <array>
@@ -49,9 +50,15 @@ std::pair<double, double> hausdorff_distances(const TriangleMesh& a, const Trian
     return CGAL::parameters::random_seed(1).number_of_points_on_faces(
         std::max<std::size_t>(kFaceSamples, m.number_of_vertices()));
   };
-  return {
-      pmp::approximate_Hausdorff_distance<CGAL::Sequential_tag>(mesh_a, mesh_b, sampling(mesh_a)),
-      pmp::approximate_Hausdorff_distance<CGAL::Sequential_tag>(mesh_b, mesh_a, sampling(mesh_b))};
+  // CGAL 5.5 samples the edges with its default generator (seeded from the clock), not with
+  // random_seed: reseed it before each side, or the figure (and every choice made from it:
+  // auto's far-patch rule, the deviation retries) depends on the time of the run.
+  auto one_side = [&](const Mesh& from, const Mesh& to) {
+    CGAL::get_default_random() = CGAL::Random(1);
+    return pmp::approximate_Hausdorff_distance<CGAL::Sequential_tag>(from, to, sampling(from));
+  };
+  const double a_to_b = one_side(mesh_a, mesh_b);
+  return {a_to_b, one_side(mesh_b, mesh_a)};
 }
 
 double max_distance_to_surface(const std::vector<Vec3>& points, const TriangleMesh& surface) {
