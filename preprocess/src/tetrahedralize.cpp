@@ -194,9 +194,16 @@ TetMesh wrap_and_mesh(const TriangleMesh& surface, const MeshingOptions& meshing
     if (last && thin) return mesh_sheet_slab(surface, meshing, diagonal, file, notes, watchdog);
     if (!thin) {
       try {
-        // Mesh_3 may move the surface what --max-deviation leaves beside the wrap's offset.
-        TetMesh mesh = detail::validate_and_mesh(wrap, meshing, file, notes, watchdog, 0.0,
-                                                 (meshing.max_deviation - offset) * diagonal);
+        // Mesh_3 may move the surface what --max-deviation leaves beside the wrap's own distance
+        // from the input; when the wrap alone takes it all (the inner parts of a
+        // self-intersecting input, concave parts it bridges), no retry can help: none then.
+        watchdog.begin("deviation of the wrap");
+        const auto [there, back] = detail::hausdorff_distances(surface, wrap);
+        const double wrap_distance = std::max(there, back);
+        const double allowed = meshing.max_deviation * diagonal - wrap_distance;
+        TetMesh mesh =
+            detail::validate_and_mesh(wrap, meshing, file, notes, watchdog, 0.0,
+                                      wrap_distance >= 0.0 ? std::max(allowed, 0.0) : 0.0);
         notes.repairs = {
             {"surface replaced by an alpha wrap of this many triangles", wrap.triangles.size()}};
         if (doublings > 0)

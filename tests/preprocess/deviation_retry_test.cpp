@@ -234,3 +234,30 @@ TEST_CASE("When the retries cannot meet --max-deviation, the report says by how 
   REQUIRE_FALSE(recorded.empty());
   CHECK(std::stod(recorded) == Approx(notes.deviation_excess).epsilon(1e-9));
 }
+
+TEST_CASE("No retry when the wrap alone lies further than --max-deviation from the input",
+          "[deviation][max-deviation][retry]") {
+  // Two interpenetrating spheres of radius 1, centres 1 apart: their wrap is the union, and
+  // each sphere's cap inside the other reaches the other's centre, 1 from the union's surface,
+  // far over --max-deviation 0.002 of the diagonal. Smaller Mesh_3 sizes cannot bring the mesh
+  // nearer the input than the wrap itself: no retry is spent.
+  TriangleMesh pair = tetseg::test::icosphere(3);
+  const TriangleMesh second = tetseg::test::icosphere(3);
+  const auto first_count = static_cast<std::uint32_t>(pair.vertices.size());
+  for (Vec3 v : second.vertices) pair.vertices.push_back({v[0] + 1.0, v[1], v[2]});
+  for (Tri t : second.triangles)
+    pair.triangles.push_back({t[0] + first_count, t[1] + first_count, t[2] + first_count});
+  BuildJobOptions options;
+  options.build.clusters = ClusterMethod::kSingle;
+  options.meshing.optimize = false;
+  options.meshing.repair = MeshingOptions::Repair::kWrap;
+  options.meshing.max_deviation = 0.002;
+  const BuildJobResult result = build_asset_from_surface(pair, "spheres.off", options);
+  const TetrahedralizeNotes& notes = result.meshing_notes;
+  const double larger = std::max(notes.hausdorff_input_to_mesh, notes.hausdorff_mesh_to_input);
+  // The caps' poles are 1 inside the union (0.9 allows for the polygons), and the diagonal
+  // is sqrt(3^2 + 2^2 + 2^2).
+  CHECK(larger > 0.9 / std::sqrt(17.0));
+  CHECK(notes.deviation_retries == 0);
+  CHECK(notes.deviation_excess == Approx(larger - 0.002).margin(1e-12));
+}
