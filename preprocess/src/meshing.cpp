@@ -209,7 +209,7 @@ SharpEdges sharp_edges(const TriangleMesh& s, double degrees) {
       edges.push_back({{std::min(a, b), std::max(a, b)}, t});
     }
   std::sort(edges.begin(), edges.end());
-  const double min_cos = std::cos(degrees * M_PI / 180.0);
+  const double min_cos = std::cos(degrees * detail::kPi / 180.0);
   SharpEdges out;
   std::vector<std::pair<std::uint32_t, std::uint32_t>> sharp;  // (vertex, other end)
   for (std::size_t i = 1; i < edges.size(); ++i) {
@@ -218,7 +218,7 @@ SharpEdges sharp_edges(const TriangleMesh& s, double degrees) {
     const Vec3& m = normal[edges[i - 1].second];
     if (detail::norm(n) > 0 && detail::norm(m) > 0 && detail::dot(n, m) < min_cos) {
       const double c = std::clamp(detail::dot(n, m), -1.0, 1.0);
-      out.max_normal_degrees = std::max(out.max_normal_degrees, std::acos(c) * 180.0 / M_PI);
+      out.max_normal_degrees = std::max(out.max_normal_degrees, std::acos(c) * 180.0 / detail::kPi);
       const auto [a, b] = edges[i].first;
       out.edges.push_back({a, b});
       sharp.push_back({a, b});
@@ -239,7 +239,8 @@ SharpEdges sharp_edges(const TriangleMesh& s, double degrees) {
         const double lengths = detail::norm(u) * detail::norm(v);
         if (!(lengths > 0)) continue;
         const double c = std::clamp(detail::dot(u, v) / lengths, -1.0, 1.0);
-        out.min_corner_degrees = std::min(out.min_corner_degrees, std::acos(c) * 180.0 / M_PI);
+        out.min_corner_degrees =
+            std::min(out.min_corner_degrees, std::acos(c) * 180.0 / detail::kPi);
       }
     i = j;
   }

@@ -34,6 +34,7 @@
 #include "cgal_mesh.hpp"
 #include "mesh_topology.hpp"
 #include "repair_internal.hpp"
+#include "vec3_math.hpp"
 
 namespace tetseg::preprocess::detail {
 namespace {
@@ -53,7 +54,6 @@ constexpr std::size_t kMaxLargeHoleWork = 4000;
 constexpr double kMaxPatchAreaOverDisk = 2.5;
 /// A patch triangle turning by more than this against a neighbour is a fold.
 constexpr double kMaxPatchTurnDegrees = 120.0;
-constexpr double kPi = 3.14159265358979323846;
 /// Self-intersections are removed locally only up to this many intersecting pairs of
 /// triangles (docs/cli.md); more is not a local defect.
 constexpr std::size_t kMaxLocalSelfIntersections = 4096;

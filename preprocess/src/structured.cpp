@@ -16,16 +16,14 @@ double orientation(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
   return detail::dot(detail::sub(b, a), detail::cross(detail::sub(c, a), detail::sub(d, a)));
 }
 
-constexpr double kPi = 3.14159265358979323846;
-
 /// A ring of nx x layers x layers hexes around the z axis (major radius 1), rotated by
 /// `place` afterwards.
 TetMesh torus(int around, int layers, const std::function<Vec3(const Vec3&)>& place) {
-  const double side = layers * 2.0 * kPi / around;
+  const double side = layers * 2.0 * detail::kPi / around;
   return hex_grid(
       around, layers, layers,
       [&](int i, int j, int k) {
-        const double angle = 2.0 * kPi * i / around;
+        const double angle = 2.0 * detail::kPi * i / around;
         const double r = 1.0 + side * (static_cast<double>(j) / layers - 0.5);
         const double z = side * (static_cast<double>(k) / layers - 0.5);
         return place(Vec3{r * std::cos(angle), r * std::sin(angle), z});
@@ -97,7 +95,7 @@ TetMesh generate_structured(StructuredShape shape, const StructuredOptions& opti
       return torus(n, layers, [](const Vec3& p) { return p; });
     case StructuredShape::kTori: {
       // Half-diagonals of both tubes must stay below the distance 1 of the centre circles.
-      const double side = layers * 2.0 * kPi / n;
+      const double side = layers * 2.0 * detail::kPi / n;
       if (n < 3 || side * std::sqrt(2.0) >= 0.9)
         throw std::invalid_argument("tubes of " + std::to_string(layers) +
                                     " layers at resolution " + std::to_string(n) +

@@ -372,7 +372,7 @@ bool spread_weights(const std::vector<Vec3>& points, const Vec3& p, double scale
 /// Fixed directions spread over the sphere (a Fibonacci lattice).
 std::vector<Vec3> sphere_directions(int count) {
   std::vector<Vec3> out;
-  const double golden = 3.14159265358979323846 * (3.0 - std::sqrt(5.0));
+  const double golden = detail::kPi * (3.0 - std::sqrt(5.0));
   for (int i = 0; i < count; ++i) {
     const double z = 1.0 - (2.0 * i + 1.0) / count;
     const double r = std::sqrt(std::max(0.0, 1.0 - z * z));

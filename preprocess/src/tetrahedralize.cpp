@@ -55,7 +55,6 @@ constexpr double kThinShell = 4.0;
 constexpr double kThinShare = 0.55;
 constexpr double kThinProbeDepth = 3.0;
 constexpr std::size_t kThinProbes = 512;
-constexpr double kPi = 3.14159265358979323846;
 /// With --repair wrap, alpha is doubled at most this many times (see tetrahedralize).
 constexpr int kMaxAlphaDoublings = 6;
 /// A wrap bridges the gaps and holes narrower than alpha, so its distance from the input grows
@@ -92,7 +91,7 @@ double thin_share(const TriangleMesh& wrap, double offset) {
       angle +=
           detail::solid_angle(probe, wrap.vertices[t[0]], wrap.vertices[t[1]], wrap.vertices[t[2]]);
     ++probed;
-    if (angle < 2.0 * kPi) ++thin;  // winding number below 1/2: outside
+    if (angle < 2.0 * detail::kPi) ++thin;  // winding number below 1/2: outside
   }
   return probed == 0 ? 1.0 : static_cast<double>(thin) / static_cast<double>(probed);
 }

@@ -9,6 +9,8 @@
 
 namespace tetseg::preprocess::detail {
 
+constexpr double kPi = 3.14159265358979323846;
+
 inline Vec3 sub(const Vec3& a, const Vec3& b) {
   return {a[0] - b[0], a[1] - b[1], a[2] - b[2]};
 }
