@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "preprocess/support/mesh_measures.hpp"
 #include "tetseg/preprocess/jobs.hpp"
 #include "tetseg/preprocess/meshing.hpp"
 #include "tetseg/preprocess/surface.hpp"
@@ -86,16 +87,7 @@ double distance_to_unit_cube(const Vec3& p) {
   return outside > 0 ? std::sqrt(outside) : inside;
 }
 
-/// The diagonal of the bounding box of `s`'s vertices.
-double diagonal_of(const TriangleMesh& s) {
-  Vec3 lo = s.vertices.front(), hi = lo;
-  for (const Vec3& p : s.vertices)
-    for (int k = 0; k < 3; ++k) {
-      lo[k] = std::min(lo[k], p[k]);
-      hi[k] = std::max(hi[k], p[k]);
-    }
-  return std::hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
-}
+using tetseg::test::diagonal_of;
 
 Vec3 sub(const Vec3& a, const Vec3& b) {
   return {a[0] - b[0], a[1] - b[1], a[2] - b[2]};

@@ -9,6 +9,7 @@
 #include <utility>
 #include <vector>
 
+#include "preprocess/support/mesh_measures.hpp"
 #include "tetseg/preprocess/io.hpp"
 #include "tetseg/preprocess/meshing.hpp"
 #include "tetseg/preprocess/surface.hpp"
@@ -395,15 +396,7 @@ TriangleMesh grid_sheet(std::uint32_t n, Height height) {
   return m;
 }
 
-double diagonal_of(const TriangleMesh& s) {
-  Vec3 lo = s.vertices.front(), hi = lo;
-  for (const Vec3& p : s.vertices)
-    for (int k = 0; k < 3; ++k) {
-      lo[k] = std::min(lo[k], p[k]);
-      hi[k] = std::max(hi[k], p[k]);
-    }
-  return std::hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
-}
+using tetseg::test::diagonal_of;
 
 /// The checks of a sheet meshed as a slab: the repairs say so (slab 0.02 of the diagonal
 /// thick, 200 ten-thousandths), the volume is the sheet's area times that thickness (plus the
