@@ -13,20 +13,28 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <fstream>
 #include <string>
 #include <vector>
 
 #include "../preprocess/src/charge_solvers.hpp"
 #include "tetseg/preprocess/charge.hpp"
+#include "tetseg/preprocess/io.hpp"
+#include "tetseg/preprocess/mesh.hpp"
 #include "tetseg/preprocess/names.hpp"
+#include "tetseg/preprocess/option_ranges.hpp"
 #include "tetseg/testing/charge_shapes.hpp"
+#include "tool_support.hpp"
 
 using namespace tetseg;
+using namespace tetseg::tools;
 using preprocess::ChargeOptions;
 using preprocess::ChargeSolver;
 using preprocess::TriangleMesh;
 
 namespace {
+
+constexpr const char* kTool = "tetseg-bench-charge";
 
 struct CaseResult {
   bool ok = false;
@@ -250,12 +258,79 @@ void print_stages(const std::string& name, const TriangleMesh& mesh, int order, 
   std::fflush(stdout);
 }
 
-}  // namespace
+/// A `--solvers` entry, "name[/preconditioner][@tolerance|@auto][:order[:theta]]", as the
+/// options of its timed runs (the other options from the command line). Throws
+/// ToolError(kExitUsage) naming the entry when it does not parse.
+struct SolverRun {
+  std::string spec;
+  ChargeOptions options;
+};
 
-int main(int argc, char** argv) {
-  CLI::App app{"Charge-density solver benchmark (docs/benchmarks.md)", "tetseg-bench-charge"};
+SolverRun parse_solver(const std::string& spec, double tolerance, int order, double theta,
+                       int leaf_size, int schwarz_set, bool exact_products) {
+  auto bad = [&](const std::string& why) {
+    return ToolError(kExitUsage, "", "--solvers " + spec + ": " + why);
+  };
+  // All of `text` as a finite number (std::stod alone takes a prefix: "1e-8x").
+  auto number = [&](const std::string& text, const char* what) {
+    std::size_t used = 0;
+    double v = 0.0;
+    try {
+      v = std::stod(text, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used == 0 || used != text.size() || !std::isfinite(v))
+      throw bad(std::string("bad ") + what + " '" + text + "'");
+    return v;
+  };
+  const std::size_t colon = spec.find(':');
+  const std::string main_spec = spec.substr(0, colon);
+  const std::size_t at = main_spec.find('@');
+  const std::string head = main_spec.substr(0, at);
+  const std::size_t slash = head.find('/');
+  const std::string name = head.substr(0, slash);
+  const std::string pre = slash == std::string::npos ? "" : head.substr(slash + 1);
+  SolverRun run{spec, ChargeOptions{}};
+  ChargeOptions& o = run.options;
+  if (!preprocess::parse_name(name, o.solver)) throw bad("unknown solver '" + name + "'");
+  if (!pre.empty() && !preprocess::parse_name(pre, o.preconditioner))
+    throw bad("unknown preconditioner '" + pre + "'");
+  // "@auto" leaves the tolerance to compute_charge (0).
+  o.tolerance = tolerance;
+  if (at != std::string::npos) {
+    const std::string t = main_spec.substr(at + 1);
+    o.tolerance = t == "auto" ? 0.0 : number(t, "tolerance");
+  }
+  o.fast_order = order;
+  o.fast_theta = theta;
+  o.leaf_size = leaf_size;
+  o.schwarz_set = schwarz_set;
+  o.relaxed_products = !exact_products;
+  if (colon != std::string::npos) {
+    const std::string rest = spec.substr(colon + 1);
+    const std::size_t colon2 = rest.find(':');
+    const double fmm_order = number(rest.substr(0, colon2), "order");
+    if (fmm_order != std::floor(fmm_order) || std::fabs(fmm_order) > 1e6)
+      throw bad("the order must be a whole number");
+    o.fast_order = static_cast<int>(fmm_order);
+    if (colon2 != std::string::npos) o.fast_theta = number(rest.substr(colon2 + 1), "theta");
+  }
+  // The library's ranges (option_ranges.hpp), checked here rather than in each child.
+  try {
+    preprocess::check_option(preprocess::option_ranges::kTolerance, o.tolerance);
+    preprocess::check_option(preprocess::option_ranges::kTheta, o.fast_theta);
+    preprocess::check_option(preprocess::option_ranges::kOrder, o.fast_order);
+  } catch (const std::invalid_argument& e) {
+    throw bad(e.what());
+  }
+  return run;
+}
+
+struct Args {
   std::string mesh_dir = TETSEG_BENCH_MESH_DIR;
   std::string real = "elephant.off";
+  bool real_given = false;  // --real or --mesh-dir on the command line: the mesh must read
   std::vector<std::string> sizes = {"1k", "5k", "20k", "100k"};
   std::vector<std::string> solvers = {"direct", "gmres", "fast", "fast@1e-8"};
   double tolerance = 1e-6;
@@ -267,32 +342,15 @@ int main(int argc, char** argv) {
   int schwarz_set = 0;
   bool exact_products = false;
   int leaf_size = ChargeOptions{}.leaf_size;
-  app.add_option("--mesh-dir", mesh_dir, "Directory with the CGAL demo meshes");
-  app.add_option("--real", real, "Real mesh (OFF) subdivided to the sizes");
-  app.add_option("--sizes", sizes,
-                 "Any of 1k 5k 20k 100k 82k 327k 1.3M (ellipsoids of 20 k^2 triangles)");
-  app.add_option("--solvers", solvers,
-                 "Any of direct gmres fast auto, optionally name/preconditioner (jacobi, block, "
-                 "near, two), @tolerance (name@auto: automatic) and :order[:theta] of the FMM");
-  app.add_option("--order", order, "FMM order of the timed fast runs (default automatic)");
-  app.add_option("--leaf-size", leaf_size, "Cluster-tree leaf size of the timed runs");
-  app.add_option("--schwarz-set", schwarz_set,
-                 "Schwarz set cap of the timed runs and --stages (0: automatic)")
-      ->check(CLI::NonNegativeNumber);
-  app.add_flag("--exact-products", exact_products,
-               "Timed fast runs: no relaxed (cheaper) GMRES products");
-  app.add_option("--theta", theta, "FMM opening parameter of the timed fast runs (0: automatic)");
-  app.add_option("--exact-residual-max", exact_max,
-                 "Largest N for the residual against the exact matrix (O(N^2) product)");
-  app.add_option("--tolerance", tolerance, "Relative residual for the timed runs");
-  app.add_flag("--no-reference{false}", reference, "Skip the reference solves");
   bool stages = false;
-  app.add_flag("--stages", stages,
-               "Instead of the solver table: wall / CPU s of the fast solver's stages (two-level "
-               "preconditioner; --order, default 8, and --theta, default 0.45)");
-  app.add_option("--repeat", repeat, "Runs per timed case; the row shows the fastest (wall)")
-      ->check(CLI::PositiveNumber);
-  CLI11_PARSE(app, argc, argv);
+};
+
+int run(const Args& a) {
+  // Every --solvers entry parses before any work starts.
+  std::vector<SolverRun> runs;
+  for (const std::string& spec : a.solvers)
+    runs.push_back(parse_solver(spec, a.tolerance, a.order, a.theta, a.leaf_size, a.schwarz_set,
+                                a.exact_products));
 
   struct Mesh {
     std::string name, size;
@@ -303,16 +361,27 @@ int main(int argc, char** argv) {
   // 20 k^2 triangles: 980, 5120, 20,480, 100,820, 81,920, 327,680, 1,310,720.
   const int ks[] = {7, 16, 32, 71, 64, 128, 256};
   const char* names[] = {"1k", "5k", "20k", "100k", "82k", "327k", "1.3M"};
+  // The real mesh ("none": ellipsoids only): the tools' reader (the file's vertices in their
+  // order). A mesh named on the command line must read; the default one may be missing (the
+  // demo meshes not unpacked).
+  const std::string real_path = a.mesh_dir + "/" + a.real;
   TriangleMesh base;
   bool have_real = false;
-  try {
-    base = test::read_off(mesh_dir + "/" + real);
+  if (a.real == "none") {
+    // ellipsoids only
+  } else if (a.real_given || std::ifstream(real_path).good()) {
+    try {
+      base = preprocess::read_triangle_mesh_keeping_vertices(real_path);
+    } catch (const preprocess::InputError& e) {
+      throw ToolError(kExitBadInput, e.file(), e.what());
+    }
     have_real = true;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "bench: no real mesh (%s); ellipsoids only\n", e.what());
+  } else {
+    std::fprintf(stderr, "%s: no real mesh (%s missing); ellipsoids only\n", kTool,
+                 real_path.c_str());
   }
   for (int s = 0; s < 7; ++s) {
-    if (std::find(sizes.begin(), sizes.end(), names[s]) == sizes.end()) continue;
+    if (std::find(a.sizes.begin(), a.sizes.end(), names[s]) == a.sizes.end()) continue;
     meshes.push_back(
         {"ellipsoid 1:0.6:0.3", names[s], test::ellipsoid(ks[s], 1.0, 0.6, 0.3), true});
     if (have_real) {
@@ -322,18 +391,19 @@ int main(int argc, char** argv) {
       const std::size_t target = targets[s];
       while (m.triangles.size() < target) m = test::subdivide(m);
       if (s == 0 && m.triangles.size() > 2000) continue;  // no ~1k version of this mesh
-      meshes.push_back({real, names[s], m, false});
+      meshes.push_back({a.real, names[s], m, false});
     }
   }
 
-  if (stages) {
+  if (a.stages) {
     std::printf(
         "| mesh | N | panels + tree | near field | two-level setup | FMM lists | one FMM product "
         "| one preconditioner application |\n|---|---|---|---|---|---|---|---|\n");
     for (const Mesh& m : meshes) {
-      print_stages(m.name, m.mesh, order >= 0 ? order : 8, theta > 0.0 ? theta : 0.45, schwarz_set);
+      print_stages(m.name, m.mesh, a.order >= 0 ? a.order : 8, a.theta > 0.0 ? a.theta : 0.45,
+                   a.schwarz_set);
     }
-    return 0;
+    return kExitOk;
   }
   std::printf(
       "| mesh | N | solver | assembly s | solve s | total s | CPU s | iterations | residual | "
@@ -349,7 +419,7 @@ int main(int argc, char** argv) {
     // 1/500 of the timed runs' theta 0.5 / order 8).
     std::vector<double> ref;
     std::string ref_name = "-";
-    if (reference) {
+    if (a.reference) {
       ChargeOptions o;
       o.tolerance = 1e-10;
       o.max_iterations = 2000;
@@ -365,7 +435,8 @@ int main(int argc, char** argv) {
         o.fast_order = 10;
         ref_name = "fast theta 0.35 order 10, 1e-10";
       }
-      std::fprintf(stderr, "bench: %s %zu reference (%s)\n", m.name.c_str(), n, ref_name.c_str());
+      std::fprintf(stderr, "%s: %s %zu reference (%s)\n", kTool, m.name.c_str(), n,
+                   ref_name.c_str());
       const CaseResult r = run_case(m.mesh, o);
       if (r.ok) {
         ref = r.density;
@@ -373,49 +444,20 @@ int main(int argc, char** argv) {
         ref_name = std::string("failed: ") + r.error;
       }
     }
-    for (const std::string& spec : solvers) {
-      // "name[/preconditioner][@tolerance][:order[:theta]]"
-      const std::size_t colon = spec.find(':');
-      const std::string main_spec = spec.substr(0, colon);
-      const std::size_t at = main_spec.find('@');
-      const std::string head = main_spec.substr(0, at);
-      const std::size_t slash = head.find('/');
-      const std::string s = head.substr(0, slash);
-      const std::string pre = slash == std::string::npos ? "" : head.substr(slash + 1);
-      ChargeOptions o;
-      bool known = preprocess::parse_name(s, o.solver);
-      if (!pre.empty()) known = known && preprocess::parse_name(pre, o.preconditioner);
-      if (!known) {
-        std::fprintf(stderr, "bench: unknown solver %s\n", spec.c_str());
-        return 2;
-      }
-      // "@auto" leaves the tolerance to compute_charge (0).
-      o.tolerance =
-          at == std::string::npos
-              ? tolerance
-              : (main_spec.substr(at + 1) == "auto" ? 0.0 : std::stod(main_spec.substr(at + 1)));
-      o.fast_order = order;
-      o.fast_theta = theta;
-      o.leaf_size = leaf_size;
-      o.schwarz_set = schwarz_set;
-      o.relaxed_products = !exact_products;
-      if (colon != std::string::npos) {
-        const std::string rest = spec.substr(colon + 1);
-        const std::size_t colon2 = rest.find(':');
-        o.fast_order = std::stoi(rest.substr(0, colon2));
-        if (colon2 != std::string::npos) o.fast_theta = std::stod(rest.substr(colon2 + 1));
-      }
+    for (const SolverRun& run : runs) {
+      const ChargeOptions& o = run.options;
       if (o.solver == ChargeSolver::kDirect && n > 6000) continue;
       if (o.solver == ChargeSolver::kGmres && n > 25000) continue;
-      std::fprintf(stderr, "bench: %s %zu %s\n", m.name.c_str(), n, spec.c_str());
-      const bool with_exact = n <= exact_max;
+      std::fprintf(stderr, "%s: %s %zu %s\n", kTool, m.name.c_str(), n, run.spec.c_str());
+      const bool with_exact = n <= a.exact_max;
       CaseResult r = run_case(m.mesh, o, with_exact);
-      for (int k = 1; k < repeat && r.ok; ++k) {
+      for (int k = 1; k < a.repeat && r.ok; ++k) {
         CaseResult again = run_case(m.mesh, o, with_exact);
         if (again.ok && again.assembly + again.solve < r.assembly + r.solve) r = std::move(again);
       }
       if (!r.ok) {
-        std::printf("| %s | %zu | %s | failed: %s |\n", m.name.c_str(), n, spec.c_str(), r.error);
+        std::printf("| %s | %zu | %s | failed: %s |\n", m.name.c_str(), n, run.spec.c_str(),
+                    r.error);
         continue;
       }
       std::string analytic = "-", vs_ref = "-", vs_ref_abs = "-", exact_res = "-";
@@ -439,12 +481,56 @@ int main(int argc, char** argv) {
       std::printf(
           "| %s | %zu | %s | %.3f | %.3f | %.3f | %.2f | %s | %.1e | %s | %.0f | %s | %s | %s | %s "
           "|\n",
-          m.name.c_str(), n, spec.c_str(), r.assembly, r.solve, r.assembly + r.solve, r.cpu,
+          m.name.c_str(), n, run.spec.c_str(), r.assembly, r.solve, r.assembly + r.solve, r.cpu,
           iterations.c_str(), r.residual, exact_res.c_str(),
           static_cast<double>(r.peak_kb) / 1024.0, analytic.c_str(), vs_ref.c_str(),
           vs_ref_abs.c_str(), ref_name.c_str());
       std::fflush(stdout);
     }
   }
-  return 0;
+  return kExitOk;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"tetseg-bench-charge " TETSEG_VERSION
+               ": run time, iterations, peak memory and error of each charge-density solver on "
+               "ellipsoids and a subdivided CGAL demo mesh (docs/benchmarks.md)",
+               "tetseg-bench-charge"};
+  app.set_version_flag("--version", "tetseg-bench-charge " TETSEG_VERSION);
+  Args a;
+  app.add_option("--mesh-dir", a.mesh_dir, "Directory with the CGAL demo meshes");
+  app.add_option("--real", a.real,
+                 "Real mesh (OFF, PLY, OBJ) in --mesh-dir subdivided to the sizes; none: "
+                 "ellipsoids only");
+  app.add_option("--sizes", a.sizes,
+                 "Any of 1k 5k 20k 100k 82k 327k 1.3M (ellipsoids of 20 k^2 triangles)")
+      ->check(CLI::IsMember({"1k", "5k", "20k", "100k", "82k", "327k", "1.3M"}));
+  app.add_option("--solvers", a.solvers,
+                 "Any of direct gmres fast auto, optionally name/preconditioner (jacobi, block, "
+                 "near, two), @tolerance (name@auto: automatic) and :order[:theta] of the FMM");
+  app.add_option("--order", a.order, "FMM order of the timed fast runs (default automatic)");
+  app.add_option("--leaf-size", a.leaf_size, "Cluster-tree leaf size of the timed runs")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--schwarz-set", a.schwarz_set,
+                 "Schwarz set cap of the timed runs and --stages (0: automatic)")
+      ->check(CLI::NonNegativeNumber);
+  app.add_flag("--exact-products", a.exact_products,
+               "Timed fast runs: no relaxed (cheaper) GMRES products");
+  app.add_option("--theta", a.theta, "FMM opening parameter of the timed fast runs (0: automatic)");
+  app.add_option("--exact-residual-max", a.exact_max,
+                 "Largest N for the residual against the exact matrix (O(N^2) product)");
+  app.add_option("--tolerance", a.tolerance, "Relative residual for the timed runs")
+      ->check(CLI::NonNegativeNumber);
+  app.add_flag("--no-reference{false}", a.reference, "Skip the reference solves");
+  app.add_flag("--stages", a.stages,
+               "Instead of the solver table: wall / CPU s of the fast solver's stages (two-level "
+               "preconditioner; --order, default 8, and --theta, default 0.45)");
+  app.add_option("--repeat", a.repeat, "Runs per timed case; the row shows the fastest (wall)")
+      ->check(CLI::PositiveNumber);
+  return run_tool(kTool, app, argc, argv, [&] {
+    a.real_given = app.count("--real") + app.count("--mesh-dir") > 0;
+    return run(a);
+  });
 }
