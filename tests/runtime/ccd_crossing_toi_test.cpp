@@ -34,9 +34,7 @@ struct Crossing {
 
 Crossing make_crossing(std::mt19937_64& rng, bool edge_edge) {
   std::uniform_real_distribution<double> unit(0.0, 1.0);
-  auto point = [&] {
-    return Vec3d{unit(rng), unit(rng), 0.1 * (unit(rng) - 0.5)};
-  };
+  auto point = [&] { return Vec3d{unit(rng), unit(rng), 0.1 * (unit(rng) - 0.5)}; };
   auto moved = [&](const Vec3d& p) {
     return Vec3d{p[0] + 0.2 * (unit(rng) - 0.5), p[1] + 0.2 * (unit(rng) - 0.5),
                  p[2] + 0.1 * (unit(rng) - 0.5)};
@@ -70,7 +68,8 @@ Crossing make_crossing(std::mt19937_64& rng, bool edge_edge) {
       // cd's direction: random, far from ab's (the edges are never near parallel).
       const double angle = 0.5 + 2.0 * unit(rng);
       const double ab_angle = std::atan2(b[1] - a[1], b[0] - a[0]);
-      const Vec3d e{std::cos(ab_angle + angle), std::sin(ab_angle + angle), 0.2 * (unit(rng) - 0.5)};
+      const Vec3d e{std::cos(ab_angle + angle), std::sin(ab_angle + angle),
+                    0.2 * (unit(rng) - 0.5)};
       Vec3d c{}, d{};
       for (int k = 0; k < 3; ++k) {
         const double on_ab = a[k] + s * (b[k] - a[k]);
@@ -108,9 +107,9 @@ TEST_CASE("A crossing decided at its root's leaf reports its time of impact with
         for (double& v : p) v = v * scale + offset;
       const auto& x = q.x;
       const tetseg::test::ExactCcd e =
-          edge_edge ? tetseg::test::exact_edge_edge(x[0], x[1], x[2], x[3], x[4], x[5], x[6], x[7])
-                    : tetseg::test::exact_vertex_face(x[0], x[1], x[2], x[3], x[4], x[5], x[6],
-                                                      x[7]);
+          edge_edge
+              ? tetseg::test::exact_edge_edge(x[0], x[1], x[2], x[3], x[4], x[5], x[6], x[7])
+              : tetseg::test::exact_vertex_face(x[0], x[1], x[2], x[3], x[4], x[5], x[6], x[7]);
       if (!e.hit || e.toi_lower <= 0.0 || e.toi_upper >= 1.0) continue;  // inside the step
       ++crossings;
       const CcdResult r =
