@@ -249,9 +249,17 @@ void Collider::Impl::detector_ends(std::uint32_t c, std::array<double, 3>& a,
   }
 }
 
+// The step's loops over nodes and triangles run on the collider's workers from this many items
+// (on 2 cores a parallel loop's fork and join cost about 1 us, the classification of 1,000
+// triangles about 10 us; docs/benchmarks.md, "Contact-rich steps"); their results do not
+// depend on the split.
+constexpr std::int64_t kParallelStepItems = 1024;
+
 void Collider::Impl::refit_and_classify() noexcept {
   const auto t_refit = Clock::now();
   const std::int64_t nv = static_cast<std::int64_t>(topo->surf_nodes.size());
+  [[maybe_unused]] const int threads = static_cast<int>(workers.size());
+  [[maybe_unused]] const bool parallel = opt.use_openmp && threads > 1;
   std::uint64_t moved = 0;
   {
     // Local pointers: the byte stores cannot then be taken to alias the collider's members.
@@ -266,7 +274,8 @@ void Collider::Impl::refit_and_classify() noexcept {
     // follows from it); nodes_moved still counts the nodes that moved.
     const bool all_live = !rest_mode && opt.include_still_pairs;
 #if defined(TETSEG_HAVE_OPENMP)
-#pragma omp parallel for reduction(+ : moved) if (opt.use_openmp && nv > 4096)
+#pragma omp parallel for reduction(+ : moved) num_threads(threads) \
+    if (parallel && nv >= kParallelStepItems)
 #endif
     for (std::int64_t i = 0; i < nv; ++i) {
       const double* a = p0 + std::size_t(nodes[i]) * 3;
@@ -295,7 +304,7 @@ void Collider::Impl::refit_and_classify() noexcept {
     Box* tb = tbox.data();
     std::uint8_t* tm = tmov.data();
 #if defined(TETSEG_HAVE_OPENMP)
-#pragma omp parallel for if (opt.use_openmp && nt > 4096)
+#pragma omp parallel for num_threads(threads) if (parallel && nt >= kParallelStepItems)
 #endif
     for (std::int64_t t = 0; t < nt; ++t) {
       const std::uint32_t i0 = tv[t][0], i1 = tv[t][1], i2 = tv[t][2];
@@ -414,17 +423,32 @@ void Collider::Impl::refit_and_classify() noexcept {
                                                                        q1[l][2], q1[l][3]));
     }
   };
-  const std::int64_t pairs = nt / 2;
-#if defined(TETSEG_HAVE_OPENMP)
-#pragma omp parallel for if (opt.use_openmp && nt > 2048)
 #endif
-  for (std::int64_t i = 0; i < pairs; ++i) classify_two(2 * i);
-  if (nt % 2 != 0) classify_one(nt - 1);
+  // On the workers from kParallelStepItems triangles (stats.step_threads: how many ran it).
+  stats.step_threads = 1;
+#if defined(TETSEG_HAVE_OPENMP)
+#pragma omp parallel num_threads(threads) if (parallel && nt >= kParallelStepItems)
+#endif
+  {
+#if defined(TETSEG_HAVE_OPENMP)
+    if (omp_get_thread_num() == 0)
+      stats.step_threads = static_cast<std::uint32_t>(omp_get_num_threads());
+#endif
+#if defined(TETSEG_HAVE_LANES2)
+    const std::int64_t pairs = nt / 2;
+#if defined(TETSEG_HAVE_OPENMP)
+#pragma omp for
+#endif
+    for (std::int64_t i = 0; i < pairs; ++i) classify_two(2 * i);
 #else
 #if defined(TETSEG_HAVE_OPENMP)
-#pragma omp parallel for if (opt.use_openmp && nt > 2048)
+#pragma omp for
 #endif
-  for (std::int64_t t = 0; t < nt; ++t) classify_one(t);
+    for (std::int64_t t = 0; t < nt; ++t) classify_one(t);
+#endif
+  }
+#if defined(TETSEG_HAVE_LANES2)
+  if (nt % 2 != 0) classify_one(nt - 1);
 #endif
   std::uint64_t count[3] = {0, 0, 0};
   for (std::uint32_t t = 0; t < tri_count; ++t) ++count[tcls[t]];

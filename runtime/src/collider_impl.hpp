@@ -218,8 +218,9 @@ struct ContactSink {
 };
 
 /// Running state of one traversal thread (index 0 is the serial one). Allocated at
-/// construction: one per OpenMP thread when `use_openmp`, else one.
-struct Worker {
+/// construction: one per OpenMP thread when `use_openmp`, else one. On its own cache lines:
+/// workers lie side by side and each writes its counters on every item it traverses.
+struct alignas(64) Worker {
   std::vector<StackItem> stack;
   ColliderStats stats;  // counters only; merged into the collider's stats after a query
   bool stop = false;

@@ -48,7 +48,9 @@ void require_same(const std::vector<Contact>& a, const std::vector<Contact>& b) 
 /// A dumbbell bent past contact in one step (its bells pass through each other): hundreds
 /// of contacts, in three clusters along the axis.
 struct BentDumbbell {
-  tetseg::test::Surface surface = tetseg::test::dumbbell(14, 20);
+  explicit BentDumbbell(int segments = 14, int rings = 20)
+      : surface(tetseg::test::dumbbell(segments, rings)) {}
+  tetseg::test::Surface surface;
   tetseg::test::Scene scene = tetseg::test::make_axial_scene(surface, {-0.8, 0.8}, {-1.6, 0, 1.6});
   std::vector<std::vector<double>> frames = tetseg::test::make_frames(
       scene, 2,
@@ -113,6 +115,46 @@ TEST_CASE("Collider contacts into a buffer on two threads equal the serial ones,
   }
 }
 
+TEST_CASE("A step on two threads classifies every triangle as the serial step does",
+          "[collider][openmp]") {
+  // At least 1,024 triangles: the step's loops run on the workers from there (collider.cpp,
+  // kParallelStepItems).
+  const BentDumbbell db(40, 24);
+  REQUIRE(db.surface.tris.size() >= 1024);
+  tetseg::ColliderOptions serial_options;
+  tetseg::ColliderOptions parallel_options = serial_options;
+  parallel_options.use_openmp = true;
+  parallel_options.threads = 2;
+  tetseg::Collider serial(db.scene.asset, serial_options);
+  tetseg::Collider parallel(db.scene.asset, parallel_options);
+  for (tetseg::Collider* c : {&serial, &parallel})
+    REQUIRE(c->step(db.frames[0].data(), db.frames[1].data()) == ColliderStatus::kOk);
+  const tetseg::ColliderStats& ss = serial.stats();
+  const tetseg::ColliderStats& ps = parallel.stats();
+  REQUIRE(ss.step_threads == 1);
+  REQUIRE(ps.step_threads == 2);  // the parallel classification ran
+  // A bend past contact leaves triangles of every class, so a triangle left unclassified or
+  // classified against the wrong positions shows.
+  REQUIRE(ss.triangles_positive > 0);
+  REQUIRE(ss.triangles_negative + ss.triangles_uncertain > 0);
+  std::size_t differ = 0;
+  for (std::size_t t = 0; t < db.surface.tris.size(); ++t)
+    differ += serial.triangle_class(t) != parallel.triangle_class(t) ? 1 : 0;
+  CHECK(differ == 0);
+  CHECK(ss.nodes_moved == ps.nodes_moved);
+  CHECK(ss.triangles_moving == ps.triangles_moving);
+  CHECK(ss.triangles_positive == ps.triangles_positive);
+  CHECK(ss.triangles_negative == ps.triangles_negative);
+  CHECK(ss.triangles_uncertain == ps.triangles_uncertain);
+  // And the contacts, in the same order.
+  ContactsResult rs, rp;
+  const std::vector<Contact> all_serial = contacts_of(serial, 100000, rs);
+  const std::vector<Contact> all_parallel = contacts_of(parallel, 100000, rp);
+  REQUIRE(parallel.stats().traversal_threads == 2);
+  REQUIRE(rs.found > 100);
+  require_same(all_serial, all_parallel);
+}
+
 TEST_CASE("The bvh mode on two threads reports brute force's contacts", "[collider][openmp]") {
   const BentDumbbell db;
   const auto& s = db.scene;
@@ -134,7 +176,7 @@ TEST_CASE("The bvh mode on two threads reports brute force's contacts", "[collid
 
 TEST_CASE("Steps and queries on two threads allocate nothing, contact buffer included",
           "[collider][openmp]") {
-  const BentDumbbell db;
+  const BentDumbbell db(40, 24);  // the step's loops on the workers too
   for (ColliderMode mode : {ColliderMode::kRvbc, ColliderMode::kBvh, ColliderMode::kCone}) {
     INFO("mode " << tetseg::to_string(mode));
     tetseg::ColliderOptions options;
@@ -149,6 +191,7 @@ TEST_CASE("Steps and queries on two threads allocate nothing, contact buffer inc
       ContactsResult r;
       REQUIRE(collider.contacts(buffer.data(), buffer.size(), r) == ColliderStatus::kOk);
       REQUIRE(collider.stats().traversal_threads == 2);
+      if (mode == ColliderMode::kRvbc) REQUIRE(collider.stats().step_threads == 2);
       REQUIRE(r.found > 100);
       tetseg::EarliestContact e;
       REQUIRE(collider.earliest_toi(e) == ColliderStatus::kOk);

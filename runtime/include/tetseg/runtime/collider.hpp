@@ -150,6 +150,9 @@ struct ColliderStats {
   /// Threads that ran the last query's traversal: 1 on the serial path, the OpenMP team size
   /// on a parallel one (use_openmp).
   std::uint32_t traversal_threads = 0;
+  /// Threads that classified the last step's triangles (rvbc): 1 serially, the OpenMP team
+  /// size with use_openmp on a body of at least 1,024 triangles; 0 when nothing was classified.
+  std::uint32_t step_threads = 0;
 };
 
 /// Result of a static intersection check of the surface at one instant.
