@@ -249,11 +249,12 @@ void Collider::Impl::detector_ends(std::uint32_t c, std::array<double, 3>& a,
   }
 }
 
-// The step's loops over nodes and triangles run on the collider's workers from this many items
-// (on 2 cores a parallel loop's fork and join cost about 1 us, the classification of 1,000
-// triangles about 10 us; docs/benchmarks.md, "Contact-rich steps"); their results do not
+// The step's loops run on the collider's workers from these many items (nodes, triangles): on 2
+// cores a parallel region's fork and join cost about 1 us, a box a few ns, a triangle's
+// classification about 10 ns (docs/benchmarks.md, "Contact-rich steps"). Their results do not
 // depend on the split.
-constexpr std::int64_t kParallelStepItems = 1024;
+constexpr std::int64_t kParallelBoxItems = 4096;
+constexpr std::int64_t kParallelClassifyItems = 1024;
 
 void Collider::Impl::refit_and_classify() noexcept {
   const auto t_refit = Clock::now();
@@ -275,7 +276,7 @@ void Collider::Impl::refit_and_classify() noexcept {
     const bool all_live = !rest_mode && opt.include_still_pairs;
 #if defined(TETSEG_HAVE_OPENMP)
 #pragma omp parallel for reduction(+ : moved) num_threads(threads) \
-    if (parallel && nv >= kParallelStepItems)
+    if (parallel && nv >= kParallelBoxItems)
 #endif
     for (std::int64_t i = 0; i < nv; ++i) {
       const double* a = p0 + std::size_t(nodes[i]) * 3;
@@ -304,7 +305,7 @@ void Collider::Impl::refit_and_classify() noexcept {
     Box* tb = tbox.data();
     std::uint8_t* tm = tmov.data();
 #if defined(TETSEG_HAVE_OPENMP)
-#pragma omp parallel for num_threads(threads) if (parallel && nt >= kParallelStepItems)
+#pragma omp parallel for num_threads(threads) if (parallel && nt >= kParallelBoxItems)
 #endif
     for (std::int64_t t = 0; t < nt; ++t) {
       const std::uint32_t i0 = tv[t][0], i1 = tv[t][1], i2 = tv[t][2];
@@ -424,10 +425,10 @@ void Collider::Impl::refit_and_classify() noexcept {
     }
   };
 #endif
-  // On the workers from kParallelStepItems triangles (stats.step_threads: how many ran it).
+  // On the workers from kParallelClassifyItems triangles (stats.step_threads: how many ran it).
   stats.step_threads = 1;
 #if defined(TETSEG_HAVE_OPENMP)
-#pragma omp parallel num_threads(threads) if (parallel && nt >= kParallelStepItems)
+#pragma omp parallel num_threads(threads) if (parallel && nt >= kParallelClassifyItems)
 #endif
   {
 #if defined(TETSEG_HAVE_OPENMP)

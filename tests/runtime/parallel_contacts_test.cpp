@@ -117,8 +117,8 @@ TEST_CASE("Collider contacts into a buffer on two threads equal the serial ones,
 
 TEST_CASE("A step on two threads classifies every triangle as the serial step does",
           "[collider][openmp]") {
-  // At least 1,024 triangles: the step's loops run on the workers from there (collider.cpp,
-  // kParallelStepItems).
+  // At least 1,024 triangles: the classification runs on the workers from there (collider.cpp,
+  // kParallelClassifyItems).
   const BentDumbbell db(40, 24);
   REQUIRE(db.surface.tris.size() >= 1024);
   tetseg::ColliderOptions serial_options;
@@ -176,7 +176,7 @@ TEST_CASE("The bvh mode on two threads reports brute force's contacts", "[collid
 
 TEST_CASE("Steps and queries on two threads allocate nothing, contact buffer included",
           "[collider][openmp]") {
-  const BentDumbbell db(40, 24);  // the step's loops on the workers too
+  const BentDumbbell db(40, 24);  // the classification on the workers too
   for (ColliderMode mode : {ColliderMode::kRvbc, ColliderMode::kBvh, ColliderMode::kCone}) {
     INFO("mode " << tetseg::to_string(mode));
     tetseg::ColliderOptions options;
