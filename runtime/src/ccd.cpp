@@ -166,10 +166,14 @@ struct VertexFaceTest {
     return c.outcome();
   }
 
-  /// The coplanarity cubic on [0, 1] in doubles: det[p-a, b-a, c-a] = det[b-a, c-a, p-a].
-  BernsteinCubic step_cubic_terms() const noexcept {
-    return orientation_detail::cubic(x0[1]->data(), x0[0]->data(), x0[2]->data(), x0[3]->data(),
-                                     x1[1]->data(), x1[0]->data(), x1[2]->data(), x1[3]->data());
+  /// The points of the coplanarity cubic on [0, 1] in doubles (orientation_detail::cubic's o,
+  /// a, b, c at both ends): det[p-a, b-a, c-a] = det[b-a, c-a, p-a].
+  void step_cubic_points(const double* (&q)[8]) const noexcept {
+    constexpr int kOrder[4] = {1, 0, 2, 3};
+    for (int j = 0; j < 4; ++j) {
+      q[j] = x0[kOrder[j]]->data();
+      q[4 + j] = x1[kOrder[j]]->data();
+    }
   }
 };
 
@@ -314,10 +318,14 @@ struct EdgeEdgeTest {
     return c.outcome();
   }
 
-  /// The coplanarity cubic on [0, 1] in doubles: det[b-a, d-a, c-a] = det[b-a, d-c, c-a].
-  BernsteinCubic step_cubic_terms() const noexcept {
-    return orientation_detail::cubic(x0[0]->data(), x0[1]->data(), x0[3]->data(), x0[2]->data(),
-                                     x1[0]->data(), x1[1]->data(), x1[3]->data(), x1[2]->data());
+  /// The points of the coplanarity cubic on [0, 1] in doubles (orientation_detail::cubic's o,
+  /// a, b, c at both ends): det[b-a, d-a, c-a] = det[b-a, d-c, c-a].
+  void step_cubic_points(const double* (&q)[8]) const noexcept {
+    constexpr int kOrder[4] = {0, 1, 3, 2};
+    for (int j = 0; j < 4; ++j) {
+      q[j] = x0[kOrder[j]]->data();
+      q[4 + j] = x1[kOrder[j]]->data();
+    }
   }
 };
 
@@ -339,8 +347,20 @@ struct Item {
   FloatBernstein poly;
 };
 
+/// The coplanarity cubic of the whole step in doubles (orientation_detail::cubic of the test's
+/// step_cubic_points).
 template <class Test>
-CcdResult run_bisection(const Test& test, const CcdOptions& options) noexcept {
+BernsteinCubic step_cubic_terms(const Test& test) noexcept {
+  const double* q[8];
+  test.step_cubic_points(q);
+  return orientation_detail::cubic(q[0], q[1], q[2], q[3], q[4], q[5], q[6], q[7]);
+}
+
+/// The test; `step_terms`, when given, is step_cubic_terms(test) computed by the caller (a
+/// batch, or a filter that evaluated the same cubic): bitwise the same result.
+template <class Test>
+CcdResult run_bisection(const Test& test, const CcdOptions& options,
+                        const BernsteinCubic* step_terms = nullptr) noexcept {
   CcdResult result;
   if (!all_finite(test.x0, 4) || !all_finite(test.x1, 4)) {
     result.outcome = CcdOutcome::kContact;
@@ -402,7 +422,8 @@ CcdResult run_bisection(const Test& test, const CcdOptions& options) noexcept {
   // (kCubicFirst: excluded by its sign, or straight to a root's leaf, or checked in full). Only
   // when even that fails does the interval check of [0, 1] run as before.
   if (exact_contact) {
-    const FloatBernstein cubic = step_cubic(test.step_cubic_terms());
+    const FloatBernstein cubic =
+        step_cubic(step_terms != nullptr ? *step_terms : step_cubic_terms(test));
     if (proven_positive(cubic) || proven_negative(cubic) || one_signed_by_halving(cubic, 3)) {
       result.intervals = 1;
       return result;
@@ -553,7 +574,47 @@ bool filter_may_hit(const Test& test) noexcept {
   return !test.template check<Iv>(0.0, 1.0, Depth::kFilter).excluded;
 }
 
+template <class Test>
+Test test_of(const CcdQuery& q, const CcdOptions& options) noexcept {
+  return Test{{&q.x0[0], &q.x0[1], &q.x0[2], &q.x0[3]},
+              {&q.x1[0], &q.x1[1], &q.x1[2], &q.x1[3]},
+              Separation(options.min_separation)};
+}
+
+/// run_bisection on each query; with exact contact the whole step's coplanarity cubics are
+/// computed two queries at a time (orientation_detail::cubic2, bitwise the scalar cubic), the
+/// rest of each test as one query (the cubic's stages decide most non-contacts at once).
+template <class Test>
+void run_batch(const CcdQuery* queries, std::size_t count, CcdResult* results,
+               const CcdOptions& options) noexcept {
+  std::size_t i = 0;
+  if (Separation(options.min_separation).zero()) {
+    for (; i + 2 <= count; i += 2) {
+      const Test tests[2] = {test_of<Test>(queries[i], options),
+                             test_of<Test>(queries[i + 1], options)};
+      const double* points[2][8];
+      tests[0].step_cubic_points(points[0]);
+      tests[1].step_cubic_points(points[1]);
+      BernsteinCubic terms[2];
+      orientation_detail::cubic2(points, terms);
+      results[i] = run_bisection(tests[0], options, &terms[0]);
+      results[i + 1] = run_bisection(tests[1], options, &terms[1]);
+    }
+  }
+  for (; i < count; ++i) results[i] = run_bisection(test_of<Test>(queries[i], options), options);
+}
+
 }  // namespace
+
+void vertex_face_ccd_batch(const CcdQuery* queries, std::size_t count, CcdResult* results,
+                           const CcdOptions& options) noexcept {
+  run_batch<VertexFaceTest>(queries, count, results, options);
+}
+
+void edge_edge_ccd_batch(const CcdQuery* queries, std::size_t count, CcdResult* results,
+                         const CcdOptions& options) noexcept {
+  run_batch<EdgeEdgeTest>(queries, count, results, options);
+}
 
 CcdResult vertex_face_ccd(const Vec3d& p0, const Vec3d& a0, const Vec3d& b0, const Vec3d& c0,
                           const Vec3d& p1, const Vec3d& a1, const Vec3d& b1, const Vec3d& c1,
