@@ -157,12 +157,22 @@ struct VertexFaceTest {
   LeafOutcome leaf(double ta, double tb) const noexcept {
     if (plane_axis >= 0) return LeafOutcome::kUndecided;
     const Iv t = hull(exact(ta), exact(tb));
-    auto d = [&](int i, int j) { return difference_over(*x0[i], *x1[i], *x0[j], *x1[j], t); };
-    const IvVec u = d(2, 1), n = cross(u, d(3, 1));
+    // The differences, cross and dot products two at a time (bitwise the scalar ones).
+    auto d2 = [&](int i, int j, int k, int l, IvVec& a, IvVec& b) {
+      difference_over2(*x0[i], *x1[i], *x0[j], *x1[j], *x0[k], *x1[k], *x0[l], *x1[l], t, a, b);
+    };
+    IvVec u, v, p1, cb, p2, ac, n, w;
+    d2(2, 1, 3, 1, u, v);
+    d2(0, 1, 3, 2, p1, cb);
+    cross2(u, v, u, p1, n, w);
     LeafConditions c;
-    if (c.apart(dot(n, cross(u, d(0, 1)))) || c.apart(dot(n, cross(d(3, 2), d(0, 2)))) ||
-        c.apart(dot(n, cross(d(1, 3), d(0, 3)))))
-      return LeafOutcome::kApart;
+    if (c.apart(dot(n, w))) return LeafOutcome::kApart;
+    d2(0, 2, 1, 3, p2, ac);
+    IvVec w_bc, w_ca;
+    cross2(cb, p2, ac, difference_over(*x0[0], *x1[0], *x0[3], *x1[3], t), w_bc, w_ca);
+    Iv e_bc, e_ca;
+    dot2(n, w_bc, n, w_ca, e_bc, e_ca);
+    if (c.apart(e_bc) || c.apart(e_ca)) return LeafOutcome::kApart;
     return c.outcome();
   }
 
@@ -309,11 +319,22 @@ struct EdgeEdgeTest {
   LeafOutcome leaf(double ta, double tb) const noexcept {
     if (plane_axis >= 0) return LeafOutcome::kUndecided;
     const Iv t = hull(exact(ta), exact(tb));
-    auto d = [&](int i, int j) { return difference_over(*x0[i], *x1[i], *x0[j], *x1[j], t); };
-    const IvVec ba = d(1, 0), dc = d(3, 2), ca = d(2, 0), n = cross(ba, dc);
+    // The differences, cross and dot products two at a time (bitwise the scalar ones).
+    auto d2 = [&](int i, int j, int k, int l, IvVec& a, IvVec& b) {
+      difference_over2(*x0[i], *x1[i], *x0[j], *x1[j], *x0[k], *x1[k], *x0[l], *x1[l], t, a, b);
+    };
+    IvVec ba, dc, ca, bc, n, w1;
+    d2(1, 0, 3, 2, ba, dc);
+    d2(2, 0, 1, 2, ca, bc);
+    cross2(ba, dc, ca, dc, n, w1);
     LeafConditions c;
-    if (c.apart(dot(cross(ca, dc), n)) || c.apart(dot(cross(d(1, 2), dc), n)) ||
-        c.apart(dot(cross(ca, ba), n)) || c.apart(dot(cross(ba, d(3, 0)), n)))
+    if (c.apart(dot(w1, n))) return LeafOutcome::kApart;
+    IvVec w2, w3;
+    cross2(bc, dc, ca, ba, w2, w3);
+    Iv h2, h3;
+    dot2(w2, n, w3, n, h2, h3);
+    if (c.apart(h2) || c.apart(h3) ||
+        c.apart(dot(cross(ba, difference_over(*x0[3], *x1[3], *x0[0], *x1[0], t)), n)))
       return LeafOutcome::kApart;
     return c.outcome();
   }

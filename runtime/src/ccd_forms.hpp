@@ -45,6 +45,54 @@ inline IvVec difference_over(const Vec3d& xi0, const Vec3d& xi1, const Vec3d& xj
   return {coord(0), coord(1), coord(2)};
 }
 
+/// difference_over(xi, xj, t) into a and difference_over(yi, yj, t) into b, bitwise, computed
+/// as two lanes where the compiler has them.
+inline void difference_over2(const Vec3d& xi0, const Vec3d& xi1, const Vec3d& xj0, const Vec3d& xj1,
+                             const Vec3d& yi0, const Vec3d& yi1, const Vec3d& yj0, const Vec3d& yj1,
+                             Iv t, IvVec& a, IvVec& b) noexcept {
+#if defined(TETSEG_HAVE_LANES2)
+  const Iv2 tt = lanes(t, t);
+  auto coord = [&](int k) {
+    const Iv2 d0 = lanes(exact(xi0[k]), exact(yi0[k])) - lanes(exact(xj0[k]), exact(yj0[k]));
+    return d0 +
+           tt * ((lanes(exact(xi1[k]), exact(yi1[k])) - lanes(exact(xj1[k]), exact(yj1[k]))) - d0);
+  };
+  const Vec<Iv2> d{coord(0), coord(1), coord(2)};
+  a = lane(d, 0);
+  b = lane(d, 1);
+#else
+  a = difference_over(xi0, xi1, xj0, xj1, t);
+  b = difference_over(yi0, yi1, yj0, yj1, t);
+#endif
+}
+
+/// cross(a, b) into ab and cross(c, d) into cd, bitwise, as two lanes where the compiler has
+/// them.
+inline void cross2(const IvVec& a, const IvVec& b, const IvVec& c, const IvVec& d, IvVec& ab,
+                   IvVec& cd) noexcept {
+#if defined(TETSEG_HAVE_LANES2)
+  const Vec<Iv2> r = cross(lanes(a, c), lanes(b, d));
+  ab = lane(r, 0);
+  cd = lane(r, 1);
+#else
+  ab = cross(a, b);
+  cd = cross(c, d);
+#endif
+}
+
+/// dot(a, b) into ab and dot(c, d) into cd, bitwise, as two lanes where the compiler has them.
+inline void dot2(const IvVec& a, const IvVec& b, const IvVec& c, const IvVec& d, Iv& ab,
+                 Iv& cd) noexcept {
+#if defined(TETSEG_HAVE_LANES2)
+  const Iv2 r = dot(lanes(a, c), lanes(b, d));
+  ab = lane(r, 0);
+  cd = lane(r, 1);
+#else
+  ab = dot(a, b);
+  cd = dot(c, d);
+#endif
+}
+
 /// A vector affine in t over the current interval: enclosures of its values at both ends.
 template <class I>
 struct Slot {

@@ -135,6 +135,32 @@ TEST_CASE("The two-lane interval kernels are bitwise the scalar interval arithme
   CHECK(differ_quad == 0);
 }
 
+TEST_CASE("The leaf enclosures two at a time are bitwise the scalar ones", "[ccd][lanes]") {
+  // difference_over2, cross2 and dot2 (ccd_forms.hpp: LeafConditions of a crossing's leaf).
+  Values values;
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  int differ = 0;
+  for (int trial = 0; trial < 1000000; ++trial) {
+    tetseg::Vec3d p[8];
+    for (auto& q : p)
+      for (double& c : q) c = values.next();
+    const double ta = std::ldexp(std::floor(unit(values.rng) * 1024.0), -10);
+    const Iv t = tetseg::ccd_detail::hull(Iv{ta, 0.0}, Iv{ta + 0x1p-30, 0.0});
+    Vec<Iv> a, b;
+    tetseg::ccd_detail::difference_over2(p[0], p[1], p[2], p[3], p[4], p[5], p[6], p[7], t, a, b);
+    differ += !same(a, tetseg::ccd_detail::difference_over(p[0], p[1], p[2], p[3], t));
+    differ += !same(b, tetseg::ccd_detail::difference_over(p[4], p[5], p[6], p[7], t));
+    const Vec<Iv> u = values.vec(), v = values.vec(), w = values.vec(), x = values.vec();
+    Vec<Iv> uv, wx;
+    tetseg::ccd_detail::cross2(u, v, w, x, uv, wx);
+    differ += !same(uv, cross_ref(u, v)) + !same(wx, cross_ref(w, x));
+    Iv d_uv, d_wx;
+    tetseg::ccd_detail::dot2(u, v, w, x, d_uv, d_wx);
+    differ += !same(d_uv, dot_ref(u, v)) + !same(d_wx, dot_ref(w, x));
+  }
+  CHECK(differ == 0);
+}
+
 TEST_CASE("Two coplanarity cubics at once are bitwise the scalar cubic", "[ccd][lanes]") {
   Values values;
   std::uniform_int_distribution<int> pick(0, 7);
@@ -147,18 +173,18 @@ TEST_CASE("Two coplanarity cubics at once are bitwise the scalar cubic", "[ccd][
     if (trial % 3 == 0) p[pick(values.rng)] = p[pick(values.rng)];
     if (trial % 5 == 0)
       for (auto& q : p) q[2] = p[0][2];
-    const double* const points[2][8] = {
-        {p[0].data(), p[1].data(), p[2].data(), p[3].data(), p[4].data(), p[5].data(), p[6].data(),
-         p[7].data()},
-        {p[8].data(), p[9].data(), p[10].data(), p[11].data(), p[12].data(), p[13].data(),
-         p[14].data(), p[15].data()}};
+    const double* const points[2][8] = {{p[0].data(), p[1].data(), p[2].data(), p[3].data(),
+                                         p[4].data(), p[5].data(), p[6].data(), p[7].data()},
+                                        {p[8].data(), p[9].data(), p[10].data(), p[11].data(),
+                                         p[12].data(), p[13].data(), p[14].data(), p[15].data()}};
     tetseg::BernsteinCubic two[2];
     tetseg::orientation_detail::cubic2(points, two);
     for (int i = 0; i < 2; ++i) {
       const auto* q = points[i];
       const tetseg::BernsteinCubic one =
           tetseg::orientation_detail::cubic(q[0], q[1], q[2], q[3], q[4], q[5], q[6], q[7]);
-      for (int k = 0; k < 4; ++k) differ += !same(one.k[k], two[i].k[k]) || !same(one.err[k], two[i].err[k]);
+      for (int k = 0; k < 4; ++k)
+        differ += !same(one.k[k], two[i].k[k]) || !same(one.err[k], two[i].err[k]);
     }
   }
   CHECK(differ == 0);
@@ -213,9 +239,9 @@ TEST_CASE("A batch of elementary tests gives bitwise the results of the calls on
     for (std::size_t i = 0; i < size; ++i) {
       const auto& x = queries[i].x;
       const tetseg::CcdResult one =
-          edge_edge ? tetseg::edge_edge_ccd(x[0], x[1], x[2], x[3], x[4], x[5], x[6], x[7], options)
-                    : tetseg::vertex_face_ccd(x[0], x[1], x[2], x[3], x[4], x[5], x[6], x[7],
-                                              options);
+          edge_edge
+              ? tetseg::edge_edge_ccd(x[0], x[1], x[2], x[3], x[4], x[5], x[6], x[7], options)
+              : tetseg::vertex_face_ccd(x[0], x[1], x[2], x[3], x[4], x[5], x[6], x[7], options);
       differ += !same(one, results[i]);
       hits += one.hit();
       ++total;

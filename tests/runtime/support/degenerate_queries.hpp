@@ -24,9 +24,9 @@ enum Family {
   kFamilies
 };
 
-inline const char* const kFamilyNames[kFamilies] = {"end in plane", "slide in plane", "start in plane",
-                                             "generic",      "near plane",     "grid",
-                                             "partly still"};
+inline const char* const kFamilyNames[kFamilies] = {
+    "end in plane", "slide in plane", "start in plane", "generic",
+    "near plane",   "grid",           "partly still"};
 
 struct Query {
   bool edge_edge;
