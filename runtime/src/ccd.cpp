@@ -21,8 +21,9 @@
 // (inside proven and the cubic changing sign; in a plane, the inside conditions), then a jump
 // to the crossing or descents in floating point with rigorous error bounds (ccd_bernstein.hpp);
 // a crossing of the cubic goes straight to its root's leaf (ccd_certificates.hpp). The forms
-// and their exclusion tests are in ccd_forms.hpp; this file holds the two tests and the
-// bisection.
+// and their exclusion tests are in ccd_forms.hpp (their products two SIMD lanes at a time,
+// bitwise the scalar interval arithmetic); this file holds the two tests, the bisection and the
+// batches.
 
 #include <algorithm>
 #include <cmath>
@@ -378,7 +379,7 @@ BernsteinCubic step_cubic_terms(const Test& test) noexcept {
 }
 
 /// The test; `step_terms`, when given, is step_cubic_terms(test) computed by the caller (a
-/// batch, or a filter that evaluated the same cubic): bitwise the same result.
+/// batch, two cubics at a time): bitwise the same result.
 template <class Test>
 CcdResult run_bisection(const Test& test, const CcdOptions& options,
                         const BernsteinCubic* step_terms = nullptr) noexcept {
