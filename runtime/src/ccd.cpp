@@ -21,8 +21,9 @@
 // (inside proven and the cubic changing sign; in a plane, the inside conditions), then a jump
 // to the crossing or descents in floating point with rigorous error bounds (ccd_bernstein.hpp);
 // a crossing of the cubic goes straight to its root's leaf (ccd_certificates.hpp). The forms
-// and their exclusion tests are in ccd_forms.hpp; this file holds the two tests and the
-// bisection.
+// and their exclusion tests are in ccd_forms.hpp (their products two SIMD lanes at a time,
+// bitwise the scalar interval arithmetic); this file holds the two tests, the bisection and the
+// batches.
 
 #include <algorithm>
 #include <cmath>
@@ -157,19 +158,33 @@ struct VertexFaceTest {
   LeafOutcome leaf(double ta, double tb) const noexcept {
     if (plane_axis >= 0) return LeafOutcome::kUndecided;
     const Iv t = hull(exact(ta), exact(tb));
-    auto d = [&](int i, int j) { return difference_over(*x0[i], *x1[i], *x0[j], *x1[j], t); };
-    const IvVec u = d(2, 1), n = cross(u, d(3, 1));
+    // The differences, cross and dot products two at a time (bitwise the scalar ones).
+    auto d2 = [&](int i, int j, int k, int l, IvVec& a, IvVec& b) {
+      difference_over2(*x0[i], *x1[i], *x0[j], *x1[j], *x0[k], *x1[k], *x0[l], *x1[l], t, a, b);
+    };
+    IvVec u, v, p1, cb, p2, ac, n, w;
+    d2(2, 1, 3, 1, u, v);
+    d2(0, 1, 3, 2, p1, cb);
+    cross2(u, v, u, p1, n, w);
     LeafConditions c;
-    if (c.apart(dot(n, cross(u, d(0, 1)))) || c.apart(dot(n, cross(d(3, 2), d(0, 2)))) ||
-        c.apart(dot(n, cross(d(1, 3), d(0, 3)))))
-      return LeafOutcome::kApart;
+    if (c.apart(dot(n, w))) return LeafOutcome::kApart;
+    d2(0, 2, 1, 3, p2, ac);
+    IvVec w_bc, w_ca;
+    cross2(cb, p2, ac, difference_over(*x0[0], *x1[0], *x0[3], *x1[3], t), w_bc, w_ca);
+    Iv e_bc, e_ca;
+    dot2(n, w_bc, n, w_ca, e_bc, e_ca);
+    if (c.apart(e_bc) || c.apart(e_ca)) return LeafOutcome::kApart;
     return c.outcome();
   }
 
-  /// The coplanarity cubic on [0, 1] in doubles: det[p-a, b-a, c-a] = det[b-a, c-a, p-a].
-  BernsteinCubic step_cubic_terms() const noexcept {
-    return orientation_detail::cubic(x0[1]->data(), x0[0]->data(), x0[2]->data(), x0[3]->data(),
-                                     x1[1]->data(), x1[0]->data(), x1[2]->data(), x1[3]->data());
+  /// The points of the coplanarity cubic on [0, 1] in doubles (orientation_detail::cubic's o,
+  /// a, b, c at both ends): det[p-a, b-a, c-a] = det[b-a, c-a, p-a].
+  void step_cubic_points(const double* (&q)[8]) const noexcept {
+    constexpr int kOrder[4] = {1, 0, 2, 3};
+    for (int j = 0; j < 4; ++j) {
+      q[j] = x0[kOrder[j]]->data();
+      q[4 + j] = x1[kOrder[j]]->data();
+    }
   }
 };
 
@@ -305,19 +320,34 @@ struct EdgeEdgeTest {
   LeafOutcome leaf(double ta, double tb) const noexcept {
     if (plane_axis >= 0) return LeafOutcome::kUndecided;
     const Iv t = hull(exact(ta), exact(tb));
-    auto d = [&](int i, int j) { return difference_over(*x0[i], *x1[i], *x0[j], *x1[j], t); };
-    const IvVec ba = d(1, 0), dc = d(3, 2), ca = d(2, 0), n = cross(ba, dc);
+    // The differences, cross and dot products two at a time (bitwise the scalar ones).
+    auto d2 = [&](int i, int j, int k, int l, IvVec& a, IvVec& b) {
+      difference_over2(*x0[i], *x1[i], *x0[j], *x1[j], *x0[k], *x1[k], *x0[l], *x1[l], t, a, b);
+    };
+    IvVec ba, dc, ca, bc, n, w1;
+    d2(1, 0, 3, 2, ba, dc);
+    d2(2, 0, 1, 2, ca, bc);
+    cross2(ba, dc, ca, dc, n, w1);
     LeafConditions c;
-    if (c.apart(dot(cross(ca, dc), n)) || c.apart(dot(cross(d(1, 2), dc), n)) ||
-        c.apart(dot(cross(ca, ba), n)) || c.apart(dot(cross(ba, d(3, 0)), n)))
+    if (c.apart(dot(w1, n))) return LeafOutcome::kApart;
+    IvVec w2, w3;
+    cross2(bc, dc, ca, ba, w2, w3);
+    Iv h2, h3;
+    dot2(w2, n, w3, n, h2, h3);
+    if (c.apart(h2) || c.apart(h3) ||
+        c.apart(dot(cross(ba, difference_over(*x0[3], *x1[3], *x0[0], *x1[0], t)), n)))
       return LeafOutcome::kApart;
     return c.outcome();
   }
 
-  /// The coplanarity cubic on [0, 1] in doubles: det[b-a, d-a, c-a] = det[b-a, d-c, c-a].
-  BernsteinCubic step_cubic_terms() const noexcept {
-    return orientation_detail::cubic(x0[0]->data(), x0[1]->data(), x0[3]->data(), x0[2]->data(),
-                                     x1[0]->data(), x1[1]->data(), x1[3]->data(), x1[2]->data());
+  /// The points of the coplanarity cubic on [0, 1] in doubles (orientation_detail::cubic's o,
+  /// a, b, c at both ends): det[b-a, d-a, c-a] = det[b-a, d-c, c-a].
+  void step_cubic_points(const double* (&q)[8]) const noexcept {
+    constexpr int kOrder[4] = {0, 1, 3, 2};
+    for (int j = 0; j < 4; ++j) {
+      q[j] = x0[kOrder[j]]->data();
+      q[4 + j] = x1[kOrder[j]]->data();
+    }
   }
 };
 
@@ -339,8 +369,20 @@ struct Item {
   FloatBernstein poly;
 };
 
+/// The coplanarity cubic of the whole step in doubles (orientation_detail::cubic of the test's
+/// step_cubic_points).
 template <class Test>
-CcdResult run_bisection(const Test& test, const CcdOptions& options) noexcept {
+BernsteinCubic step_cubic_terms(const Test& test) noexcept {
+  const double* q[8];
+  test.step_cubic_points(q);
+  return orientation_detail::cubic(q[0], q[1], q[2], q[3], q[4], q[5], q[6], q[7]);
+}
+
+/// The test; `step_terms`, when given, is step_cubic_terms(test) computed by the caller (a
+/// batch, two cubics at a time): bitwise the same result.
+template <class Test>
+CcdResult run_bisection(const Test& test, const CcdOptions& options,
+                        const BernsteinCubic* step_terms = nullptr) noexcept {
   CcdResult result;
   if (!all_finite(test.x0, 4) || !all_finite(test.x1, 4)) {
     result.outcome = CcdOutcome::kContact;
@@ -402,7 +444,8 @@ CcdResult run_bisection(const Test& test, const CcdOptions& options) noexcept {
   // (kCubicFirst: excluded by its sign, or straight to a root's leaf, or checked in full). Only
   // when even that fails does the interval check of [0, 1] run as before.
   if (exact_contact) {
-    const FloatBernstein cubic = step_cubic(test.step_cubic_terms());
+    const FloatBernstein cubic =
+        step_cubic(step_terms != nullptr ? *step_terms : step_cubic_terms(test));
     if (proven_positive(cubic) || proven_negative(cubic) || one_signed_by_halving(cubic, 3)) {
       result.intervals = 1;
       return result;
@@ -553,7 +596,47 @@ bool filter_may_hit(const Test& test) noexcept {
   return !test.template check<Iv>(0.0, 1.0, Depth::kFilter).excluded;
 }
 
+template <class Test>
+Test test_of(const CcdQuery& q, const CcdOptions& options) noexcept {
+  return Test{{&q.x0[0], &q.x0[1], &q.x0[2], &q.x0[3]},
+              {&q.x1[0], &q.x1[1], &q.x1[2], &q.x1[3]},
+              Separation(options.min_separation)};
+}
+
+/// run_bisection on each query; with exact contact the whole step's coplanarity cubics are
+/// computed two queries at a time (orientation_detail::cubic2, bitwise the scalar cubic), the
+/// rest of each test as one query (the cubic's stages decide most non-contacts at once).
+template <class Test>
+void run_batch(const CcdQuery* queries, std::size_t count, CcdResult* results,
+               const CcdOptions& options) noexcept {
+  std::size_t i = 0;
+  if (Separation(options.min_separation).zero()) {
+    for (; i + 2 <= count; i += 2) {
+      const Test tests[2] = {test_of<Test>(queries[i], options),
+                             test_of<Test>(queries[i + 1], options)};
+      const double* points[2][8];
+      tests[0].step_cubic_points(points[0]);
+      tests[1].step_cubic_points(points[1]);
+      BernsteinCubic terms[2];
+      orientation_detail::cubic2(points, terms);
+      results[i] = run_bisection(tests[0], options, &terms[0]);
+      results[i + 1] = run_bisection(tests[1], options, &terms[1]);
+    }
+  }
+  for (; i < count; ++i) results[i] = run_bisection(test_of<Test>(queries[i], options), options);
+}
+
 }  // namespace
+
+void vertex_face_ccd_batch(const CcdQuery* queries, std::size_t count, CcdResult* results,
+                           const CcdOptions& options) noexcept {
+  run_batch<VertexFaceTest>(queries, count, results, options);
+}
+
+void edge_edge_ccd_batch(const CcdQuery* queries, std::size_t count, CcdResult* results,
+                         const CcdOptions& options) noexcept {
+  run_batch<EdgeEdgeTest>(queries, count, results, options);
+}
 
 CcdResult vertex_face_ccd(const Vec3d& p0, const Vec3d& a0, const Vec3d& b0, const Vec3d& c0,
                           const Vec3d& p1, const Vec3d& a1, const Vec3d& b1, const Vec3d& c1,

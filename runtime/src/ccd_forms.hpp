@@ -6,6 +6,7 @@
 // apart). Internal to the runtime.
 
 #include <cmath>
+#include <type_traits>
 
 #include "ccd_interval.hpp"
 #include "tetseg/runtime/ccd.hpp"
@@ -42,6 +43,54 @@ inline IvVec difference_over(const Vec3d& xi0, const Vec3d& xi1, const Vec3d& xj
     return d0 + t * ((exact(xi1[k]) - exact(xj1[k])) - d0);
   };
   return {coord(0), coord(1), coord(2)};
+}
+
+/// difference_over(xi, xj, t) into a and difference_over(yi, yj, t) into b, bitwise, computed
+/// as two lanes where the compiler has them.
+inline void difference_over2(const Vec3d& xi0, const Vec3d& xi1, const Vec3d& xj0, const Vec3d& xj1,
+                             const Vec3d& yi0, const Vec3d& yi1, const Vec3d& yj0, const Vec3d& yj1,
+                             Iv t, IvVec& a, IvVec& b) noexcept {
+#if defined(TETSEG_HAVE_LANES2)
+  const Iv2 tt = lanes(t, t);
+  auto coord = [&](int k) {
+    const Iv2 d0 = lanes(exact(xi0[k]), exact(yi0[k])) - lanes(exact(xj0[k]), exact(yj0[k]));
+    return d0 +
+           tt * ((lanes(exact(xi1[k]), exact(yi1[k])) - lanes(exact(xj1[k]), exact(yj1[k]))) - d0);
+  };
+  const Vec<Iv2> d{coord(0), coord(1), coord(2)};
+  a = lane(d, 0);
+  b = lane(d, 1);
+#else
+  a = difference_over(xi0, xi1, xj0, xj1, t);
+  b = difference_over(yi0, yi1, yj0, yj1, t);
+#endif
+}
+
+/// cross(a, b) into ab and cross(c, d) into cd, bitwise, as two lanes where the compiler has
+/// them.
+inline void cross2(const IvVec& a, const IvVec& b, const IvVec& c, const IvVec& d, IvVec& ab,
+                   IvVec& cd) noexcept {
+#if defined(TETSEG_HAVE_LANES2)
+  const Vec<Iv2> r = cross(lanes(a, c), lanes(b, d));
+  ab = lane(r, 0);
+  cd = lane(r, 1);
+#else
+  ab = cross(a, b);
+  cd = cross(c, d);
+#endif
+}
+
+/// dot(a, b) into ab and dot(c, d) into cd, bitwise, as two lanes where the compiler has them.
+inline void dot2(const IvVec& a, const IvVec& b, const IvVec& c, const IvVec& d, Iv& ab,
+                 Iv& cd) noexcept {
+#if defined(TETSEG_HAVE_LANES2)
+  const Iv2 r = dot(lanes(a, c), lanes(b, d));
+  ab = lane(r, 0);
+  cd = lane(r, 1);
+#else
+  ab = dot(a, b);
+  cd = dot(c, d);
+#endif
 }
 
 /// A vector affine in t over the current interval: enclosures of its values at both ends.
@@ -101,6 +150,18 @@ struct CrossSums {
 
 template <class I>
 CrossSums<I> cross_sums(const Slot<I>& w1, const Slot<I>& w2) noexcept {
+#if defined(TETSEG_HAVE_LANES2)
+  if constexpr (std::is_same_v<I, Iv>) {
+    // Lanes: (v0 x v0, v1 x v1) and (v0 x v1, v1 x v0), each bitwise the scalar cross.
+    const Vec<Iv2> a = lanes(w1.v[0], w1.v[1]);
+    const Vec<Iv2> ends = cross(a, lanes(w2.v[0], w2.v[1]));
+    const Vec<Iv2> mixed = cross(a, lanes(w2.v[1], w2.v[0]));
+    return {{lane(ends, 0),
+             {lane(mixed.x, 0) + lane(mixed.x, 1), lane(mixed.y, 0) + lane(mixed.y, 1),
+              lane(mixed.z, 0) + lane(mixed.z, 1)},
+             lane(ends, 1)}};
+  }
+#endif
   const Vec<I> mixed0 = cross(w1.v[0], w2.v[1]);
   const Vec<I> mixed1 = cross(w1.v[1], w2.v[0]);
   return {{cross(w1.v[0], w2.v[0]),
@@ -124,6 +185,16 @@ Sums<I, 2> cross2(const Slot<I>& w1, const Slot<I>& w2, int axis) noexcept {
 /// (w1 x w2) . w3 (degree 3), with n = w1 x w2.
 template <class I>
 Sums<I, 3> trilinear(const CrossSums<I>& n, const Slot<I>& w3) noexcept {
+#if defined(TETSEG_HAVE_LANES2)
+  if constexpr (std::is_same_v<I, Iv>) {
+    // Lanes: the end sums (n0 . v0, n2 . v1); the middle ones as (n0 . v1, n1 . v1) +
+    // (n1 . v0, n2 . v0), each lane the scalar expression.
+    const Iv2 ends = dot(lanes(n.c[0], n.c[2]), lanes(w3.v[0], w3.v[1]));
+    const Iv2 middle = dot(lanes(n.c[0], n.c[1]), lanes(w3.v[1], w3.v[1])) +
+                       dot(lanes(n.c[1], n.c[2]), lanes(w3.v[0], w3.v[0]));
+    return {{lane(ends, 0), lane(middle, 0), lane(middle, 1), lane(ends, 1)}};
+  }
+#endif
   return {{dot(n.c[0], w3.v[0]), dot(n.c[0], w3.v[1]) + dot(n.c[1], w3.v[0]),
            dot(n.c[1], w3.v[1]) + dot(n.c[2], w3.v[0]), dot(n.c[2], w3.v[1])}};
 }
@@ -131,6 +202,18 @@ Sums<I, 3> trilinear(const CrossSums<I>& n, const Slot<I>& w3) noexcept {
 /// (w1 x w2) . (w3 x w4) (degree 4), with l = w1 x w2 and r = w3 x w4.
 template <class I>
 Sums<I, 4> quadrilinear(const CrossSums<I>& l, const CrossSums<I>& r) noexcept {
+#if defined(TETSEG_HAVE_LANES2)
+  if constexpr (std::is_same_v<I, Iv>) {
+    // Lanes: the end sums (l0 . r0, l2 . r2); (s1, s3) as (l0 . r1, l1 . r2) +
+    // (l1 . r0, l2 . r1); s2's first two products, then its third alone.
+    const Iv2 ends = dot(lanes(l.c[0], l.c[2]), lanes(r.c[0], r.c[2]));
+    const Iv2 odd = dot(lanes(l.c[0], l.c[1]), lanes(r.c[1], r.c[2])) +
+                    dot(lanes(l.c[1], l.c[2]), lanes(r.c[0], r.c[1]));
+    const Iv2 middle = dot(lanes(l.c[0], l.c[1]), lanes(r.c[2], r.c[1]));
+    return {{lane(ends, 0), lane(odd, 0), lane(middle, 0) + lane(middle, 1) + dot(l.c[2], r.c[0]),
+             lane(odd, 1), lane(ends, 1)}};
+  }
+#endif
   return {{dot(l.c[0], r.c[0]), dot(l.c[0], r.c[1]) + dot(l.c[1], r.c[0]),
            dot(l.c[0], r.c[2]) + dot(l.c[1], r.c[1]) + dot(l.c[2], r.c[0]),
            dot(l.c[1], r.c[2]) + dot(l.c[2], r.c[1]), dot(l.c[2], r.c[2])}};

@@ -13,6 +13,7 @@
 #include <emmintrin.h>
 #endif
 
+#include "lanes2.hpp"
 #include "tetseg/runtime/classify.hpp"
 
 namespace tetseg {
@@ -26,41 +27,69 @@ constexpr double kRelErr = 16.0 * kEps;
 // Absolute slack for gradual underflow in the products (a few subnormal ulps per operation).
 constexpr double kAbsErr = 1e-300;
 
-struct V3 {
-  double x, y, z;
+template <class T>
+struct Vec3T {
+  T x, y, z;
 };
+using V3 = Vec3T<double>;
 
+/// |x| (lanes2.hpp: the same for two lanes).
+inline double magnitude(double x) noexcept {
+  return std::fabs(x);
+}
+#if defined(TETSEG_HAVE_LANES2)
+using tetseg::Lanes2;
+using tetseg::magnitude;
+#endif
+
+template <class T>
+inline Vec3T<T> sub(const Vec3T<T>& a, const Vec3T<T>& b) noexcept {
+  return {a.x - b.x, a.y - b.y, a.z - b.z};
+}
 inline V3 sub(const double* a, const double* b) noexcept {
   return {a[0] - b[0], a[1] - b[1], a[2] - b[2]};
 }
 
 /// The 2x2 minors of columns (v, w) and the sums of their absolute products.
-struct Minors {
-  double m0, m1, m2;
-  double s0, s1, s2;
+template <class T>
+struct MinorsT {
+  T m0, m1, m2;
+  T s0, s1, s2;
 };
+using Minors = MinorsT<double>;
 
-inline Minors minors(const V3& v, const V3& w) noexcept {
+template <class T>
+inline MinorsT<T> minors(const Vec3T<T>& v, const Vec3T<T>& w) noexcept {
   return {v.y * w.z - v.z * w.y,
           v.x * w.z - v.z * w.x,
           v.x * w.y - v.y * w.x,
-          std::fabs(v.y * w.z) + std::fabs(v.z * w.y),
-          std::fabs(v.x * w.z) + std::fabs(v.z * w.x),
-          std::fabs(v.x * w.y) + std::fabs(v.y * w.x)};
+          magnitude(v.y * w.z) + magnitude(v.z * w.y),
+          magnitude(v.x * w.z) + magnitude(v.z * w.x),
+          magnitude(v.x * w.y) + magnitude(v.y * w.x)};
 }
 
 /// det(u, v, w) and its permanent from u and the minors of (v, w).
-inline void det_perm(const V3& u, const Minors& m, double& det, double& perm) noexcept {
+template <class T>
+inline void det_perm(const Vec3T<T>& u, const MinorsT<T>& m, T& det, T& perm) noexcept {
   det = u.x * m.m0 - u.y * m.m1 + u.z * m.m2;
-  perm = std::fabs(u.x) * m.s0 + std::fabs(u.y) * m.s1 + std::fabs(u.z) * m.s2;
+  perm = magnitude(u.x) * m.s0 + magnitude(u.y) * m.s1 + magnitude(u.z) * m.s2;
 }
 
+/// Bernstein coefficients and their error bounds, in T (BernsteinCubic for doubles).
+template <class T>
+struct CubicTerms {
+  T k[4];
+  T err[4];
+};
+
 /// Bernstein coefficients of det(u(t), v(t), w(t)) for linear u, v, w, from u0, u1 and the
-/// minors m_jk = minors(v_j, w_k) (j, k = start 0 / end 1 of the step).
-inline BernsteinCubic bernstein(const V3& u0, const V3& u1, const Minors& m00, const Minors& m10,
-                                const Minors& m01, const Minors& m11) noexcept {
-  BernsteinCubic r;
-  double d[3], p[3];
+/// minors m_jk = minors(v_j, w_k) (j, k = start 0 / end 1 of the step), into r (k and err of
+/// T: BernsteinCubic for doubles, CubicTerms<Lanes2> for two cubics at once).
+template <class T, class Out>
+inline void bernstein_into(const Vec3T<T>& u0, const Vec3T<T>& u1, const MinorsT<T>& m00,
+                           const MinorsT<T>& m10, const MinorsT<T>& m01, const MinorsT<T>& m11,
+                           Out& r) noexcept {
+  T d[3], p[3];
   det_perm(u0, m00, r.k[0], p[0]);
   r.err[0] = kRelErr * p[0] + kAbsErr;
   det_perm(u1, m00, d[0], p[0]);
@@ -75,6 +104,12 @@ inline BernsteinCubic bernstein(const V3& u0, const V3& u1, const Minors& m00, c
   r.err[2] = kRelErr * (p[0] + p[1] + p[2]) + kAbsErr;
   det_perm(u1, m11, r.k[3], p[0]);
   r.err[3] = kRelErr * p[0] + kAbsErr;
+}
+
+inline BernsteinCubic bernstein(const V3& u0, const V3& u1, const Minors& m00, const Minors& m10,
+                                const Minors& m01, const Minors& m11) noexcept {
+  BernsteinCubic r;
+  bernstein_into(u0, u1, m00, m10, m01, m11, r);
   return r;
 }
 
@@ -108,17 +143,6 @@ inline void bernstein_k(const V& u0, const V& u1, const M& m00, const M& m10, co
   k[3] = det(u1, m11);
 }
 
-#if defined(__GNUC__)
-#define TETSEG_HAVE_LANES2 1
-/// Two doubles computed lane by lane with the scalar operations (GCC/Clang vector extension):
-/// each lane is bitwise the scalar result.
-typedef double Lanes2 __attribute__((vector_size(16)));
-#endif
-
-template <class T>
-struct Vec3T {
-  T x, y, z;
-};
 template <class T>
 struct MinorTerms {
   T m0, m1, m2;
@@ -189,6 +213,31 @@ inline BernsteinCubic cubic(const double* o0, const double* a0, const double* b0
   const V3 v0 = sub(b0, o0), w0 = sub(c0, o0), v1 = sub(b1, o1), w1 = sub(c1, o1);
   return bernstein(sub(a0, o0), sub(a1, o1), minors(v0, w0), minors(v1, w0), minors(v0, w1),
                    minors(v1, w1));
+}
+
+/// `cubic` of two sets of points at once: out[i] is bitwise cubic(p[i][0], ..., p[i][7]) (the
+/// points o0, a0, b0, c0, o1, a1, b1, c1), both computed lane by lane where the compiler has
+/// vector extensions (SSE2 on x86-64: two doubles per instruction).
+inline void cubic2(const double* const (&p)[2][8], BernsteinCubic (&out)[2]) noexcept {
+#if defined(TETSEG_HAVE_LANES2)
+  Vec3T<Lanes2> q[8];
+  for (int j = 0; j < 8; ++j)
+    q[j] = {Lanes2{p[0][j][0], p[1][j][0]}, Lanes2{p[0][j][1], p[1][j][1]},
+            Lanes2{p[0][j][2], p[1][j][2]}};
+  const Vec3T<Lanes2> v0 = sub(q[2], q[0]), w0 = sub(q[3], q[0]), v1 = sub(q[6], q[4]),
+                      w1 = sub(q[7], q[4]);
+  CubicTerms<Lanes2> r;
+  bernstein_into(sub(q[1], q[0]), sub(q[5], q[4]), minors(v0, w0), minors(v1, w0), minors(v0, w1),
+                 minors(v1, w1), r);
+  for (int i = 0; i < 2; ++i)
+    for (int k = 0; k < 4; ++k) {
+      out[i].k[k] = r.k[k][i];
+      out[i].err[k] = r.err[k][i];
+    }
+#else
+  for (int i = 0; i < 2; ++i)
+    out[i] = cubic(p[i][0], p[i][1], p[i][2], p[i][3], p[i][4], p[i][5], p[i][6], p[i][7]);
+#endif
 }
 
 }  // namespace orientation_detail

@@ -279,3 +279,58 @@ TEST_CASE(
   CHECK(worst <= 1.0);
   CHECK(worst_scaled > 1.0);  // the bound is load-bearing
 }
+
+TEST_CASE(
+    "The two-lane cross products of the interval checks enclose the exact values, and an "
+    "eighth of their radii does not",
+    "[ccd][filter][lanes]") {
+  // cross_sums (ccd_forms.hpp) computes its four cross products two at a time (Iv2): each
+  // radius must cover the rounding of the midpoint. Exact input vectors over many scales, some
+  // nearly parallel (cancellation), against the exact GMP cross products.
+  using tetseg::ccd_detail::Iv;
+  using tetseg::ccd_detail::Slot;
+  using tetseg::ccd_detail::Vec;
+  std::mt19937_64 rng(2511);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  std::uniform_int_distribution<int> exponent(-40, 40);
+  auto vec = [&](double scale) {
+    return Vec<Iv>{{scale * unit(rng), 0.0}, {scale * unit(rng), 0.0}, {scale * unit(rng), 0.0}};
+  };
+  using Q3 = std::array<mpq_class, 3>;
+  auto exact_vec = [](const Vec<Iv>& v) { return Q3{v.x.m, v.y.m, v.z.m}; };
+  auto cross = [](const Q3& a, const Q3& b) {
+    return Q3{mpq_class(a[1] * b[2] - a[2] * b[1]), mpq_class(a[2] * b[0] - a[0] * b[2]),
+              mpq_class(a[0] * b[1] - a[1] * b[0])};
+  };
+  // Largest |exact - midpoint| / radius over all components.
+  double worst = 0.0;
+  auto record = [&](const Vec<Iv>& got, const Q3& exact) {
+    const Iv c[3] = {got.x, got.y, got.z};
+    for (int k = 0; k < 3; ++k) {
+      const double error = std::fabs(mpq_class(exact[k] - c[k].m).get_d());
+      if (error > 0.0) worst = std::max(worst, error / c[k].r);
+    }
+  };
+  for (int trial = 0; trial < 100000; ++trial) {
+    const double scale = std::ldexp(1.0, exponent(rng));
+    Slot<Iv> w1{{vec(scale), vec(scale)}}, w2{{vec(scale), vec(scale)}};
+    if (trial % 2 == 0) {  // nearly parallel: w2 ~ w1 rounded
+      for (int i = 0; i < 2; ++i) {
+        w2.v[i] = {{w1.v[i].x.m * 3.0 + unit(rng) * scale * 1e-12, 0.0},
+                   {w1.v[i].y.m * 3.0, 0.0},
+                   {w1.v[i].z.m * 3.0, 0.0}};
+      }
+    }
+    const auto sums = tetseg::ccd_detail::cross_sums(w1, w2);
+    const Q3 a0 = exact_vec(w1.v[0]), a1 = exact_vec(w1.v[1]), b0 = exact_vec(w2.v[0]),
+             b1 = exact_vec(w2.v[1]);
+    const Q3 m0 = cross(a0, b1), m1 = cross(a1, b0);
+    record(sums.c[0], cross(a0, b0));
+    record(sums.c[1],
+           Q3{mpq_class(m0[0] + m1[0]), mpq_class(m0[1] + m1[1]), mpq_class(m0[2] + m1[2])});
+    record(sums.c[2], cross(a1, b1));
+  }
+  INFO("largest error / radius: " << worst);
+  CHECK(worst <= 1.0);
+  CHECK(worst * 8.0 > 1.0);  // an eighth of the radius is violated: the radii are load-bearing
+}

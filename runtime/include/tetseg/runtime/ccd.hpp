@@ -21,6 +21,7 @@
 /// exceptions. The floating-point environment must be round-to-nearest (the default).
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
 
 namespace tetseg {
@@ -67,6 +68,24 @@ CcdResult vertex_face_ccd(const Vec3d& p0, const Vec3d& a0, const Vec3d& b0, con
 CcdResult edge_edge_ccd(const Vec3d& a0, const Vec3d& b0, const Vec3d& c0, const Vec3d& d0,
                         const Vec3d& a1, const Vec3d& b1, const Vec3d& c1, const Vec3d& d1,
                         const CcdOptions& options = {}) noexcept;
+
+/// One query of a batch: the four points in the argument order of vertex_face_ccd (p, a, b, c)
+/// or edge_edge_ccd (a, b, c, d), at the start (x0) and at the end (x1) of the step.
+struct CcdQuery {
+  Vec3d x0[4];
+  Vec3d x1[4];
+};
+
+/// vertex_face_ccd on queries[0..count) into results[0..count): bitwise the results of the
+/// calls one by one. With exact contact (min_separation 0) the first stage, the coplanarity
+/// cubic of the whole step in doubles, is computed for two queries at a time (SIMD lanes);
+/// the rest of each test runs as in vertex_face_ccd.
+void vertex_face_ccd_batch(const CcdQuery* queries, std::size_t count, CcdResult* results,
+                           const CcdOptions& options = {}) noexcept;
+
+/// edge_edge_ccd on a batch, as vertex_face_ccd_batch.
+void edge_edge_ccd_batch(const CcdQuery* queries, std::size_t count, CcdResult* results,
+                         const CcdOptions& options = {}) noexcept;
 
 /// Cheap conservative pre-filter for vertex_face_ccd (same arguments): false only when a
 /// contact over the whole step is impossible (swept boxes disjoint, or the coplanarity cubic
