@@ -431,7 +431,7 @@ struct Collider::Impl {
   /// force of a surface-only body, which has no clusters).
   bool uses_global_bvh() const noexcept {
     return opt.mode == ColliderMode::kBvh || opt.mode == ColliderMode::kCone ||
-           (!asset && opt.mode != ColliderMode::kBrute);
+           (!asset && opt.mode != ColliderMode::kBrute && opt.mode != ColliderMode::kSweep);
   }
   /// The whole-surface BVH is refit and traversed by the current query kind.
   bool global_bvh_active() const noexcept { return rest_mode ? !asset : uses_global_bvh(); }
@@ -544,6 +544,19 @@ struct Collider::Impl {
   void build_seam_orphans();
   /// Tests every seam orphan that no non-culled triangle pair holds (filters, elementary test).
   void test_seam_orphans(Worker& w) const noexcept;
+
+  // --- collider_sweep.cpp (kSweep)
+  /// A swept box in float, rounded outwards: [lo, hi] on the sweep axis, then the other two.
+  struct SweepBox {
+    float lo, hi, lo1, hi1, lo2, hi2;
+    std::uint32_t id, unused;
+  };
+  std::vector<SweepBox> sweep_vertices, sweep_faces, sweep_edges;  // sized at construction
+  /// The axis (0..2) along which the triangles' swept boxes overlap least (sweep_features).
+  int sweep_axis() const noexcept;
+  /// Every vertex-face and edge-edge pair with four distinct nodes whose swept boxes overlap
+  /// (sort and sweep), each once, through process_vertex_face / process_edge_edge.
+  void sweep_features(Worker& w) noexcept;
 
   // --- collider_cone.cpp (kCone; the cone maths: normal_cone.hpp)
   ConeData cone;  // kCone, indexed by global BVH node
