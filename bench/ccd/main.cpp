@@ -287,9 +287,9 @@ int command_frames(const std::string& path0, const std::string& path1, bool json
                  static_cast<unsigned long long>(stats.ee_candidates),
                  static_cast<unsigned long long>(stats.tests), cpu, stats.broad_seconds,
                  stats.test_seconds);
-  } else if (broad_phase == soup::BroadPhase::kRuntimeSweep && asset_path.empty()) {
+  } else if (broad_phase == soup::BroadPhase::kFeatures && asset_path.empty()) {
     std::fprintf(stderr,
-                 "%s: sweep mode: %llu feature pairs, %llu elementary tests; CPU %.3f s (PLY "
+                 "%s: features mode: %llu feature pairs, %llu elementary tests; CPU %.3f s (PLY "
                  "reading excluded)\n",
                  kTool, static_cast<unsigned long long>(stats.feature_pairs),
                  static_cast<unsigned long long>(stats.tests), cpu);
@@ -382,7 +382,7 @@ int main(int argc, char** argv) {
 
   auto* frames = app.add_subcommand(
       "frames",
-      "All contacts between two PLY frames of a triangle soup (the runtime's sweep mode)");
+      "All contacts between two PLY frames of a triangle soup (the runtime's features mode)");
   std::string ply0, ply1;
   frames->add_option("t0", ply0, "Frame at the start of the step (PLY)")->required();
   frames->add_option("t1", ply1, "Frame at the end of the step (PLY, same faces)")->required();
@@ -400,7 +400,7 @@ int main(int argc, char** argv) {
   auto* bvh_flag = frames
                        ->add_flag("--bvh", bvh,
                                   "The soup as one surface-only scene body (whole-surface BVH, "
-                                  "triangle pairs) instead of the sweep mode")
+                                  "triangle pairs) instead of the features mode")
                        ->excludes(brute_flag)
                        ->excludes(sweep_flag);
   frames
@@ -437,7 +437,7 @@ int main(int argc, char** argv) {
                             brute                        ? soup::BroadPhase::kBrute
                             : sweep                      ? soup::BroadPhase::kSweep
                             : bvh || !asset_path.empty() ? soup::BroadPhase::kScene
-                                                         : soup::BroadPhase::kRuntimeSweep,
+                                                         : soup::BroadPhase::kFeatures,
                             skip_still ? soup::StillPairs::kSkip : soup::StillPairs::kInclude,
                             asset_path);
     return command_truth(truth_ply, boxes_path, bools_path, kind);

@@ -275,13 +275,12 @@ std::vector<Contact> scene_contacts(const std::vector<std::array<double, 3>>& x0
   return sorted_contacts(found);
 }
 
-// The soup as one Collider in ColliderMode::kSweep (per-feature sort and sweep, the runtime's
-// filters and elementary tests); contacts in the order of `find_contacts`.
-std::vector<Contact> collider_sweep_contacts(const std::vector<std::array<double, 3>>& x0,
-                                             const std::vector<std::array<double, 3>>& x1,
-                                             const std::vector<std::array<std::uint32_t, 3>>& faces,
-                                             const CcdOptions& options, FrameStats* stats,
-                                             StillPairs still_pairs) {
+// The soup as one Collider in ColliderMode::kFeatures (per-feature BVHs, the runtime's filters
+// and elementary tests); contacts in the order of `find_contacts`.
+std::vector<Contact> collider_features_contacts(
+    const std::vector<std::array<double, 3>>& x0, const std::vector<std::array<double, 3>>& x1,
+    const std::vector<std::array<std::uint32_t, 3>>& faces, const CcdOptions& options,
+    FrameStats* stats, StillPairs still_pairs) {
   const auto nodes = static_cast<std::uint32_t>(x0.size());
   std::vector<std::uint32_t> ids;
   ids.reserve(faces.size() * 3);
@@ -290,7 +289,7 @@ std::vector<Contact> collider_sweep_contacts(const std::vector<std::array<double
       BodyShape::from_triangles(ids.data(), faces.size(), nodes);
   if (!shape) throw std::runtime_error("faces with a repeated or out-of-range vertex");
   ColliderOptions collider_options;
-  collider_options.mode = ColliderMode::kSweep;
+  collider_options.mode = ColliderMode::kFeatures;
   collider_options.ccd = options;
   collider_options.include_still_pairs = still_pairs == StillPairs::kInclude;
   Collider collider(shape, collider_options);
@@ -331,11 +330,11 @@ std::vector<Contact> find_contacts(const std::vector<std::array<double, 3>>& x0,
                                    const CcdOptions& options, BroadPhase broad_phase,
                                    FrameStats* stats, StillPairs still_pairs,
                                    const tetseg::Asset* asset) {
-  if (broad_phase == BroadPhase::kRuntimeSweep && asset == nullptr) {
+  if (broad_phase == BroadPhase::kFeatures && asset == nullptr) {
     if (x0.empty()) return {};
-    return collider_sweep_contacts(x0, x1, faces, options, stats, still_pairs);
+    return collider_features_contacts(x0, x1, faces, options, stats, still_pairs);
   }
-  if (broad_phase == BroadPhase::kScene || broad_phase == BroadPhase::kRuntimeSweep)
+  if (broad_phase == BroadPhase::kScene || broad_phase == BroadPhase::kFeatures)
     return scene_contacts(x0, x1, faces, options, stats, still_pairs, asset);
   if (broad_phase == BroadPhase::kSweep)
     return sweep_contacts(x0, x1, faces, options, stats, still_pairs);

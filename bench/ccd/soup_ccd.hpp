@@ -1,9 +1,9 @@
 #pragma once
 /// \file
 /// All contacts of a deforming triangle soup over one linear step, through the runtime: by
-/// default a `tetseg::Collider` of the soup in `ColliderMode::kSweep` (vertex-face and
-/// edge-edge candidates by sort and sweep over per-feature swept boxes, the runtime's filters
-/// and elementary tests); `kScene`: one surface-only body of a `tetseg::Scene` (median-split
+/// default a `tetseg::Collider` of the soup in `ColliderMode::kFeatures` (vertex-face and
+/// edge-edge candidates from BVHs over per-feature swept boxes, the runtime's filters and
+/// elementary tests); `kScene`: one surface-only body of a `tetseg::Scene` (median-split
 /// BVH over the swept triangle boxes, self-traversal, feature pairs with four distinct nodes
 /// deduplicated exactly, the same filters and tests). By default still feature pairs (four vertices
 /// with x0 == x1) are tested too, so the result is every touching pair of the frame; with
@@ -29,10 +29,10 @@ struct Contact {
 };
 
 enum class BroadPhase {
-  kRuntimeSweep,  ///< the runtime: a Collider in ColliderMode::kSweep (default)
-  kScene,         ///< the runtime: one surface-only scene body (whole-surface BVH)
-  kSweep,         ///< sort and sweep along x over swept boxes, the same elementary tests (baseline)
-  kBrute,         ///< all face pairs (quadratic; a reference for tests)
+  kFeatures,  ///< the runtime: a Collider in ColliderMode::kFeatures (default)
+  kScene,     ///< the runtime: one surface-only scene body (whole-surface BVH)
+  kSweep,     ///< sort and sweep along x over swept boxes, the same elementary tests (baseline)
+  kBrute,     ///< all face pairs (quadratic; a reference for tests)
 };
 
 /// Which feature pairs whose four vertices are all still (x0 == x1 bitwise) are tested.
@@ -65,7 +65,7 @@ struct FrameStats {
 std::vector<Contact> find_contacts(
     const std::vector<std::array<double, 3>>& x0, const std::vector<std::array<double, 3>>& x1,
     const std::vector<std::array<std::uint32_t, 3>>& faces, const CcdOptions& options,
-    BroadPhase broad_phase = BroadPhase::kRuntimeSweep, FrameStats* stats = nullptr,
+    BroadPhase broad_phase = BroadPhase::kFeatures, FrameStats* stats = nullptr,
     StillPairs still_pairs = StillPairs::kInclude, const tetseg::Asset* asset = nullptr);
 
 /// CPU time of the calling thread, in seconds.

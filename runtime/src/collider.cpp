@@ -25,8 +25,8 @@ const char* to_string(ColliderMode mode) noexcept {
       return "brute";
     case ColliderMode::kCone:
       return "cone";
-    case ColliderMode::kSweep:
-      return "sweep";
+    case ColliderMode::kFeatures:
+      return "features";
   }
   return "unknown";
 }
@@ -34,7 +34,7 @@ const char* to_string(ColliderMode mode) noexcept {
 bool parse_collider_mode(const char* name, ColliderMode& out) noexcept {
   if (!name) return false;
   for (ColliderMode m : {ColliderMode::kRvbc, ColliderMode::kBvh, ColliderMode::kBrute,
-                         ColliderMode::kCone, ColliderMode::kSweep}) {
+                         ColliderMode::kCone, ColliderMode::kFeatures}) {
     if (std::strcmp(name, to_string(m)) == 0) {
       out = m;
       return true;
@@ -150,10 +150,13 @@ void Collider::Impl::construct(std::shared_ptr<const BodyShape> sh, const Collid
   wmov.assign(nw, 0);
   wsign.assign(nw, 0);
   cluster_err.resize(cluster_count());
-  if (opt.mode == ColliderMode::kSweep) {
-    sweep_vertices.resize(nv);
-    sweep_faces.resize(tri_count);
-    sweep_edges.resize(topo->edges.size());
+  if (opt.mode == ColliderMode::kFeatures) {
+    vertex_tree.reserve(static_cast<std::uint32_t>(nv));
+    face_tree.reserve(tri_count);
+    edge_tree.reserve(static_cast<std::uint32_t>(topo->edges.size()));
+    ebox.resize(topo->edges.size());
+    feature_build_stack.resize(kMedianBvhStack);
+    for (Worker& w : workers) w.stack.resize(std::max<std::size_t>(w.stack.size(), 1024));
   }
   skip_adjacent = uses_global_bvh();
   if (skip_adjacent) build_orphan_sets();

@@ -205,6 +205,22 @@ struct WholeSurfaceBvh {
   }
 };
 
+/// A median-split BVH over item boxes (kFeatures: vertices, edges or triangles of one body),
+/// built from scratch by `build` into storage reserved by `reserve`.
+struct FeatureTree {
+  std::vector<format::BvhNode> nodes;
+  std::uint32_t count = 0;          // nodes in use
+  std::vector<std::uint32_t> leaf;  // item ids in leaf order
+  std::vector<double> centroid;     // scratch for the build
+  std::vector<Box> box;             // per node
+  std::vector<std::uint32_t> size;  // items under each node
+  /// Allocates everything for `items` items (may throw).
+  void reserve(std::uint32_t items);
+  /// Builds over `items` boxes (`leaf_size` items per leaf at most) without allocating.
+  void build(const Box* item_box, std::uint32_t items, std::uint32_t leaf_size,
+             MedianBvhTask* stack) noexcept;
+};
+
 /// A caller's contact buffer, shared by every worker of one query: it keeps the `cap`
 /// smallest contacts in `contact_less` order (a max-heap on that order while filling; the
 /// query sorts it at the end), so its content does not depend on which worker finds what, or
@@ -431,7 +447,7 @@ struct Collider::Impl {
   /// force of a surface-only body, which has no clusters).
   bool uses_global_bvh() const noexcept {
     return opt.mode == ColliderMode::kBvh || opt.mode == ColliderMode::kCone ||
-           (!asset && opt.mode != ColliderMode::kBrute && opt.mode != ColliderMode::kSweep);
+           (!asset && opt.mode != ColliderMode::kBrute && opt.mode != ColliderMode::kFeatures);
   }
   /// The whole-surface BVH is refit and traversed by the current query kind.
   bool global_bvh_active() const noexcept { return rest_mode ? !asset : uses_global_bvh(); }
@@ -545,18 +561,15 @@ struct Collider::Impl {
   /// Tests every seam orphan that no non-culled triangle pair holds (filters, elementary test).
   void test_seam_orphans(Worker& w) const noexcept;
 
-  // --- collider_sweep.cpp (kSweep)
-  /// A swept box in float, rounded outwards: [lo, hi] on the sweep axis, then the other two.
-  struct SweepBox {
-    float lo, hi, lo1, hi1, lo2, hi2;
-    std::uint32_t id, unused;
-  };
-  std::vector<SweepBox> sweep_vertices, sweep_faces, sweep_edges;  // sized at construction
-  /// The axis (0..2) along which the triangles' swept boxes overlap least (sweep_features).
-  int sweep_axis() const noexcept;
-  /// Every vertex-face and edge-edge pair with four distinct nodes whose swept boxes overlap
-  /// (sort and sweep), each once, through process_vertex_face / process_edge_edge.
-  void sweep_features(Worker& w) noexcept;
+  // --- collider_features.cpp (kFeatures)
+  /// Median-split BVHs over the swept boxes of the surface vertices, triangles and edges,
+  /// rebuilt every step; `ebox` the edges' swept boxes. Sized at construction.
+  FeatureTree vertex_tree, face_tree, edge_tree;
+  std::vector<Box> ebox;
+  std::vector<MedianBvhTask> feature_build_stack;
+  /// Every vertex-face and edge-edge pair with four distinct nodes whose swept boxes overlap,
+  /// each once, through process_vertex_face / process_edge_edge. False on stack overflow.
+  bool feature_pairs(Worker& w) noexcept;
 
   // --- collider_cone.cpp (kCone; the cone maths: normal_cone.hpp)
   ConeData cone;  // kCone, indexed by global BVH node
