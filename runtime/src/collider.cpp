@@ -155,8 +155,10 @@ void Collider::Impl::construct(std::shared_ptr<const BodyShape> sh, const Collid
     face_tree.reserve(tri_count);
     edge_tree.reserve(static_cast<std::uint32_t>(topo->edges.size()));
     ebox.resize(topo->edges.size());
+    vdiag.resize(nv);
+    tdiag.resize(tri_count);
+    ediag.resize(topo->edges.size());
     feature_build_stack.resize(kMedianBvhStack);
-    for (Worker& w : workers) w.stack.resize(std::max<std::size_t>(w.stack.size(), 1024));
   }
   skip_adjacent = uses_global_bvh();
   if (skip_adjacent) build_orphan_sets();

@@ -205,6 +205,13 @@ struct WholeSurfaceBvh {
   }
 };
 
+/// Slabs of a swept feature along the four diagonals (1,1,1), (1,1,-1), (1,-1,1), (-1,1,1)
+/// (unnormalised projections, in float rounded outwards): with the box, a 14-DOP.
+struct Diagonals {
+  float lo[4] = {INFINITY, INFINITY, INFINITY, INFINITY};
+  float hi[4] = {-INFINITY, -INFINITY, -INFINITY, -INFINITY};
+};
+
 /// A median-split BVH over item boxes (kFeatures: vertices, edges or triangles of one body),
 /// built from scratch by `build` into storage reserved by `reserve`.
 struct FeatureTree {
@@ -566,6 +573,7 @@ struct Collider::Impl {
   /// rebuilt every step; `ebox` the edges' swept boxes. Sized at construction.
   FeatureTree vertex_tree, face_tree, edge_tree;
   std::vector<Box> ebox;
+  std::vector<Diagonals> vdiag, tdiag, ediag;  // per surface vertex, triangle, edge
   std::vector<MedianBvhTask> feature_build_stack;
   /// Every vertex-face and edge-edge pair with four distinct nodes whose swept boxes overlap,
   /// each once, through process_vertex_face / process_edge_edge. False on stack overflow.
