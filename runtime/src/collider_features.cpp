@@ -179,15 +179,6 @@ bool Collider::Impl::feature_pairs(Worker& w) noexcept {
   if (!vf_ok) return false;
 
   // Edge-edge: a pair of edges meets in one leaf (positions i < j) or one leaf pair.
-  struct P {
-    ~P() {
-      fprintf(stderr,
-              "vf checks %llu pass %llu ee checks %llu pass %llu; vf nodes %llu total %llu\n",
-              g_checks[0], g_checks[1], g_checks[2], g_checks[3], g_checks[4], g_checks[5]);
-    }
-  };
-  static P p;
-  g_checks[5] = w.stats.node_pairs_visited;
   return overlapping_leaves(
       edge_tree, edge_tree, true, margin, w,
       [&](std::uint32_t fa, std::uint32_t na, std::uint32_t fb, std::uint32_t nb, bool same) {
