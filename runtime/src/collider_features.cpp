@@ -190,9 +190,9 @@ bool Collider::Impl::feature_pairs(Worker& w) noexcept {
             const std::uint32_t e2 = edge_tree.leaf[j];
             const Box& b2 = ebox[e2];
             if (!boxes_overlap(b1, b2, margin)) continue;
-            if (diagonals && !diagonals_overlap(ediag[e1], ediag[e2])) continue;
             const std::array<std::uint32_t, 2>& E2 = topo->edges[e2];
             if (E1[0] == E2[0] || E1[0] == E2[1] || E1[1] == E2[0] || E1[1] == E2[1]) continue;
+            if (diagonals && !diagonals_overlap(ediag[e1], ediag[e2])) continue;
             process_edge_edge(w, *this, e1, b1, *this, e2, b2);
           }
         }
