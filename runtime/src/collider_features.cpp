@@ -17,20 +17,79 @@ void FeatureTree::reserve(std::uint32_t items) {
   const std::size_t cap = items == 0 ? 1 : 2 * std::size_t(items) - 1;
   nodes.resize(cap);
   leaf.resize(items);
-  centroid.resize(std::size_t(items) * 3);
+  key.resize(items);
   box.resize(cap);
   size.assign(cap, 0);
 }
 
+namespace {
+
+// The 10 low bits of v spread to every third bit (Morton code of one axis).
+inline std::uint32_t spread_bits(std::uint32_t v) noexcept {
+  v = (v | (v << 16)) & 0x030000ffu;
+  v = (v | (v << 8)) & 0x0300f00fu;
+  v = (v | (v << 4)) & 0x030c30c3u;
+  v = (v | (v << 2)) & 0x09249249u;
+  return v;
+}
+
+}  // namespace
+
 void FeatureTree::build(const Box* item_box, std::uint32_t items, std::uint32_t leaf_size,
                         MedianBvhTask* stack) noexcept {
+  count = 0;
+  if (items == 0) return;
+  // Items in the Morton order of their box centres (30 bits over the centres' bounding box,
+  // ties by item id: a pure function of the boxes).
+  double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+  for (std::uint32_t i = 0; i < items; ++i)
+    for (int k = 0; k < 3; ++k) {
+      const double c = item_box[i].lo[k] + item_box[i].hi[k];
+      lo[k] = std::min(lo[k], c);
+      hi[k] = std::max(hi[k], c);
+    }
+  double scale[3];
+  for (int k = 0; k < 3; ++k) scale[k] = hi[k] > lo[k] ? 1023.0 / (hi[k] - lo[k]) : 0.0;
   for (std::uint32_t i = 0; i < items; ++i) {
-    leaf[i] = i;
-    for (int k = 0; k < 3; ++k)
-      centroid[std::size_t(i) * 3 + k] = 0.5 * (item_box[i].lo[k] + item_box[i].hi[k]);
+    std::uint32_t code = 0;
+    for (int k = 0; k < 3; ++k) {
+      const double q = (item_box[i].lo[k] + item_box[i].hi[k] - lo[k]) * scale[k];
+      code |= spread_bits(static_cast<std::uint32_t>(std::min(1023.0, std::max(0.0, q)))) << k;
+    }
+    key[i] = (std::uint64_t(code) << 32) | i;
   }
-  count = build_median_bvh(centroid.data(), leaf.data(), items, leaf_size, nodes.data(), stack,
-                           kMedianBvhStack);
+  std::sort(key.begin(), key.begin() + items);
+  for (std::uint32_t i = 0; i < items; ++i) leaf[i] = static_cast<std::uint32_t>(key[i]);
+  // Top down: a range splits where its highest differing Morton bit turns on (in the middle
+  // when all its codes are equal); at most `leaf_size` items make a leaf. Children follow
+  // their parent, so reverse order is bottom-up. Depth <= 30 + log2(items) < kMedianBvhStack.
+  count = 1;
+  std::size_t top = 0;
+  stack[top++] = {0, 0, items};
+  while (top > 0) {
+    const MedianBvhTask task = stack[--top];
+    const std::uint32_t begin = task.begin, end = task.end;
+    if (end - begin <= leaf_size) {
+      nodes[task.node] = {begin, 0, end - begin};
+      continue;
+    }
+    const std::uint32_t first = static_cast<std::uint32_t>(key[begin] >> 32);
+    const std::uint32_t last = static_cast<std::uint32_t>(key[end - 1] >> 32);
+    std::uint32_t mid = begin + (end - begin) / 2;
+    if (first != last) {
+      const std::uint32_t bit = 0x80000000u >> __builtin_clz(first ^ last);
+      const std::uint64_t* split =
+          std::partition_point(key.data() + begin, key.data() + end, [&](std::uint64_t k) {
+            return ((k >> 32) & bit) == 0;
+          });
+      mid = static_cast<std::uint32_t>(split - key.data());
+    }
+    const std::uint32_t left = count, right = count + 1;
+    count += 2;
+    nodes[task.node] = {left, right, 0};
+    stack[top++] = {right, mid, end};
+    stack[top++] = {left, begin, mid};
+  }
   // Children come after their parents: reverse order is bottom-up.
   for (std::uint32_t i = count; i-- > 0;) {
     const format::BvhNode& n = nodes[i];

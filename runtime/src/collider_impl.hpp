@@ -212,13 +212,13 @@ struct Diagonals {
   float hi[4] = {-INFINITY, -INFINITY, -INFINITY, -INFINITY};
 };
 
-/// A median-split BVH over item boxes (kFeatures: vertices, edges or triangles of one body),
-/// built from scratch by `build` into storage reserved by `reserve`.
+/// A BVH over item boxes (kFeatures: vertices, edges or triangles of one body) in the Morton
+/// order of their centres, built from scratch by `build` into storage reserved by `reserve`.
 struct FeatureTree {
   std::vector<format::BvhNode> nodes;
   std::uint32_t count = 0;          // nodes in use
   std::vector<std::uint32_t> leaf;  // item ids in leaf order
-  std::vector<double> centroid;     // scratch for the build
+  std::vector<std::uint64_t> key;   // scratch for the build: Morton code, item id
   std::vector<Box> box;             // per node
   std::vector<std::uint32_t> size;  // items under each node
   /// Allocates everything for `items` items (may throw).
