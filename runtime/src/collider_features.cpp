@@ -79,9 +79,8 @@ void FeatureTree::build(const Box* item_box, std::uint32_t items, std::uint32_t 
     if (first != last) {
       const std::uint32_t bit = 0x80000000u >> __builtin_clz(first ^ last);
       const std::uint64_t* split =
-          std::partition_point(key.data() + begin, key.data() + end, [&](std::uint64_t k) {
-            return ((k >> 32) & bit) == 0;
-          });
+          std::partition_point(key.data() + begin, key.data() + end,
+                               [&](std::uint64_t k) { return ((k >> 32) & bit) == 0; });
       mid = static_cast<std::uint32_t>(split - key.data());
     }
     const std::uint32_t left = count, right = count + 1;

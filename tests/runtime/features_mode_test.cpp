@@ -77,7 +77,8 @@ std::shared_ptr<const BodyShape> shape_of(const std::vector<format::Triangle>& t
                                           std::size_t nodes) {
   std::vector<std::uint32_t> ids;
   for (const auto& t : tris) ids.insert(ids.end(), t.begin(), t.end());
-  auto shape = BodyShape::from_triangles(ids.data(), tris.size(), static_cast<std::uint32_t>(nodes));
+  auto shape =
+      BodyShape::from_triangles(ids.data(), tris.size(), static_cast<std::uint32_t>(nodes));
   REQUIRE(shape);
   return shape;
 }
@@ -139,6 +140,49 @@ TEST_CASE("Features mode: random soups report exactly the brute-force oracle's c
   }
   CHECK(with_contacts >= 10);  // the soups do collide: the comparison is not vacuous
   CHECK(still_only >= 1);      // and some contacts are between still nodes only
+}
+
+TEST_CASE("Features mode: contacts exactly at the ends of the diagonal slabs are found",
+          "[collider][features][oracle]") {
+  // A vertex reaching a face's corner a at t = 1 along a diagonal s, the face stretching away
+  // from a along s: the vertex's slab along s ends exactly where the face's begins (and their
+  // boxes touch too), so slabs that are not closed, or are narrower than the exact
+  // projections, lose the contact. Dyadic coordinates: the oracle decides exactly.
+  const double diagonals[4][3] = {{1, 1, 1}, {1, 1, -1}, {1, -1, 1}, {-1, 1, 1}};
+  std::mt19937_64 rng(7);
+  std::uniform_int_distribution<int> grid(-1024, 1024);
+  const std::vector<format::Triangle> tris = {{0, 1, 2}, {3, 4, 5}};
+  const auto shape = shape_of(tris, 6);
+  int found = 0;
+  for (const auto& s : diagonals) {
+    for (int trial = 0; trial < 8; ++trial) {
+      CAPTURE(s[0], s[1], s[2], trial);
+      double a[3];
+      for (double& c : a) c = std::ldexp(grid(rng), -6) + (trial % 2 ? 1e6 : 0.0);
+      std::vector<double> x0(18), x1(18);
+      auto put = [](std::vector<double>& x, int node, double px, double py, double pz) {
+        x[3 * node] = px, x[3 * node + 1] = py, x[3 * node + 2] = pz;
+      };
+      for (auto* x : {&x0, &x1}) {
+        put(*x, 0, a[0], a[1], a[2]);
+        put(*x, 1, a[0] + s[0] * 0.75, a[1], a[2]);
+        put(*x, 2, a[0], a[1] + s[1] * 0.5, a[2]);
+        put(*x, 4, a[0] + 5, a[1] + 5, a[2] + 5);  // the vertex's triangle, far off
+        put(*x, 5, a[0] + 5, a[1] + 6, a[2] + 5);
+      }
+      put(x0, 3, a[0] - 0.25 * s[0], a[1] - 0.25 * s[1], a[2] - 0.25 * s[2]);
+      put(x1, 3, a[0], a[1], a[2]);
+      const OracleBody body{tris.data(), tris.size(), x0.data(), x1.data(), true};
+      const StepTruth truth = step_truth(body);
+      REQUIRE_FALSE(truth.required.empty());
+      ColliderOptions options;
+      options.mode = ColliderMode::kFeatures;
+      Collider collider(shape, options);
+      require_matches_oracle(answer(collider, x0.data(), x1.data()), truth, Expect::kAllContacts);
+      ++found;
+    }
+  }
+  CHECK(found == 32);
 }
 
 TEST_CASE("Features mode: a minimum separation reports what the brute mode reports",

@@ -40,7 +40,8 @@ int run(const std::string& asset_path, const std::string& frames_path, const std
   options.use_openmp = openmp;
   options.time_tests = true;  // the JSON reports elementary-test time separately
   if (!tetseg::parse_collider_mode(mode_name.c_str(), options.mode))
-    throw ToolError(kExitUsage, "", "unknown mode '" + mode_name + "' (rvbc, bvh, brute, cone, features)");
+    throw ToolError(kExitUsage, "",
+                    "unknown mode '" + mode_name + "' (rvbc, bvh, brute, cone, features)");
   tetseg::Asset asset;
   std::string why;
   const tetseg::Status s = tetseg::load_asset_file(asset_path, asset, &why);
