@@ -17,6 +17,8 @@ void FeatureTree::reserve(std::uint32_t items) {
   const std::size_t cap = items == 0 ? 1 : 2 * std::size_t(items) - 1;
   nodes.resize(cap);
   leaf.resize(items);
+  leaf_box.resize(items);
+  leaf_diag.resize(items);
   key.resize(items);
   box.resize(cap);
   size.assign(cap, 0);
@@ -59,7 +61,10 @@ void FeatureTree::build(const Box* item_box, std::uint32_t items, std::uint32_t 
     key[i] = (std::uint64_t(code) << 32) | i;
   }
   std::sort(key.begin(), key.begin() + items);
-  for (std::uint32_t i = 0; i < items; ++i) leaf[i] = static_cast<std::uint32_t>(key[i]);
+  for (std::uint32_t i = 0; i < items; ++i) {
+    leaf[i] = static_cast<std::uint32_t>(key[i]);
+    leaf_box[i] = item_box[leaf[i]];
+  }
   // Top down: a range splits where its highest differing Morton bit turns on (in the middle
   // when all its codes are equal); at most `leaf_size` items make a leaf. Children follow
   // their parent, so reverse order is bottom-up. Depth <= 30 + log2(items) < kMedianBvhStack.
@@ -93,8 +98,8 @@ void FeatureTree::build(const Box* item_box, std::uint32_t items, std::uint32_t 
   for (std::uint32_t i = count; i-- > 0;) {
     const format::BvhNode& n = nodes[i];
     if (n.count > 0) {
-      Box b = item_box[leaf[n.first]];
-      for (std::uint32_t k = 1; k < n.count; ++k) box_union(b, item_box[leaf[n.first + k]]);
+      Box b = leaf_box[n.first];
+      for (std::uint32_t k = 1; k < n.count; ++k) box_union(b, leaf_box[n.first + k]);
       box[i] = b;
       size[i] = n.count;
     } else {
@@ -199,35 +204,40 @@ bool Collider::Impl::feature_pairs(Worker& w) noexcept {
       add_diagonals(pos1(topo->surf_nodes[i]), d);
       vdiag[i] = d;
     }
-    for (std::uint32_t t = 0; t < tri_count; ++t) {
-      Diagonals d = vdiag[topo->tri_verts[t][0]];
-      merge_diagonals(d, vdiag[topo->tri_verts[t][1]]);
-      merge_diagonals(d, vdiag[topo->tri_verts[t][2]]);
-      tdiag[t] = d;
-    }
-    for (std::uint32_t e = 0; e < ne; ++e) {
-      Diagonals d = vdiag[topo->edge_verts[e][0]];
-      merge_diagonals(d, vdiag[topo->edge_verts[e][1]]);
-      ediag[e] = d;
-    }
   }
   MedianBvhTask* build_stack = feature_build_stack.data();
   vertex_tree.build(vbox.data(), nv, kLeafSize, build_stack);
   face_tree.build(tbox.data(), tri_count, kLeafSize, build_stack);
   edge_tree.build(ebox.data(), ne, kLeafSize, build_stack);
+  if (diagonals) {  // the trees' slabs in leaf order
+    for (std::uint32_t i = 0; i < nv; ++i) vertex_tree.leaf_diag[i] = vdiag[vertex_tree.leaf[i]];
+    for (std::uint32_t i = 0; i < tri_count; ++i) {
+      const std::array<std::uint32_t, 3>& tv = topo->tri_verts[face_tree.leaf[i]];
+      Diagonals d = vdiag[tv[0]];
+      merge_diagonals(d, vdiag[tv[1]]);
+      merge_diagonals(d, vdiag[tv[2]]);
+      face_tree.leaf_diag[i] = d;
+    }
+    for (std::uint32_t i = 0; i < ne; ++i) {
+      const std::array<std::uint32_t, 2>& ev = topo->edge_verts[edge_tree.leaf[i]];
+      Diagonals d = vdiag[ev[0]];
+      merge_diagonals(d, vdiag[ev[1]]);
+      edge_tree.leaf_diag[i] = d;
+    }
+  }
 
   // Vertex-face: a vertex and a face meet in one leaf pair of the two trees.
   const bool vf_ok = overlapping_leaves(
       vertex_tree, face_tree, false, margin, w,
       [&](std::uint32_t fa, std::uint32_t na, std::uint32_t fb, std::uint32_t nb, bool) {
         for (std::uint32_t i = fa; i < fa + na; ++i) {
-          const std::uint32_t v = vertex_tree.leaf[i];
-          const Box& bv = vbox[v];
-          const std::uint32_t p = topo->surf_nodes[v];
+          const Box& bv = vertex_tree.leaf_box[i];
+          const std::uint32_t p = topo->surf_nodes[vertex_tree.leaf[i]];
           for (std::uint32_t j = fb; j < fb + nb; ++j) {
+            if (!boxes_overlap(bv, face_tree.leaf_box[j], margin)) continue;
+            if (diagonals && !diagonals_overlap(vertex_tree.leaf_diag[i], face_tree.leaf_diag[j]))
+              continue;
             const std::uint32_t f = face_tree.leaf[j];
-            if (!boxes_overlap(bv, tbox[f], margin)) continue;
-            if (diagonals && !diagonals_overlap(vdiag[v], tdiag[f])) continue;
             const format::Triangle& tri = tris[f];
             if (p == tri[0] || p == tri[1] || p == tri[2]) continue;
             process_vertex_face(w, *this, p, *this, f);
@@ -242,15 +252,16 @@ bool Collider::Impl::feature_pairs(Worker& w) noexcept {
       [&](std::uint32_t fa, std::uint32_t na, std::uint32_t fb, std::uint32_t nb, bool same) {
         for (std::uint32_t i = fa; i < fa + na; ++i) {
           const std::uint32_t e1 = edge_tree.leaf[i];
-          const Box& b1 = ebox[e1];
+          const Box& b1 = edge_tree.leaf_box[i];
           const std::array<std::uint32_t, 2>& E1 = topo->edges[e1];
           for (std::uint32_t j = same ? i + 1 : fb; j < fb + nb; ++j) {
-            const std::uint32_t e2 = edge_tree.leaf[j];
-            const Box& b2 = ebox[e2];
+            const Box& b2 = edge_tree.leaf_box[j];
             if (!boxes_overlap(b1, b2, margin)) continue;
+            const std::uint32_t e2 = edge_tree.leaf[j];
             const std::array<std::uint32_t, 2>& E2 = topo->edges[e2];
             if (E1[0] == E2[0] || E1[0] == E2[1] || E1[1] == E2[0] || E1[1] == E2[1]) continue;
-            if (diagonals && !diagonals_overlap(ediag[e1], ediag[e2])) continue;
+            if (diagonals && !diagonals_overlap(edge_tree.leaf_diag[i], edge_tree.leaf_diag[j]))
+              continue;
             process_edge_edge(w, *this, e1, b1, *this, e2, b2);
           }
         }

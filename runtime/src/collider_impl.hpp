@@ -216,11 +216,13 @@ struct Diagonals {
 /// order of their centres, built from scratch by `build` into storage reserved by `reserve`.
 struct FeatureTree {
   std::vector<format::BvhNode> nodes;
-  std::uint32_t count = 0;          // nodes in use
-  std::vector<std::uint32_t> leaf;  // item ids in leaf order
-  std::vector<std::uint64_t> key;   // scratch for the build: Morton code, item id
-  std::vector<Box> box;             // per node
-  std::vector<std::uint32_t> size;  // items under each node
+  std::uint32_t count = 0;           // nodes in use
+  std::vector<std::uint32_t> leaf;   // item ids in leaf order
+  std::vector<Box> leaf_box;         // item boxes in leaf order
+  std::vector<Diagonals> leaf_diag;  // item slabs in leaf order (filled by the caller)
+  std::vector<std::uint64_t> key;    // scratch for the build: Morton code, item id
+  std::vector<Box> box;              // per node
+  std::vector<std::uint32_t> size;   // items under each node
   /// Allocates everything for `items` items (may throw).
   void reserve(std::uint32_t items);
   /// Builds over `items` boxes (`leaf_size` items per leaf at most) without allocating.
@@ -573,7 +575,7 @@ struct Collider::Impl {
   /// rebuilt every step; `ebox` the edges' swept boxes. Sized at construction.
   FeatureTree vertex_tree, face_tree, edge_tree;
   std::vector<Box> ebox;
-  std::vector<Diagonals> vdiag, tdiag, ediag;  // per surface vertex, triangle, edge
+  std::vector<Diagonals> vdiag;  // per surface vertex
   std::vector<MedianBvhTask> feature_build_stack;
   /// Every vertex-face and edge-edge pair with four distinct nodes whose swept boxes overlap,
   /// each once, through process_vertex_face / process_edge_edge. False on stack overflow.
