@@ -166,8 +166,9 @@ int main(int argc, char** argv) {
   app.add_option("asset", asset_path, "Asset file (.tetseg)")->required();
   app.add_option("frames", frames_path, "Frame-sequence file (docs/format.md)")->required();
   app.add_option("--mode", mode,
-                 "Candidate search: rvbc (default), bvh, brute or cone (normal cones, ICCD-style)")
-      ->check(CLI::IsMember({"rvbc", "bvh", "brute", "cone"}));
+                 "Candidate search: rvbc (default), bvh, brute, cone (normal cones, ICCD-style) or "
+                 "features (per-feature trees)")
+      ->check(CLI::IsMember({"rvbc", "bvh", "brute", "cone", "features"}));
   app.add_option("--query", query, "any, earliest or all (default)")
       ->check(CLI::IsMember({"any", "earliest", "all"}));
   app.add_flag("--json", json, "Machine-readable output on stdout");
