@@ -287,7 +287,13 @@ int command_frames(const std::string& path0, const std::string& path1, bool json
                  static_cast<unsigned long long>(stats.ee_candidates),
                  static_cast<unsigned long long>(stats.tests), cpu, stats.broad_seconds,
                  stats.test_seconds);
-  } else if (broad_phase == soup::BroadPhase::kScene) {
+  } else if (broad_phase == soup::BroadPhase::kFeatures && asset_path.empty()) {
+    std::fprintf(stderr,
+                 "%s: features mode: %llu feature pairs, %llu elementary tests; CPU %.3f s (PLY "
+                 "reading excluded)\n",
+                 kTool, static_cast<unsigned long long>(stats.feature_pairs),
+                 static_cast<unsigned long long>(stats.tests), cpu);
+  } else {
     std::fprintf(stderr,
                  "%s: scene%s: %llu triangle pairs, %llu feature pairs, %llu elementary tests%s; "
                  "CPU %.3f s (PLY reading excluded)\n",
@@ -374,14 +380,16 @@ int main(int argc, char** argv) {
   queries->add_option("--time-tolerance", options.time_tolerance, "Bisection stop width in t")
       ->check(CLI::PositiveNumber);
 
-  auto* frames =
-      app.add_subcommand("frames", "All contacts between two PLY frames of a triangle soup (BVH)");
+  auto* frames = app.add_subcommand(
+      "frames",
+      "All contacts between two PLY frames of a triangle soup (the runtime's features mode)");
   std::string ply0, ply1;
   frames->add_option("t0", ply0, "Frame at the start of the step (PLY)")->required();
   frames->add_option("t1", ply1, "Frame at the end of the step (PLY, same faces)")->required();
   frames->add_flag("--json", json, "Print JSON");
   bool brute = false;
   bool sweep = false;
+  bool bvh = false;
   auto* brute_flag = frames->add_flag("--brute", brute,
                                       "All face pairs instead of the BVH (quadratic; for tests)");
   auto* sweep_flag =
@@ -389,6 +397,12 @@ int main(int argc, char** argv) {
           ->add_flag("--sweep", sweep,
                      "Sort and sweep over swept boxes, then the same elementary tests (baseline)")
           ->excludes(brute_flag);
+  auto* bvh_flag = frames
+                       ->add_flag("--bvh", bvh,
+                                  "The soup as one surface-only scene body (whole-surface BVH, "
+                                  "triangle pairs) instead of the features mode")
+                       ->excludes(brute_flag)
+                       ->excludes(sweep_flag);
   frames
       ->add_option("--min-separation", options.min_separation, "Minimum separation (length units)")
       ->check(CLI::NonNegativeNumber);
@@ -399,7 +413,8 @@ int main(int argc, char** argv) {
                    "frame's vertices and its triangles the frame's faces, in order (a surface "
                    "asset built from the first frame). Steps are presumed to start contact-free")
       ->excludes(brute_flag)
-      ->excludes(sweep_flag);
+      ->excludes(sweep_flag)
+      ->excludes(bvh_flag);
   bool skip_still = false;
   frames->add_flag("--skip-still", skip_still,
                    "Do not test pairs whose four vertices are still (x0 == x1): the runtime's "
@@ -419,9 +434,10 @@ int main(int argc, char** argv) {
     if (queries->parsed()) return command_queries(dir, json, method, options);
     if (frames->parsed())
       return command_frames(ply0, ply1, json, options,
-                            brute   ? soup::BroadPhase::kBrute
-                            : sweep ? soup::BroadPhase::kSweep
-                                    : soup::BroadPhase::kScene,
+                            brute                        ? soup::BroadPhase::kBrute
+                            : sweep                      ? soup::BroadPhase::kSweep
+                            : bvh || !asset_path.empty() ? soup::BroadPhase::kScene
+                                                         : soup::BroadPhase::kFeatures,
                             skip_still ? soup::StillPairs::kSkip : soup::StillPairs::kInclude,
                             asset_path);
     return command_truth(truth_ply, boxes_path, bools_path, kind);

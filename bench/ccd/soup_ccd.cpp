@@ -7,6 +7,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "tetseg/runtime/collider.hpp"
 #include "tetseg/runtime/scene.hpp"
 
 namespace tetseg::tools::soup {
@@ -190,6 +191,23 @@ std::vector<Contact> sweep_contacts(const std::vector<std::array<double, 3>>& x0
   return contacts;
 }
 
+// The runtime's contacts in the order of `find_contacts`: vertex-face by (vertex, face id), then
+// edge-edge by nodes.
+std::vector<Contact> sorted_contacts(std::vector<tetseg::Contact>& found) {
+  std::sort(found.begin(), found.end(), [](const tetseg::Contact& a, const tetseg::Contact& b) {
+    if (a.kind != b.kind) return a.kind == ContactKind::kVertexFace;
+    if (a.kind == ContactKind::kVertexFace && a.nodes[0] != b.nodes[0])
+      return a.nodes[0] < b.nodes[0];
+    if (a.kind == ContactKind::kVertexFace) return a.triangle < b.triangle;
+    return a.nodes < b.nodes;
+  });
+  std::vector<Contact> contacts;
+  contacts.reserve(found.size());
+  for (const tetseg::Contact& c : found)
+    contacts.push_back({c.kind == ContactKind::kVertexFace, c.nodes, c.toi});
+  return contacts;
+}
+
 // The soup as one surface-only body of a runtime scene (one median-split BVH over the swept
 // triangle boxes, self traversal, exact deduplication, the runtime's feature filters and
 // elementary tests). Memory: the mesh, the scene's scratch and the contacts found.
@@ -254,19 +272,48 @@ std::vector<Contact> scene_contacts(const std::vector<std::array<double, 3>>& x0
     stats->tests = body_stats.feature_tests;
     stats->orientation_culled = body_stats.node_pairs_orientation_culled;
   }
-  // Vertex-face by (vertex, face id), then edge-edge by nodes.
-  std::sort(found.begin(), found.end(), [](const tetseg::Contact& a, const tetseg::Contact& b) {
-    if (a.kind != b.kind) return a.kind == ContactKind::kVertexFace;
-    if (a.kind == ContactKind::kVertexFace && a.nodes[0] != b.nodes[0])
-      return a.nodes[0] < b.nodes[0];
-    if (a.kind == ContactKind::kVertexFace) return a.triangle < b.triangle;
-    return a.nodes < b.nodes;
-  });
-  std::vector<Contact> contacts;
-  contacts.reserve(found.size());
-  for (const tetseg::Contact& c : found)
-    contacts.push_back({c.kind == ContactKind::kVertexFace, c.nodes, c.toi});
-  return contacts;
+  return sorted_contacts(found);
+}
+
+// The soup as one Collider in ColliderMode::kFeatures (per-feature BVHs, the runtime's filters
+// and elementary tests); contacts in the order of `find_contacts`.
+std::vector<Contact> collider_features_contacts(
+    const std::vector<std::array<double, 3>>& x0, const std::vector<std::array<double, 3>>& x1,
+    const std::vector<std::array<std::uint32_t, 3>>& faces, const CcdOptions& options,
+    FrameStats* stats, StillPairs still_pairs) {
+  const auto nodes = static_cast<std::uint32_t>(x0.size());
+  std::vector<std::uint32_t> ids;
+  ids.reserve(faces.size() * 3);
+  for (const auto& f : faces) ids.insert(ids.end(), f.begin(), f.end());
+  std::shared_ptr<const BodyShape> shape =
+      BodyShape::from_triangles(ids.data(), faces.size(), nodes);
+  if (!shape) throw std::runtime_error("faces with a repeated or out-of-range vertex");
+  ColliderOptions collider_options;
+  collider_options.mode = ColliderMode::kFeatures;
+  collider_options.ccd = options;
+  collider_options.include_still_pairs = still_pairs == StillPairs::kInclude;
+  Collider collider(shape, collider_options);
+  ColliderStatus st = collider.step(x0.front().data(), x1.front().data());
+  if (st != ColliderStatus::kOk)
+    throw std::runtime_error(std::string("step rejected: ") + tetseg::to_string(st));
+  // Room for a few contacts per face (dense contact frames such as cloth-ball have about 1.2);
+  // more take a second pass.
+  std::vector<tetseg::Contact> found(4 * faces.size() + 1024);
+  ContactsResult r;
+  st = collider.contacts(found.data(), found.size(), r);
+  if (st == ColliderStatus::kOk && r.truncated()) {
+    found.resize(r.found);
+    st = collider.contacts(found.data(), found.size(), r);
+  }
+  if (st != ColliderStatus::kOk)
+    throw std::runtime_error(std::string("query failed: ") + tetseg::to_string(st));
+  found.resize(r.written);
+  if (stats != nullptr) {
+    const ColliderStats& s = collider.stats();
+    stats->feature_pairs = s.feature_pairs;
+    stats->tests = s.feature_tests;
+  }
+  return sorted_contacts(found);
 }
 
 }  // namespace
@@ -283,7 +330,11 @@ std::vector<Contact> find_contacts(const std::vector<std::array<double, 3>>& x0,
                                    const CcdOptions& options, BroadPhase broad_phase,
                                    FrameStats* stats, StillPairs still_pairs,
                                    const tetseg::Asset* asset) {
-  if (broad_phase == BroadPhase::kScene)
+  if (broad_phase == BroadPhase::kFeatures && asset == nullptr) {
+    if (x0.empty()) return {};
+    return collider_features_contacts(x0, x1, faces, options, stats, still_pairs);
+  }
+  if (broad_phase == BroadPhase::kScene || broad_phase == BroadPhase::kFeatures)
     return scene_contacts(x0, x1, faces, options, stats, still_pairs, asset);
   if (broad_phase == BroadPhase::kSweep)
     return sweep_contacts(x0, x1, faces, options, stats, still_pairs);

@@ -492,7 +492,7 @@ PYBIND11_MODULE(_runtime, m) {
   m.attr("CONTACT_DTYPE") = contact_dtype();
   m.attr("VERTEX_FACE") = static_cast<int>(ContactKind::kVertexFace);
   m.attr("EDGE_EDGE") = static_cast<int>(ContactKind::kEdgeEdge);
-  m.attr("MODES") = py::make_tuple("rvbc", "bvh", "brute", "cone");
+  m.attr("MODES") = py::make_tuple("rvbc", "bvh", "brute", "cone", "features");
 
   py::class_<PyAsset>(m, "Asset",
                       "A validated, immutable asset (load with tetseg.load_asset). Arrays are "

@@ -27,7 +27,7 @@ SCENES = {
 }
 
 
-@pytest.mark.parametrize("mode", ["rvbc", "bvh", "brute", "cone"])
+@pytest.mark.parametrize("mode", ["rvbc", "bvh", "brute", "cone", "features"])
 @pytest.mark.parametrize("scene", sorted(SCENES))
 def test_contacts_equal_tetseg_run_step_by_step(bin_dir, tmp_path, mode, scene):
     shape = scene.split("-")[0]
@@ -197,6 +197,7 @@ def test_modes_agree_with_brute_force_up_to_the_first_contact(bin_dir, tmp_path,
             if earliest is not None:
                 assert earliest["toi"] == brute_earliest["toi"], (mode, step)
         assert found["bvh"][2] == brute, step
+        assert found["features"][2] == brute, step
         if brute_any:
             first = brute_earliest["toi"]
             at_first = {k: t for k, t in brute.items() if t == first}

@@ -48,19 +48,32 @@ void BodyShape::Data::build() {
       for (std::uint32_t v : triangles[t]) vt_list[fill[surf_index[v]]++] = t;
   }
 
-  // Unique edges and edge -> triangle adjacency.
-  std::vector<std::array<std::uint32_t, 3>> half;  // lo, hi, triangle*3+slot
-  half.reserve(std::size_t(tri_count) * 3);
-  for (std::uint32_t t = 0; t < tri_count; ++t) {
-    for (std::uint32_t s = 0; s < 3; ++s) {
-      std::uint32_t u = triangles[t][s], v = triangles[t][(s + 1) % 3];
-      if (u > v) std::swap(u, v);
-      half.push_back({u, v, t * 3 + s});
+  // Unique edges and edge -> triangle adjacency: the half edges (lo, hi, triangle*3+slot) in
+  // sorted order, by a counting sort on lo (stable: slots ascending within a bucket), then
+  // each bucket (the edges around one node: a few) sorted by (hi, slot).
+  std::vector<std::array<std::uint32_t, 3>> half(std::size_t(tri_count) * 3);
+  {
+    std::vector<std::uint32_t> start(std::size_t(node_count) + 1, 0);
+    for (std::uint32_t t = 0; t < tri_count; ++t)
+      for (std::uint32_t s = 0; s < 3; ++s)
+        ++start[std::size_t(std::min(triangles[t][s], triangles[t][(s + 1) % 3])) + 1];
+    for (std::size_t n = 0; n < node_count; ++n) start[n + 1] += start[n];
+    std::vector<std::uint32_t> fill(start.begin(), start.end() - 1);
+    for (std::uint32_t t = 0; t < tri_count; ++t) {
+      for (std::uint32_t s = 0; s < 3; ++s) {
+        std::uint32_t u = triangles[t][s], v = triangles[t][(s + 1) % 3];
+        if (u > v) std::swap(u, v);
+        half[fill[u]++] = {u, v, t * 3 + s};
+      }
     }
+    for (std::size_t n = 0; n < node_count; ++n)
+      std::sort(half.begin() + start[n], half.begin() + start[n + 1]);
   }
-  std::sort(half.begin(), half.end());
   tri_edges.assign(tri_count, {0, 0, 0});
   et_offset.clear();
+  edges.reserve(half.size());
+  et_offset.reserve(half.size() + 1);
+  et_list.reserve(half.size());
   for (std::size_t i = 0; i < half.size(); ++i) {
     if (i == 0 || half[i][0] != half[i - 1][0] || half[i][1] != half[i - 1][1]) {
       edges.push_back({half[i][0], half[i][1]});

@@ -25,14 +25,16 @@ const char* to_string(ColliderMode mode) noexcept {
       return "brute";
     case ColliderMode::kCone:
       return "cone";
+    case ColliderMode::kFeatures:
+      return "features";
   }
   return "unknown";
 }
 
 bool parse_collider_mode(const char* name, ColliderMode& out) noexcept {
   if (!name) return false;
-  for (ColliderMode m :
-       {ColliderMode::kRvbc, ColliderMode::kBvh, ColliderMode::kBrute, ColliderMode::kCone}) {
+  for (ColliderMode m : {ColliderMode::kRvbc, ColliderMode::kBvh, ColliderMode::kBrute,
+                         ColliderMode::kCone, ColliderMode::kFeatures}) {
     if (std::strcmp(name, to_string(m)) == 0) {
       out = m;
       return true;
@@ -148,6 +150,14 @@ void Collider::Impl::construct(std::shared_ptr<const BodyShape> sh, const Collid
   wmov.assign(nw, 0);
   wsign.assign(nw, 0);
   cluster_err.resize(cluster_count());
+  if (opt.mode == ColliderMode::kFeatures) {
+    vertex_tree.reserve(static_cast<std::uint32_t>(nv));
+    face_tree.reserve(tri_count);
+    edge_tree.reserve(static_cast<std::uint32_t>(topo->edges.size()));
+    ebox.resize(topo->edges.size());
+    vdiag.resize(nv);
+    feature_build_stack.resize(kMedianBvhStack);
+  }
   skip_adjacent = uses_global_bvh();
   if (skip_adjacent) build_orphan_sets();
   if (opt.mode == ColliderMode::kRvbc && cluster_count() > 1) build_seam_orphans();

@@ -205,6 +205,31 @@ struct WholeSurfaceBvh {
   }
 };
 
+/// Slabs of a swept feature along the four diagonals (1,1,1), (1,1,-1), (1,-1,1), (-1,1,1)
+/// (unnormalised projections, in float rounded outwards): with the box, a 14-DOP.
+struct Diagonals {
+  float lo[4] = {INFINITY, INFINITY, INFINITY, INFINITY};
+  float hi[4] = {-INFINITY, -INFINITY, -INFINITY, -INFINITY};
+};
+
+/// A BVH over item boxes (kFeatures: vertices, edges or triangles of one body) in the Morton
+/// order of their centres, built from scratch by `build` into storage reserved by `reserve`.
+struct FeatureTree {
+  std::vector<format::BvhNode> nodes;
+  std::uint32_t count = 0;           // nodes in use
+  std::vector<std::uint32_t> leaf;   // item ids in leaf order
+  std::vector<Box> leaf_box;         // item boxes in leaf order
+  std::vector<Diagonals> leaf_diag;  // item slabs in leaf order (filled by the caller)
+  std::vector<std::uint64_t> key;    // scratch for the build: Morton code, item id
+  std::vector<Box> box;              // per node
+  std::vector<std::uint32_t> size;   // items under each node
+  /// Allocates everything for `items` items (may throw).
+  void reserve(std::uint32_t items);
+  /// Builds over `items` boxes (`leaf_size` items per leaf at most) without allocating.
+  void build(const Box* item_box, std::uint32_t items, std::uint32_t leaf_size,
+             MedianBvhTask* stack) noexcept;
+};
+
 /// A caller's contact buffer, shared by every worker of one query: it keeps the `cap`
 /// smallest contacts in `contact_less` order (a max-heap on that order while filling; the
 /// query sorts it at the end), so its content does not depend on which worker finds what, or
@@ -432,7 +457,7 @@ struct Collider::Impl {
   /// force of a surface-only body, which has no clusters).
   bool uses_global_bvh() const noexcept {
     return opt.mode == ColliderMode::kBvh || opt.mode == ColliderMode::kCone ||
-           (!asset && opt.mode != ColliderMode::kBrute);
+           (!asset && opt.mode != ColliderMode::kBrute && opt.mode != ColliderMode::kFeatures);
   }
   /// The whole-surface BVH is refit and traversed by the current query kind.
   bool global_bvh_active() const noexcept { return rest_mode ? !asset : uses_global_bvh(); }
@@ -545,6 +570,17 @@ struct Collider::Impl {
   void build_seam_orphans();
   /// Tests every seam orphan that no non-culled triangle pair holds (filters, elementary test).
   void test_seam_orphans(Worker& w) const noexcept;
+
+  // --- collider_features.cpp (kFeatures)
+  /// Median-split BVHs over the swept boxes of the surface vertices, triangles and edges,
+  /// rebuilt every step; `ebox` the edges' swept boxes. Sized at construction.
+  FeatureTree vertex_tree, face_tree, edge_tree;
+  std::vector<Box> ebox;
+  std::vector<Diagonals> vdiag;  // per surface vertex
+  std::vector<MedianBvhTask> feature_build_stack;
+  /// Every vertex-face and edge-edge pair with four distinct nodes whose swept boxes overlap,
+  /// each once, through process_vertex_face / process_edge_edge. False on stack overflow.
+  bool feature_pairs(Worker& w) noexcept;
 
   // --- collider_cone.cpp (kCone; the cone maths: normal_cone.hpp)
   ConeData cone;  // kCone, indexed by global BVH node

@@ -108,7 +108,8 @@ ColliderStatus Scene::add_body(std::shared_ptr<const BodyShape> shape, const Bod
                                std::uint32_t* id) noexcept {
   if (!m_impl) return ColliderStatus::kNotReady;
   Impl& s = *m_impl;
-  if (!shape || options.mode == ColliderMode::kBrute) return ColliderStatus::kInvalidArgument;
+  if (!shape || options.mode == ColliderMode::kBrute || options.mode == ColliderMode::kFeatures)
+    return ColliderStatus::kInvalidArgument;
   s.have_step = false;
   try {
     ColliderOptions co;

@@ -42,7 +42,7 @@ grep -q '{"kind": "vf", "vertex": 3, "face": \[0, 1, 2\], "toi": 0.4999' "$work/
 # sweep report them); --skip-still keeps the runtime's still rule (only the falling vertex).
 printf 'ply\nformat ascii 1.0\nelement vertex 12\nproperty double x\nproperty double y\nproperty double z\nelement face 4\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n0.25 0.25 0.5\n2 2 1\n2 3 1\n10 10 5\n11 10 5\n10 11 5\n10.25 10.25 5\n11.25 10.25 5\n10.25 11.25 5\n3 0 1 2\n3 3 4 5\n3 6 7 8\n3 9 10 11\n' > "$work/s0.ply"
 sed 's/^0.25 0.25 0.5$/0.25 0.25 -0.5/' "$work/s0.ply" > "$work/s1.ply"
-for broad in "" --brute --sweep; do
+for broad in "" --bvh --brute --sweep; do
   "$tool" frames "$work/s0.ply" "$work/s1.ply" $broad 2>/dev/null > "$work/still_all"
   "$tool" frames "$work/s0.ply" "$work/s1.ply" $broad --skip-still 2>/dev/null > "$work/still_skip"
   grep -q '^vf 9 6 7 8 0$' "$work/still_all" || fail "still floor ($broad): vertex 9 in face 6 7 8 not reported: $(cat "$work/still_all")"
@@ -53,7 +53,7 @@ for broad in "" --brute --sweep; do
   cmp -s "$work/still_skip" "$work/moving_only" ||
     fail "still floor ($broad) --skip-still: $(cat "$work/still_skip")"
   [ -z "$broad" ] && cp "$work/still_all" "$work/still_scene"
-  cmp -s "$work/still_all" "$work/still_scene" || fail "still floor: $broad differs from the runtime scene"
+  cmp -s "$work/still_all" "$work/still_scene" || fail "still floor: $broad differs from the runtime features mode"
 done
 echo "still floor: $(wc -l < "$work/still_scene") contacts by default, $(wc -l < "$work/still_skip") with --skip-still"
 
@@ -75,11 +75,13 @@ awk -v out0="$work/r0.ply" -v out1="$work/r1.ply" 'BEGIN {
     for (i = 0; i < 100; i++) print 3, 450 + i, 451 + i, 452 + i > o }
 }'
 for sep in 0 0.01; do
-  "$tool" frames "$work/r0.ply" "$work/r1.ply" --min-separation $sep 2>/dev/null > "$work/bvh"
+  "$tool" frames "$work/r0.ply" "$work/r1.ply" --min-separation $sep 2>/dev/null > "$work/features"
+  "$tool" frames "$work/r0.ply" "$work/r1.ply" --min-separation $sep --bvh 2>/dev/null > "$work/bvh"
   "$tool" frames "$work/r0.ply" "$work/r1.ply" --min-separation $sep --brute 2>/dev/null > "$work/brute"
   [ "$(wc -l < "$work/brute")" -gt 20 ] || fail "random soup: too few contacts to compare"
   cmp -s "$work/bvh" "$work/brute" || fail "random soup (min separation $sep): BVH and brute force differ"
-  echo "random soup, min separation $sep: $(wc -l < "$work/bvh") contacts, BVH = brute force"
+  cmp -s "$work/features" "$work/brute" || fail "random soup (min separation $sep): features mode and brute force differ"
+  echo "random soup, min separation $sep: $(wc -l < "$work/bvh") contacts, features mode = BVH = brute force"
 done
 
 if [ ! -d "$data" ]; then
@@ -108,7 +110,7 @@ for totals in "$vf" "$ee"; do
 done
 grep -q '"unit-tests": {"vertex_face": {"queries": 250' "$work/q.json" || fail "per-scene JSON"
 
-# Whole frames, through the runtime's soup path (one surface-only scene body): every true pair
+# Whole frames, through the runtime's soup path (the features mode): every true pair
 # (a candidate in boxes/ whose exact mma_bool answer is true) is among the contacts reported,
 # and no reported contact is outside the true set (measured: 0 false positives on all three
 # frames, docs/benchmarks.md; this check keeps that figure true).
@@ -144,14 +146,17 @@ check_frame cloth-funnel 227 227 228
 check_frame rod-twist 3036 3036 3037
 check_frame cloth-ball 92 cloth_ball92 cloth_ball93
 
-# The runtime scene path (one surface-only body) lists exactly brute force's contacts on a
-# reference frame, in the same order and with the same times.
+# The runtime's features mode (the default) and its scene path (--bvh, one surface-only body)
+# list exactly brute force's contacts on a reference frame, in the same order and with the
+# same times.
 funnel="$data/sample-scalable-ccd-data/cloth-funnel/frames"
 if [ -d "$funnel" ]; then
   "$tool" frames "$funnel/227.ply" "$funnel/228.ply" 2>/dev/null > "$work/scene"
   "$tool" frames "$funnel/227.ply" "$funnel/228.ply" --brute 2>/dev/null > "$work/brute"
   [ "$(wc -l < "$work/scene")" -eq 134 ] || fail "cloth-funnel: $(wc -l < "$work/scene") contacts, expected 134"
-  cmp -s "$work/scene" "$work/brute" || fail "cloth-funnel: scene and brute force differ"
+  cmp -s "$work/scene" "$work/brute" || fail "cloth-funnel: features mode and brute force differ"
+  "$tool" frames "$funnel/227.ply" "$funnel/228.ply" --bvh 2>/dev/null > "$work/bvh"
+  cmp -s "$work/bvh" "$work/brute" || fail "cloth-funnel: scene body (--bvh) and brute force differ"
   # The sort-and-sweep baseline: the data README's AABB candidate counts, the same contacts.
   "$tool" frames "$funnel/227.ply" "$funnel/228.ply" --sweep 2>"$work/err" > "$work/sweep"
   grep -q "sort and sweep: 7319 VF + 33770 EE candidates" "$work/err" || fail "sweep: $(cat "$work/err")"

@@ -40,7 +40,8 @@ int run(const std::string& asset_path, const std::string& frames_path, const std
   options.use_openmp = openmp;
   options.time_tests = true;  // the JSON reports elementary-test time separately
   if (!tetseg::parse_collider_mode(mode_name.c_str(), options.mode))
-    throw ToolError(kExitUsage, "", "unknown mode '" + mode_name + "' (rvbc, bvh, brute, cone)");
+    throw ToolError(kExitUsage, "",
+                    "unknown mode '" + mode_name + "' (rvbc, bvh, brute, cone, features)");
   tetseg::Asset asset;
   std::string why;
   const tetseg::Status s = tetseg::load_asset_file(asset_path, asset, &why);
@@ -165,8 +166,9 @@ int main(int argc, char** argv) {
   app.add_option("asset", asset_path, "Asset file (.tetseg)")->required();
   app.add_option("frames", frames_path, "Frame-sequence file (docs/format.md)")->required();
   app.add_option("--mode", mode,
-                 "Candidate search: rvbc (default), bvh, brute or cone (normal cones, ICCD-style)")
-      ->check(CLI::IsMember({"rvbc", "bvh", "brute", "cone"}));
+                 "Candidate search: rvbc (default), bvh, brute, cone (normal cones, ICCD-style) or "
+                 "features (per-feature trees)")
+      ->check(CLI::IsMember({"rvbc", "bvh", "brute", "cone", "features"}));
   app.add_option("--query", query, "any, earliest or all (default)")
       ->check(CLI::IsMember({"any", "earliest", "all"}));
   app.add_flag("--json", json, "Machine-readable output on stdout");

@@ -30,9 +30,14 @@ enum class ColliderMode : std::uint8_t {
   kBvh = 1,    ///< one BVH over the whole surface, overlap culling only
   kBrute = 2,  ///< every feature pair with 4 distinct nodes and overlapping swept boxes
   kCone = 3,   ///< baseline: `kBvh` + continuous normal cones and contour tests (ICCD-like)
+  /// Per-feature BVHs: vertex-face and edge-edge candidates straight from trees over the swept
+  /// boxes of the vertices, edges and triangles (rebuilt every step), overlap culling only,
+  /// no triangle pairs and no orphan sets: for triangle soups and contact-rich steps
+  /// (docs/runtime.md, "Features mode"). One thread. Not a scene body mode.
+  kFeatures = 4,
 };
 
-/// Short stable name: "rvbc", "bvh", "brute", "cone".
+/// Short stable name: "rvbc", "bvh", "brute", "cone", "features".
 const char* to_string(ColliderMode mode) noexcept;
 /// Parses a name of `to_string`; false when unknown.
 bool parse_collider_mode(const char* name, ColliderMode& out) noexcept;

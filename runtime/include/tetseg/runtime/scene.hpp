@@ -47,7 +47,7 @@ inline constexpr std::size_t kOwnPositions = ~std::size_t(0);
 struct BodyOptions {
   /// Self-collision method: `kRvbc` (default; a surface-only body uses `kBvh`), `kBvh` or
   /// `kCone`. Between bodies the body's BVHs (cluster BVHs for `kRvbc`, else its whole-surface
-  /// BVH) are culled by overlap only. `kBrute` is rejected (kInvalidArgument).
+  /// BVH) are culled by overlap only. `kBrute` and `kFeatures` are rejected (kInvalidArgument).
   ColliderMode mode = ColliderMode::kRvbc;
   /// The body never moves: only its `x0` is read (x1 may be null), for both ends of every step.
   bool still = false;
@@ -83,8 +83,8 @@ class Scene {
 
   /// Adds a body over `shape` (non-null) and allocates its scratch. Its id (0, 1, ... in
   /// order of addition) goes to `*id` when given. Every pair with the new body is enabled.
-  /// kInvalidArgument for a null shape or `kBrute`; kNotReady when out of memory. Invalidates
-  /// the current step.
+  /// kInvalidArgument for a null shape, `kBrute` or `kFeatures`; kNotReady when out of memory.
+  /// Invalidates the current step.
   ColliderStatus add_body(std::shared_ptr<const BodyShape> shape, const BodyOptions& options,
                           std::uint32_t* id = nullptr) noexcept;
   std::uint32_t body_count() const noexcept;

@@ -1,0 +1,266 @@
+// ColliderMode::kFeatures (per-feature BVHs, collider_features.cpp) against independent truth:
+// the brute-force oracle over all feature pairs (scene_oracle.hpp: the runtime's elementary
+// tests on every pair, no broad phase) and the exact rational oracle (exact_scene_oracle.hpp),
+// on random triangle soups (separate triangles and a connected strip, some nodes still) and
+// on a libcgal-demo mesh deformed over steps until it touches itself. Every contact the
+// oracle finds is reported, each once, at the oracle's time, nothing else; with
+// `include_still_pairs` the still pairs too; the brute mode's contacts are the same list.
+
+#include <algorithm>
+#include <catch2/catch.hpp>
+#include <memory>
+#include <random>
+#include <vector>
+
+#include "runtime/support/compare.hpp"
+#include "runtime/support/motions.hpp"
+#include "runtime/support/off.hpp"
+#include "tetseg/runtime/body_shape.hpp"
+#include "tetseg/runtime/collider.hpp"
+#include "tetseg/runtime/scene.hpp"
+
+using namespace tetseg;
+using namespace tetseg::test;
+
+namespace {
+
+/// A random soup: `loose` separate small triangles and a strip of `strip` triangles sharing
+/// nodes, in the unit cube, each node moving by up to `motion` per axis; nodes with an index
+/// divisible by `still_every` (0: none) do not move, and then two still triangles overlap in
+/// one plane (still pairs touching for the whole step).
+struct Soup {
+  std::vector<format::Triangle> tris;
+  std::vector<double> x0, x1;
+};
+
+Soup random_soup(unsigned seed, int loose, int strip, double motion, int still_every) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  Soup s;
+  auto node = [&](double x, double y, double z, bool force_still = false) {
+    const auto id = static_cast<std::uint32_t>(s.x0.size() / 3);
+    const bool still =
+        force_still || (still_every > 0 && id % static_cast<std::uint32_t>(still_every) == 0);
+    for (double c : {x, y, z}) {
+      s.x0.push_back(c);
+      s.x1.push_back(still ? c : c + motion * (u(rng) - 0.5));
+    }
+    return id;
+  };
+  for (int i = 0; i < loose; ++i) {
+    const double cx = u(rng), cy = u(rng), cz = u(rng);
+    std::uint32_t v[3];
+    for (auto& id : v) id = node(cx + 0.15 * u(rng), cy + 0.15 * u(rng), cz + 0.15 * u(rng));
+    s.tris.push_back({v[0], v[1], v[2]});
+  }
+  // A zigzag strip along x with a random wave in z: neighbours share edges and nodes.
+  std::uint32_t a = node(0, 0.5, 0.5), b = node(0, 0.6, 0.5 + 0.05 * u(rng));
+  for (int i = 0; i < strip; ++i) {
+    const double x = 0.02 * (i + 1);
+    const std::uint32_t c = node(x, i % 2 ? 0.6 : 0.5, 0.5 + 0.1 * (u(rng) - 0.5));
+    s.tris.push_back({a, b, c});
+    a = b;
+    b = c;
+  }
+  if (still_every > 0) {
+    for (double d : {0.0, 0.1}) {
+      const std::uint32_t p = node(0.1 + d, 0.1 + d, 0.2, true);
+      const std::uint32_t q = node(0.4 + d, 0.1 + d, 0.2, true);
+      const std::uint32_t r = node(0.1 + d, 0.4 + d, 0.2, true);
+      s.tris.push_back({p, q, r});
+    }
+  }
+  return s;
+}
+
+std::shared_ptr<const BodyShape> shape_of(const std::vector<format::Triangle>& tris,
+                                          std::size_t nodes) {
+  std::vector<std::uint32_t> ids;
+  for (const auto& t : tris) ids.insert(ids.end(), t.begin(), t.end());
+  auto shape =
+      BodyShape::from_triangles(ids.data(), tris.size(), static_cast<std::uint32_t>(nodes));
+  REQUIRE(shape);
+  return shape;
+}
+
+std::vector<Contact> contacts_of(const std::shared_ptr<const BodyShape>& shape,
+                                 ColliderOptions options, const double* x0, const double* x1) {
+  Collider collider(shape, options);
+  REQUIRE(collider.status() == ColliderStatus::kOk);
+  std::vector<Contact> found = answer(collider, x0, x1).contacts;
+  std::sort(found.begin(), found.end(), contact_less);
+  return found;
+}
+
+/// Same features, times and start flags, in the same (contact_less) order.
+void require_same_list(const std::vector<Contact>& got, const std::vector<Contact>& want) {
+  REQUIRE(got.size() == want.size());
+  for (std::size_t i = 0; i < got.size(); ++i) {
+    CAPTURE(i, describe(got[i]), describe(want[i]));
+    REQUIRE(same_feature(got[i], want[i]));
+    REQUIRE(got[i].toi == want[i].toi);
+    REQUIRE(got[i].at_start == want[i].at_start);
+  }
+}
+
+}  // namespace
+
+TEST_CASE("Features mode: random soups report exactly the brute-force oracle's contacts",
+          "[collider][features][oracle]") {
+  int with_contacts = 0, still_only = 0;
+  for (unsigned seed = 1; seed <= 12; ++seed) {
+    CAPTURE(seed);
+    const Soup s = random_soup(seed, 60, 40, 0.3, seed % 3 == 0 ? 0 : 4);
+    const auto shape = shape_of(s.tris, s.x0.size() / 3);
+    const OracleBody body{s.tris.data(), s.tris.size(), s.x0.data(), s.x1.data(), true};
+    // Default still rule: the oracle's list exactly, and every exact contact (step_truth
+    // requires the oracle to hold each at a time no later than the exact one).
+    ColliderOptions options;
+    options.mode = ColliderMode::kFeatures;
+    const std::vector<Contact> features = contacts_of(shape, options, s.x0.data(), s.x1.data());
+    require_same_list(features, scene_brute_contacts({body}));
+    const StepTruth truth = step_truth(body);
+    StepAnswer a;
+    a.contacts = features;
+    a.any = !features.empty();
+    a.earliest.found = a.any;
+    if (a.any) a.earliest.contact = features.front();
+    require_matches_oracle(a, truth, Expect::kAllContacts);
+    with_contacts += truth.required.empty() ? 0 : 1;
+    // The brute mode lists the same contacts.
+    ColliderOptions brute = options;
+    brute.mode = ColliderMode::kBrute;
+    require_same_list(features, contacts_of(shape, brute, s.x0.data(), s.x1.data()));
+    // Still pairs included: the oracle with still pairs, which has more when nodes are still.
+    options.include_still_pairs = true;
+    const std::vector<Contact> with_still = contacts_of(shape, options, s.x0.data(), s.x1.data());
+    const std::vector<Contact> oracle_still = scene_brute_contacts({body}, true);
+    require_same_list(with_still, oracle_still);
+    still_only += with_still.size() > features.size() ? 1 : 0;
+  }
+  CHECK(with_contacts >= 10);  // the soups do collide: the comparison is not vacuous
+  CHECK(still_only >= 1);      // and some contacts are between still nodes only
+}
+
+TEST_CASE("Features mode: contacts exactly at the ends of the diagonal slabs are found",
+          "[collider][features][oracle]") {
+  // A vertex reaching a face's corner a at t = 1 along a diagonal s, the face stretching away
+  // from a along s: the vertex's slab along s ends exactly where the face's begins (and their
+  // boxes touch too), so slabs that are not closed, or are narrower than the exact
+  // projections, lose the contact. Dyadic coordinates: the oracle decides exactly.
+  const double diagonals[4][3] = {{1, 1, 1}, {1, 1, -1}, {1, -1, 1}, {-1, 1, 1}};
+  std::mt19937_64 rng(7);
+  std::uniform_int_distribution<int> grid(-1024, 1024);
+  const std::vector<format::Triangle> tris = {{0, 1, 2}, {3, 4, 5}};
+  const auto shape = shape_of(tris, 6);
+  int found = 0;
+  for (const auto& s : diagonals) {
+    for (int trial = 0; trial < 8; ++trial) {
+      CAPTURE(s[0], s[1], s[2], trial);
+      double a[3];
+      for (double& c : a) c = std::ldexp(grid(rng), -6) + (trial % 2 ? 1e6 : 0.0);
+      std::vector<double> x0(18), x1(18);
+      auto put = [](std::vector<double>& x, int node, double px, double py, double pz) {
+        x[3 * node] = px, x[3 * node + 1] = py, x[3 * node + 2] = pz;
+      };
+      for (auto* x : {&x0, &x1}) {
+        put(*x, 0, a[0], a[1], a[2]);
+        put(*x, 1, a[0] + s[0] * 0.75, a[1], a[2]);
+        put(*x, 2, a[0], a[1] + s[1] * 0.5, a[2]);
+        put(*x, 4, a[0] + 5, a[1] + 5, a[2] + 5);  // the vertex's triangle, far off
+        put(*x, 5, a[0] + 5, a[1] + 6, a[2] + 5);
+      }
+      put(x0, 3, a[0] - 0.25 * s[0], a[1] - 0.25 * s[1], a[2] - 0.25 * s[2]);
+      put(x1, 3, a[0], a[1], a[2]);
+      const OracleBody body{tris.data(), tris.size(), x0.data(), x1.data(), true};
+      const StepTruth truth = step_truth(body);
+      REQUIRE_FALSE(truth.required.empty());
+      ColliderOptions options;
+      options.mode = ColliderMode::kFeatures;
+      Collider collider(shape, options);
+      require_matches_oracle(answer(collider, x0.data(), x1.data()), truth, Expect::kAllContacts);
+      ++found;
+    }
+  }
+  CHECK(found == 32);
+}
+
+TEST_CASE("Features mode: a minimum separation reports what the brute mode reports",
+          "[collider][features]") {
+  for (unsigned seed = 20; seed <= 24; ++seed) {
+    CAPTURE(seed);
+    const Soup s = random_soup(seed, 50, 30, 0.2, 5);
+    const auto shape = shape_of(s.tris, s.x0.size() / 3);
+    ColliderOptions options;
+    options.mode = ColliderMode::kFeatures;
+    options.ccd.min_separation = 0.01;
+    ColliderOptions brute = options;
+    brute.mode = ColliderMode::kBrute;
+    const std::vector<Contact> features = contacts_of(shape, options, s.x0.data(), s.x1.data());
+    CHECK_FALSE(features.empty());
+    require_same_list(features, contacts_of(shape, brute, s.x0.data(), s.x1.data()));
+  }
+}
+
+TEST_CASE("Features mode: a deformed real mesh matches the exact oracle up to its first contact",
+          "[collider][features][oracle][mesh]") {
+  const std::string name = GENERATE(as<std::string>{}, "eight", "joint");
+  CAPTURE(name);
+  Surface mesh;
+  if (!read_demo_surface(name, mesh)) return;
+  const auto shape = shape_of(mesh.tris, mesh.verts.size());
+  const double size = bounding_diagonal(mesh);
+  const Waves waves(11, 0.2 * size, 6.0 / size);
+  ColliderOptions options;
+  options.mode = ColliderMode::kFeatures;
+  Collider features(shape, options);
+  options.mode = ColliderMode::kBvh;
+  Collider bvh(shape, options);
+  int steps = 0;
+  bool touched = false;
+  for (int f = 0; f < 10 && !touched; ++f) {
+    CAPTURE(f);
+    std::vector<double> x0, x1;
+    for (const P3& p : mesh.verts) {
+      const P3 a = waves(p, f / 10.0), b = waves(p, (f + 1) / 10.0);
+      x0.insert(x0.end(), a.begin(), a.end());
+      x1.insert(x1.end(), b.begin(), b.end());
+    }
+    const OracleBody body{mesh.tris.data(), mesh.tris.size(), x0.data(), x1.data(), true};
+    const StepTruth truth = step_truth(body);
+    const StepAnswer a = answer(features, x0.data(), x1.data());
+    require_matches_oracle(a, truth, Expect::kAllContacts);
+    std::vector<Contact> got = a.contacts, want = answer(bvh, x0.data(), x1.data()).contacts;
+    std::sort(got.begin(), got.end(), contact_less);
+    std::sort(want.begin(), want.end(), contact_less);
+    require_same_list(got, want);
+    ++steps;
+    touched = !truth.required.empty();
+  }
+  CHECK(touched);  // the deformation does make the surface touch itself
+  CHECK(steps >= 2);
+}
+
+TEST_CASE("Features mode: names, scenes and statuses", "[collider][features][api]") {
+  ColliderMode parsed = ColliderMode::kRvbc;
+  REQUIRE(parse_collider_mode("features", parsed));
+  CHECK(parsed == ColliderMode::kFeatures);
+  CHECK(std::string(to_string(ColliderMode::kFeatures)) == "features");
+  // Not a scene body mode (like kBrute).
+  const Soup s = random_soup(3, 60, 40, 0.3, 0);
+  tetseg::Scene scene;
+  BodyOptions body;
+  body.mode = ColliderMode::kFeatures;
+  CHECK(scene.add_body(shape_of(s.tris, s.x0.size() / 3), body) ==
+        ColliderStatus::kInvalidArgument);
+  // A traversal stack too small for the trees fails with kOverflow, not a partial answer.
+  ColliderOptions options;
+  options.mode = ColliderMode::kFeatures;
+  options.traversal_stack = 2;
+  Collider collider(shape_of(s.tris, s.x0.size() / 3), options);
+  REQUIRE(collider.step(s.x0.data(), s.x1.data()) == ColliderStatus::kOk);
+  std::vector<Contact> buffer(64);
+  ContactsResult r;
+  CHECK(collider.contacts(buffer.data(), buffer.size(), r) == ColliderStatus::kOverflow);
+  CHECK(r.written == 0);
+}
