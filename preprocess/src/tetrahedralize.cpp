@@ -63,8 +63,9 @@ constexpr int kMaxAlphaDoublings = 6;
 /// kAlphaPerDeviation x --max-deviation (or --wrap-alpha when larger) only when the slab
 /// (mesh_sheet_slab, within about --wrap-sheet-offset of the input) does not mesh.
 constexpr double kAlphaPerDeviation = 2.0;
-/// That slab's Mesh_3 runs are bounded (seconds; past it, the doublings): slabs mesh in 1-20 s
-/// on libcgal-demo, but b9_mesh.off's ran over 300 s.
+/// That slab's Mesh_3 runs are each bounded (CPU seconds of the meshing thread,
+/// Watchdog::begin_bounded; past it, the doublings): slabs mesh in 1-20 s on libcgal-demo, but
+/// b9_mesh.off's ran over 300 s.
 constexpr double kSlabMeshingSeconds = 20.0;
 
 /// The share of the probed vertices of `wrap` (closed, outward) that lie on a thin part (see
