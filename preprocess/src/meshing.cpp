@@ -5,7 +5,6 @@
 // mesh3_polyhedral.cpp.
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -51,7 +50,9 @@ constexpr double kMinBudget = 200000.0;
 /// protecting them made dino and femur run over 180 s, hand fail (docs/benchmarks-history.md).
 constexpr double kSharpEdgeDegrees = 60.0;
 constexpr double kProtectEdgeFacets = 8.0;
-/// Mesh_3 with protected sharp edges stops after this many seconds and the surface is
+/// Mesh_3 with protected sharp edges stops after this many seconds of its thread's CPU time
+/// (the load of other processes does not move it; CGAL offers no count of its protection's
+/// steps to bound instead) and the surface is
 /// refused like one whose refinement reached the vertex budget: on corners much sharper than
 /// the sizes (the needle tetrahedron (0,0,0), (1,0,0), (0,L,0), (0,0,1): L = 40 took 8 s, 80
 /// 45 s, 160 over 5 min) CGAL's protection loops without inserting vertices, which the budget
@@ -72,22 +73,36 @@ constexpr double kRetrySizeFactors[] = {1.0, 0.7, 0.5};
 /// (--max-deviation), meshing is retried at most kMaxDeviationRetries times, each with the
 /// facet distance times kDeviationRetryMargin x asked / measured distance (clamped to
 /// [kMinRetryShrink, kMaxRetryShrink]) and the facet size times its square root (cell sizes
-/// unchanged), with sharp edges protected once the input's sharp edges lie further than asked
-/// from the mesh (Mesh_3 rounds them off unprotected: fandisk). Mesh_3's facet distance bounds
-/// the distance of its facets' centres from the surface, not the Hausdorff distance: elephant
-/// deviates about twice its facet distance, fandisk three times (docs/benchmarks.md).
+/// unchanged). Mesh_3's facet distance bounds the distance of its facets' centres from the
+/// surface, not the Hausdorff distance: elephant deviates about twice its facet distance,
+/// fandisk three times (docs/benchmarks.md).
 constexpr int kMaxDeviationRetries = 2;
 constexpr double kDeviationRetryMargin = 0.7;
 constexpr double kMinRetryShrink = 0.25;
 constexpr double kMaxRetryShrink = 0.7;
-/// Each retry's Mesh_3 runs together are bounded by kRetryTimeFactor x the first meshing's seconds,
-/// within [kMinRetrySeconds, kMaxRetrySeconds] and at most half of the time limit left; past
-/// the bound, the nearest mesh so far is kept. The vertex budget stays the first meshing's.
-/// A retry that does not come nearer ends the retries (libcgal-demo cheese and the wrapped cow
-/// spent 54 and 17 s on two retries that gained nothing).
-constexpr double kRetryTimeFactor = 2.0;
-constexpr double kMinRetrySeconds = 10.0;
-constexpr double kMaxRetrySeconds = 20.0;
+/// A retry protects the sharp edges at once when the input's sharp edges lie further than asked
+/// from the mesh (Mesh_3 rounds them off unprotected: fandisk) and form at most this many
+/// curves (connected sets of sharp edges): CAD parts (fandisk, cross 1, rotor 9, anchor 12).
+/// Organic scans' sharp edges are mostly tessellation noise in many curves (triceratops 96,
+/// femur 274, camel 77): their protected retries ran into the protection's time bound
+/// (triceratops, femur) or helped (camel), so they are protected only after an unprotected
+/// retry (keep_within_distance).
+constexpr std::size_t kMaxProtectedCurves = 16;
+/// Work bounds of the retries (deterministic, unlike time bounds: the same input gives the
+/// same asset on a loaded machine). A retry is expected to make the first mesh's vertices
+/// divided by its facet distance factor (surface vertices grow as the inverse square of the
+/// facet size); it is not run when that passes kMaxRetryVertices (cheese: 26k vertices in 33 s
+/// for its first mesh, its retries could not finish), each of its Mesh_3 runs stops after
+/// kRetryVertexFactor times that, and all of them (the boundary retries: optimisation off,
+/// smaller sizes) after kRetryRunsPerBudget times that again (refused as not converging: the
+/// nearest mesh so far is kept). The time limit (--time-limit) stays the outer bound.
+constexpr double kMaxRetryVertices = 40000.0;
+constexpr double kRetryVertexFactor = 2.0;
+constexpr std::size_t kRetryRunsPerBudget = 3;
+/// Whether the deviation retries perturb slivers before exuding them. They do not: on a
+/// retry's finer surface, perturbation took 7.5 of triceratops' 10 CPU seconds (exudation only:
+/// 2.8 s, the same deviation); the boundary retries already accept exudation only.
+constexpr bool kDeviationRetryPerturb = false;
 
 }  // namespace
 
@@ -190,7 +205,35 @@ struct SharpEdges {
   double max_normal_degrees = 0.0;
   /// The sharp edges, as pairs of vertex ids.
   std::vector<std::pair<std::uint32_t, std::uint32_t>> edges;
+  /// The connected sets of sharp edges (sharing vertices): feature curves, or noise.
+  std::size_t curves = 0;
 };
+
+/// How many connected sets the edges form (union-find over their vertex ids).
+std::size_t count_edge_components(const std::vector<std::pair<std::uint32_t, std::uint32_t>>& edges,
+                                  std::size_t vertex_count) {
+  std::vector<std::uint32_t> parent(vertex_count);
+  for (std::size_t v = 0; v < vertex_count; ++v) parent[v] = static_cast<std::uint32_t>(v);
+  const auto root = [&](std::uint32_t v) {
+    while (parent[v] != v) v = parent[v] = parent[parent[v]];
+    return v;
+  };
+  std::size_t components = 0;
+  std::vector<bool> touched(vertex_count, false);
+  for (const auto& [a, b] : edges) {
+    for (const std::uint32_t v : {a, b})
+      if (!touched[v]) {
+        touched[v] = true;
+        ++components;
+      }
+    const std::uint32_t ra = root(a), rb = root(b);
+    if (ra != rb) {
+      parent[ra] = rb;
+      --components;
+    }
+  }
+  return components;
+}
 
 SharpEdges sharp_edges(const TriangleMesh& s, double degrees) {
   std::vector<Vec3> normal(s.triangles.size());
@@ -226,6 +269,7 @@ SharpEdges sharp_edges(const TriangleMesh& s, double degrees) {
     }
   }
   out.count = out.edges.size();
+  out.curves = count_edge_components(out.edges, s.vertices.size());
   std::sort(sharp.begin(), sharp.end());
   sharp.erase(std::unique(sharp.begin(), sharp.end()), sharp.end());
   for (std::size_t i = 0; i < sharp.size();) {
@@ -353,10 +397,13 @@ struct RetrySizes {
   double facet_distance = 1.0;       ///< factor
   double facet_size = 1.0;           ///< factor (the cell size stays)
   bool protect_sharp_edges = false;  ///< whatever the input's edge lengths
-  std::size_t max_vertices = 0;      ///< > 0: this vertex budget instead of the sizes'
-  /// > 0: every Mesh_3 run of the call together stops after this many seconds (refused as
-  /// not converging), whatever runs the boundary retries add.
-  double total_seconds = 0.0;
+  /// false: no sliver perturbation (exudation only, when optimising), kDeviationRetryPerturb.
+  bool perturb = true;
+  /// > 0: each Mesh_3 run of the call makes at most this many vertices, and the runs together
+  /// (the boundary retries included) kRetryRunsPerBudget times that, each run's budget at most
+  /// what the runs before it left (past it: refused as not converging); 0: each run has the
+  /// budget of its sizes (vertex_budget).
+  std::size_t run_vertices = 0;
 };
 
 /// Mesh_3 on a closed surface (pinch points allowed), checked, with the retries of
@@ -403,16 +450,16 @@ TetMesh mesh_closed_surface(const TriangleMesh& input, const MeshingOptions& mes
   if (criteria.optimize)
     attempts.insert(attempts.end(),
                     {{"exudation only", true, false}, {"no optimisation", false, false}});
+  if (!retry.perturb && criteria.optimize) attempts.erase(attempts.begin());
   std::string first_defect;
   std::string defects;
-  const auto started = std::chrono::steady_clock::now();
+  std::size_t vertices_made = 0;
   for (const double factor : kRetrySizeFactors) {
     detail::Mesh3Criteria sized = criteria;
     sized.facet_size *= factor;
     sized.cell_size *= factor;
     sized.facet_distance *= factor;
-    sized.max_vertices =
-        retry.max_vertices > 0 ? retry.max_vertices : vertex_budget(sized, diagonal);
+    sized.max_vertices = vertex_budget(sized, diagonal);
     if (sharp &&
         (retry.protect_sharp_edges || median_edge >= kProtectEdgeFacets * sized.facet_size)) {
       sized.sharp_edge_angle = kSharpEdgeDegrees;
@@ -439,21 +486,20 @@ TetMesh mesh_closed_surface(const TriangleMesh& input, const MeshingOptions& mes
       detail::Mesh3Criteria tried = sized;
       tried.optimize = attempt.optimize;
       tried.perturb = attempt.perturb;
-      double run_bound = bound_seconds;
-      if (retry.total_seconds > 0.0) {
-        const double left =
-            retry.total_seconds -
-            std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-        if (left < 1.0)
+      if (retry.run_vertices > 0) {
+        const std::size_t total = kRetryRunsPerBudget * retry.run_vertices;
+        if (vertices_made >= total)
           throw InputError(file, "tetrahedralize: CGAL Mesh_3 did not converge within " +
-                                     std::to_string(static_cast<int>(retry.total_seconds)) + " s");
-        run_bound = run_bound > 0.0 ? std::min(run_bound, left) : left;
+                                     std::to_string(total) + " vertices");
+        tried.max_vertices =
+            std::min({tried.max_vertices, retry.run_vertices, total - vertices_made});
       }
       const TetMesh mesh =
           run_mesh_3_guarded(input, tried, file, watchdog,
                              std::string("CGAL Mesh_3 (") + attempt.name + ", sizes x" +
                                  std::to_string(factor).substr(0, 3) + ")",
-                             run_bound);
+                             bound_seconds);
+      vertices_made += mesh.nodes.size();
       if (mesh.tets.empty())
         throw InputError(file,
                          "meshing produced no tetrahedra (is the surface closed and "
@@ -479,12 +525,11 @@ TetMesh mesh_closed_surface(const TriangleMesh& input, const MeshingOptions& mes
                              "need a smaller --facet-size");
 }
 
-/// The larger of the two (approximate) Hausdorff distances between `surface` and the boundary
-/// of `mesh`, absolute; -1 when not measurable.
-double boundary_distance(const TriangleMesh& surface, const TetMesh& mesh) {
+/// The two (approximate) Hausdorff distances between `surface` and the boundary of `mesh`
+/// (surface to mesh, mesh to surface), absolute; -1 when not measurable.
+std::pair<double, double> boundary_distances(const TriangleMesh& surface, const TetMesh& mesh) {
   const TriangleMesh boundary{mesh.nodes, extract_surface(mesh).triangles};
-  const auto [there, back] = detail::hausdorff_distances(surface, boundary);
-  return std::max(there, back);
+  return detail::hausdorff_distances(surface, boundary);
 }
 
 /// Points along the sharp edges of `surface` (each edge's ends and its quarter points; at most
@@ -510,75 +555,103 @@ std::vector<Vec3> sharp_edge_samples(const TriangleMesh& surface, const SharpEdg
 /// The deviation retries (kMaxDeviationRetries): while the boundary of `mesh` lies further than
 /// `max_distance` (absolute, > 0) from `surface`, meshing is repeated at smaller sizes, and the
 /// nearest mesh is returned, with its notes; notes.deviation_retries counts the meshings
-/// repeated. `first_seconds`: how long the first meshing took.
+/// repeated, `distances` gets the returned mesh's two distances (boundary_distances).
+/// Sharp edges lying further than `max_distance` from the mesh are protected at once when they
+/// form at most kMaxProtectedCurves curves; else first unprotected, and protected at the same
+/// sizes only when the unprotected retry leaves them that far and over `max_distance` (camel:
+/// 0.011 -> 0.0039 protected; triceratops and femur meet it unprotected, whose protected
+/// retries ran into their bound). A protected retry refused is followed by the same sizes
+/// unprotected.
 TetMesh keep_within_distance(const TriangleMesh& surface, TetMesh best, double max_distance,
-                             double first_seconds, const MeshingOptions& meshing,
-                             const std::string& file, TetrahedralizeNotes& notes,
-                             detail::Watchdog& watchdog) {
+                             const MeshingOptions& meshing, const std::string& file,
+                             TetrahedralizeNotes& notes, detail::Watchdog& watchdog,
+                             std::pair<double, double>& distances) {
   watchdog.begin("deviation of the meshed boundary");
-  double distance = boundary_distance(surface, best);
-  if (!(distance > max_distance)) return best;
+  distances = boundary_distances(surface, best);
+  double best_distance = std::max(distances.first, distances.second);
+  if (!(best_distance > max_distance)) return best;
   const TetrahedralizeNotes notes_before = notes;
-  const double diagonal = detail::bounding_box_diagonal(surface.vertices);
   const SharpEdges sharp = sharp_edges(surface, kSharpEdgeDegrees);
   const std::vector<Vec3> sharp_samples = sharp_edge_samples(surface, sharp);
-  RetrySizes sizes;
-  sizes.max_vertices =
-      vertex_budget(resolve(meshing, default_facet_size_for_diagonal(diagonal)), diagonal);
-  double best_distance = distance;
+  const bool feature_curves = sharp.curves <= kMaxProtectedCurves;
+  const auto sharp_edges_far = [&](const TetMesh& mesh) {
+    if (sharp_samples.empty()) return false;
+    const TriangleMesh boundary{mesh.nodes, extract_surface(mesh).triangles};
+    return detail::max_distance_to_surface(sharp_samples, boundary) > max_distance;
+  };
+  const double first_vertices = static_cast<double>(best.nodes.size());
+  RetrySizes sizes;  // those of `best`
+  sizes.perturb = kDeviationRetryPerturb;
   std::string best_sizes;
   std::size_t retries = 0;
+  bool repeat_flipped = false;  // the next retry: the last sizes, the protection switched
+  bool flipped = false;         // the last retry was such a repeat
   bool protection_failed = false;
+  RetrySizes tried_sizes;
   for (int retry = 1; retry <= kMaxDeviationRetries; ++retry) {
-    const double shrink = std::clamp(kDeviationRetryMargin * max_distance / distance,
-                                     kMinRetryShrink, kMaxRetryShrink);
-    RetrySizes tried_sizes = sizes;
-    tried_sizes.facet_distance *= shrink;
-    tried_sizes.facet_size *= std::sqrt(shrink);
-    if (protection_failed) {
-      tried_sizes.protect_sharp_edges = false;
-    } else if (!tried_sizes.protect_sharp_edges && !sharp_samples.empty()) {
-      const TriangleMesh boundary{best.nodes, extract_surface(best).triangles};
+    if (repeat_flipped) {
+      tried_sizes.protect_sharp_edges = !tried_sizes.protect_sharp_edges;
+    } else {
+      const double shrink = std::clamp(kDeviationRetryMargin * max_distance / best_distance,
+                                       kMinRetryShrink, kMaxRetryShrink);
+      tried_sizes = sizes;
+      tried_sizes.facet_distance *= shrink;
+      tried_sizes.facet_size *= std::sqrt(shrink);
+      const double expected_vertices = first_vertices / tried_sizes.facet_distance;
+      if (expected_vertices > kMaxRetryVertices) break;
+      tried_sizes.run_vertices =
+          static_cast<std::size_t>(std::ceil(kRetryVertexFactor * expected_vertices));
       tried_sizes.protect_sharp_edges =
-          detail::max_distance_to_surface(sharp_samples, boundary) > max_distance;
+          !protection_failed &&
+          (sizes.protect_sharp_edges || (feature_curves && sharp_edges_far(best)));
     }
-    const double bound =
-        std::min(std::clamp(kRetryTimeFactor * first_seconds, kMinRetrySeconds, kMaxRetrySeconds),
-                 0.5 * watchdog.seconds_left());
-    if (!(bound > 1.0)) break;
-    tried_sizes.total_seconds = bound;
+    // Near the time limit (the outer bound, wall time), a retry gets at most half of what is
+    // left, so that it cannot make the build refused that has a mesh already.
+    const double time_left = 0.5 * watchdog.seconds_left();
+    if (!(time_left > 1.0)) break;
+    flipped = repeat_flipped;
+    repeat_flipped = false;
     TetrahedralizeNotes tried_notes = notes_before;
     TetMesh tried;
+    ++retries;
     try {
-      tried = mesh_closed_surface(surface, meshing, file, tried_notes, watchdog, 0.0, tried_sizes);
+      tried = mesh_closed_surface(surface, meshing, file, tried_notes, watchdog,
+                                  time_left < 1e6 ? time_left : 0.0, tried_sizes);
     } catch (const TimeLimitExceeded&) {
       throw;
     } catch (const InputError&) {
-      // Over its bound or refused: with sharp edges protected (slow on finely tessellated
-      // inputs, whose sharp edges are mostly noise), the next retry takes the same sizes
-      // unprotected; else the nearest mesh so far is kept.
-      ++retries;
-      if (!tried_sizes.protect_sharp_edges) break;
-      protection_failed = true;
+      // Refused (over its vertex bound, the protection's time bound, or CGAL failed): the same
+      // sizes with the protection switched, once; else the nearest mesh so far is kept.
+      if (tried_sizes.protect_sharp_edges) protection_failed = true;
+      repeat_flipped = !flipped && (tried_sizes.protect_sharp_edges ||
+                                    (!protection_failed && sharp_edges_far(best)));
+      if (!repeat_flipped) break;
       continue;
     }
-    ++retries;
-    sizes = tried_sizes;
     watchdog.begin("deviation of the meshed boundary");
-    distance = boundary_distance(surface, tried);
-    if (distance >= 0.0 && distance < best_distance) {
+    const std::pair<double, double> tried_distances = boundary_distances(surface, tried);
+    const double distance = std::max(tried_distances.first, tried_distances.second);
+    const bool nearer = distance >= 0.0 && distance < best_distance;
+    if (nearer) {
       char text[120];
-      std::snprintf(text, sizeof text, "facet distance x%.2g, facet size x%.2g%s",
-                    sizes.facet_distance, sizes.facet_size,
-                    sizes.protect_sharp_edges ? ", sharp edges protected" : "");
+      std::snprintf(text, sizeof text, "facet distance x%.2g, facet size x%.2g%s%s",
+                    tried_sizes.facet_distance, tried_sizes.facet_size,
+                    tried_sizes.protect_sharp_edges ? ", sharp edges protected" : "",
+                    !tried_sizes.perturb && meshing.optimize ? ", no sliver perturbation" : "");
       best_distance = distance;
       best_sizes = text;
+      sizes = tried_sizes;
       notes = tried_notes;
-      best = std::move(tried);
-    } else {
-      break;  // smaller sizes did not bring it nearer; smaller still would cost more
+      distances = tried_distances;
+      if (distance <= max_distance) {
+        best = std::move(tried);
+        break;
+      }
     }
-    if (distance <= max_distance) break;
+    repeat_flipped = !flipped && !tried_sizes.protect_sharp_edges && !protection_failed &&
+                     sharp_edges_far(tried);
+    if (nearer) best = std::move(tried);
+    if (!nearer && !repeat_flipped) break;  // smaller sizes did not bring it nearer
   }
   notes.deviation_retries = retries;
   notes.deviation_retry_sizes = best_sizes;
@@ -590,7 +663,8 @@ TetMesh keep_within_distance(const TriangleMesh& surface, TetMesh best, double m
 TetMesh detail::validate_and_mesh(const TriangleMesh& source, const MeshingOptions& meshing,
                                   const std::string& file, TetrahedralizeNotes& notes,
                                   detail::Watchdog& watchdog, double bound_seconds,
-                                  double max_distance) {
+                                  double max_distance, std::pair<double, double>* distances) {
+  if (distances != nullptr) *distances = {-1.0, -1.0};
   watchdog.begin("surface validation");
   TriangleMesh split;
   detail::SurfaceCheck check;
@@ -606,13 +680,13 @@ TetMesh detail::validate_and_mesh(const TriangleMesh& source, const MeshingOptio
   }
   detail::check_surface_not_nested(source, file);
   const TriangleMesh& meshed = split.triangles.empty() ? source : split;
-  const auto started = std::chrono::steady_clock::now();
   TetMesh mesh = mesh_closed_surface(meshed, meshing, file, notes, watchdog, bound_seconds);
   if (!(max_distance > 0.0)) return mesh;
-  const double seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-  return keep_within_distance(meshed, std::move(mesh), max_distance, seconds, meshing, file, notes,
-                              watchdog);
+  std::pair<double, double> measured{-1.0, -1.0};
+  mesh = keep_within_distance(meshed, std::move(mesh), max_distance, meshing, file, notes, watchdog,
+                              measured);
+  if (distances != nullptr && split.triangles.empty()) *distances = measured;
+  return mesh;
 }
 
 }  // namespace tetseg::preprocess

@@ -2,6 +2,9 @@
 
 #include "watchdog.hpp"
 
+#include <pthread.h>
+#include <time.h>
+
 #include <algorithm>
 #include <cstdio>
 
@@ -12,6 +15,15 @@ namespace {
 
 /// Seconds between progress reports.
 constexpr double kProgressSeconds = 10.0;
+/// Wall seconds between looks at the CPU time of a bounded step.
+constexpr double kBoundPollSeconds = 0.1;
+
+/// CPU seconds `clock` has counted (0 when it cannot be read).
+double cpu_seconds(clockid_t clock) {
+  timespec t{};
+  if (clock_gettime(clock, &t) != 0) return 0.0;
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
 
 }  // namespace
 
@@ -39,7 +51,9 @@ void Watchdog::run() {
   while (!m_done) {
     double wake = next_report;
     if (m_limit > 0.0 && !m_stop.load()) wake = std::min(wake, m_limit);
-    if (m_bound_end > 0.0 && !m_bound_reached) wake = std::min(wake, m_bound_end);
+    const double elapsed = std::chrono::duration<double>(Clock::now() - m_start).count();
+    if (m_bound_cpu_seconds > 0.0 && !m_bound_reached)
+      wake = std::min(wake, elapsed + kBoundPollSeconds);
     const auto until = m_start + std::chrono::duration_cast<Clock::duration>(
                                      std::chrono::duration<double>(std::min(wake, kNever)));
     m_wake.wait_until(lock, until, [this] { return m_done || m_changed; });
@@ -47,7 +61,8 @@ void Watchdog::run() {
     if (m_done) break;
     const double now = std::chrono::duration<double>(Clock::now() - m_start).count();
     if (m_limit > 0.0 && now >= m_limit) m_stop.store(true, std::memory_order_release);
-    if (m_bound_end > 0.0 && now >= m_bound_end && !m_bound_reached) {
+    if (m_bound_cpu_seconds > 0.0 && !m_bound_reached &&
+        cpu_seconds(m_bound_clock) - m_bound_cpu_start >= m_bound_cpu_seconds) {
       m_bound_reached = true;
       m_stop.store(true, std::memory_order_release);
     }
@@ -96,7 +111,10 @@ void Watchdog::begin_bounded(const std::string& step, double seconds) {
   {
     const std::lock_guard<std::mutex> lock(m_mutex);
     m_step = step;
-    m_bound_end = std::chrono::duration<double>(Clock::now() - m_start).count() + seconds;
+    if (pthread_getcpuclockid(pthread_self(), &m_bound_clock) != 0)
+      m_bound_clock = CLOCK_PROCESS_CPUTIME_ID;
+    m_bound_cpu_start = cpu_seconds(m_bound_clock);
+    m_bound_cpu_seconds = seconds;
     m_bound_reached = false;
     m_changed = true;
   }
@@ -106,7 +124,7 @@ void Watchdog::begin_bounded(const std::string& step, double seconds) {
 bool Watchdog::end_bounded() {
   const std::lock_guard<std::mutex> lock(m_mutex);
   const bool reached = m_bound_reached;
-  m_bound_end = 0.0;
+  m_bound_cpu_seconds = 0.0;
   m_bound_reached = false;
   const bool limit_passed =
       m_limit > 0.0 && std::chrono::duration<double>(Clock::now() - m_start).count() >= m_limit;

@@ -4,6 +4,8 @@
 // stop flag that CGAL Mesh_3 polls (mesh_3_options pointer_to_stop_atomic_boolean), and the
 // steps that cannot be stopped are checked between them (check).
 
+#include <time.h>
+
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
@@ -34,8 +36,9 @@ class Watchdog {
   void check() const;
   /// check(), then set_step(step).
   void begin(const std::string& step);
-  /// begin(step), and the stop flag is also raised `seconds` from now (a bound on one step
-  /// that may not end: end_bounded says whether it was reached).
+  /// begin(step), and the stop flag is also raised once the calling thread has run `seconds`
+  /// of CPU time from now (a bound on one step that may not end, which the load of other
+  /// processes does not move as it moves wall time: end_bounded says whether it was reached).
   void begin_bounded(const std::string& step, double seconds);
   /// Ends the bound of begin_bounded; true when it was reached (the stop flag is lowered
   /// again unless the limit has passed too).
@@ -52,8 +55,12 @@ class Watchdog {
   mutable std::mutex m_mutex;
   std::condition_variable m_wake;
   bool m_done = false;
-  bool m_changed = false;    ///< wakes the thread to recompute its next wake-up
-  double m_bound_end = 0.0;  ///< begin_bounded's end, seconds from the start; 0: none
+  bool m_changed = false;  ///< wakes the thread to recompute its next wake-up
+  // begin_bounded's bound: CPU seconds of the thread that began it (m_bound_clock) from
+  // m_bound_cpu_start; 0: none.
+  double m_bound_cpu_seconds = 0.0;
+  double m_bound_cpu_start = 0.0;
+  clockid_t m_bound_clock = CLOCK_PROCESS_CPUTIME_ID;
   bool m_bound_reached = false;
   std::string m_step;
   std::thread m_thread;

@@ -7,6 +7,7 @@
 #include <array>
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <cstdint>
 #include <map>
 #include <string>
 #include <vector>
@@ -252,4 +253,103 @@ TEST_CASE("No retry when the wrap alone lies further than --max-deviation from t
   CHECK(larger > 0.9 / std::sqrt(17.0));
   CHECK(notes.deviation_retries == 0);
   CHECK(notes.deviation_excess == Approx(larger - 0.002).margin(1e-12));
+}
+
+TEST_CASE("A retry expected to pass the retries' vertex bound is not run",
+          "[deviation][max-deviation][retry]") {
+  // A small cell size fills the unit ball with about 35k vertices; the facet size 0.5 and
+  // distance 0.02 of the diagonal leave the surface over --max-deviation 0.0005. A retry would make
+  // at least the first mesh's vertices / 0.7 (its facet distance shrinks at least that much), over
+  // the 40k the retries may make (meshing.cpp, kMaxRetryVertices): none is run, and the excess is
+  // reported. The same ball with a cell size 1.5 times larger (about 10k vertices) is retried.
+  const TriangleMesh sphere = tetseg::test::icosphere(16);
+  MeshingOptions meshing;
+  meshing.optimize = false;
+  meshing.max_deviation = 0.0005;
+  meshing.facet_size = 0.5;
+  meshing.facet_distance = 0.02 * diagonal_of(sphere);
+  meshing.cell_size = 0.045;
+  TetrahedralizeNotes notes;
+  const TetMesh mesh = tetrahedralize(sphere, meshing, "ball.off", &notes);
+  INFO("first mesh: " << mesh.nodes.size() << " vertices");
+  CHECK(mesh.nodes.size() > 40000 * 0.7);
+  CHECK(notes.deviation_retries == 0);
+  CHECK(notes.deviation_excess > 0.0);
+  meshing.cell_size = 0.045 * 1.5;
+  TetrahedralizeNotes coarser_notes;
+  const TetMesh coarser = tetrahedralize(sphere, meshing, "ball.off", &coarser_notes);
+  INFO("coarser first mesh: " << coarser.nodes.size() << " vertices");
+  CHECK(coarser_notes.deviation_retries >= 1);
+}
+
+TEST_CASE("Sharp edges in many curves: the first retry leaves them unprotected",
+          "[deviation][max-deviation][retry]") {
+  // 18 finely tessellated unit cubes (a 3 x 3 x 2 grid, 0.5 apart): their sharp edges form 18
+  // curves, over the 16 a retry protects at once (CAD parts have fewer; tessellation noise on
+  // organic scans many more). Mesh_3 rounds their edges off over --max-deviation 0.004; the
+  // first retry, unprotected at smaller sizes, meets it (as for one such cube; the single cube
+  // above, one curve, is protected at once).
+  const TriangleMesh cube = subdivided_cube(8);
+  TriangleMesh cubes;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      for (int k = 0; k < 2; ++k) {
+        const auto offset = static_cast<std::uint32_t>(cubes.vertices.size());
+        for (const Vec3& v : cube.vertices)
+          cubes.vertices.push_back({v[0] + 1.5 * i, v[1] + 1.5 * j, v[2] + 1.5 * k});
+        for (const Tri& t : cube.triangles)
+          cubes.triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
+      }
+  MeshingOptions meshing;
+  meshing.optimize = false;
+  meshing.max_deviation = 0.004;
+  TetrahedralizeNotes notes;
+  tetrahedralize(cubes, meshing, "cubes.off", &notes);
+  CHECK(notes.deviation_retries == 1);  // protected at once, it takes two, or stays protected
+  CHECK(notes.deviation_retry_sizes.find("facet distance x") == 0);
+  CHECK(notes.deviation_retry_sizes.find("sharp edges protected") == std::string::npos);
+  CHECK(notes.deviation_excess == 0.0);
+}
+
+TEST_CASE("A build with deviation retries gives the same tets twice",
+          "[deviation][max-deviation][retry][determinism]") {
+  // The retries are bounded by vertex counts, not seconds: the same input gives the same mesh
+  // whatever the machine's load (with a time bound, a retry near it came out either way).
+  const TriangleMesh sphere = tetseg::test::icosphere(16);
+  MeshingOptions meshing;
+  meshing.max_deviation = 0.002;
+  meshing.facet_size = 0.5;
+  meshing.facet_distance = 0.02 * diagonal_of(sphere);
+  TetrahedralizeNotes first_notes, second_notes;
+  const TetMesh first = tetrahedralize(sphere, meshing, "ball.off", &first_notes);
+  const TetMesh second = tetrahedralize(sphere, meshing, "ball.off", &second_notes);
+  CHECK(first_notes.deviation_retries >= 1);
+  CHECK(first.nodes == second.nodes);
+  CHECK(first.tets == second.tets);
+  CHECK(first_notes.hausdorff_input_to_mesh == second_notes.hausdorff_input_to_mesh);
+  CHECK(first_notes.hausdorff_mesh_to_input == second_notes.hausdorff_mesh_to_input);
+}
+
+TEST_CASE("The deviation is measured against the input, not the surface fix made of it",
+          "[deviation][max-deviation]") {
+  // A unit sphere with a cap of angular radius 0.3 cut off: fix fills the hole (about 2 % of
+  // the area, so auto keeps the patch), and the mesh's surface over the patch lies about
+  // sin(0.3) from the input's rim. The retry check measures the mesh against the fixed
+  // surface (near 0 there); only where fix changed nothing may its figure be the report's.
+  const TriangleMesh full = tetseg::test::icosphere(8);
+  TriangleMesh open;
+  open.vertices = full.vertices;
+  for (const Tri& t : full.triangles) {
+    double z = 0.0;
+    for (int k = 0; k < 3; ++k) z += full.vertices[t[k]][2] / 3.0;
+    if (z < std::cos(0.3)) open.triangles.push_back(t);
+  }
+  REQUIRE(open.triangles.size() < full.triangles.size());
+  TetrahedralizeNotes notes;
+  tetrahedralize(open, MeshingOptions{}, "capless.off", &notes);
+  REQUIRE_FALSE(notes.repairs.empty());  // the hole filled
+  CHECK(notes.repair_used == MeshingOptions::Repair::kFix);
+  const double rim = std::sin(0.3) / notes.diagonal;  // from the patch's centre, relative
+  CHECK(notes.hausdorff_mesh_to_input > 0.7 * rim);
+  CHECK(notes.hausdorff_mesh_to_input < 1.1 * rim);
 }

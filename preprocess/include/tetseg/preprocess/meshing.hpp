@@ -131,7 +131,8 @@ struct TetrahedralizeNotes {
   /// Mesh_3 runs repeated at smaller sizes (at most 2) because the meshed boundary lay further
   /// than max_deviation allows from the surface meshed; 0: none. The nearest mesh is returned:
   /// deviation_retry_sizes says with which sizes ("facet distance x0.35, facet size x0.59,
-  /// sharp edges protected"), "" when the first mesh stayed the nearest.
+  /// sharp edges protected, no sliver perturbation"), "" when the first mesh stayed the
+  /// nearest.
   std::size_t deviation_retries = 0;
   std::string deviation_retry_sizes;
 };
