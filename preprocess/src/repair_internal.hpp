@@ -31,12 +31,14 @@ std::vector<RepairCount> repair_soup(TriangleMesh& mesh, bool keep_largest_compo
 /// surface enclosing the soup at about `offset` from it. May throw what CGAL throws.
 TriangleMesh alpha_wrap(const TriangleMesh& soup, double alpha, double offset);
 
-/// Approximate Hausdorff distances (CGAL approximate_Hausdorff_distance, sampling vertices,
-/// edges and faces with a fixed seed) from `a` to `b` and from `b` to `a`, absolute; the
-/// soups may have any defects; {-1, -1} when either has no usable triangle.
+/// Approximate Hausdorff distances (the figure of CGAL approximate_Hausdorff_distance,
+/// sampling vertices, edges and faces with a fixed seed: never above the true distance) from
+/// `a` to `b` and from `b` to `a`, absolute; the soups may have any defects; {-1, -1} when
+/// either has no usable triangle. Each thread keeps the last surfaces prepared (tree, samples)
+/// and figures measured, so measuring a surface again costs a comparison of the soups.
 std::pair<double, double> hausdorff_distances(const TriangleMesh& a, const TriangleMesh& b);
 
-/// The largest distance from `points` to the triangles of `surface` (exact per point, CGAL
+/// The largest distance from `points` to the triangles of `surface` (exact per point, as CGAL
 /// max_distance_to_triangle_mesh), absolute; -1 without points or usable triangles.
 double max_distance_to_surface(const std::vector<Vec3>& points, const TriangleMesh& surface);
 
