@@ -9,6 +9,7 @@
 #include <utility>
 #include <vector>
 
+#include "../../preprocess/src/repair_internal.hpp"
 #include "preprocess/support/mesh_measures.hpp"
 #include "tetseg/preprocess/io.hpp"
 #include "tetseg/preprocess/meshing.hpp"
@@ -206,6 +207,59 @@ TEST_CASE("Fix removes a local self-intersection by CGAL's local remeshing", "[m
   // The rest of the sphere is kept: the volume of the unit ball within Mesh_3's facet error.
   CHECK(total_tet_volume(m) == Approx(4.0 * std::acos(-1.0) / 3.0).epsilon(0.05));
   CHECK(notes.hausdorff_input_to_mesh < 0.1);
+}
+
+namespace {
+
+/// `s` with the vertex nearest `direction` slid along the surface past its neighbours (about
+/// 0.35 of the radius, then 1.02 out): its fan folds over the next triangles, a few intersecting
+/// pairs in one place. `direction` must not be along z.
+void fold_near(TriangleMesh& s, const Vec3& direction) {
+  std::size_t nearest = 0;
+  double best = -1e300;
+  for (std::size_t v = 0; v < s.vertices.size(); ++v) {
+    const Vec3& q = s.vertices[v];
+    const double along = q[0] * direction[0] + q[1] * direction[1] + q[2] * direction[2];
+    if (along > best) best = along, nearest = v;
+  }
+  Vec3& p = s.vertices[nearest];
+  const Vec3 tangent = {-p[1], p[0], 0.0};
+  const double t = std::hypot(tangent[0], tangent[1]);
+  Vec3 moved;
+  for (int k = 0; k < 3; ++k) moved[k] = p[k] + 0.35 * tangent[k] / t;
+  const double r = std::hypot(moved[0], moved[1], moved[2]);
+  for (int k = 0; k < 3; ++k) p[k] = 1.02 * moved[k] / r;
+}
+
+}  // namespace
+
+TEST_CASE("Self-intersection removal is bounded by work, not time: the same repair every run",
+          "[meshing][repair]") {
+  // Three folds far apart on a geodesic sphere: three separate patches of intersecting
+  // triangles, so at least three local remeshings (one per patch).
+  TriangleMesh s = tetseg::test::icosphere(6);
+  fold_near(s, {1.0, 0.3, 0.2});
+  fold_near(s, {-1.0, 0.2, -0.3});
+  fold_near(s, {0.2, -1.0, 0.4});
+  const auto removed = [](const std::vector<RepairCount>& repairs) {
+    for (const RepairCount& r : repairs)
+      if (r.kind.find("self-intersecting triangle pairs removed") != std::string::npos)
+        return r.count;
+    return std::size_t{0};
+  };
+  TriangleMesh once = s, twice = s;
+  const auto first = tetseg::preprocess::detail::repair_soup(once);
+  const auto second = tetseg::preprocess::detail::repair_soup(twice);
+  REQUIRE(removed(first) > 0);
+  CHECK(removed(second) == removed(first));
+  CHECK(once.vertices == twice.vertices);
+  CHECK(once.triangles == twice.triangles);
+  // The bound takes effect: allowed two local remeshings, the removal stops before the third
+  // patch and nothing is kept (the surface is returned as it was, pairs left to validation).
+  TriangleMesh bounded = s;
+  const auto stopped = tetseg::preprocess::detail::repair_soup(bounded, false, nullptr, 2);
+  CHECK(removed(stopped) == 0);
+  CHECK(bounded.triangles.size() == s.triangles.size());
 }
 
 TEST_CASE("Fix fills small holes, names what it cannot repair and points to wrap",
