@@ -262,6 +262,79 @@ TEST_CASE("Self-intersection removal is bounded by work, not time: the same repa
   CHECK(bounded.triangles.size() == s.triangles.size());
 }
 
+TEST_CASE("Fix tries at most 4000 border edges of holes over 64 edges", "[meshing][repair]") {
+  // Ten open tubes, each with two round holes of 201 border edges: 4020 edges over 64 in all.
+  // Each hole fills flat (no fold, a disk's area, no crossing), but the work bound stops before
+  // the twentieth (19 x 201 = 3819 tried; the twentieth would make 4020).
+  TriangleMesh tubes;
+  for (int k = 0; k < 10; ++k) {
+    const TriangleMesh tube = open_cylinder(201);
+    const auto offset = static_cast<std::uint32_t>(tubes.vertices.size());
+    for (Vec3 p : tube.vertices) {
+      p[0] += 2.0 * k;
+      tubes.vertices.push_back(p);
+    }
+    for (const Tri& t : tube.triangles)
+      tubes.triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
+  }
+  const auto repairs = tetseg::preprocess::detail::repair_soup(tubes);
+  std::size_t filled = 0;
+  for (const RepairCount& r : repairs)
+    if (r.kind == "holes filled") filled = r.count;
+  CHECK(filled == 19);
+}
+
+namespace {
+
+/// The part of an 11.5k-triangle unit sphere at z >= `z_cut` (its triangles with every
+/// corner there): an open dome, one hole of about 100 border edges around its rim.
+TriangleMesh dome(double z_cut) {
+  TriangleMesh s = tetseg::test::icosphere(24);
+  std::vector<Tri> kept;
+  for (const Tri& t : s.triangles)
+    if (s.vertices[t[0]][2] >= z_cut && s.vertices[t[1]][2] >= z_cut &&
+        s.vertices[t[2]][2] >= z_cut)
+      kept.push_back(t);
+  s.triangles = kept;
+  return s;
+}
+
+std::size_t holes_filled(TriangleMesh s) {
+  for (const RepairCount& r : tetseg::preprocess::detail::repair_soup(s))
+    if (r.kind == "holes filled") return r.count;
+  return 0;
+}
+
+}  // namespace
+
+TEST_CASE("Fix leaves open a hole over 64 edges whose patch folds against its rim",
+          "[meshing][repair]") {
+  // A dome's rim at height z meets the patch across it at 90 + asin(z) degrees: 107 at z = 0.3,
+  // filled; 134 at z = 0.7, over the 120-degree fold limit, so left open (nothing else refuses
+  // that patch: it neither bulges nor crosses the dome).
+  CHECK(holes_filled(dome(0.3)) == 1);
+  CHECK(holes_filled(dome(0.7)) == 0);
+}
+
+TEST_CASE("Fix leaves open a hole over 64 edges whose patch crosses the surface",
+          "[meshing][repair]") {
+  // An open tube (two round holes of 201 border edges at z = 0 and z = 2) and a small closed
+  // sphere sitting across the plane of its upper end: that end's flat patch would cut through
+  // the sphere, so only the lower hole is filled (no fold, a disk's area: only the crossing
+  // refuses it).
+  TriangleMesh s = open_cylinder(201);
+  const TriangleMesh ball = tetseg::test::icosphere(2, 0.2);
+  const auto offset = static_cast<std::uint32_t>(s.vertices.size());
+  for (Vec3 p : ball.vertices) {
+    p[2] += 2.0;
+    s.vertices.push_back(p);
+  }
+  for (const Tri& t : ball.triangles)
+    s.triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
+  CHECK(holes_filled(open_cylinder(201)) == 2);
+  CHECK(holes_filled(s) == 1);
+}
+
 TEST_CASE("Fix fills small holes, names what it cannot repair and points to wrap",
           "[meshing][repair]") {
   SECTION("A cube with a triangle missing is closed again.") {
