@@ -3,6 +3,7 @@
 // alpha wrap of `--repair wrap` (alpha_wrap.cpp) and the distance they cost
 // (surface_distance.cpp).
 
+#include <atomic>
 #include <cstddef>
 #include <utility>
 #include <vector>
@@ -30,10 +31,12 @@ constexpr std::size_t kMaxRemovalPatches = 200;
 /// `keep_largest_component` every edge-connected component but the one of largest area
 /// removed, unused vertices dropped. Returns the repairs made (kind, count; kinds with a zero
 /// count are left out). Vertex ids are renumbered in order of first use. When given,
-/// `patch_area` gets the area of the triangles that fill holes.
+/// `patch_area` gets the area of the triangles that fill holes, and the removal stops (and is
+/// not kept) once `*time_limit_reached` (the build's --time-limit, which then refuses it).
 std::vector<RepairCount> repair_soup(TriangleMesh& mesh, bool keep_largest_component = false,
                                      double* patch_area = nullptr,
-                                     std::size_t max_removal_patches = kMaxRemovalPatches);
+                                     std::size_t max_removal_patches = kMaxRemovalPatches,
+                                     const std::atomic<bool>* time_limit_reached = nullptr);
 
 /// CGAL 3D alpha wrapping of the triangle soup `soup` (any defects; at least one triangle),
 /// with absolute `alpha` and `offset` (> 0): a closed, 2-manifold, self-intersection-free

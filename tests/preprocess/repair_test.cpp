@@ -3,6 +3,7 @@
 // (closed, 2-manifold, no self-intersection) and its volume compared with the exact one.
 
 #include <algorithm>
+#include <atomic>
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <string>
@@ -260,6 +261,12 @@ TEST_CASE("Self-intersection removal is bounded by work, not time: the same repa
   const auto stopped = tetseg::preprocess::detail::repair_soup(bounded, false, nullptr, 2);
   CHECK(removed(stopped) == 0);
   CHECK(bounded.triangles.size() == s.triangles.size());
+  // The build's --time-limit (the watchdog's flag, raised) stops it too.
+  const std::atomic<bool> time_limit_reached{true};
+  TriangleMesh late = s;
+  CHECK(removed(tetseg::preprocess::detail::repair_soup(
+            late, false, nullptr, tetseg::preprocess::detail::kMaxRemovalPatches,
+            &time_limit_reached)) == 0);
 }
 
 TEST_CASE("Fix tries at most 4000 border edges of holes over 64 edges", "[meshing][repair]") {
