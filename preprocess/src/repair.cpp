@@ -22,7 +22,7 @@
 
 #include <algorithm>
 #include <array>
-#include <chrono>
+#include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <exception>
@@ -57,10 +57,6 @@ constexpr double kMaxPatchTurnDegrees = 120.0;
 /// Self-intersections are removed locally only up to this many intersecting pairs of
 /// triangles (docs/cli.md); more is not a local defect.
 constexpr std::size_t kMaxLocalSelfIntersections = 4096;
-/// The bound on CGAL's self-intersection removal (libcgal-demo: diplodocus.off, 177 pairs,
-/// removed in about 2 s; mannequin-devil.off, 1643 pairs, ends in 3 s; man.off, 848 pairs,
-/// gives up after 10 s or more).
-constexpr double kSelfIntersectionRemovalSeconds = 10.0;
 /// Self-intersection removal is kept only when the surface moved at most this much (two-sided
 /// Hausdorff distance, of the bounding-box diagonal; the default --max-deviation). A folded fan
 /// on a sphere (tests): 0.007; diplodocus.off 0.003; mannequin-devil.off 0.012 and bones.off
@@ -184,34 +180,42 @@ std::size_t count_zero_area_faces(const Mesh& mesh) {
   return count;
 }
 
-/// Stops CGAL's self-intersection removal (checked between its steps and components) once
-/// kSelfIntersectionRemovalSeconds have passed: a bound on a step whose work grows with the
-/// pairs and how tangled they are.
-struct RemovalDeadline
+/// Stops CGAL's self-intersection removal (checked before each round and each patch) once it
+/// has started `max_patches` local remeshings (a bound on work that grows with the pairs and
+/// how tangled they are), or once `*time_limit_reached` (the build's --time-limit).
+struct RemovalWorkBound
     : CGAL::Polygon_mesh_processing::experimental::Remove_self_intersection_default_visitor<
           cgal::SurfaceMesh> {
-  std::chrono::steady_clock::time_point end;
-  bool stop() const { return std::chrono::steady_clock::now() > end; }
+  std::size_t max_patches = 0;
+  std::size_t* patches = nullptr;  // shared: CGAL copies the visitor
+  const std::atomic<bool>* time_limit_reached = nullptr;
+  void start_component_handling() { ++*patches; }
+  bool stop() const {
+    return *patches >= max_patches || (time_limit_reached != nullptr && *time_limit_reached);
+  }
 };
 
 /// Removes the self-intersections of `mesh` when they are local (at most
 /// kMaxLocalSelfIntersections pairs of triangles): CGAL's local remeshing
-/// (experimental::remove_self_intersections, within kSelfIntersectionRemovalSeconds). The
+/// (experimental::remove_self_intersections, at most `max_patches` local remeshings, stopped
+/// at `*time_limit_reached`). The
 /// result is kept only if it is closed, no intersection is left and it still encloses a
 /// volume; returns the number of intersecting pairs removed (0: none, too many, or CGAL could
 /// not remove them all, and `mesh` is unchanged).
-std::size_t remove_local_self_intersections(Mesh& mesh) {
+std::size_t remove_local_self_intersections(Mesh& mesh, std::size_t max_patches,
+                                            const std::atomic<bool>* time_limit_reached) {
   namespace pmp = CGAL::Polygon_mesh_processing;
   std::vector<std::pair<Mesh::Face_index, Mesh::Face_index>> pairs;
   pmp::self_intersections(mesh, std::back_inserter(pairs));
   if (pairs.empty() || pairs.size() > kMaxLocalSelfIntersections) return 0;
   Mesh attempt = mesh;
-  RemovalDeadline deadline;
-  deadline.end = std::chrono::steady_clock::now() +
-                 std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                     std::chrono::duration<double>(kSelfIntersectionRemovalSeconds));
+  std::size_t patches = 0;
+  RemovalWorkBound bound;
+  bound.max_patches = max_patches;
+  bound.patches = &patches;
+  bound.time_limit_reached = time_limit_reached;
   try {
-    if (!pmp::experimental::remove_self_intersections(attempt, CGAL::parameters::visitor(deadline)))
+    if (!pmp::experimental::remove_self_intersections(attempt, CGAL::parameters::visitor(bound)))
       return 0;
   } catch (const std::exception&) {
     return 0;  // CGAL gave up on this input; the intersections are reported by validation
@@ -244,7 +248,8 @@ std::size_t remove_local_self_intersections(Mesh& mesh) {
 /// rewritten only when something changed.
 template <class Record>
 void repair_as_mesh(std::vector<Point>& points, std::vector<Polygon>& polygons,
-                    const Record& record, double& patch_area) {
+                    const Record& record, double& patch_area, std::size_t max_removal_patches,
+                    const std::atomic<bool>* time_limit_reached) {
   namespace pmp = CGAL::Polygon_mesh_processing;
   if (polygons.empty() || !pmp::is_polygon_soup_a_polygon_mesh(polygons)) return;
   Mesh mesh;
@@ -268,7 +273,8 @@ void repair_as_mesh(std::vector<Point>& points, std::vector<Polygon>& polygons,
   // which Mesh_3 never ended. So removal is tried only when the filled patches are under
   // kMaxPatchAreaForRemoval of the area.
   if (CGAL::is_closed(mesh) && patch_area <= kMaxPatchAreaForRemoval * pmp::area(mesh)) {
-    const std::size_t removed = remove_local_self_intersections(mesh);
+    const std::size_t removed =
+        remove_local_self_intersections(mesh, max_removal_patches, time_limit_reached);
     record("self-intersecting triangle pairs removed by local remeshing", removed);
     changed |= removed > 0;
   }
@@ -325,7 +331,9 @@ std::size_t keep_largest_component(const std::vector<Point>& points,
 
 }  // namespace
 
-std::vector<RepairCount> repair_soup(TriangleMesh& mesh, bool keep_largest, double* patch_area) {
+std::vector<RepairCount> repair_soup(TriangleMesh& mesh, bool keep_largest, double* patch_area,
+                                     std::size_t max_removal_patches,
+                                     const std::atomic<bool>* time_limit_reached) {
   namespace pmp = CGAL::Polygon_mesh_processing;
   std::vector<RepairCount> repairs;
   auto record = [&repairs](const char* kind, std::size_t count) {
@@ -370,7 +378,7 @@ std::vector<RepairCount> repair_soup(TriangleMesh& mesh, bool keep_largest, doub
   record("isolated vertices removed",
          static_cast<std::size_t>(std::count(used.begin(), used.end(), 0)));
   double patches = 0.0;
-  repair_as_mesh(points, polygons, record, patches);
+  repair_as_mesh(points, polygons, record, patches, max_removal_patches, time_limit_reached);
   if (patch_area != nullptr) *patch_area = patches;
   if (keep_largest && !polygons.empty())
     record("smaller components removed", keep_largest_component(points, polygons));

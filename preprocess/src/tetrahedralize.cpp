@@ -364,7 +364,9 @@ TriangleMesh fixed_surface(const TriangleMesh& surface, const MeshingOptions& me
                            detail::Watchdog& watchdog, double* patch_area = nullptr) {
   watchdog.begin("repair");
   TriangleMesh fixed = surface;
-  notes.repairs = detail::repair_soup(fixed, meshing.keep_largest_component, patch_area);
+  notes.repairs = detail::repair_soup(fixed, meshing.keep_largest_component, patch_area,
+                                      detail::kMaxRemovalPatches, watchdog.stop_flag());
+  watchdog.check();  // a removal stopped by --time-limit: refused as such
   if (fixed.triangles.empty())
     throw InputError(file, "tetrahedralize: no triangle is left after repair");
   return fixed;

@@ -3,12 +3,14 @@
 // (closed, 2-manifold, no self-intersection) and its volume compared with the exact one.
 
 #include <algorithm>
+#include <atomic>
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "../../preprocess/src/repair_internal.hpp"
 #include "preprocess/support/mesh_measures.hpp"
 #include "tetseg/preprocess/io.hpp"
 #include "tetseg/preprocess/meshing.hpp"
@@ -206,6 +208,138 @@ TEST_CASE("Fix removes a local self-intersection by CGAL's local remeshing", "[m
   // The rest of the sphere is kept: the volume of the unit ball within Mesh_3's facet error.
   CHECK(total_tet_volume(m) == Approx(4.0 * std::acos(-1.0) / 3.0).epsilon(0.05));
   CHECK(notes.hausdorff_input_to_mesh < 0.1);
+}
+
+namespace {
+
+/// `s` with the vertex nearest `direction` slid along the surface past its neighbours (about
+/// 0.35 of the radius, then 1.02 out): its fan folds over the next triangles, a few intersecting
+/// pairs in one place. `direction` must not be along z.
+void fold_near(TriangleMesh& s, const Vec3& direction) {
+  std::size_t nearest = 0;
+  double best = -1e300;
+  for (std::size_t v = 0; v < s.vertices.size(); ++v) {
+    const Vec3& q = s.vertices[v];
+    const double along = q[0] * direction[0] + q[1] * direction[1] + q[2] * direction[2];
+    if (along > best) best = along, nearest = v;
+  }
+  Vec3& p = s.vertices[nearest];
+  const Vec3 tangent = {-p[1], p[0], 0.0};
+  const double t = std::hypot(tangent[0], tangent[1]);
+  Vec3 moved;
+  for (int k = 0; k < 3; ++k) moved[k] = p[k] + 0.35 * tangent[k] / t;
+  const double r = std::hypot(moved[0], moved[1], moved[2]);
+  for (int k = 0; k < 3; ++k) p[k] = 1.02 * moved[k] / r;
+}
+
+}  // namespace
+
+TEST_CASE("Self-intersection removal is bounded by work, not time: the same repair every run",
+          "[meshing][repair]") {
+  // Three folds far apart on a geodesic sphere: three separate patches of intersecting
+  // triangles, so at least three local remeshings (one per patch).
+  TriangleMesh s = tetseg::test::icosphere(6);
+  fold_near(s, {1.0, 0.3, 0.2});
+  fold_near(s, {-1.0, 0.2, -0.3});
+  fold_near(s, {0.2, -1.0, 0.4});
+  const auto removed = [](const std::vector<RepairCount>& repairs) {
+    for (const RepairCount& r : repairs)
+      if (r.kind.find("self-intersecting triangle pairs removed") != std::string::npos)
+        return r.count;
+    return std::size_t{0};
+  };
+  TriangleMesh once = s, twice = s;
+  const auto first = tetseg::preprocess::detail::repair_soup(once);
+  const auto second = tetseg::preprocess::detail::repair_soup(twice);
+  REQUIRE(removed(first) > 0);
+  CHECK(removed(second) == removed(first));
+  CHECK(once.vertices == twice.vertices);
+  CHECK(once.triangles == twice.triangles);
+  // The bound takes effect: allowed two local remeshings, the removal stops before the third
+  // patch and nothing is kept (the surface is returned as it was, pairs left to validation).
+  TriangleMesh bounded = s;
+  const auto stopped = tetseg::preprocess::detail::repair_soup(bounded, false, nullptr, 2);
+  CHECK(removed(stopped) == 0);
+  CHECK(bounded.triangles.size() == s.triangles.size());
+  // The build's --time-limit (the watchdog's flag, raised) stops it too.
+  const std::atomic<bool> time_limit_reached{true};
+  TriangleMesh late = s;
+  CHECK(removed(tetseg::preprocess::detail::repair_soup(
+            late, false, nullptr, tetseg::preprocess::detail::kMaxRemovalPatches,
+            &time_limit_reached)) == 0);
+}
+
+TEST_CASE("Fix tries at most 4000 border edges of holes over 64 edges", "[meshing][repair]") {
+  // Ten open tubes, each with two round holes of 201 border edges: 4020 edges over 64 in all.
+  // Each hole fills flat (no fold, a disk's area, no crossing), but the work bound stops before
+  // the twentieth (19 x 201 = 3819 tried; the twentieth would make 4020).
+  TriangleMesh tubes;
+  for (int k = 0; k < 10; ++k) {
+    const TriangleMesh tube = open_cylinder(201);
+    const auto offset = static_cast<std::uint32_t>(tubes.vertices.size());
+    for (Vec3 p : tube.vertices) {
+      p[0] += 2.0 * k;
+      tubes.vertices.push_back(p);
+    }
+    for (const Tri& t : tube.triangles)
+      tubes.triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
+  }
+  const auto repairs = tetseg::preprocess::detail::repair_soup(tubes);
+  std::size_t filled = 0;
+  for (const RepairCount& r : repairs)
+    if (r.kind == "holes filled") filled = r.count;
+  CHECK(filled == 19);
+}
+
+namespace {
+
+/// The part of an 11.5k-triangle unit sphere at z >= `z_cut` (its triangles with every
+/// corner there): an open dome, one hole of about 100 border edges around its rim.
+TriangleMesh dome(double z_cut) {
+  TriangleMesh s = tetseg::test::icosphere(24);
+  std::vector<Tri> kept;
+  for (const Tri& t : s.triangles)
+    if (s.vertices[t[0]][2] >= z_cut && s.vertices[t[1]][2] >= z_cut &&
+        s.vertices[t[2]][2] >= z_cut)
+      kept.push_back(t);
+  s.triangles = kept;
+  return s;
+}
+
+std::size_t holes_filled(TriangleMesh s) {
+  for (const RepairCount& r : tetseg::preprocess::detail::repair_soup(s))
+    if (r.kind == "holes filled") return r.count;
+  return 0;
+}
+
+}  // namespace
+
+TEST_CASE("Fix leaves open a hole over 64 edges whose patch folds against its rim",
+          "[meshing][repair]") {
+  // A dome's rim at height z meets the patch across it at 90 + asin(z) degrees: 107 at z = 0.3,
+  // filled; 134 at z = 0.7, over the 120-degree fold limit, so left open (nothing else refuses
+  // that patch: it neither bulges nor crosses the dome).
+  CHECK(holes_filled(dome(0.3)) == 1);
+  CHECK(holes_filled(dome(0.7)) == 0);
+}
+
+TEST_CASE("Fix leaves open a hole over 64 edges whose patch crosses the surface",
+          "[meshing][repair]") {
+  // An open tube (two round holes of 201 border edges at z = 0 and z = 2) and a small closed
+  // sphere sitting across the plane of its upper end: that end's flat patch would cut through
+  // the sphere, so only the lower hole is filled (no fold, a disk's area: only the crossing
+  // refuses it).
+  TriangleMesh s = open_cylinder(201);
+  const TriangleMesh ball = tetseg::test::icosphere(2, 0.2);
+  const auto offset = static_cast<std::uint32_t>(s.vertices.size());
+  for (Vec3 p : ball.vertices) {
+    p[2] += 2.0;
+    s.vertices.push_back(p);
+  }
+  for (const Tri& t : ball.triangles)
+    s.triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
+  CHECK(holes_filled(open_cylinder(201)) == 2);
+  CHECK(holes_filled(s) == 1);
 }
 
 TEST_CASE("Fix fills small holes, names what it cannot repair and points to wrap",
