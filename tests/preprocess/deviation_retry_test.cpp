@@ -89,38 +89,7 @@ double distance_to_unit_cube(const Vec3& p) {
 }
 
 using tetseg::test::diagonal_of;
-
-Vec3 sub(const Vec3& a, const Vec3& b) {
-  return {a[0] - b[0], a[1] - b[1], a[2] - b[2]};
-}
-double dot(const Vec3& a, const Vec3& b) {
-  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-
-/// Distance from `p` to the triangle abc (Ericson, Real-Time Collision Detection, 5.1.5).
-double distance_to_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
-  const Vec3 ab = sub(b, a), ac = sub(c, a), ap = sub(p, a);
-  const double d1 = dot(ab, ap), d2 = dot(ac, ap);
-  const auto length = [&](const Vec3& q) { return std::sqrt(dot(sub(p, q), sub(p, q))); };
-  if (d1 <= 0 && d2 <= 0) return length(a);
-  const Vec3 bp = sub(p, b);
-  const double d3 = dot(ab, bp), d4 = dot(ac, bp);
-  if (d3 >= 0 && d4 <= d3) return length(b);
-  const double vc = d1 * d4 - d3 * d2;
-  if (vc <= 0 && d1 >= 0 && d3 <= 0) return length(lerp(a, b, d1 / (d1 - d3)));
-  const Vec3 cp = sub(p, c);
-  const double d5 = dot(ab, cp), d6 = dot(ac, cp);
-  if (d6 >= 0 && d5 <= d6) return length(c);
-  const double vb = d5 * d2 - d1 * d6;
-  if (vb <= 0 && d2 >= 0 && d6 <= 0) return length(lerp(a, c, d2 / (d2 - d6)));
-  const double va = d3 * d6 - d5 * d4;
-  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0)
-    return length(lerp(b, c, (d4 - d3) / ((d4 - d3) + (d5 - d6))));
-  const double denominator = 1.0 / (va + vb + vc);
-  const double v = vb * denominator, w = vc * denominator;
-  return length(
-      {a[0] + ab[0] * v + ac[0] * w, a[1] + ab[1] * v + ac[1] * w, a[2] + ab[2] * v + ac[2] * w});
-}
+using tetseg::test::squared_distance_to_triangle;
 
 /// The largest distance from points on the twelve edges of the unit cube to the boundary of
 /// `mesh` (brute force): how far the mesh rounded them off.
@@ -135,11 +104,12 @@ double cube_edges_to_mesh(const TetMesh& mesh) {
           p[axis] = k / 20.0;
           p[(axis + 1) % 3] = u;
           p[(axis + 2) % 3] = w;
-          double nearest = 1e300;
+          double nearest_squared = 1e300;
           for (const Tri& t : boundary)
-            nearest = std::min(nearest, distance_to_triangle(p, mesh.nodes[t[0]], mesh.nodes[t[1]],
-                                                             mesh.nodes[t[2]]));
-          largest = std::max(largest, nearest);
+            nearest_squared = std::min(
+                nearest_squared, squared_distance_to_triangle(p, mesh.nodes[t[0]], mesh.nodes[t[1]],
+                                                              mesh.nodes[t[2]]));
+          largest = std::max(largest, std::sqrt(nearest_squared));
         }
   return largest;
 }
@@ -167,7 +137,7 @@ TEST_CASE("A deviation retry brings a sphere within --max-deviation (analytic di
   CHECK(notes.deviation_excess == 0.0);
   double farthest = 0.0;
   for (const Vec3& p : boundary_samples(mesh))
-    farthest = std::max(farthest, std::fabs(std::sqrt(dot(p, p)) - 1.0));
+    farthest = std::max(farthest, std::fabs(std::hypot(p[0], p[1], p[2]) - 1.0));
   CHECK(farthest <= 0.002 * notes.diagonal + 2.2e-4);
   CHECK(farthest > 0.0);  // re-meshed, not the input returned
 }

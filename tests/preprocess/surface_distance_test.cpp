@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "../../preprocess/src/repair_internal.hpp"
+#include "preprocess/support/mesh_measures.hpp"
 #include "tetseg/preprocess/meshing.hpp"
 #include "tetseg/preprocess/surface.hpp"
 #include "tetseg/testing/charge_shapes.hpp"
@@ -93,37 +94,7 @@ double dot(const Vec3& a, const Vec3& b) {
   return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
 }
 
-// The squared distance from p to the triangle abc (closest point by Voronoi regions, Ericson,
-// Real-Time Collision Detection 5.1.5): independent of CGAL.
-double squared_distance_to_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
-  const Vec3 ab = minus(b, a), ac = minus(c, a), ap = minus(p, a);
-  const double d1 = dot(ab, ap), d2 = dot(ac, ap);
-  auto squared = [&](const Vec3& q) {
-    const Vec3 d = minus(p, q);
-    return dot(d, d);
-  };
-  auto along = [](const Vec3& o, const Vec3& e, double t) {
-    return Vec3{o[0] + t * e[0], o[1] + t * e[1], o[2] + t * e[2]};
-  };
-  if (d1 <= 0 && d2 <= 0) return squared(a);
-  const Vec3 bp = minus(p, b);
-  const double d3 = dot(ab, bp), d4 = dot(ac, bp);
-  if (d3 >= 0 && d4 <= d3) return squared(b);
-  const double vc = d1 * d4 - d3 * d2;
-  if (vc <= 0 && d1 >= 0 && d3 <= 0) return squared(along(a, ab, d1 / (d1 - d3)));
-  const Vec3 cp = minus(p, c);
-  const double d5 = dot(ab, cp), d6 = dot(ac, cp);
-  if (d6 >= 0 && d5 <= d6) return squared(c);
-  const double vb = d5 * d2 - d1 * d6;
-  if (vb <= 0 && d2 >= 0 && d6 <= 0) return squared(along(a, ac, d2 / (d2 - d6)));
-  const double va = d3 * d6 - d5 * d4;
-  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0)
-    return squared(along(b, minus(c, b), (d4 - d3) / ((d4 - d3) + (d5 - d6))));
-  const double denominator = 1.0 / (va + vb + vc);
-  const double v = vb * denominator, w = vc * denominator;
-  return squared(
-      {a[0] + ab[0] * v + ac[0] * w, a[1] + ab[1] * v + ac[1] * w, a[2] + ab[2] * v + ac[2] * w});
-}
+using tetseg::test::squared_distance_to_triangle;
 
 struct BruteForce {
   double distance;  // the largest distance from a grid point of `from` to `to`
