@@ -4,7 +4,6 @@
 // surface (--repair fix / wrap / slab / auto).
 
 #include <string>
-#include <utility>
 #include <vector>
 
 #include "tetseg/preprocess/meshing.hpp"
@@ -24,14 +23,10 @@ double bounding_box_diagonal(const std::vector<Vec3>& points);
 /// repeated at smaller sizes while the meshed boundary lies further than that from `source`
 /// (meshing.cpp, kMaxDeviationRetries: a bounded number of retries, each bounded in vertices,
 /// none expected to pass kMaxRetryVertices), and the nearest mesh is returned;
-/// notes.deviation_retries and notes.deviation_retry_sizes say what was done. When `distances` is
-/// given, it receives the (input to mesh, mesh to input) Hausdorff distances, absolute, between
-/// `source` and the returned mesh's boundary when they were measured against `source` itself
-/// (max_distance > 0, no pinched vertex split), else {-1, -1}: the caller whose `source` is the
-/// input needs no second measurement. Throws InputError, TimeLimitExceeded.
+/// notes.deviation_retries and notes.deviation_retry_sizes say what was done. Throws InputError,
+/// TimeLimitExceeded.
 TetMesh validate_and_mesh(const TriangleMesh& source, const MeshingOptions& meshing,
                           const std::string& file, TetrahedralizeNotes& notes, Watchdog& watchdog,
-                          double bound_seconds = 0.0, double max_distance = 0.0,
-                          std::pair<double, double>* distances = nullptr);
+                          double bound_seconds = 0.0, double max_distance = 0.0);
 
 }  // namespace tetseg::preprocess::detail

@@ -525,11 +525,12 @@ TetMesh mesh_closed_surface(const TriangleMesh& input, const MeshingOptions& mes
                              "need a smaller --facet-size");
 }
 
-/// The two (approximate) Hausdorff distances between `surface` and the boundary of `mesh`
-/// (surface to mesh, mesh to surface), absolute; -1 when not measurable.
-std::pair<double, double> boundary_distances(const TriangleMesh& surface, const TetMesh& mesh) {
+/// The larger of the two (approximate) Hausdorff distances between `surface` and the boundary
+/// of `mesh`, absolute; -1 when not measurable.
+double boundary_distance(const TriangleMesh& surface, const TetMesh& mesh) {
   const TriangleMesh boundary{mesh.nodes, extract_surface(mesh).triangles};
-  return detail::hausdorff_distances(surface, boundary);
+  const auto [there, back] = detail::hausdorff_distances(surface, boundary);
+  return std::max(there, back);
 }
 
 /// Points along the sharp edges of `surface` (each edge's ends and its quarter points; at most
@@ -555,7 +556,7 @@ std::vector<Vec3> sharp_edge_samples(const TriangleMesh& surface, const SharpEdg
 /// The deviation retries (kMaxDeviationRetries): while the boundary of `mesh` lies further than
 /// `max_distance` (absolute, > 0) from `surface`, meshing is repeated at smaller sizes, and the
 /// nearest mesh is returned, with its notes; notes.deviation_retries counts the meshings
-/// repeated, `distances` gets the returned mesh's two distances (boundary_distances).
+/// repeated.
 /// Sharp edges lying further than `max_distance` from the mesh are protected at once when they
 /// form at most kMaxProtectedCurves curves; else first unprotected, and protected at the same
 /// sizes only when the unprotected retry leaves them that far and over `max_distance` (camel:
@@ -564,11 +565,9 @@ std::vector<Vec3> sharp_edge_samples(const TriangleMesh& surface, const SharpEdg
 /// unprotected.
 TetMesh keep_within_distance(const TriangleMesh& surface, TetMesh best, double max_distance,
                              const MeshingOptions& meshing, const std::string& file,
-                             TetrahedralizeNotes& notes, detail::Watchdog& watchdog,
-                             std::pair<double, double>& distances) {
+                             TetrahedralizeNotes& notes, detail::Watchdog& watchdog) {
   watchdog.begin("deviation of the meshed boundary");
-  distances = boundary_distances(surface, best);
-  double best_distance = std::max(distances.first, distances.second);
+  double best_distance = boundary_distance(surface, best);
   if (!(best_distance > max_distance)) return best;
   const TetrahedralizeNotes notes_before = notes;
   const SharpEdges sharp = sharp_edges(surface, kSharpEdgeDegrees);
@@ -629,8 +628,7 @@ TetMesh keep_within_distance(const TriangleMesh& surface, TetMesh best, double m
       continue;
     }
     watchdog.begin("deviation of the meshed boundary");
-    const std::pair<double, double> tried_distances = boundary_distances(surface, tried);
-    const double distance = std::max(tried_distances.first, tried_distances.second);
+    const double distance = boundary_distance(surface, tried);
     const bool nearer = distance >= 0.0 && distance < best_distance;
     if (nearer) {
       char text[120];
@@ -642,7 +640,6 @@ TetMesh keep_within_distance(const TriangleMesh& surface, TetMesh best, double m
       best_sizes = text;
       sizes = tried_sizes;
       notes = tried_notes;
-      distances = tried_distances;
       if (distance <= max_distance) {
         best = std::move(tried);
         break;
@@ -663,8 +660,7 @@ TetMesh keep_within_distance(const TriangleMesh& surface, TetMesh best, double m
 TetMesh detail::validate_and_mesh(const TriangleMesh& source, const MeshingOptions& meshing,
                                   const std::string& file, TetrahedralizeNotes& notes,
                                   detail::Watchdog& watchdog, double bound_seconds,
-                                  double max_distance, std::pair<double, double>* distances) {
-  if (distances != nullptr) *distances = {-1.0, -1.0};
+                                  double max_distance) {
   watchdog.begin("surface validation");
   TriangleMesh split;
   detail::SurfaceCheck check;
@@ -682,11 +678,8 @@ TetMesh detail::validate_and_mesh(const TriangleMesh& source, const MeshingOptio
   const TriangleMesh& meshed = split.triangles.empty() ? source : split;
   TetMesh mesh = mesh_closed_surface(meshed, meshing, file, notes, watchdog, bound_seconds);
   if (!(max_distance > 0.0)) return mesh;
-  std::pair<double, double> measured{-1.0, -1.0};
-  mesh = keep_within_distance(meshed, std::move(mesh), max_distance, meshing, file, notes, watchdog,
-                              measured);
-  if (distances != nullptr && split.triangles.empty()) *distances = measured;
-  return mesh;
+  return keep_within_distance(meshed, std::move(mesh), max_distance, meshing, file, notes,
+                              watchdog);
 }
 
 }  // namespace tetseg::preprocess

@@ -312,9 +312,12 @@ namespace {
 
 /// How far the surface moved (repairs, wrap and Mesh_3's re-meshing of the boundary): the
 /// distances between the input and the boundary of the tets, whatever the repair, into `notes`.
-void record_deviation(std::pair<double, double> distances, const MeshingOptions& meshing,
-                      double diagonal, TetrahedralizeNotes& notes) {
-  const auto [there, back] = distances;
+/// A figure measured before for the same two surfaces (the deviation retries' check when fix
+/// changed nothing, auto's check of a wrap) is not measured again: hausdorff_distances keeps it.
+void measure_deviation(const TriangleMesh& surface, const TetMesh& mesh,
+                       const MeshingOptions& meshing, double diagonal, TetrahedralizeNotes& notes) {
+  const TriangleMesh meshed{mesh.nodes, extract_surface(mesh).triangles};
+  const auto [there, back] = detail::hausdorff_distances(surface, meshed);
   if (there >= 0.0 && diagonal > 0.0) {
     notes.hausdorff_input_to_mesh = there / diagonal;
     notes.hausdorff_mesh_to_input = back / diagonal;
@@ -322,28 +325,6 @@ void record_deviation(std::pair<double, double> distances, const MeshingOptions&
     notes.deviation_excess =
         std::max(0.0, std::max(there, back) / diagonal - meshing.max_deviation);
   }
-}
-
-void measure_deviation(const TriangleMesh& surface, const TetMesh& mesh,
-                       const MeshingOptions& meshing, double diagonal, TetrahedralizeNotes& notes) {
-  const TriangleMesh meshed{mesh.nodes, extract_surface(mesh).triangles};
-  record_deviation(detail::hausdorff_distances(surface, meshed), meshing, diagonal, notes);
-}
-
-/// validate_and_mesh of `meshed`, which fix made of `input` (or `input` itself): when fix
-/// changed nothing, the deviation the retry check measured is the input's, recorded in `notes`
-/// (one Hausdorff distance per build, not two: about 6 % of a default elephant build each).
-TetMesh mesh_recording_deviation(const TriangleMesh& input, const TriangleMesh& meshed,
-                                 const MeshingOptions& meshing, double diagonal,
-                                 const std::string& file, TetrahedralizeNotes& notes,
-                                 detail::Watchdog& watchdog) {
-  std::pair<double, double> distances;
-  TetMesh mesh = detail::validate_and_mesh(meshed, meshing, file, notes, watchdog, 0.0,
-                                           meshing.max_deviation * diagonal, &distances);
-  if (&meshed == &input ||
-      (meshed.vertices == input.vertices && meshed.triangles == input.triangles))
-    record_deviation(distances, meshing, diagonal, notes);
-  return mesh;
 }
 
 /// Hole patches making at least this share of a fixed surface's area close an open surface
@@ -397,7 +378,8 @@ TetMesh fix_or_wrap(const TriangleMesh& surface, const MeshingOptions& meshing, 
       fix_deviation = std::max(there, back) / diagonal;
     }
     if (fix_deviation <= meshing.max_deviation)
-      return mesh_recording_deviation(surface, fixed, meshing, diagonal, file, notes, watchdog);
+      return detail::validate_and_mesh(fixed, meshing, file, notes, watchdog, 0.0,
+                                       meshing.max_deviation * diagonal);
   } catch (const TimeLimitExceeded&) {
     throw;
   } catch (const InputError& e) {
@@ -436,7 +418,8 @@ TetMesh fix_or_wrap(const TriangleMesh& surface, const MeshingOptions& meshing, 
   const TetrahedralizeNotes wrap_notes = notes;
   notes = fix_notes;
   try {
-    return mesh_recording_deviation(surface, fixed, meshing, diagonal, file, notes, watchdog);
+    return detail::validate_and_mesh(fixed, meshing, file, notes, watchdog, 0.0,
+                                     meshing.max_deviation * diagonal);
   } catch (const TimeLimitExceeded&) {
     throw;
   } catch (const InputError&) {
@@ -460,22 +443,19 @@ TetMesh tetrahedralize_in_place(const TriangleMesh& surface, const MeshingOption
   TetMesh mesh;
   out_notes.repair_used = meshing.repair;
   if (meshing.repair == Repair::kFix) {
-    mesh = mesh_recording_deviation(surface,
-                                    fixed_surface(surface, meshing, file, out_notes, watchdog),
-                                    meshing, diagonal, file, out_notes, watchdog);
+    mesh = detail::validate_and_mesh(fixed_surface(surface, meshing, file, out_notes, watchdog),
+                                     meshing, file, out_notes, watchdog, 0.0,
+                                     meshing.max_deviation * diagonal);
   } else if (meshing.repair == Repair::kWrap) {
     mesh = wrap_and_mesh(surface, meshing, file, out_notes, watchdog);
   } else if (meshing.repair == Repair::kAuto) {
     mesh = fix_or_wrap(surface, meshing, diagonal, file, out_notes, watchdog);
   } else {
-    mesh = mesh_recording_deviation(surface, surface, meshing, diagonal, file, out_notes, watchdog);
+    mesh = detail::validate_and_mesh(surface, meshing, file, out_notes, watchdog, 0.0,
+                                     meshing.max_deviation * diagonal);
   }
-  // Measured once: here unless the path that gave the mesh measured it against the input
-  // (mesh_recording_deviation; auto's wrap checked against fix's far hole patches).
-  if (out_notes.hausdorff_input_to_mesh < 0.0) {
-    watchdog.begin("deviation measurement");
-    measure_deviation(surface, mesh, meshing, diagonal, out_notes);
-  }
+  watchdog.begin("deviation measurement");
+  measure_deviation(surface, mesh, meshing, diagonal, out_notes);
   watchdog.check();
   return mesh;
 }
