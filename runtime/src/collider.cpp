@@ -156,6 +156,7 @@ void Collider::Impl::construct(std::shared_ptr<const BodyShape> sh, const Collid
     edge_tree.reserve(static_cast<std::uint32_t>(topo->edges.size()));
     ebox.resize(topo->edges.size());
     vdiag.resize(nv);
+    item_diag.resize(std::max<std::size_t>(tri_count, topo->edges.size()));
     feature_build_stack.resize(kMedianBvhStack);
   }
   skip_adjacent = uses_global_bvh();

@@ -15,13 +15,12 @@ namespace tetseg {
 
 void FeatureTree::reserve(std::uint32_t items) {
   const std::size_t cap = items == 0 ? 1 : 2 * std::size_t(items) - 1;
-  nodes.resize(cap);
+  // Default-initialised (not zeroed): only what a build writes is ever touched.
+  nodes.reset(new FeatureNode[cap]);
+  leaves.reset(new FeatureLeaf[items == 0 ? 1 : items]);
   leaf.resize(items);
   leaf_box.resize(items);
-  leaf_diag.resize(items);
   key.resize(items);
-  box.resize(cap);
-  size.assign(cap, 0);
 }
 
 namespace {
@@ -37,9 +36,56 @@ inline std::uint32_t spread_bits(std::uint32_t v) noexcept {
 
 }  // namespace
 
-void FeatureTree::build(const Box* item_box, std::uint32_t items, std::uint32_t leaf_size,
+namespace {
+
+// Leaf `f` over leaf positions [begin, begin + n) (n <= 4) and its node's lanes (`node`).
+void fill_leaf(const FeatureTree& t, std::uint32_t begin, std::uint32_t n,
+               const Diagonals* item_diag, double margin, const std::uint32_t* item_nodes,
+               int nodes_per_item, FeatureLeaf& f, FeatureNode& node) noexcept {
+  f.first = begin;
+  f.lanes = (1u << n) - 1;
+  for (int k = 0; k < kFeatureLanes; ++k) {
+    node.lo[k] = INFINITY;
+    node.hi[k] = -INFINITY;
+  }
+  for (std::uint32_t j = 0; j < 4; ++j) {
+    if (j >= n) {  // an empty lane overlaps nothing (and `lanes` masks it out)
+      for (int k = 0; k < kFeatureLanes; ++k) {
+        f.lo[k][j] = INFINITY;
+        f.hi[k][j] = -INFINITY;
+      }
+      f.item[j] = kNone;
+      for (int r = 0; r < 3; ++r) f.node[r][j] = kNone;
+      continue;
+    }
+    const std::uint32_t item = t.leaf[begin + j];
+    const Box& b = t.leaf_box[begin + j];
+    for (int k = 0; k < 3; ++k) {
+      f.lo[k][j] = float_down(b.lo[k]);
+      f.hi[k][j] = float_up(b.hi[k] + margin);  // the sum boxes_overlap compares
+    }
+    for (int k = 0; k < 4; ++k) {
+      f.lo[3 + k][j] = item_diag ? item_diag[item].lo[k] : -INFINITY;
+      f.hi[3 + k][j] = item_diag ? item_diag[item].hi[k] : INFINITY;
+    }
+    f.item[j] = item;
+    for (int r = 0; r < 3; ++r)
+      f.node[r][j] =
+          r < nodes_per_item ? item_nodes[std::size_t(item) * nodes_per_item + r] : kNone;
+    for (int k = 0; k < kFeatureLanes; ++k) {
+      node.lo[k] = std::min(node.lo[k], f.lo[k][j]);
+      node.hi[k] = std::max(node.hi[k], f.hi[k][j]);
+    }
+  }
+}
+
+}  // namespace
+
+void FeatureTree::build(const Box* item_box, const Diagonals* item_diag, double margin,
+                        std::uint32_t items, const std::uint32_t* item_nodes, int nodes_per_item,
                         MedianBvhTask* stack) noexcept {
-  count = 0;
+  constexpr std::uint32_t kLeafSize = 4;  // a FeatureLeaf's lanes
+  count = leaf_count = 0;
   if (items == 0) return;
   // Items in the Morton order of their box centres (30 bits over the centres' bounding box,
   // ties by item id: a pure function of the boxes).
@@ -66,16 +112,20 @@ void FeatureTree::build(const Box* item_box, std::uint32_t items, std::uint32_t 
     leaf_box[i] = item_box[leaf[i]];
   }
   // Top down: a range splits where its highest differing Morton bit turns on (in the middle
-  // when all its codes are equal); at most `leaf_size` items make a leaf. Children follow
-  // their parent, so reverse order is bottom-up. Depth <= 30 + log2(items) < kMedianBvhStack.
+  // when all its codes are equal); at most four items make a leaf. Depth <= 30 + log2(items)
+  // < kMedianBvhStack.
   count = 1;
   std::size_t top = 0;
   stack[top++] = {0, 0, items};
   while (top > 0) {
     const MedianBvhTask task = stack[--top];
     const std::uint32_t begin = task.begin, end = task.end;
-    if (end - begin <= leaf_size) {
-      nodes[task.node] = {begin, 0, end - begin};
+    FeatureNode& node = nodes[task.node];
+    if (end - begin <= kLeafSize) {
+      fill_leaf(*this, begin, end - begin, item_diag, margin, item_nodes, nodes_per_item,
+                leaves[leaf_count], node);
+      node.a = leaf_count++;
+      node.b = 0;
       continue;
     }
     const std::uint32_t first = static_cast<std::uint32_t>(key[begin] >> 32);
@@ -88,32 +138,26 @@ void FeatureTree::build(const Box* item_box, std::uint32_t items, std::uint32_t 
                                [&](std::uint64_t k) { return ((k >> 32) & bit) == 0; });
       mid = static_cast<std::uint32_t>(split - key.data());
     }
-    const std::uint32_t left = count, right = count + 1;
+    node.a = count;  // left child; the right one is count + 1
+    node.b = end - begin;
     count += 2;
-    nodes[task.node] = {left, right, 0};
-    stack[top++] = {right, mid, end};
-    stack[top++] = {left, begin, mid};
+    stack[top++] = {node.a + 1, mid, end};
+    stack[top++] = {node.a, begin, mid};
   }
-  // Children come after their parents: reverse order is bottom-up.
+  // Inner nodes' lanes: children come after their parents, so reverse order is bottom-up.
   for (std::uint32_t i = count; i-- > 0;) {
-    const format::BvhNode& n = nodes[i];
-    if (n.count > 0) {
-      Box b = leaf_box[n.first];
-      for (std::uint32_t k = 1; k < n.count; ++k) box_union(b, leaf_box[n.first + k]);
-      box[i] = b;
-      size[i] = n.count;
-    } else {
-      Box b = box[n.first];
-      box_union(b, box[n.second]);
-      box[i] = b;
-      size[i] = size[n.first] + size[n.second];
+    FeatureNode& n = nodes[i];
+    if (n.b == 0) continue;
+    const FeatureNode& l = nodes[n.a];
+    const FeatureNode& r = nodes[n.a + 1];
+    for (int k = 0; k < kFeatureLanes; ++k) {
+      n.lo[k] = std::min(l.lo[k], r.lo[k]);
+      n.hi[k] = std::max(l.hi[k], r.hi[k]);
     }
   }
 }
 
 namespace {
-
-constexpr std::uint32_t kLeafSize = 4;
 
 // Projections of point p on the four diagonals (1,1,1), (1,1,-1), (1,-1,1), (-1,1,1), merged
 // into `d` (lo[4], hi[4]) as floats that hold the exact projections: with m = |x| + |y| + |z|,
@@ -136,53 +180,44 @@ inline void merge_diagonals(Diagonals& a, const Diagonals& b) noexcept {
   }
 }
 
-// The diagonal slabs of two swept features overlap (each holds the convex hull of its nodes'
-// positions at both ends of the step, which holds the feature at every t).
-inline bool diagonals_overlap(const Diagonals& a, const Diagonals& b) noexcept {
-  bool apart = false;
-  for (int k = 0; k < 4; ++k) apart |= (a.lo[k] > b.hi[k]) | (b.lo[k] > a.hi[k]);
-  return !apart;
-}
-
-// Every pair of leaves of trees a and b (a == b: every pair of leaves of one tree, a leaf with
-// itself included) whose node boxes overlap (with `margin`), each once: leaves(first_a,
-// count_a, first_b, count_b, same_leaf). False when `stack` (capacity `cap`) is too small.
+// Every pair of leaves of trees a and b (self: every pair of leaves of one tree, a leaf with
+// itself included) whose nodes' lanes overlap, each once: leaves(leaf_a, leaf_b, same_leaf).
+// False when the worker's stack is too small.
 template <class Leaves>
-bool overlapping_leaves(const FeatureTree& a, const FeatureTree& b, bool self, double margin,
-                        Worker& w, Leaves&& leaves) noexcept {
+bool overlapping_leaves(const FeatureTree& a, const FeatureTree& b, bool self, Worker& w,
+                        Leaves&& leaves) noexcept {
   if (a.count == 0 || b.count == 0) return true;
   StackItem* stack = w.stack.data();
   const std::size_t cap = w.stack.size();
   std::size_t top = 0;
-  if (self || boxes_overlap(a.box[0], b.box[0], margin)) stack[top++] = {0, 0};
+  if (self || nodes_overlap(a.nodes[0], b.nodes[0])) stack[top++] = {0, 0};
   while (top > 0 && !w.stop) {
     const StackItem it = stack[--top];
     ++w.stats.node_pairs_visited;
-    const format::BvhNode& na = a.nodes[it.a];
-    const format::BvhNode& nb = b.nodes[it.b];
+    const FeatureNode& na = a.nodes[it.a];
+    const FeatureNode& nb = b.nodes[it.b];
     if (top + 3 > cap) return false;
     if (self && it.a == it.b) {
-      if (na.count > 0) {
-        leaves(na.first, na.count, na.first, na.count, true);
+      if (na.b == 0) {
+        leaves(a.leaves[na.a], a.leaves[na.a], true);
         continue;
       }
-      stack[top++] = {na.first, na.first};
-      stack[top++] = {na.second, na.second};
-      if (boxes_overlap(a.box[na.first], a.box[na.second], margin))
-        stack[top++] = {na.first, na.second};
+      stack[top++] = {na.a, na.a};
+      stack[top++] = {na.a + 1, na.a + 1};
+      if (nodes_overlap(a.nodes[na.a], a.nodes[na.a + 1])) stack[top++] = {na.a, na.a + 1};
       continue;
     }
-    if (na.count > 0 && nb.count > 0) {
-      leaves(na.first, na.count, nb.first, nb.count, false);
+    if (na.b == 0 && nb.b == 0) {
+      leaves(a.leaves[na.a], b.leaves[nb.a], false);
       continue;
     }
-    const bool split_a = nb.count > 0 || (na.count == 0 && a.size[it.a] >= b.size[it.b]);
+    const bool split_a = nb.b == 0 || (na.b != 0 && na.b >= nb.b);
     if (split_a) {
-      if (boxes_overlap(a.box[na.second], b.box[it.b], margin)) stack[top++] = {na.second, it.b};
-      if (boxes_overlap(a.box[na.first], b.box[it.b], margin)) stack[top++] = {na.first, it.b};
+      if (nodes_overlap(a.nodes[na.a + 1], nb)) stack[top++] = {na.a + 1, it.b};
+      if (nodes_overlap(a.nodes[na.a], nb)) stack[top++] = {na.a, it.b};
     } else {
-      if (boxes_overlap(a.box[it.a], b.box[nb.second], margin)) stack[top++] = {it.a, nb.second};
-      if (boxes_overlap(a.box[it.a], b.box[nb.first], margin)) stack[top++] = {it.a, nb.first};
+      if (nodes_overlap(na, b.nodes[nb.a + 1])) stack[top++] = {it.a, nb.a + 1};
+      if (nodes_overlap(na, b.nodes[nb.a])) stack[top++] = {it.a, nb.a};
     }
   }
   return true;
@@ -206,63 +241,60 @@ bool Collider::Impl::feature_pairs(Worker& w) noexcept {
     }
   }
   MedianBvhTask* build_stack = feature_build_stack.data();
-  vertex_tree.build(vbox.data(), nv, kLeafSize, build_stack);
-  face_tree.build(tbox.data(), tri_count, kLeafSize, build_stack);
-  edge_tree.build(ebox.data(), ne, kLeafSize, build_stack);
-  if (diagonals) {  // the trees' slabs in leaf order
-    for (std::uint32_t i = 0; i < nv; ++i) vertex_tree.leaf_diag[i] = vdiag[vertex_tree.leaf[i]];
-    for (std::uint32_t i = 0; i < tri_count; ++i) {
-      const std::array<std::uint32_t, 3>& tv = topo->tri_verts[face_tree.leaf[i]];
+  vertex_tree.build(vbox.data(), diagonals ? vdiag.data() : nullptr, margin, nv,
+                    topo->surf_nodes.data(), 1, build_stack);
+  if (diagonals) {
+    for (std::uint32_t t = 0; t < tri_count; ++t) {
+      const std::array<std::uint32_t, 3>& tv = topo->tri_verts[t];
       Diagonals d = vdiag[tv[0]];
       merge_diagonals(d, vdiag[tv[1]]);
       merge_diagonals(d, vdiag[tv[2]]);
-      face_tree.leaf_diag[i] = d;
-    }
-    for (std::uint32_t i = 0; i < ne; ++i) {
-      const std::array<std::uint32_t, 2>& ev = topo->edge_verts[edge_tree.leaf[i]];
-      Diagonals d = vdiag[ev[0]];
-      merge_diagonals(d, vdiag[ev[1]]);
-      edge_tree.leaf_diag[i] = d;
+      item_diag[t] = d;
     }
   }
+  face_tree.build(tbox.data(), diagonals ? item_diag.data() : nullptr, margin, tri_count,
+                  tri_count ? tris[0].data() : nullptr, 3, build_stack);
+  if (diagonals) {
+    for (std::uint32_t e = 0; e < ne; ++e) {
+      const std::array<std::uint32_t, 2>& ev = topo->edge_verts[e];
+      Diagonals d = vdiag[ev[0]];
+      merge_diagonals(d, vdiag[ev[1]]);
+      item_diag[e] = d;
+    }
+  }
+  edge_tree.build(ebox.data(), diagonals ? item_diag.data() : nullptr, margin, ne,
+                  topo->edges.empty() ? nullptr : topo->edges[0].data(), 2, build_stack);
 
-  // Vertex-face: a vertex and a face meet in one leaf pair of the two trees.
+  // Vertex-face: a vertex and a face meet in one leaf pair of the two trees. The float lanes
+  // pass a superset of the double box check (feature_bounds.hpp), which process_vertex_face
+  // repeats.
   const bool vf_ok = overlapping_leaves(
-      vertex_tree, face_tree, false, margin, w,
-      [&](std::uint32_t fa, std::uint32_t na, std::uint32_t fb, std::uint32_t nb, bool) {
-        for (std::uint32_t i = fa; i < fa + na; ++i) {
-          const Box& bv = vertex_tree.leaf_box[i];
-          const std::uint32_t p = topo->surf_nodes[vertex_tree.leaf[i]];
-          for (std::uint32_t j = fb; j < fb + nb; ++j) {
-            if (!boxes_overlap(bv, face_tree.leaf_box[j], margin)) continue;
-            if (diagonals && !diagonals_overlap(vertex_tree.leaf_diag[i], face_tree.leaf_diag[j]))
-              continue;
-            const std::uint32_t f = face_tree.leaf[j];
-            const format::Triangle& tri = tris[f];
-            if (p == tri[0] || p == tri[1] || p == tri[2]) continue;
-            process_vertex_face(w, *this, p, *this, f);
+      vertex_tree, face_tree, false, w, [&](const FeatureLeaf& va, const FeatureLeaf& fb, bool) {
+        for (int i = 0; i < 4 && (va.lanes >> i & 1u); ++i) {
+          const std::uint32_t p = va.node[0][i];
+          for (unsigned m = leaf_overlap_mask(va, i, fb); m != 0; m &= m - 1) {
+            const int j = __builtin_ctz(m);
+            if (p == fb.node[0][j] || p == fb.node[1][j] || p == fb.node[2][j]) continue;
+            process_vertex_face(w, *this, p, *this, fb.item[j]);
           }
         }
       });
   if (!vf_ok) return false;
 
-  // Edge-edge: a pair of edges meets in one leaf (positions i < j) or one leaf pair.
+  // Edge-edge: a pair of edges meets in one leaf (lanes i < j) or one leaf pair; the double
+  // box check is process_edge_edge's.
   return overlapping_leaves(
-      edge_tree, edge_tree, true, margin, w,
-      [&](std::uint32_t fa, std::uint32_t na, std::uint32_t fb, std::uint32_t nb, bool same) {
-        for (std::uint32_t i = fa; i < fa + na; ++i) {
-          const std::uint32_t e1 = edge_tree.leaf[i];
-          const Box& b1 = edge_tree.leaf_box[i];
-          const std::array<std::uint32_t, 2>& E1 = topo->edges[e1];
-          for (std::uint32_t j = same ? i + 1 : fb; j < fb + nb; ++j) {
-            const Box& b2 = edge_tree.leaf_box[j];
-            if (!boxes_overlap(b1, b2, margin)) continue;
-            const std::uint32_t e2 = edge_tree.leaf[j];
-            const std::array<std::uint32_t, 2>& E2 = topo->edges[e2];
-            if (E1[0] == E2[0] || E1[0] == E2[1] || E1[1] == E2[0] || E1[1] == E2[1]) continue;
-            if (diagonals && !diagonals_overlap(edge_tree.leaf_diag[i], edge_tree.leaf_diag[j]))
-              continue;
-            process_edge_edge(w, *this, e1, b1, *this, e2, b2);
+      edge_tree, edge_tree, true, w, [&](const FeatureLeaf& ea, const FeatureLeaf& eb, bool same) {
+        for (int i = 0; i < 4 && (ea.lanes >> i & 1u); ++i) {
+          const std::uint32_t a0 = ea.node[0][i], a1 = ea.node[1][i];
+          unsigned m = leaf_overlap_mask(ea, i, eb);
+          if (same) m &= ~0u << (i + 1);
+          for (; m != 0; m &= m - 1) {
+            const int j = __builtin_ctz(m);
+            const std::uint32_t b0 = eb.node[0][j], b1 = eb.node[1][j];
+            if (a0 == b0 || a0 == b1 || a1 == b0 || a1 == b1) continue;
+            process_edge_edge(w, *this, ea.item[i], edge_tree.leaf_box[ea.first + i], *this,
+                              eb.item[j], edge_tree.leaf_box[eb.first + j]);
           }
         }
       });

@@ -14,6 +14,7 @@
 #endif
 
 #include "body_shape_data.hpp"
+#include "feature_bounds.hpp"
 #include "normal_cone.hpp"
 #include "orientation_terms.hpp"
 #include "plane_filter.hpp"
@@ -214,20 +215,24 @@ struct Diagonals {
 
 /// A BVH over item boxes (kFeatures: vertices, edges or triangles of one body) in the Morton
 /// order of their centres, built from scratch by `build` into storage reserved by `reserve`.
+/// Nodes and leaves hold float bounds rounded outwards (feature_bounds.hpp): the box, inflated
+/// by the margin on its hi side, and the diagonal slabs.
 struct FeatureTree {
-  std::vector<format::BvhNode> nodes;
-  std::uint32_t count = 0;           // nodes in use
-  std::vector<std::uint32_t> leaf;   // item ids in leaf order
-  std::vector<Box> leaf_box;         // item boxes in leaf order
-  std::vector<Diagonals> leaf_diag;  // item slabs in leaf order (filled by the caller)
-  std::vector<std::uint64_t> key;    // scratch for the build: Morton code, item id
-  std::vector<Box> box;              // per node
-  std::vector<std::uint32_t> size;   // items under each node
+  std::unique_ptr<FeatureNode[]> nodes;   // node 0 the root; children after their parents
+  std::uint32_t count = 0;                // nodes in use
+  std::unique_ptr<FeatureLeaf[]> leaves;  // by leaf (FeatureNode::a of a leaf node)
+  std::uint32_t leaf_count = 0;
+  std::vector<std::uint32_t> leaf;  // item ids in leaf order
+  std::vector<Box> leaf_box;        // item boxes (double) in leaf order
+  std::vector<std::uint64_t> key;   // scratch for the build: Morton code, item id
   /// Allocates everything for `items` items (may throw).
   void reserve(std::uint32_t items);
-  /// Builds over `items` boxes (`leaf_size` items per leaf at most) without allocating.
-  void build(const Box* item_box, std::uint32_t items, std::uint32_t leaf_size,
-             MedianBvhTask* stack) noexcept;
+  /// Builds over `items` items without allocating: their double boxes `item_box`, their slabs
+  /// `item_diag` (null: slabs off, with a minimum separation), `margin` (the minimum
+  /// separation: added to every hi before rounding up), and their `nodes_per_item` nodes
+  /// each at `item_nodes` (1 to 3; kept in the leaves for the shared-node check).
+  void build(const Box* item_box, const Diagonals* item_diag, double margin, std::uint32_t items,
+             const std::uint32_t* item_nodes, int nodes_per_item, MedianBvhTask* stack) noexcept;
 };
 
 /// A caller's contact buffer, shared by every worker of one query: it keeps the `cap`
@@ -572,11 +577,12 @@ struct Collider::Impl {
   void test_seam_orphans(Worker& w) const noexcept;
 
   // --- collider_features.cpp (kFeatures)
-  /// Median-split BVHs over the swept boxes of the surface vertices, triangles and edges,
+  /// Morton-order BVHs over the swept boxes of the surface vertices, triangles and edges,
   /// rebuilt every step; `ebox` the edges' swept boxes. Sized at construction.
   FeatureTree vertex_tree, face_tree, edge_tree;
   std::vector<Box> ebox;
-  std::vector<Diagonals> vdiag;  // per surface vertex
+  std::vector<Diagonals> vdiag;      // per surface vertex
+  std::vector<Diagonals> item_diag;  // scratch: per triangle, then per edge
   std::vector<MedianBvhTask> feature_build_stack;
   /// Every vertex-face and edge-edge pair with four distinct nodes whose swept boxes overlap,
   /// each once, through process_vertex_face / process_edge_edge. False on stack overflow.
