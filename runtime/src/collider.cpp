@@ -151,9 +151,9 @@ void Collider::Impl::construct(std::shared_ptr<const BodyShape> sh, const Collid
   wsign.assign(nw, 0);
   cluster_err.resize(cluster_count());
   if (opt.mode == ColliderMode::kFeatures) {
-    vertex_tree.reserve(static_cast<std::uint32_t>(nv));
-    face_tree.reserve(tri_count);
-    edge_tree.reserve(static_cast<std::uint32_t>(topo->edges.size()));
+    vertex_tree.reserve(static_cast<std::uint32_t>(nv), false);
+    face_tree.reserve(tri_count, false);
+    edge_tree.reserve(static_cast<std::uint32_t>(topo->edges.size()), true);
     ebox.resize(topo->edges.size());
     vdiag.resize(nv);
     item_diag.resize(std::max<std::size_t>(tri_count, topo->edges.size()));

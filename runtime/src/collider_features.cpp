@@ -13,14 +13,15 @@
 
 namespace tetseg {
 
-void FeatureTree::reserve(std::uint32_t items) {
+void FeatureTree::reserve(std::uint32_t items, bool keep_boxes) {
   const std::size_t cap = items == 0 ? 1 : 2 * std::size_t(items) - 1;
   // Default-initialised (not zeroed): only what a build writes is ever touched.
   nodes.reset(new FeatureNode[cap]);
   leaves.reset(new FeatureLeaf[items == 0 ? 1 : items]);
   leaf.resize(items);
-  leaf_box.resize(items);
+  leaf_box.resize(keep_boxes ? items : 0);
   key.resize(items);
+  key_scratch.resize(items);
 }
 
 namespace {
@@ -39,7 +40,7 @@ inline std::uint32_t spread_bits(std::uint32_t v) noexcept {
 namespace {
 
 // Leaf `f` over leaf positions [begin, begin + n) (n <= 4) and its node's lanes (`node`).
-void fill_leaf(const FeatureTree& t, std::uint32_t begin, std::uint32_t n,
+void fill_leaf(const FeatureTree& t, std::uint32_t begin, std::uint32_t n, const Box* item_box,
                const Diagonals* item_diag, double margin, const std::uint32_t* item_nodes,
                int nodes_per_item, FeatureLeaf& f, FeatureNode& node) noexcept {
   f.first = begin;
@@ -59,7 +60,7 @@ void fill_leaf(const FeatureTree& t, std::uint32_t begin, std::uint32_t n,
       continue;
     }
     const std::uint32_t item = t.leaf[begin + j];
-    const Box& b = t.leaf_box[begin + j];
+    const Box& b = item_box[item];
     for (int k = 0; k < 3; ++k) {
       f.lo[k][j] = float_down(b.lo[k]);
       f.hi[k][j] = float_up(b.hi[k] + margin);  // the sum boxes_overlap compares
@@ -104,13 +105,23 @@ void FeatureTree::build(const Box* item_box, const Diagonals* item_diag, double 
       const double q = (item_box[i].lo[k] + item_box[i].hi[k] - lo[k]) * scale[k];
       code |= spread_bits(static_cast<std::uint32_t>(std::min(1023.0, std::max(0.0, q)))) << k;
     }
-    key[i] = (std::uint64_t(code) << 32) | i;
+    key_scratch[i] = (std::uint64_t(code) << 32) | i;
   }
-  std::sort(key.begin(), key.begin() + items);
-  for (std::uint32_t i = 0; i < items; ++i) {
-    leaf[i] = static_cast<std::uint32_t>(key[i]);
-    leaf_box[i] = item_box[leaf[i]];
+  // Sorted by code, ties by id: a stable radix sort of the codes (three passes of 10 bits)
+  // over the keys in id order. The result lands in `key`.
+  std::uint64_t* from = key_scratch.data();
+  std::uint64_t* to = key.data();
+  for (int shift = 32; shift < 62; shift += 10) {
+    std::uint32_t start[1025] = {};
+    for (std::uint32_t i = 0; i < items; ++i) ++start[((from[i] >> shift) & 1023) + 1];
+    for (int d = 0; d < 1024; ++d) start[d + 1] += start[d];
+    for (std::uint32_t i = 0; i < items; ++i) to[start[(from[i] >> shift) & 1023]++] = from[i];
+    std::swap(from, to);
   }
+  if (from != key.data()) std::copy(from, from + items, key.data());
+  for (std::uint32_t i = 0; i < items; ++i) leaf[i] = static_cast<std::uint32_t>(key[i]);
+  if (!leaf_box.empty())
+    for (std::uint32_t i = 0; i < items; ++i) leaf_box[i] = item_box[leaf[i]];
   // Top down: a range splits where its highest differing Morton bit turns on (in the middle
   // when all its codes are equal); at most four items make a leaf. Depth <= 30 + log2(items)
   // < kMedianBvhStack.
@@ -122,7 +133,7 @@ void FeatureTree::build(const Box* item_box, const Diagonals* item_diag, double 
     const std::uint32_t begin = task.begin, end = task.end;
     FeatureNode& node = nodes[task.node];
     if (end - begin <= kLeafSize) {
-      fill_leaf(*this, begin, end - begin, item_diag, margin, item_nodes, nodes_per_item,
+      fill_leaf(*this, begin, end - begin, item_box, item_diag, margin, item_nodes, nodes_per_item,
                 leaves[leaf_count], node);
       node.a = leaf_count++;
       node.b = 0;

@@ -223,10 +223,10 @@ struct FeatureTree {
   std::unique_ptr<FeatureLeaf[]> leaves;  // by leaf (FeatureNode::a of a leaf node)
   std::uint32_t leaf_count = 0;
   std::vector<std::uint32_t> leaf;  // item ids in leaf order
-  std::vector<Box> leaf_box;        // item boxes (double) in leaf order
-  std::vector<std::uint64_t> key;   // scratch for the build: Morton code, item id
-  /// Allocates everything for `items` items (may throw).
-  void reserve(std::uint32_t items);
+  std::vector<Box> leaf_box;  // item boxes (double) in leaf order (only when reserved so)
+  std::vector<std::uint64_t> key, key_scratch;  // the build's: Morton code, item id
+  /// Allocates everything for `items` items (may throw); `keep_boxes`: fill `leaf_box`.
+  void reserve(std::uint32_t items, bool keep_boxes);
   /// Builds over `items` items without allocating: their double boxes `item_box`, their slabs
   /// `item_diag` (null: slabs off, with a minimum separation), `margin` (the minimum
   /// separation: added to every hi before rounding up), and their `nodes_per_item` nodes

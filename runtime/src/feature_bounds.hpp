@@ -89,13 +89,19 @@ inline bool nodes_overlap(const FeatureNode& a, const FeatureNode& b) noexcept {
 /// intervals), for the items of b.
 inline unsigned leaf_overlap_mask(const FeatureLeaf& a, int i, const FeatureLeaf& b) noexcept {
 #if defined(__SSE2__)
-  __m128 apart = _mm_setzero_ps();
-  for (int k = 0; k < kFeatureLanes; ++k) {
+  // The box lanes first: most item pairs of overlapping leaves are apart there already.
+  auto apart_in = [&](int k) {
     const __m128 lo = _mm_set1_ps(a.lo[k][i]), hi = _mm_set1_ps(a.hi[k][i]);
-    apart = _mm_or_ps(apart, _mm_or_ps(_mm_cmpgt_ps(lo, _mm_load_ps(b.hi[k])),
-                                       _mm_cmpgt_ps(_mm_load_ps(b.lo[k]), hi)));
-  }
-  return ~static_cast<unsigned>(_mm_movemask_ps(apart)) & b.lanes;
+    return _mm_or_ps(_mm_cmpgt_ps(lo, _mm_load_ps(b.hi[k])),
+                     _mm_cmpgt_ps(_mm_load_ps(b.lo[k]), hi));
+  };
+  const unsigned box = ~static_cast<unsigned>(
+                           _mm_movemask_ps(_mm_or_ps(apart_in(0), _mm_or_ps(apart_in(1), apart_in(2))))) &
+                       b.lanes;
+  if (box == 0) return 0;
+  const __m128 slabs =
+      _mm_or_ps(_mm_or_ps(apart_in(3), apart_in(4)), _mm_or_ps(apart_in(5), apart_in(6)));
+  return ~static_cast<unsigned>(_mm_movemask_ps(slabs)) & box;
 #else
   unsigned mask = 0;
   for (int j = 0; j < 4; ++j) {
