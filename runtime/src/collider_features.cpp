@@ -207,7 +207,7 @@ bool overlapping_leaves(const FeatureTree& a, const FeatureTree& b, bool self, W
     ++w.stats.node_pairs_visited;
     const FeatureNode& na = a.nodes[it.a];
     const FeatureNode& nb = b.nodes[it.b];
-    if (top + 3 > cap) return false;
+    if (top + 4 > cap) return false;
     if (self && it.a == it.b) {
       if (na.b == 0) {
         leaves(a.leaves[na.a], a.leaves[na.a], true);
@@ -222,7 +222,13 @@ bool overlapping_leaves(const FeatureTree& a, const FeatureTree& b, bool self, W
       leaves(a.leaves[na.a], b.leaves[nb.a], false);
       continue;
     }
-    const bool split_a = nb.b == 0 || (na.b != 0 && na.b >= nb.b);
+    if (na.b != 0 && nb.b != 0) {  // both inner: the four pairs of children
+      for (std::uint32_t ca = na.a + 2; ca-- > na.a;)
+        for (std::uint32_t cb = nb.a + 2; cb-- > nb.a;)
+          if (nodes_overlap(a.nodes[ca], b.nodes[cb])) stack[top++] = {ca, cb};
+      continue;
+    }
+    const bool split_a = nb.b == 0;
     if (split_a) {
       if (nodes_overlap(a.nodes[na.a + 1], nb)) stack[top++] = {na.a + 1, it.b};
       if (nodes_overlap(a.nodes[na.a], nb)) stack[top++] = {na.a, it.b};
