@@ -151,12 +151,15 @@ void Collider::Impl::construct(std::shared_ptr<const BodyShape> sh, const Collid
   wsign.assign(nw, 0);
   cluster_err.resize(cluster_count());
   if (opt.mode == ColliderMode::kFeatures) {
-    vertex_tree.reserve(static_cast<std::uint32_t>(nv), false);
-    face_tree.reserve(tri_count, false);
-    edge_tree.reserve(static_cast<std::uint32_t>(topo->edges.size()), true);
-    ebox.resize(topo->edges.size());
+    const std::size_t ne = topo->edges.size();
+    vertex_tree.reserve(static_cast<std::uint32_t>(nv));
+    face_tree.reserve(tri_count);
+    edge_tree.reserve(static_cast<std::uint32_t>(ne));
+    const std::size_t most = std::max({std::size_t(nv), std::size_t(tri_count), ne});
+    feature_key.resize(most);
+    feature_key_scratch.resize(most);
     vdiag.resize(nv);
-    item_diag.resize(std::max<std::size_t>(tri_count, topo->edges.size()));
+    item_diag.resize(std::max<std::size_t>(tri_count, ne));
     feature_build_stack.resize(kMedianBvhStack);
   }
   skip_adjacent = uses_global_bvh();

@@ -13,15 +13,10 @@
 
 namespace tetseg {
 
-void FeatureTree::reserve(std::uint32_t items, bool keep_boxes) {
-  const std::size_t cap = items == 0 ? 1 : 2 * std::size_t(items) - 1;
-  // Default-initialised (not zeroed): only what a build writes is ever touched.
-  nodes.reset(new FeatureNode[cap]);
+void FeatureTree::reserve(std::uint32_t items) {
+  // Default-initialised: only what a build writes is ever touched.
+  nodes.reset(new FeatureNode[items == 0 ? 1 : 2 * std::size_t(items) - 1]);
   leaves.reset(new FeatureLeaf[items == 0 ? 1 : items]);
-  leaf.resize(items);
-  leaf_box.resize(keep_boxes ? items : 0);
-  key.resize(items);
-  key_scratch.resize(items);
 }
 
 namespace {
@@ -39,11 +34,11 @@ inline std::uint32_t spread_bits(std::uint32_t v) noexcept {
 
 namespace {
 
-// Leaf `f` over leaf positions [begin, begin + n) (n <= 4) and its node's lanes (`node`).
-void fill_leaf(const FeatureTree& t, std::uint32_t begin, std::uint32_t n, const Box* item_box,
+// Leaf `f` of the items key[0, n) (n <= 4, Morton code and item id each) and its node's lanes.
+template <class ItemBox>
+void fill_leaf(const std::uint64_t* key, std::uint32_t n, const ItemBox& item_box,
                const Diagonals* item_diag, double margin, const std::uint32_t* item_nodes,
                int nodes_per_item, FeatureLeaf& f, FeatureNode& node) noexcept {
-  f.first = begin;
   f.lanes = (1u << n) - 1;
   for (int k = 0; k < kFeatureLanes; ++k) {
     node.lo[k] = INFINITY;
@@ -59,8 +54,8 @@ void fill_leaf(const FeatureTree& t, std::uint32_t begin, std::uint32_t n, const
       for (int r = 0; r < 3; ++r) f.node[r][j] = kNone;
       continue;
     }
-    const std::uint32_t item = t.leaf[begin + j];
-    const Box& b = item_box[item];
+    const auto item = static_cast<std::uint32_t>(key[j]);
+    const Box b = item_box(item);
     for (int k = 0; k < 3; ++k) {
       f.lo[k][j] = float_down(b.lo[k]);
       f.hi[k][j] = float_up(b.hi[k] + margin);  // the sum boxes_overlap compares
@@ -71,8 +66,7 @@ void fill_leaf(const FeatureTree& t, std::uint32_t begin, std::uint32_t n, const
     }
     f.item[j] = item;
     for (int r = 0; r < 3; ++r)
-      f.node[r][j] =
-          r < nodes_per_item ? item_nodes[std::size_t(item) * nodes_per_item + r] : kNone;
+      f.node[r][j] = r < nodes_per_item ? item_nodes[std::size_t(item) * nodes_per_item + r] : kNone;
     for (int k = 0; k < kFeatureLanes; ++k) {
       node.lo[k] = std::min(node.lo[k], f.lo[k][j]);
       node.hi[k] = std::max(node.hi[k], f.hi[k][j]);
@@ -82,8 +76,10 @@ void fill_leaf(const FeatureTree& t, std::uint32_t begin, std::uint32_t n, const
 
 }  // namespace
 
-void FeatureTree::build(const Box* item_box, const Diagonals* item_diag, double margin,
+template <class ItemBox>
+void FeatureTree::build(const ItemBox& item_box, const Diagonals* item_diag, double margin,
                         std::uint32_t items, const std::uint32_t* item_nodes, int nodes_per_item,
+                        std::uint64_t* key, std::uint64_t* key_scratch,
                         MedianBvhTask* stack) noexcept {
   constexpr std::uint32_t kLeafSize = 4;  // a FeatureLeaf's lanes
   count = leaf_count = 0;
@@ -91,26 +87,29 @@ void FeatureTree::build(const Box* item_box, const Diagonals* item_diag, double 
   // Items in the Morton order of their box centres (30 bits over the centres' bounding box,
   // ties by item id: a pure function of the boxes).
   double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-  for (std::uint32_t i = 0; i < items; ++i)
+  for (std::uint32_t i = 0; i < items; ++i) {
+    const Box b = item_box(i);
     for (int k = 0; k < 3; ++k) {
-      const double c = item_box[i].lo[k] + item_box[i].hi[k];
+      const double c = b.lo[k] + b.hi[k];
       lo[k] = std::min(lo[k], c);
       hi[k] = std::max(hi[k], c);
     }
+  }
   double scale[3];
   for (int k = 0; k < 3; ++k) scale[k] = hi[k] > lo[k] ? 1023.0 / (hi[k] - lo[k]) : 0.0;
   for (std::uint32_t i = 0; i < items; ++i) {
+    const Box b = item_box(i);
     std::uint32_t code = 0;
     for (int k = 0; k < 3; ++k) {
-      const double q = (item_box[i].lo[k] + item_box[i].hi[k] - lo[k]) * scale[k];
+      const double q = (b.lo[k] + b.hi[k] - lo[k]) * scale[k];
       code |= spread_bits(static_cast<std::uint32_t>(std::min(1023.0, std::max(0.0, q)))) << k;
     }
     key_scratch[i] = (std::uint64_t(code) << 32) | i;
   }
   // Sorted by code, ties by id: a stable radix sort of the codes (three passes of 10 bits)
   // over the keys in id order. The result lands in `key`.
-  std::uint64_t* from = key_scratch.data();
-  std::uint64_t* to = key.data();
+  std::uint64_t* from = key_scratch;
+  std::uint64_t* to = key;
   for (int shift = 32; shift < 62; shift += 10) {
     std::uint32_t start[1025] = {};
     for (std::uint32_t i = 0; i < items; ++i) ++start[((from[i] >> shift) & 1023) + 1];
@@ -118,10 +117,7 @@ void FeatureTree::build(const Box* item_box, const Diagonals* item_diag, double 
     for (std::uint32_t i = 0; i < items; ++i) to[start[(from[i] >> shift) & 1023]++] = from[i];
     std::swap(from, to);
   }
-  if (from != key.data()) std::copy(from, from + items, key.data());
-  for (std::uint32_t i = 0; i < items; ++i) leaf[i] = static_cast<std::uint32_t>(key[i]);
-  if (!leaf_box.empty())
-    for (std::uint32_t i = 0; i < items; ++i) leaf_box[i] = item_box[leaf[i]];
+  if (from != key) std::copy(from, from + items, key);
   // Top down: a range splits where its highest differing Morton bit turns on (in the middle
   // when all its codes are equal); at most four items make a leaf. Depth <= 30 + log2(items)
   // < kMedianBvhStack.
@@ -133,7 +129,7 @@ void FeatureTree::build(const Box* item_box, const Diagonals* item_diag, double 
     const std::uint32_t begin = task.begin, end = task.end;
     FeatureNode& node = nodes[task.node];
     if (end - begin <= kLeafSize) {
-      fill_leaf(*this, begin, end - begin, item_box, item_diag, margin, item_nodes, nodes_per_item,
+      fill_leaf(key + begin, end - begin, item_box, item_diag, margin, item_nodes, nodes_per_item,
                 leaves[leaf_count], node);
       node.a = leaf_count++;
       node.b = 0;
@@ -145,9 +141,9 @@ void FeatureTree::build(const Box* item_box, const Diagonals* item_diag, double 
     if (first != last) {
       const std::uint32_t bit = 0x80000000u >> __builtin_clz(first ^ last);
       const std::uint64_t* split =
-          std::partition_point(key.data() + begin, key.data() + end,
+          std::partition_point(key + begin, key + end,
                                [&](std::uint64_t k) { return ((k >> 32) & bit) == 0; });
-      mid = static_cast<std::uint32_t>(split - key.data());
+      mid = static_cast<std::uint32_t>(split - key);
     }
     node.a = count;  // left child; the right one is count + 1
     node.b = end - begin;
@@ -246,7 +242,6 @@ bool Collider::Impl::feature_pairs(Worker& w) noexcept {
   const double margin = opt.ccd.min_separation;
   const std::uint32_t nv = static_cast<std::uint32_t>(topo->surf_nodes.size());
   const std::uint32_t ne = static_cast<std::uint32_t>(topo->edges.size());
-  for (std::uint32_t e = 0; e < ne; ++e) ebox[e] = edge_box(e);
   // Diagonal slabs (exact contact only; with a minimum separation the boxes alone cull).
   const bool diagonals = margin <= 0;
   if (diagonals) {
@@ -257,9 +252,12 @@ bool Collider::Impl::feature_pairs(Worker& w) noexcept {
       vdiag[i] = d;
     }
   }
+  std::uint64_t* key = feature_key.data();
+  std::uint64_t* key_scratch = feature_key_scratch.data();
   MedianBvhTask* build_stack = feature_build_stack.data();
-  vertex_tree.build(vbox.data(), diagonals ? vdiag.data() : nullptr, margin, nv,
-                    topo->surf_nodes.data(), 1, build_stack);
+  vertex_tree.build([&](std::uint32_t i) -> const Box& { return vbox[i]; },
+                    diagonals ? vdiag.data() : nullptr, margin, nv, topo->surf_nodes.data(), 1,
+                    key, key_scratch, build_stack);
   if (diagonals) {
     for (std::uint32_t t = 0; t < tri_count; ++t) {
       const std::array<std::uint32_t, 3>& tv = topo->tri_verts[t];
@@ -269,8 +267,9 @@ bool Collider::Impl::feature_pairs(Worker& w) noexcept {
       item_diag[t] = d;
     }
   }
-  face_tree.build(tbox.data(), diagonals ? item_diag.data() : nullptr, margin, tri_count,
-                  tri_count ? tris[0].data() : nullptr, 3, build_stack);
+  face_tree.build([&](std::uint32_t t) -> const Box& { return tbox[t]; },
+                  diagonals ? item_diag.data() : nullptr, margin, tri_count,
+                  tri_count ? tris[0].data() : nullptr, 3, key, key_scratch, build_stack);
   if (diagonals) {
     for (std::uint32_t e = 0; e < ne; ++e) {
       const std::array<std::uint32_t, 2>& ev = topo->edge_verts[e];
@@ -279,8 +278,9 @@ bool Collider::Impl::feature_pairs(Worker& w) noexcept {
       item_diag[e] = d;
     }
   }
-  edge_tree.build(ebox.data(), diagonals ? item_diag.data() : nullptr, margin, ne,
-                  topo->edges.empty() ? nullptr : topo->edges[0].data(), 2, build_stack);
+  edge_tree.build([&](std::uint32_t e) { return edge_box(e); },
+                  diagonals ? item_diag.data() : nullptr, margin, ne,
+                  ne ? topo->edges[0].data() : nullptr, 2, key, key_scratch, build_stack);
 
   // Vertex-face: a vertex and a face meet in one leaf pair of the two trees. The float lanes
   // pass a superset of the double box check (feature_bounds.hpp), which process_vertex_face
@@ -298,8 +298,8 @@ bool Collider::Impl::feature_pairs(Worker& w) noexcept {
       });
   if (!vf_ok) return false;
 
-  // Edge-edge: a pair of edges meets in one leaf (lanes i < j) or one leaf pair; the double
-  // box check is process_edge_edge's.
+  // Edge-edge: a pair of edges meets in one leaf (lanes i < j) or one leaf pair; the still
+  // rule and the double box check are process_edge_edge's.
   return overlapping_leaves(
       edge_tree, edge_tree, true, w, [&](const FeatureLeaf& ea, const FeatureLeaf& eb, bool same) {
         for (int i = 0; i < 4 && (ea.lanes >> i & 1u); ++i) {
@@ -310,8 +310,7 @@ bool Collider::Impl::feature_pairs(Worker& w) noexcept {
             const int j = __builtin_ctz(m);
             const std::uint32_t b0 = eb.node[0][j], b1 = eb.node[1][j];
             if (a0 == b0 || a0 == b1 || a1 == b0 || a1 == b1) continue;
-            process_edge_edge(w, *this, ea.item[i], edge_tree.leaf_box[ea.first + i], *this,
-                              eb.item[j], edge_tree.leaf_box[eb.first + j]);
+            process_edge_edge(w, *this, ea.item[i], *this, eb.item[j]);
           }
         }
       });

@@ -222,17 +222,17 @@ struct FeatureTree {
   std::uint32_t count = 0;                // nodes in use
   std::unique_ptr<FeatureLeaf[]> leaves;  // by leaf (FeatureNode::a of a leaf node)
   std::uint32_t leaf_count = 0;
-  std::vector<std::uint32_t> leaf;  // item ids in leaf order
-  std::vector<Box> leaf_box;  // item boxes (double) in leaf order (only when reserved so)
-  std::vector<std::uint64_t> key, key_scratch;  // the build's: Morton code, item id
-  /// Allocates everything for `items` items (may throw); `keep_boxes`: fill `leaf_box`.
-  void reserve(std::uint32_t items, bool keep_boxes);
-  /// Builds over `items` items without allocating: their double boxes `item_box`, their slabs
-  /// `item_diag` (null: slabs off, with a minimum separation), `margin` (the minimum
-  /// separation: added to every hi before rounding up), and their `nodes_per_item` nodes
-  /// each at `item_nodes` (1 to 3; kept in the leaves for the shared-node check).
-  void build(const Box* item_box, const Diagonals* item_diag, double margin, std::uint32_t items,
-             const std::uint32_t* item_nodes, int nodes_per_item, MedianBvhTask* stack) noexcept;
+  /// Allocates everything for `items` items (may throw; nothing is written until a build).
+  void reserve(std::uint32_t items);
+  /// Builds over `items` items without allocating: item i's double box `item_box(i)`, its
+  /// slabs `item_diag[i]` (null: slabs off, with a minimum separation), `margin` (the minimum
+  /// separation: added to every hi before rounding up), and its `nodes_per_item` nodes at
+  /// `item_nodes` (1 to 3; kept in the leaves for the shared-node check). `key` and
+  /// `key_scratch`: room for `items` each. Defined in collider_features.cpp (its only user).
+  template <class ItemBox>
+  void build(const ItemBox& item_box, const Diagonals* item_diag, double margin,
+             std::uint32_t items, const std::uint32_t* item_nodes, int nodes_per_item,
+             std::uint64_t* key, std::uint64_t* key_scratch, MedianBvhTask* stack) noexcept;
 };
 
 /// A caller's contact buffer, shared by every worker of one query: it keeps the `cap`
@@ -578,9 +578,9 @@ struct Collider::Impl {
 
   // --- collider_features.cpp (kFeatures)
   /// Morton-order BVHs over the swept boxes of the surface vertices, triangles and edges,
-  /// rebuilt every step; `ebox` the edges' swept boxes. Sized at construction.
+  /// rebuilt every step. Sized at construction.
   FeatureTree vertex_tree, face_tree, edge_tree;
-  std::vector<Box> ebox;
+  std::vector<std::uint64_t> feature_key, feature_key_scratch;  // the builds' (largest tree)
   std::vector<Diagonals> vdiag;      // per surface vertex
   std::vector<Diagonals> item_diag;  // scratch: per triangle, then per edge
   std::vector<MedianBvhTask> feature_build_stack;

@@ -55,14 +55,13 @@ struct alignas(64) FeatureNode {
 };
 
 /// Up to four items of a leaf in structure-of-arrays form (lane k of item i: lo[k][i],
-/// hi[k][i]), their item ids, their position in the tree's leaf order (first + i) and their
-/// nodes (vertex: node[0]; edge: node[0..1]; face: node[0..2]); `lanes`: a bit per item.
+/// hi[k][i]), their item ids and their nodes (vertex: node[0]; edge: node[0..1]; face:
+/// node[0..2]); `lanes`: a bit per item (the first n).
 struct alignas(64) FeatureLeaf {
   float lo[kFeatureLanes][4];
   float hi[kFeatureLanes][4];
   std::uint32_t item[4];
   std::uint32_t node[3][4];
-  std::uint32_t first;
   std::uint32_t lanes;
 };
 
