@@ -306,11 +306,14 @@ bool Collider::Impl::feature_pairs(Worker& w) noexcept {
           const std::uint32_t a0 = ea.node[0][i], a1 = ea.node[1][i];
           unsigned m = leaf_overlap_mask(ea, i, eb);
           if (same) m &= ~0u << (i + 1);
+          if (m == 0) continue;
+          const std::uint32_t e1 = ea.item[i];
+          const Box box1 = edge_box(e1);
           for (; m != 0; m &= m - 1) {
             const int j = __builtin_ctz(m);
             const std::uint32_t b0 = eb.node[0][j], b1 = eb.node[1][j];
             if (a0 == b0 || a0 == b1 || a1 == b0 || a1 == b1) continue;
-            process_edge_edge(w, *this, ea.item[i], *this, eb.item[j]);
+            process_edge_edge(w, *this, e1, box1, *this, eb.item[j], edge_box(eb.item[j]));
           }
         }
       });
