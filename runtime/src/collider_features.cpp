@@ -17,6 +17,7 @@ void FeatureTree::reserve(std::uint32_t items) {
   // Default-initialised: only what a build writes is ever touched.
   nodes.reset(new FeatureNode[items == 0 ? 1 : 2 * std::size_t(items) - 1]);
   leaves.reset(new FeatureLeaf[items == 0 ? 1 : items]);
+  wides.reset(new FeatureWide[items == 0 ? 1 : items]);
 }
 
 namespace {
@@ -39,7 +40,7 @@ template <class ItemBox>
 void fill_leaf(const std::uint64_t* key, std::uint32_t n, const ItemBox& item_box,
                const Diagonals* item_diag, double margin, const std::uint32_t* item_nodes,
                int nodes_per_item, FeatureLeaf& f, FeatureNode& node) noexcept {
-  f.lanes = (1u << n) - 1;
+  f.bounds.lanes = (1u << n) - 1;
   for (int k = 0; k < kFeatureLanes; ++k) {
     node.lo[k] = INFINITY;
     node.hi[k] = -INFINITY;
@@ -47,8 +48,8 @@ void fill_leaf(const std::uint64_t* key, std::uint32_t n, const ItemBox& item_bo
   for (std::uint32_t j = 0; j < 4; ++j) {
     if (j >= n) {  // an empty lane overlaps nothing (and `lanes` masks it out)
       for (int k = 0; k < kFeatureLanes; ++k) {
-        f.lo[k][j] = INFINITY;
-        f.hi[k][j] = -INFINITY;
+        f.bounds.lo[k][j] = INFINITY;
+        f.bounds.hi[k][j] = -INFINITY;
       }
       f.item[j] = kNone;
       for (int r = 0; r < 3; ++r) f.node[r][j] = kNone;
@@ -57,19 +58,19 @@ void fill_leaf(const std::uint64_t* key, std::uint32_t n, const ItemBox& item_bo
     const auto item = static_cast<std::uint32_t>(key[j]);
     const Box b = item_box(item);
     for (int k = 0; k < 3; ++k) {
-      f.lo[k][j] = float_down(b.lo[k]);
-      f.hi[k][j] = float_up(b.hi[k] + margin);  // the sum boxes_overlap compares
+      f.bounds.lo[k][j] = float_down(b.lo[k]);
+      f.bounds.hi[k][j] = float_up(b.hi[k] + margin);  // the sum boxes_overlap compares
     }
     for (int k = 0; k < 4; ++k) {
-      f.lo[3 + k][j] = item_diag ? item_diag[item].lo[k] : -INFINITY;
-      f.hi[3 + k][j] = item_diag ? item_diag[item].hi[k] : INFINITY;
+      f.bounds.lo[3 + k][j] = item_diag ? item_diag[item].lo[k] : -INFINITY;
+      f.bounds.hi[3 + k][j] = item_diag ? item_diag[item].hi[k] : INFINITY;
     }
     f.item[j] = item;
     for (int r = 0; r < 3; ++r)
       f.node[r][j] = r < nodes_per_item ? item_nodes[std::size_t(item) * nodes_per_item + r] : kNone;
     for (int k = 0; k < kFeatureLanes; ++k) {
-      node.lo[k] = std::min(node.lo[k], f.lo[k][j]);
-      node.hi[k] = std::max(node.hi[k], f.hi[k][j]);
+      node.lo[k] = std::min(node.lo[k], f.bounds.lo[k][j]);
+      node.hi[k] = std::max(node.hi[k], f.bounds.hi[k][j]);
     }
   }
 }
@@ -162,6 +163,45 @@ void FeatureTree::build(const ItemBox& item_box, const Diagonals* item_diag, dou
       n.hi[k] = std::max(l.hi[k], r.hi[k]);
     }
   }
+  // Four-wide: from the root down, an inner node's slots are its children, the inner slot with
+  // most items expanded into its two children while fewer than four; each inner slot in turn
+  // (its FeatureWide numbered when it is queued, in the task's `begin`).
+  auto id_of = [&](std::uint32_t node, std::uint32_t wide) {
+    return nodes[node].b == 0 ? kFeatureLeafBit | nodes[node].a : wide;
+  };
+  wide_count = 0;
+  top = 0;
+  root = id_of(0, 0);
+  if (nodes[0].b != 0) stack[top++] = {0, wide_count++, 0};
+  while (top > 0) {
+    const MedianBvhTask task = stack[--top];
+    const FeatureNode& n = nodes[task.node];
+    std::uint32_t slot[4] = {n.a, n.a + 1, 0, 0};
+    int used = 2;
+    while (used < 4) {
+      int widest = -1;
+      for (int j = 0; j < used; ++j)
+        if (nodes[slot[j]].b != 0 && (widest < 0 || nodes[slot[j]].b > nodes[slot[widest]].b))
+          widest = j;
+      if (widest < 0) break;
+      const std::uint32_t left = nodes[slot[widest]].a;
+      slot[widest] = left;
+      slot[used++] = left + 1;
+    }
+    FeatureWide& wide = wides[task.begin];
+    wide.bounds.lanes = (1u << used) - 1;
+    for (int j = 0; j < 4; ++j) {
+      const bool in_use = j < used;
+      for (int k = 0; k < kFeatureLanes; ++k) {
+        wide.bounds.lo[k][j] = in_use ? nodes[slot[j]].lo[k] : INFINITY;
+        wide.bounds.hi[k][j] = in_use ? nodes[slot[j]].hi[k] : -INFINITY;
+      }
+      wide.child[j] = kNone;
+      if (!in_use) continue;
+      wide.child[j] = id_of(slot[j], wide_count);
+      if (nodes[slot[j]].b != 0) stack[top++] = {slot[j], wide_count++, 0};
+    }
+  }
 }
 
 namespace {
@@ -188,7 +228,8 @@ inline void merge_diagonals(Diagonals& a, const Diagonals& b) noexcept {
 }
 
 // Every pair of leaves of trees a and b (self: every pair of leaves of one tree, a leaf with
-// itself included) whose nodes' lanes overlap, each once: leaves(leaf_a, leaf_b, same_leaf).
+// itself included) whose lanes overlap, each once: leaves(leaf_a, leaf_b, same_leaf). Nodes
+// are checked four at a time (FeatureWide); an inner node against a leaf, by the leaf's items.
 // False when the worker's stack is too small.
 template <class Leaves>
 bool overlapping_leaves(const FeatureTree& a, const FeatureTree& b, bool self, Worker& w,
@@ -197,40 +238,58 @@ bool overlapping_leaves(const FeatureTree& a, const FeatureTree& b, bool self, W
   StackItem* stack = w.stack.data();
   const std::size_t cap = w.stack.size();
   std::size_t top = 0;
-  if (self || nodes_overlap(a.nodes[0], b.nodes[0])) stack[top++] = {0, 0};
+  stack[top++] = {a.root, b.root};
+  auto is_leaf = [](std::uint32_t id) { return (id & kFeatureLeafBit) != 0; };
+  auto prefetch = [&](const FeatureTree& t, std::uint32_t id) {
+    const void* p = is_leaf(id) ? static_cast<const void*>(&t.leaves[id & ~kFeatureLeafBit])
+                                : static_cast<const void*>(&t.wides[id]);
+    __builtin_prefetch(p);
+    __builtin_prefetch(static_cast<const char*>(p) + 64);
+    __builtin_prefetch(static_cast<const char*>(p) + 128);
+    __builtin_prefetch(static_cast<const char*>(p) + 192);
+  };
   while (top > 0 && !w.stop) {
     const StackItem it = stack[--top];
+    if (top > 0) {  // the next pair's blocks, while this one is checked
+      prefetch(a, stack[top - 1].a);
+      prefetch(b, stack[top - 1].b);
+    }
     ++w.stats.node_pairs_visited;
-    const FeatureNode& na = a.nodes[it.a];
-    const FeatureNode& nb = b.nodes[it.b];
-    if (top + 4 > cap) return false;
+    if (top + 16 > cap) return false;
+    const bool leaf_a = is_leaf(it.a), leaf_b = is_leaf(it.b);
+    if (leaf_a && leaf_b) {
+      leaves(a.leaves[it.a & ~kFeatureLeafBit], b.leaves[it.b & ~kFeatureLeafBit],
+             self && it.a == it.b);
+      continue;
+    }
     if (self && it.a == it.b) {
-      if (na.b == 0) {
-        leaves(a.leaves[na.a], a.leaves[na.a], true);
-        continue;
+      const FeatureWide& wa = a.wides[it.a];
+      for (int i = 0; i < 4 && (wa.bounds.lanes >> i & 1u); ++i) {
+        stack[top++] = {wa.child[i], wa.child[i]};
+        for (unsigned m = slot_overlap_mask(wa.bounds, i, wa.bounds) & (~0u << (i + 1)); m != 0;
+             m &= m - 1)
+          stack[top++] = {wa.child[i], wa.child[__builtin_ctz(m)]};
       }
-      stack[top++] = {na.a, na.a};
-      stack[top++] = {na.a + 1, na.a + 1};
-      if (nodes_overlap(a.nodes[na.a], a.nodes[na.a + 1])) stack[top++] = {na.a, na.a + 1};
       continue;
     }
-    if (na.b == 0 && nb.b == 0) {
-      leaves(a.leaves[na.a], b.leaves[nb.a], false);
-      continue;
-    }
-    if (na.b != 0 && nb.b != 0) {  // both inner: the four pairs of children
-      for (std::uint32_t ca = na.a + 2; ca-- > na.a;)
-        for (std::uint32_t cb = nb.a + 2; cb-- > nb.a;)
-          if (nodes_overlap(a.nodes[ca], b.nodes[cb])) stack[top++] = {ca, cb};
-      continue;
-    }
-    const bool split_a = nb.b == 0;
-    if (split_a) {
-      if (nodes_overlap(a.nodes[na.a + 1], nb)) stack[top++] = {na.a + 1, it.b};
-      if (nodes_overlap(a.nodes[na.a], nb)) stack[top++] = {na.a, it.b};
+    if (!leaf_a && !leaf_b) {  // up to four against four
+      const FeatureWide& wa = a.wides[it.a];
+      const FeatureWide& wb = b.wides[it.b];
+      for (int i = 0; i < 4 && (wa.bounds.lanes >> i & 1u); ++i)
+        for (unsigned m = slot_overlap_mask(wa.bounds, i, wb.bounds); m != 0; m &= m - 1)
+          stack[top++] = {wa.child[i], wb.child[__builtin_ctz(m)]};
+    } else if (!leaf_a) {  // an inner node against the items of a leaf
+      const FeatureWide& wa = a.wides[it.a];
+      const FeatureSlots& lb = b.leaves[it.b & ~kFeatureLeafBit].bounds;
+      unsigned m = 0;
+      for (int i = 0; i < 4 && (lb.lanes >> i & 1u); ++i) m |= slot_overlap_mask(lb, i, wa.bounds);
+      for (; m != 0; m &= m - 1) stack[top++] = {wa.child[__builtin_ctz(m)], it.b};
     } else {
-      if (nodes_overlap(na, b.nodes[nb.a + 1])) stack[top++] = {it.a, nb.a + 1};
-      if (nodes_overlap(na, b.nodes[nb.a])) stack[top++] = {it.a, nb.a};
+      const FeatureSlots& la = a.leaves[it.a & ~kFeatureLeafBit].bounds;
+      const FeatureWide& wb = b.wides[it.b];
+      unsigned m = 0;
+      for (int i = 0; i < 4 && (la.lanes >> i & 1u); ++i) m |= slot_overlap_mask(la, i, wb.bounds);
+      for (; m != 0; m &= m - 1) stack[top++] = {it.a, wb.child[__builtin_ctz(m)]};
     }
   }
   return true;
@@ -287,9 +346,9 @@ bool Collider::Impl::feature_pairs(Worker& w) noexcept {
   // repeats.
   const bool vf_ok = overlapping_leaves(
       vertex_tree, face_tree, false, w, [&](const FeatureLeaf& va, const FeatureLeaf& fb, bool) {
-        for (int i = 0; i < 4 && (va.lanes >> i & 1u); ++i) {
+        for (int i = 0; i < 4 && (va.bounds.lanes >> i & 1u); ++i) {
           const std::uint32_t p = va.node[0][i];
-          for (unsigned m = leaf_overlap_mask(va, i, fb); m != 0; m &= m - 1) {
+          for (unsigned m = slot_overlap_mask(va.bounds, i, fb.bounds); m != 0; m &= m - 1) {
             const int j = __builtin_ctz(m);
             if (p == fb.node[0][j] || p == fb.node[1][j] || p == fb.node[2][j]) continue;
             process_vertex_face(w, *this, p, *this, fb.item[j]);
@@ -302,9 +361,9 @@ bool Collider::Impl::feature_pairs(Worker& w) noexcept {
   // rule and the double box check are process_edge_edge's.
   return overlapping_leaves(
       edge_tree, edge_tree, true, w, [&](const FeatureLeaf& ea, const FeatureLeaf& eb, bool same) {
-        for (int i = 0; i < 4 && (ea.lanes >> i & 1u); ++i) {
+        for (int i = 0; i < 4 && (ea.bounds.lanes >> i & 1u); ++i) {
           const std::uint32_t a0 = ea.node[0][i], a1 = ea.node[1][i];
-          unsigned m = leaf_overlap_mask(ea, i, eb);
+          unsigned m = slot_overlap_mask(ea.bounds, i, eb.bounds);
           if (same) m &= ~0u << (i + 1);
           if (m == 0) continue;
           const std::uint32_t e1 = ea.item[i];

@@ -216,12 +216,17 @@ struct Diagonals {
 /// A BVH over item boxes (kFeatures: vertices, edges or triangles of one body) in the Morton
 /// order of their centres, built from scratch by `build` into storage reserved by `reserve`.
 /// Nodes and leaves hold float bounds rounded outwards (feature_bounds.hpp): the box, inflated
-/// by the margin on its hi side, and the diagonal slabs.
+/// by the margin on its hi side, and the diagonal slabs. The traversal sees the binary tree
+/// four-wide: an inner node's FeatureWide holds up to four descendants (the root's and each
+/// inner descendant's in turn), so one SIMD test checks a node against four.
 struct FeatureTree {
   std::unique_ptr<FeatureNode[]> nodes;   // node 0 the root; children after their parents
   std::uint32_t count = 0;                // nodes in use
   std::unique_ptr<FeatureLeaf[]> leaves;  // by leaf (FeatureNode::a of a leaf node)
   std::uint32_t leaf_count = 0;
+  std::unique_ptr<FeatureWide[]> wides;  // inner nodes seen four-wide
+  std::uint32_t wide_count = 0;
+  std::uint32_t root = 0;  // the root's id: a FeatureWide, or kFeatureLeafBit | its leaf
   /// Allocates everything for `items` items (may throw; nothing is written until a build).
   void reserve(std::uint32_t items);
   /// Builds over `items` items without allocating: item i's double box `item_box(i)`, its

@@ -44,9 +44,9 @@ inline float float_down(double d) noexcept {
 /// The smallest float >= d (d not NaN).
 inline float float_up(double d) noexcept { return -float_down(-d); }
 
-/// A tree node: lanes 0-6 of `lo` / `hi`, then (lane 7) `a` and `b`: inner node: a = left
-/// child (the right one is a + 1), b = items under it (> 0); leaf: a = its FeatureLeaf, b = 0.
-/// One cache line.
+/// A node of the binary tree a build makes first: lanes 0-6 of `lo` / `hi`, then (lane 7) `a`
+/// and `b`: a leaf has b = 0 and a = its FeatureLeaf; an inner node b = the items under it and
+/// a = its left child (the right one is a + 1).
 struct alignas(64) FeatureNode {
   float lo[kFeatureLanes];
   std::uint32_t a;
@@ -54,63 +54,75 @@ struct alignas(64) FeatureNode {
   std::uint32_t b;
 };
 
-/// Up to four items of a leaf in structure-of-arrays form (lane k of item i: lo[k][i],
-/// hi[k][i]), their item ids and their nodes (vertex: node[0]; edge: node[0..1]; face:
-/// node[0..2]); `lanes`: a bit per item (the first n).
-struct alignas(64) FeatureLeaf {
+/// Up to four slots in structure-of-arrays form (lane k of slot j: lo[k][j], hi[k][j]);
+/// `lanes`: a bit per slot in use (the first n; an unused slot also overlaps nothing).
+struct alignas(64) FeatureSlots {
   float lo[kFeatureLanes][4];
   float hi[kFeatureLanes][4];
-  std::uint32_t item[4];
-  std::uint32_t node[3][4];
   std::uint32_t lanes;
 };
 
-/// The lanes of two nodes overlap (closed intervals).
-inline bool nodes_overlap(const FeatureNode& a, const FeatureNode& b) noexcept {
-#if defined(__SSE2__)
-  const float* pa = a.lo;
-  const float* pb = b.lo;
-  const __m128 alo0 = _mm_load_ps(pa), alo1 = _mm_load_ps(pa + 4);
-  const __m128 ahi0 = _mm_load_ps(pa + 8), ahi1 = _mm_load_ps(pa + 12);
-  const __m128 blo0 = _mm_load_ps(pb), blo1 = _mm_load_ps(pb + 4);
-  const __m128 bhi0 = _mm_load_ps(pb + 8), bhi1 = _mm_load_ps(pb + 12);
-  const __m128 apart0 = _mm_or_ps(_mm_cmpgt_ps(alo0, bhi0), _mm_cmpgt_ps(blo0, ahi0));
-  const __m128 apart1 = _mm_or_ps(_mm_cmpgt_ps(alo1, bhi1), _mm_cmpgt_ps(blo1, ahi1));
-  return (_mm_movemask_ps(apart0) | (_mm_movemask_ps(apart1) & 7)) == 0;  // lane 7: a, b
-#else
-  bool apart = false;
-  for (int k = 0; k < kFeatureLanes; ++k) apart |= (a.lo[k] > b.hi[k]) | (b.lo[k] > a.hi[k]);
-  return !apart;
-#endif
-}
+/// A leaf: its items' lanes, their ids and their nodes (vertex: node[0]; edge: node[0..1];
+/// face: node[0..2]).
+struct FeatureLeaf {
+  FeatureSlots bounds;
+  std::uint32_t item[4];
+  std::uint32_t node[3][4];
+};
 
-/// Bit j set when item i of leaf `a` overlaps item j of leaf `b` in all seven lanes (closed
-/// intervals), for the items of b.
-inline unsigned leaf_overlap_mask(const FeatureLeaf& a, int i, const FeatureLeaf& b) noexcept {
+/// A traversal's id of a leaf: kFeatureLeafBit | its index (else: a FeatureWide's index).
+inline constexpr std::uint32_t kFeatureLeafBit = 0x80000000u;
+
+/// An inner node seen four-wide: the lanes of up to four descendant nodes (its children, the
+/// larger ones expanded into theirs) and their ids (a FeatureWide, or kFeatureLeafBit | leaf).
+struct FeatureWide {
+  FeatureSlots bounds;
+  std::uint32_t child[4];
+};
+
+/// Bit j set when the lanes `lo[k * stride]`, `hi[k * stride]` (k < 7) overlap slot j of `b`
+/// in all seven lanes (closed intervals), for the slots in use.
+inline unsigned slots_overlap_mask(const float* lo, const float* hi, int stride,
+                                   const FeatureSlots& b) noexcept {
 #if defined(__SSE2__)
-  // The box lanes first: most item pairs of overlapping leaves are apart there already.
+  // The box lanes first: most slot pairs of overlapping nodes are apart there already.
   auto apart_in = [&](int k) {
-    const __m128 lo = _mm_set1_ps(a.lo[k][i]), hi = _mm_set1_ps(a.hi[k][i]);
-    return _mm_or_ps(_mm_cmpgt_ps(lo, _mm_load_ps(b.hi[k])),
-                     _mm_cmpgt_ps(_mm_load_ps(b.lo[k]), hi));
+    const __m128 l = _mm_set1_ps(lo[k * stride]), h = _mm_set1_ps(hi[k * stride]);
+    return _mm_or_ps(_mm_cmpgt_ps(l, _mm_load_ps(b.hi[k])), _mm_cmpgt_ps(_mm_load_ps(b.lo[k]), h));
   };
-  const unsigned box = ~static_cast<unsigned>(
-                           _mm_movemask_ps(_mm_or_ps(apart_in(0), _mm_or_ps(apart_in(1), apart_in(2))))) &
-                       b.lanes;
-  if (box == 0) return 0;
+  const __m128 box = _mm_or_ps(apart_in(0), _mm_or_ps(apart_in(1), apart_in(2)));
+  const unsigned near = ~static_cast<unsigned>(_mm_movemask_ps(box)) & b.lanes;
+  if (near == 0) return 0;
   const __m128 slabs =
       _mm_or_ps(_mm_or_ps(apart_in(3), apart_in(4)), _mm_or_ps(apart_in(5), apart_in(6)));
-  return ~static_cast<unsigned>(_mm_movemask_ps(slabs)) & box;
+  return ~static_cast<unsigned>(_mm_movemask_ps(slabs)) & near;
 #else
   unsigned mask = 0;
   for (int j = 0; j < 4; ++j) {
     bool apart = false;
     for (int k = 0; k < kFeatureLanes; ++k)
-      apart |= (a.lo[k][i] > b.hi[k][j]) | (b.lo[k][j] > a.hi[k][i]);
+      apart |= (lo[k * stride] > b.hi[k][j]) | (b.lo[k][j] > hi[k * stride]);
     mask |= apart ? 0u : 1u << j;
   }
   return mask & b.lanes;
 #endif
+}
+
+/// Slot i of `a` against the slots of `b`.
+inline unsigned slot_overlap_mask(const FeatureSlots& a, int i, const FeatureSlots& b) noexcept {
+  return slots_overlap_mask(&a.lo[0][i], &a.hi[0][i], 4, b);
+}
+
+/// A node's lanes against the slots of `b`.
+inline unsigned node_overlap_mask(const FeatureNode& a, const FeatureSlots& b) noexcept {
+  return slots_overlap_mask(a.lo, a.hi, 1, b);
+}
+
+/// The lanes of two nodes overlap (closed intervals).
+inline bool nodes_overlap(const FeatureNode& a, const FeatureNode& b) noexcept {
+  bool apart = false;
+  for (int k = 0; k < kFeatureLanes; ++k) apart |= (a.lo[k] > b.hi[k]) | (b.lo[k] > a.hi[k]);
+  return !apart;
 }
 
 }  // namespace tetseg
