@@ -158,8 +158,8 @@ void Collider::Impl::construct(std::shared_ptr<const BodyShape> sh, const Collid
     const std::size_t most = std::max({std::size_t(nv), std::size_t(tri_count), ne});
     feature_key.resize(most);
     feature_key_scratch.resize(most);
-    vdiag.resize(nv);
-    item_diag.resize(std::max<std::size_t>(tri_count, ne));
+    vslabs.resize(nv);
+    item_slabs.resize(std::max<std::size_t>(tri_count, ne));
     feature_build_stack.resize(kMedianBvhStack);
   }
   skip_adjacent = uses_global_bvh();

@@ -38,16 +38,16 @@ namespace {
 // Leaf `f` of the items key[0, n) (n <= 4, Morton code and item id each) and its node's lanes.
 template <class ItemBox>
 void fill_leaf(const std::uint64_t* key, std::uint32_t n, const ItemBox& item_box,
-               const Diagonals* item_diag, double margin, const std::uint32_t* item_nodes,
+               const Slabs* item_slabs, double margin, const std::uint32_t* item_nodes,
                int nodes_per_item, FeatureLeaf& f, FeatureNode& node) noexcept {
   f.bounds.lanes = (1u << n) - 1;
-  for (int k = 0; k < kFeatureLanes; ++k) {
+  for (int k = 0; k < kNodeLanes; ++k) {
     node.lo[k] = INFINITY;
     node.hi[k] = -INFINITY;
   }
   for (std::uint32_t j = 0; j < 4; ++j) {
     if (j >= n) {  // an empty lane overlaps nothing (and `lanes` masks it out)
-      for (int k = 0; k < kFeatureLanes; ++k) {
+      for (int k = 0; k < kLeafLanes; ++k) {
         f.bounds.lo[k][j] = INFINITY;
         f.bounds.hi[k][j] = -INFINITY;
       }
@@ -61,14 +61,14 @@ void fill_leaf(const std::uint64_t* key, std::uint32_t n, const ItemBox& item_bo
       f.bounds.lo[k][j] = float_down(b.lo[k]);
       f.bounds.hi[k][j] = float_up(b.hi[k] + margin);  // the sum boxes_overlap compares
     }
-    for (int k = 0; k < 4; ++k) {
-      f.bounds.lo[3 + k][j] = item_diag ? item_diag[item].lo[k] : -INFINITY;
-      f.bounds.hi[3 + k][j] = item_diag ? item_diag[item].hi[k] : INFINITY;
+    for (int k = 0; k < kSlabs; ++k) {
+      f.bounds.lo[3 + k][j] = item_slabs ? item_slabs[item].lo[k] : -INFINITY;
+      f.bounds.hi[3 + k][j] = item_slabs ? item_slabs[item].hi[k] : INFINITY;
     }
     f.item[j] = item;
     for (int r = 0; r < 3; ++r)
       f.node[r][j] = r < nodes_per_item ? item_nodes[std::size_t(item) * nodes_per_item + r] : kNone;
-    for (int k = 0; k < kFeatureLanes; ++k) {
+    for (int k = 0; k < kNodeLanes; ++k) {
       node.lo[k] = std::min(node.lo[k], f.bounds.lo[k][j]);
       node.hi[k] = std::max(node.hi[k], f.bounds.hi[k][j]);
     }
@@ -78,7 +78,7 @@ void fill_leaf(const std::uint64_t* key, std::uint32_t n, const ItemBox& item_bo
 }  // namespace
 
 template <class ItemBox>
-void FeatureTree::build(const ItemBox& item_box, const Diagonals* item_diag, double margin,
+void FeatureTree::build(const ItemBox& item_box, const Slabs* item_slabs, double margin,
                         std::uint32_t items, const std::uint32_t* item_nodes, int nodes_per_item,
                         std::uint64_t* key, std::uint64_t* key_scratch,
                         MedianBvhTask* stack) noexcept {
@@ -130,7 +130,7 @@ void FeatureTree::build(const ItemBox& item_box, const Diagonals* item_diag, dou
     const std::uint32_t begin = task.begin, end = task.end;
     FeatureNode& node = nodes[task.node];
     if (end - begin <= kLeafSize) {
-      fill_leaf(key + begin, end - begin, item_box, item_diag, margin, item_nodes, nodes_per_item,
+      fill_leaf(key + begin, end - begin, item_box, item_slabs, margin, item_nodes, nodes_per_item,
                 leaves[leaf_count], node);
       node.a = leaf_count++;
       node.b = 0;
@@ -158,7 +158,7 @@ void FeatureTree::build(const ItemBox& item_box, const Diagonals* item_diag, dou
     if (n.b == 0) continue;
     const FeatureNode& l = nodes[n.a];
     const FeatureNode& r = nodes[n.a + 1];
-    for (int k = 0; k < kFeatureLanes; ++k) {
+    for (int k = 0; k < kNodeLanes; ++k) {
       n.lo[k] = std::min(l.lo[k], r.lo[k]);
       n.hi[k] = std::max(l.hi[k], r.hi[k]);
     }
@@ -192,7 +192,7 @@ void FeatureTree::build(const ItemBox& item_box, const Diagonals* item_diag, dou
     wide.bounds.lanes = (1u << used) - 1;
     for (int j = 0; j < 4; ++j) {
       const bool in_use = j < used;
-      for (int k = 0; k < kFeatureLanes; ++k) {
+      for (int k = 0; k < kNodeLanes; ++k) {
         wide.bounds.lo[k][j] = in_use ? nodes[slot[j]].lo[k] : INFINITY;
         wide.bounds.hi[k][j] = in_use ? nodes[slot[j]].hi[k] : -INFINITY;
       }
@@ -206,22 +206,23 @@ void FeatureTree::build(const ItemBox& item_box, const Diagonals* item_diag, dou
 
 namespace {
 
-// Projections of point p on the four diagonals (1,1,1), (1,1,-1), (1,-1,1), (-1,1,1), merged
-// into `d` (lo[4], hi[4]) as floats that hold the exact projections: with m = |x| + |y| + |z|,
-// a sum of three doubles errs by at most 2^-52 m and its rounding to float by at most 2^-24
-// (m + w) (2^-149 below the normal range), both inside the widening w = 2^-21 m + 1e-30.
-inline void add_diagonals(const double* p, Diagonals& d) noexcept {
+// Projections of point p on the ten directions of Slabs, merged into `d` as floats that hold
+// the exact projections: with m = |x| + |y| + |z|, a sum of two or three doubles errs by at
+// most 2^-52 m and its rounding to float by at most 2^-24 (m + w) (2^-149 below the normal
+// range), both inside the widening w = 2^-21 m + 1e-30.
+inline void add_slabs(const double* p, Slabs& d) noexcept {
   const double x = p[0], y = p[1], z = p[2];
   const double w = 0x1p-21 * (std::fabs(x) + std::fabs(y) + std::fabs(z)) + 1e-30;
-  const double s[4] = {x + y + z, x + y - z, x - y + z, -x + y + z};
-  for (int k = 0; k < 4; ++k) {
+  const double s[kSlabs] = {x + y + z, x + y - z, x - y + z, -x + y + z, x + y,
+                            x - y,     x + z,     x - z,     y + z,      y - z};
+  for (int k = 0; k < kSlabs; ++k) {
     d.lo[k] = std::min(d.lo[k], static_cast<float>(s[k] - w));
     d.hi[k] = std::max(d.hi[k], static_cast<float>(s[k] + w));
   }
 }
 
-inline void merge_diagonals(Diagonals& a, const Diagonals& b) noexcept {
-  for (int k = 0; k < 4; ++k) {
+inline void merge_slabs(Slabs& a, const Slabs& b) noexcept {
+  for (int k = 0; k < kSlabs; ++k) {
     a.lo[k] = std::min(a.lo[k], b.lo[k]);
     a.hi[k] = std::max(a.hi[k], b.hi[k]);
   }
@@ -266,7 +267,7 @@ bool overlapping_leaves(const FeatureTree& a, const FeatureTree& b, bool self, W
       const FeatureWide& wa = a.wides[it.a];
       for (int i = 0; i < 4 && (wa.bounds.lanes >> i & 1u); ++i) {
         stack[top++] = {wa.child[i], wa.child[i]};
-        for (unsigned m = slot_overlap_mask(wa.bounds, i, wa.bounds) & (~0u << (i + 1)); m != 0;
+        for (unsigned m = slot_overlap_mask<0, kNodeLanes>(wa.bounds, i, wa.bounds) & (~0u << (i + 1)); m != 0;
              m &= m - 1)
           stack[top++] = {wa.child[i], wa.child[__builtin_ctz(m)]};
       }
@@ -276,19 +277,19 @@ bool overlapping_leaves(const FeatureTree& a, const FeatureTree& b, bool self, W
       const FeatureWide& wa = a.wides[it.a];
       const FeatureWide& wb = b.wides[it.b];
       for (int i = 0; i < 4 && (wa.bounds.lanes >> i & 1u); ++i)
-        for (unsigned m = slot_overlap_mask(wa.bounds, i, wb.bounds); m != 0; m &= m - 1)
+        for (unsigned m = slot_overlap_mask<0, kNodeLanes>(wa.bounds, i, wb.bounds); m != 0; m &= m - 1)
           stack[top++] = {wa.child[i], wb.child[__builtin_ctz(m)]};
     } else if (!leaf_a) {  // an inner node against the items of a leaf
       const FeatureWide& wa = a.wides[it.a];
-      const FeatureSlots& lb = b.leaves[it.b & ~kFeatureLeafBit].bounds;
+      const FeatureSlots<kLeafLanes>& lb = b.leaves[it.b & ~kFeatureLeafBit].bounds;
       unsigned m = 0;
-      for (int i = 0; i < 4 && (lb.lanes >> i & 1u); ++i) m |= slot_overlap_mask(lb, i, wa.bounds);
+      for (int i = 0; i < 4 && (lb.lanes >> i & 1u); ++i) m |= slot_overlap_mask<0, kNodeLanes>(lb, i, wa.bounds);
       for (; m != 0; m &= m - 1) stack[top++] = {wa.child[__builtin_ctz(m)], it.b};
     } else {
-      const FeatureSlots& la = a.leaves[it.a & ~kFeatureLeafBit].bounds;
+      const FeatureSlots<kLeafLanes>& la = a.leaves[it.a & ~kFeatureLeafBit].bounds;
       const FeatureWide& wb = b.wides[it.b];
       unsigned m = 0;
-      for (int i = 0; i < 4 && (la.lanes >> i & 1u); ++i) m |= slot_overlap_mask(la, i, wb.bounds);
+      for (int i = 0; i < 4 && (la.lanes >> i & 1u); ++i) m |= slot_overlap_mask<0, kNodeLanes>(la, i, wb.bounds);
       for (; m != 0; m &= m - 1) stack[top++] = {it.a, wb.child[__builtin_ctz(m)]};
     }
   }
@@ -301,58 +302,58 @@ bool Collider::Impl::feature_pairs(Worker& w) noexcept {
   const double margin = opt.ccd.min_separation;
   const std::uint32_t nv = static_cast<std::uint32_t>(topo->surf_nodes.size());
   const std::uint32_t ne = static_cast<std::uint32_t>(topo->edges.size());
-  // Diagonal slabs (exact contact only; with a minimum separation the boxes alone cull).
-  const bool diagonals = margin <= 0;
-  if (diagonals) {
+  // Slabs (exact contact only; with a minimum separation the boxes alone cull).
+  const bool slabs = margin <= 0;
+  if (slabs) {
     for (std::uint32_t i = 0; i < nv; ++i) {
-      Diagonals d;
-      add_diagonals(pos0(topo->surf_nodes[i]), d);
-      add_diagonals(pos1(topo->surf_nodes[i]), d);
-      vdiag[i] = d;
+      Slabs d;
+      add_slabs(pos0(topo->surf_nodes[i]), d);
+      add_slabs(pos1(topo->surf_nodes[i]), d);
+      vslabs[i] = d;
     }
   }
   std::uint64_t* key = feature_key.data();
   std::uint64_t* key_scratch = feature_key_scratch.data();
   MedianBvhTask* build_stack = feature_build_stack.data();
   vertex_tree.build([&](std::uint32_t i) -> const Box& { return vbox[i]; },
-                    diagonals ? vdiag.data() : nullptr, margin, nv, topo->surf_nodes.data(), 1,
+                    slabs ? vslabs.data() : nullptr, margin, nv, topo->surf_nodes.data(), 1,
                     key, key_scratch, build_stack);
-  if (diagonals) {
+  if (slabs) {
     for (std::uint32_t t = 0; t < tri_count; ++t) {
       const std::array<std::uint32_t, 3>& tv = topo->tri_verts[t];
-      Diagonals d = vdiag[tv[0]];
-      merge_diagonals(d, vdiag[tv[1]]);
-      merge_diagonals(d, vdiag[tv[2]]);
-      item_diag[t] = d;
+      Slabs d = vslabs[tv[0]];
+      merge_slabs(d, vslabs[tv[1]]);
+      merge_slabs(d, vslabs[tv[2]]);
+      item_slabs[t] = d;
     }
   }
   face_tree.build([&](std::uint32_t t) -> const Box& { return tbox[t]; },
-                  diagonals ? item_diag.data() : nullptr, margin, tri_count,
+                  slabs ? item_slabs.data() : nullptr, margin, tri_count,
                   tri_count ? tris[0].data() : nullptr, 3, key, key_scratch, build_stack);
-  if (diagonals) {
+  if (slabs) {
     for (std::uint32_t e = 0; e < ne; ++e) {
       const std::array<std::uint32_t, 2>& ev = topo->edge_verts[e];
-      Diagonals d = vdiag[ev[0]];
-      merge_diagonals(d, vdiag[ev[1]]);
-      item_diag[e] = d;
+      Slabs d = vslabs[ev[0]];
+      merge_slabs(d, vslabs[ev[1]]);
+      item_slabs[e] = d;
     }
   }
   edge_tree.build([&](std::uint32_t e) { return edge_box(e); },
-                  diagonals ? item_diag.data() : nullptr, margin, ne,
+                  slabs ? item_slabs.data() : nullptr, margin, ne,
                   ne ? topo->edges[0].data() : nullptr, 2, key, key_scratch, build_stack);
 
-  // Vertex-face: a vertex and a face meet in one leaf pair of the two trees. The float lanes
-  // pass a superset of the double box check (feature_bounds.hpp), which process_vertex_face
-  // repeats.
+  // Vertex-face: a vertex and a face meet in one leaf pair of the two trees. The node lanes,
+  // then the shared node, then the other lanes: a superset of the double box check
+  // (feature_bounds.hpp), which process_vertex_face repeats.
   const bool vf_ok = overlapping_leaves(
       vertex_tree, face_tree, false, w, [&](const FeatureLeaf& va, const FeatureLeaf& fb, bool) {
         for (int i = 0; i < 4 && (va.bounds.lanes >> i & 1u); ++i) {
           const std::uint32_t p = va.node[0][i];
-          for (unsigned m = slot_overlap_mask(va.bounds, i, fb.bounds); m != 0; m &= m - 1) {
-            const int j = __builtin_ctz(m);
-            if (p == fb.node[0][j] || p == fb.node[1][j] || p == fb.node[2][j]) continue;
-            process_vertex_face(w, *this, p, *this, fb.item[j]);
-          }
+          unsigned m = slot_overlap_mask<0, kNodeLanes>(va.bounds, i, fb.bounds) &
+                       ~items_holding(p, fb, 3);
+          if (m != 0) m &= slot_overlap_mask<kNodeLanes, kLeafLanes>(va.bounds, i, fb.bounds);
+          for (; m != 0; m &= m - 1)
+            process_vertex_face(w, *this, p, *this, fb.item[__builtin_ctz(m)]);
         }
       });
   if (!vf_ok) return false;
@@ -362,17 +363,16 @@ bool Collider::Impl::feature_pairs(Worker& w) noexcept {
   return overlapping_leaves(
       edge_tree, edge_tree, true, w, [&](const FeatureLeaf& ea, const FeatureLeaf& eb, bool same) {
         for (int i = 0; i < 4 && (ea.bounds.lanes >> i & 1u); ++i) {
-          const std::uint32_t a0 = ea.node[0][i], a1 = ea.node[1][i];
-          unsigned m = slot_overlap_mask(ea.bounds, i, eb.bounds);
+          unsigned m = slot_overlap_mask<0, kNodeLanes>(ea.bounds, i, eb.bounds) &
+                       ~(items_holding(ea.node[0][i], eb, 2) | items_holding(ea.node[1][i], eb, 2));
           if (same) m &= ~0u << (i + 1);
+          if (m != 0) m &= slot_overlap_mask<kNodeLanes, kLeafLanes>(ea.bounds, i, eb.bounds);
           if (m == 0) continue;
           const std::uint32_t e1 = ea.item[i];
           const Box box1 = edge_box(e1);
           for (; m != 0; m &= m - 1) {
-            const int j = __builtin_ctz(m);
-            const std::uint32_t b0 = eb.node[0][j], b1 = eb.node[1][j];
-            if (a0 == b0 || a0 == b1 || a1 == b0 || a1 == b1) continue;
-            process_edge_edge(w, *this, e1, box1, *this, eb.item[j], edge_box(eb.item[j]));
+            const std::uint32_t e2 = eb.item[__builtin_ctz(m)];
+            process_edge_edge(w, *this, e1, box1, *this, e2, edge_box(e2));
           }
         }
       });

@@ -206,17 +206,10 @@ struct WholeSurfaceBvh {
   }
 };
 
-/// Slabs of a swept feature along the four diagonals (1,1,1), (1,1,-1), (1,-1,1), (-1,1,1)
-/// (unnormalised projections, in float rounded outwards): with the box, a 14-DOP.
-struct Diagonals {
-  float lo[4] = {INFINITY, INFINITY, INFINITY, INFINITY};
-  float hi[4] = {-INFINITY, -INFINITY, -INFINITY, -INFINITY};
-};
-
 /// A BVH over item boxes (kFeatures: vertices, edges or triangles of one body) in the Morton
 /// order of their centres, built from scratch by `build` into storage reserved by `reserve`.
 /// Nodes and leaves hold float bounds rounded outwards (feature_bounds.hpp): the box, inflated
-/// by the margin on its hi side, and the diagonal slabs. The traversal sees the binary tree
+/// by the margin on its hi side, and the slabs (Slabs). The traversal sees the binary tree
 /// four-wide: an inner node's FeatureWide holds up to four descendants (the root's and each
 /// inner descendant's in turn), so one SIMD test checks a node against four.
 struct FeatureTree {
@@ -230,12 +223,12 @@ struct FeatureTree {
   /// Allocates everything for `items` items (may throw; nothing is written until a build).
   void reserve(std::uint32_t items);
   /// Builds over `items` items without allocating: item i's double box `item_box(i)`, its
-  /// slabs `item_diag[i]` (null: slabs off, with a minimum separation), `margin` (the minimum
+  /// slabs `item_slabs[i]` (null: slabs off, with a minimum separation), `margin` (the minimum
   /// separation: added to every hi before rounding up), and its `nodes_per_item` nodes at
   /// `item_nodes` (1 to 3; kept in the leaves for the shared-node check). `key` and
   /// `key_scratch`: room for `items` each. Defined in collider_features.cpp (its only user).
   template <class ItemBox>
-  void build(const ItemBox& item_box, const Diagonals* item_diag, double margin,
+  void build(const ItemBox& item_box, const Slabs* item_slabs, double margin,
              std::uint32_t items, const std::uint32_t* item_nodes, int nodes_per_item,
              std::uint64_t* key, std::uint64_t* key_scratch, MedianBvhTask* stack) noexcept;
 };
@@ -586,8 +579,8 @@ struct Collider::Impl {
   /// rebuilt every step. Sized at construction.
   FeatureTree vertex_tree, face_tree, edge_tree;
   std::vector<std::uint64_t> feature_key, feature_key_scratch;  // the builds' (largest tree)
-  std::vector<Diagonals> vdiag;      // per surface vertex
-  std::vector<Diagonals> item_diag;  // scratch: per triangle, then per edge
+  std::vector<Slabs> vslabs;      // per surface vertex
+  std::vector<Slabs> item_slabs;  // scratch: per triangle, then per edge
   std::vector<MedianBvhTask> feature_build_stack;
   /// Every vertex-face and edge-edge pair with four distinct nodes whose swept boxes overlap,
   /// each once, through process_vertex_face / process_edge_edge. False on stack overflow.
