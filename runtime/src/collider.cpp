@@ -159,7 +159,6 @@ void Collider::Impl::construct(std::shared_ptr<const BodyShape> sh, const Collid
     feature_key.resize(most);
     feature_key_scratch.resize(most);
     vslabs.resize(nv);
-    item_slabs.resize(std::max<std::size_t>(tri_count, ne));
     feature_build_stack.resize(kMedianBvhStack);
   }
   skip_adjacent = uses_global_bvh();

@@ -36,9 +36,9 @@ inline std::uint32_t spread_bits(std::uint32_t v) noexcept {
 namespace {
 
 // Leaf `f` of the items key[0, n) (n <= 4, Morton code and item id each) and its node's lanes.
-template <class ItemBox>
+template <class ItemBox, class ItemSlabs>
 void fill_leaf(const std::uint64_t* key, std::uint32_t n, const ItemBox& item_box,
-               const Slabs* item_slabs, double margin, const std::uint32_t* item_nodes,
+               const ItemSlabs& item_slabs, bool slabs, double margin, const std::uint32_t* item_nodes,
                int nodes_per_item, FeatureLeaf& f, FeatureNode& node) noexcept {
   f.bounds.lanes = (1u << n) - 1;
   for (int k = 0; k < kNodeLanes; ++k) {
@@ -61,9 +61,11 @@ void fill_leaf(const std::uint64_t* key, std::uint32_t n, const ItemBox& item_bo
       f.bounds.lo[k][j] = float_down(b.lo[k]);
       f.bounds.hi[k][j] = float_up(b.hi[k] + margin);  // the sum boxes_overlap compares
     }
+    Slabs d;
+    if (slabs) d = item_slabs(item);
     for (int k = 0; k < kSlabs; ++k) {
-      f.bounds.lo[3 + k][j] = item_slabs ? item_slabs[item].lo[k] : -INFINITY;
-      f.bounds.hi[3 + k][j] = item_slabs ? item_slabs[item].hi[k] : INFINITY;
+      f.bounds.lo[3 + k][j] = slabs ? d.lo[k] : -INFINITY;
+      f.bounds.hi[3 + k][j] = slabs ? d.hi[k] : INFINITY;
     }
     f.item[j] = item;
     for (int r = 0; r < 3; ++r)
@@ -77,8 +79,9 @@ void fill_leaf(const std::uint64_t* key, std::uint32_t n, const ItemBox& item_bo
 
 }  // namespace
 
-template <class ItemBox>
-void FeatureTree::build(const ItemBox& item_box, const Slabs* item_slabs, double margin,
+template <class ItemBox, class ItemSlabs>
+void FeatureTree::build(const ItemBox& item_box, const ItemSlabs& item_slabs, bool slabs,
+                        double margin,
                         std::uint32_t items, const std::uint32_t* item_nodes, int nodes_per_item,
                         std::uint64_t* key, std::uint64_t* key_scratch,
                         MedianBvhTask* stack) noexcept {
@@ -130,7 +133,7 @@ void FeatureTree::build(const ItemBox& item_box, const Slabs* item_slabs, double
     const std::uint32_t begin = task.begin, end = task.end;
     FeatureNode& node = nodes[task.node];
     if (end - begin <= kLeafSize) {
-      fill_leaf(key + begin, end - begin, item_box, item_slabs, margin, item_nodes, nodes_per_item,
+      fill_leaf(key + begin, end - begin, item_box, item_slabs, slabs, margin, item_nodes, nodes_per_item,
                 leaves[leaf_count], node);
       node.a = leaf_count++;
       node.b = 0;
@@ -146,6 +149,10 @@ void FeatureTree::build(const ItemBox& item_box, const Slabs* item_slabs, double
                                [&](std::uint64_t k) { return ((k >> 32) & bit) == 0; });
       mid = static_cast<std::uint32_t>(split - key);
     }
+    // Full leaves: the split moved to the nearest multiple of four items from `begin` (all
+    // leaves but the last hold four; at most two levels per Morton bit, within the stack).
+    mid = begin + std::min((mid - begin + 2) / kLeafSize, (end - begin - 1) / kLeafSize) * kLeafSize;
+    mid = std::max(mid, begin + kLeafSize);
     node.a = count;  // left child; the right one is count + 1
     node.b = end - begin;
     count += 2;
@@ -316,31 +323,28 @@ bool Collider::Impl::feature_pairs(Worker& w) noexcept {
   std::uint64_t* key_scratch = feature_key_scratch.data();
   MedianBvhTask* build_stack = feature_build_stack.data();
   vertex_tree.build([&](std::uint32_t i) -> const Box& { return vbox[i]; },
-                    slabs ? vslabs.data() : nullptr, margin, nv, topo->surf_nodes.data(), 1,
-                    key, key_scratch, build_stack);
-  if (slabs) {
-    for (std::uint32_t t = 0; t < tri_count; ++t) {
-      const std::array<std::uint32_t, 3>& tv = topo->tri_verts[t];
-      Slabs d = vslabs[tv[0]];
-      merge_slabs(d, vslabs[tv[1]]);
-      merge_slabs(d, vslabs[tv[2]]);
-      item_slabs[t] = d;
-    }
-  }
-  face_tree.build([&](std::uint32_t t) -> const Box& { return tbox[t]; },
-                  slabs ? item_slabs.data() : nullptr, margin, tri_count,
-                  tri_count ? tris[0].data() : nullptr, 3, key, key_scratch, build_stack);
-  if (slabs) {
-    for (std::uint32_t e = 0; e < ne; ++e) {
-      const std::array<std::uint32_t, 2>& ev = topo->edge_verts[e];
-      Slabs d = vslabs[ev[0]];
-      merge_slabs(d, vslabs[ev[1]]);
-      item_slabs[e] = d;
-    }
-  }
-  edge_tree.build([&](std::uint32_t e) { return edge_box(e); },
-                  slabs ? item_slabs.data() : nullptr, margin, ne,
-                  ne ? topo->edges[0].data() : nullptr, 2, key, key_scratch, build_stack);
+                    [&](std::uint32_t i) -> const Slabs& { return vslabs[i]; }, slabs, margin, nv,
+                    topo->surf_nodes.data(), 1, key, key_scratch, build_stack);
+  face_tree.build(
+      [&](std::uint32_t t) -> const Box& { return tbox[t]; },
+      [&](std::uint32_t t) {
+        const std::array<std::uint32_t, 3>& tv = topo->tri_verts[t];
+        Slabs d = vslabs[tv[0]];
+        merge_slabs(d, vslabs[tv[1]]);
+        merge_slabs(d, vslabs[tv[2]]);
+        return d;
+      },
+      slabs, margin, tri_count, tri_count ? tris[0].data() : nullptr, 3, key, key_scratch,
+      build_stack);
+  edge_tree.build(
+      [&](std::uint32_t e) { return edge_box(e); },
+      [&](std::uint32_t e) {
+        const std::array<std::uint32_t, 2>& ev = topo->edge_verts[e];
+        Slabs d = vslabs[ev[0]];
+        merge_slabs(d, vslabs[ev[1]]);
+        return d;
+      },
+      slabs, margin, ne, ne ? topo->edges[0].data() : nullptr, 2, key, key_scratch, build_stack);
 
   // Vertex-face: a vertex and a face meet in one leaf pair of the two trees. The node lanes,
   // then the shared node, then the other lanes: a superset of the double box check

@@ -223,12 +223,12 @@ struct FeatureTree {
   /// Allocates everything for `items` items (may throw; nothing is written until a build).
   void reserve(std::uint32_t items);
   /// Builds over `items` items without allocating: item i's double box `item_box(i)`, its
-  /// slabs `item_slabs[i]` (null: slabs off, with a minimum separation), `margin` (the minimum
-  /// separation: added to every hi before rounding up), and its `nodes_per_item` nodes at
-  /// `item_nodes` (1 to 3; kept in the leaves for the shared-node check). `key` and
+  /// slabs `item_slabs(i)` (when `slabs`; else off, with a minimum separation), `margin` (the
+  /// minimum separation: added to every hi before rounding up), and its `nodes_per_item`
+  /// nodes at `item_nodes` (1 to 3; kept in the leaves for the shared-node check). `key` and
   /// `key_scratch`: room for `items` each. Defined in collider_features.cpp (its only user).
-  template <class ItemBox>
-  void build(const ItemBox& item_box, const Slabs* item_slabs, double margin,
+  template <class ItemBox, class ItemSlabs>
+  void build(const ItemBox& item_box, const ItemSlabs& item_slabs, bool slabs, double margin,
              std::uint32_t items, const std::uint32_t* item_nodes, int nodes_per_item,
              std::uint64_t* key, std::uint64_t* key_scratch, MedianBvhTask* stack) noexcept;
 };
@@ -579,8 +579,7 @@ struct Collider::Impl {
   /// rebuilt every step. Sized at construction.
   FeatureTree vertex_tree, face_tree, edge_tree;
   std::vector<std::uint64_t> feature_key, feature_key_scratch;  // the builds' (largest tree)
-  std::vector<Slabs> vslabs;      // per surface vertex
-  std::vector<Slabs> item_slabs;  // scratch: per triangle, then per edge
+  std::vector<Slabs> vslabs;  // per surface vertex
   std::vector<MedianBvhTask> feature_build_stack;
   /// Every vertex-face and edge-edge pair with four distinct nodes whose swept boxes overlap,
   /// each once, through process_vertex_face / process_edge_edge. False on stack overflow.
