@@ -8,16 +8,46 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
+#include <new>
+#include <type_traits>
+#if defined(__linux__)
+#include <sys/mman.h>
+#endif
 
 #include "collider_impl.hpp"
 
 namespace tetseg {
 
+namespace {
+
+// Room for n T (trivial types), not written: only what a build writes is ever touched. A large
+// array is aligned to 2 MiB and, on Linux, asks for transparent huge pages: a build writes tens
+// of MB that are new to the process, and first touches of 4 KiB pages (a fault each) cost more
+// than the writes themselves (docs/benchmarks.md, "Contact-rich steps", issue25l).
+template <class T>
+T* large_array(std::size_t n) {
+  static_assert(std::is_trivially_default_constructible<T>::value, "not written");
+  constexpr std::size_t kHuge = std::size_t(2) << 20;
+  std::size_t bytes = std::max<std::size_t>(n, 1) * sizeof(T);
+  const std::size_t align = bytes >= kHuge ? kHuge : alignof(T);
+  bytes = (bytes + align - 1) / align * align;
+  void* p = std::aligned_alloc(align, bytes);
+  if (p == nullptr) throw std::bad_alloc();
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+  if (align == kHuge) madvise(p, bytes, MADV_HUGEPAGE);  // advice only: failure is harmless
+#endif
+  return static_cast<T*>(p);
+}
+
+}  // namespace
+
 void FeatureTree::reserve(std::uint32_t items) {
-  // Default-initialised: only what a build writes is ever touched.
-  nodes.reset(new FeatureNode[items == 0 ? 1 : 2 * std::size_t(items) - 1]);
-  leaves.reset(new FeatureLeaf[items == 0 ? 1 : items]);
-  wides.reset(new FeatureWide[items == 0 ? 1 : items]);
+  // Every leaf but the last holds four items (build).
+  const std::size_t leaf_cap = std::max<std::size_t>(1, (std::size_t(items) + 3) / 4);
+  nodes.reset(large_array<FeatureNode>(2 * leaf_cap - 1));
+  leaves.reset(large_array<FeatureLeaf>(leaf_cap));
+  wides.reset(large_array<FeatureWide>(leaf_cap));
 }
 
 namespace {

@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cstddef>
 #include <cstdint>
+#include <cstdlib>
 #include <memory>
 #include <vector>
 #if defined(__SSE2__)
@@ -213,11 +214,17 @@ struct WholeSurfaceBvh {
 /// four-wide: an inner node's FeatureWide holds up to four descendants (the root's and each
 /// inner descendant's in turn), so one SIMD test checks a node against four.
 struct FeatureTree {
-  std::unique_ptr<FeatureNode[]> nodes;   // node 0 the root; children after their parents
-  std::uint32_t count = 0;                // nodes in use
-  std::unique_ptr<FeatureLeaf[]> leaves;  // by leaf (FeatureNode::a of a leaf node)
+  /// Storage from std::aligned_alloc (large_array in collider_features.cpp).
+  struct Free {
+    void operator()(void* p) const noexcept { std::free(p); }
+  };
+  template <class T>
+  using Array = std::unique_ptr<T[], Free>;
+  Array<FeatureNode> nodes;   // node 0 the root; children after their parents
+  std::uint32_t count = 0;    // nodes in use
+  Array<FeatureLeaf> leaves;  // by leaf (FeatureNode::a of a leaf node)
   std::uint32_t leaf_count = 0;
-  std::unique_ptr<FeatureWide[]> wides;  // inner nodes seen four-wide
+  Array<FeatureWide> wides;  // inner nodes seen four-wide
   std::uint32_t wide_count = 0;
   std::uint32_t root = 0;  // the root's id: a FeatureWide, or kFeatureLeafBit | its leaf
   /// Allocates everything for `items` items (may throw; nothing is written until a build).
