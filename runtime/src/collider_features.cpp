@@ -68,8 +68,9 @@ namespace {
 // Leaf `f` of the items key[0, n) (n <= 4, Morton code and item id each) and its node's lanes.
 template <class ItemBox, class ItemSlabs>
 void fill_leaf(const std::uint64_t* key, std::uint32_t n, const ItemBox& item_box,
-               const ItemSlabs& item_slabs, bool slabs, double margin, const std::uint32_t* item_nodes,
-               int nodes_per_item, FeatureLeaf& f, FeatureNode& node) noexcept {
+               const ItemSlabs& item_slabs, bool slabs, double margin,
+               const std::uint32_t* item_nodes, int nodes_per_item, FeatureLeaf& f,
+               FeatureNode& node) noexcept {
   f.bounds.lanes = (1u << n) - 1;
   for (int k = 0; k < kNodeLanes; ++k) {
     node.lo[k] = INFINITY;
@@ -99,7 +100,8 @@ void fill_leaf(const std::uint64_t* key, std::uint32_t n, const ItemBox& item_bo
     }
     f.item[j] = item;
     for (int r = 0; r < 3; ++r)
-      f.node[r][j] = r < nodes_per_item ? item_nodes[std::size_t(item) * nodes_per_item + r] : kNone;
+      f.node[r][j] =
+          r < nodes_per_item ? item_nodes[std::size_t(item) * nodes_per_item + r] : kNone;
     for (int k = 0; k < kNodeLanes; ++k) {
       node.lo[k] = std::min(node.lo[k], f.bounds.lo[k][j]);
       node.hi[k] = std::max(node.hi[k], f.bounds.hi[k][j]);
@@ -111,9 +113,8 @@ void fill_leaf(const std::uint64_t* key, std::uint32_t n, const ItemBox& item_bo
 
 template <class ItemBox, class ItemSlabs>
 void FeatureTree::build(const ItemBox& item_box, const ItemSlabs& item_slabs, bool slabs,
-                        double margin,
-                        std::uint32_t items, const std::uint32_t* item_nodes, int nodes_per_item,
-                        std::uint64_t* key, std::uint64_t* key_scratch,
+                        double margin, std::uint32_t items, const std::uint32_t* item_nodes,
+                        int nodes_per_item, std::uint64_t* key, std::uint64_t* key_scratch,
                         MedianBvhTask* stack) noexcept {
   constexpr std::uint32_t kLeafSize = 4;  // a FeatureLeaf's lanes
   count = leaf_count = 0;
@@ -163,8 +164,8 @@ void FeatureTree::build(const ItemBox& item_box, const ItemSlabs& item_slabs, bo
     const std::uint32_t begin = task.begin, end = task.end;
     FeatureNode& node = nodes[task.node];
     if (end - begin <= kLeafSize) {
-      fill_leaf(key + begin, end - begin, item_box, item_slabs, slabs, margin, item_nodes, nodes_per_item,
-                leaves[leaf_count], node);
+      fill_leaf(key + begin, end - begin, item_box, item_slabs, slabs, margin, item_nodes,
+                nodes_per_item, leaves[leaf_count], node);
       node.a = leaf_count++;
       node.b = 0;
       continue;
@@ -174,14 +175,14 @@ void FeatureTree::build(const ItemBox& item_box, const ItemSlabs& item_slabs, bo
     std::uint32_t mid = begin + (end - begin) / 2;
     if (first != last) {
       const std::uint32_t bit = 0x80000000u >> __builtin_clz(first ^ last);
-      const std::uint64_t* split =
-          std::partition_point(key + begin, key + end,
-                               [&](std::uint64_t k) { return ((k >> 32) & bit) == 0; });
+      const std::uint64_t* split = std::partition_point(
+          key + begin, key + end, [&](std::uint64_t k) { return ((k >> 32) & bit) == 0; });
       mid = static_cast<std::uint32_t>(split - key);
     }
     // Full leaves: the split moved to the nearest multiple of four items from `begin` (all
     // leaves but the last hold four; at most two levels per Morton bit, within the stack).
-    mid = begin + std::min((mid - begin + 2) / kLeafSize, (end - begin - 1) / kLeafSize) * kLeafSize;
+    mid =
+        begin + std::min((mid - begin + 2) / kLeafSize, (end - begin - 1) / kLeafSize) * kLeafSize;
     mid = std::max(mid, begin + kLeafSize);
     node.a = count;  // left child; the right one is count + 1
     node.b = end - begin;
@@ -304,8 +305,9 @@ bool overlapping_leaves(const FeatureTree& a, const FeatureTree& b, bool self, W
       const FeatureWide& wa = a.wides[it.a];
       for (int i = 0; i < 4 && (wa.bounds.lanes >> i & 1u); ++i) {
         stack[top++] = {wa.child[i], wa.child[i]};
-        for (unsigned m = slot_overlap_mask<0, kNodeLanes>(wa.bounds, i, wa.bounds) & (~0u << (i + 1)); m != 0;
-             m &= m - 1)
+        for (unsigned m =
+                 slot_overlap_mask<0, kNodeLanes>(wa.bounds, i, wa.bounds) & (~0u << (i + 1));
+             m != 0; m &= m - 1)
           stack[top++] = {wa.child[i], wa.child[__builtin_ctz(m)]};
       }
       continue;
@@ -314,19 +316,22 @@ bool overlapping_leaves(const FeatureTree& a, const FeatureTree& b, bool self, W
       const FeatureWide& wa = a.wides[it.a];
       const FeatureWide& wb = b.wides[it.b];
       for (int i = 0; i < 4 && (wa.bounds.lanes >> i & 1u); ++i)
-        for (unsigned m = slot_overlap_mask<0, kNodeLanes>(wa.bounds, i, wb.bounds); m != 0; m &= m - 1)
+        for (unsigned m = slot_overlap_mask<0, kNodeLanes>(wa.bounds, i, wb.bounds); m != 0;
+             m &= m - 1)
           stack[top++] = {wa.child[i], wb.child[__builtin_ctz(m)]};
     } else if (!leaf_a) {  // an inner node against the items of a leaf
       const FeatureWide& wa = a.wides[it.a];
       const FeatureSlots<kLeafLanes>& lb = b.leaves[it.b & ~kFeatureLeafBit].bounds;
       unsigned m = 0;
-      for (int i = 0; i < 4 && (lb.lanes >> i & 1u); ++i) m |= slot_overlap_mask<0, kNodeLanes>(lb, i, wa.bounds);
+      for (int i = 0; i < 4 && (lb.lanes >> i & 1u); ++i)
+        m |= slot_overlap_mask<0, kNodeLanes>(lb, i, wa.bounds);
       for (; m != 0; m &= m - 1) stack[top++] = {wa.child[__builtin_ctz(m)], it.b};
     } else {
       const FeatureSlots<kLeafLanes>& la = a.leaves[it.a & ~kFeatureLeafBit].bounds;
       const FeatureWide& wb = b.wides[it.b];
       unsigned m = 0;
-      for (int i = 0; i < 4 && (la.lanes >> i & 1u); ++i) m |= slot_overlap_mask<0, kNodeLanes>(la, i, wb.bounds);
+      for (int i = 0; i < 4 && (la.lanes >> i & 1u); ++i)
+        m |= slot_overlap_mask<0, kNodeLanes>(la, i, wb.bounds);
       for (; m != 0; m &= m - 1) stack[top++] = {it.a, wb.child[__builtin_ctz(m)]};
     }
   }
@@ -355,26 +360,25 @@ bool Collider::Impl::feature_pairs(Worker& w) noexcept {
   vertex_tree.build([&](std::uint32_t i) -> const Box& { return vbox[i]; },
                     [&](std::uint32_t i) -> const Slabs& { return vslabs[i]; }, slabs, margin, nv,
                     topo->surf_nodes.data(), 1, key, key_scratch, build_stack);
-  face_tree.build(
-      [&](std::uint32_t t) -> const Box& { return tbox[t]; },
-      [&](std::uint32_t t) {
-        const std::array<std::uint32_t, 3>& tv = topo->tri_verts[t];
-        Slabs d = vslabs[tv[0]];
-        merge_slabs(d, vslabs[tv[1]]);
-        merge_slabs(d, vslabs[tv[2]]);
-        return d;
-      },
-      slabs, margin, tri_count, tri_count ? tris[0].data() : nullptr, 3, key, key_scratch,
-      build_stack);
-  edge_tree.build(
-      [&](std::uint32_t e) { return edge_box(e); },
-      [&](std::uint32_t e) {
-        const std::array<std::uint32_t, 2>& ev = topo->edge_verts[e];
-        Slabs d = vslabs[ev[0]];
-        merge_slabs(d, vslabs[ev[1]]);
-        return d;
-      },
-      slabs, margin, ne, ne ? topo->edges[0].data() : nullptr, 2, key, key_scratch, build_stack);
+  face_tree.build([&](std::uint32_t t) -> const Box& { return tbox[t]; },
+                  [&](std::uint32_t t) {
+                    const std::array<std::uint32_t, 3>& tv = topo->tri_verts[t];
+                    Slabs d = vslabs[tv[0]];
+                    merge_slabs(d, vslabs[tv[1]]);
+                    merge_slabs(d, vslabs[tv[2]]);
+                    return d;
+                  },
+                  slabs, margin, tri_count, tri_count ? tris[0].data() : nullptr, 3, key,
+                  key_scratch, build_stack);
+  edge_tree.build([&](std::uint32_t e) { return edge_box(e); },
+                  [&](std::uint32_t e) {
+                    const std::array<std::uint32_t, 2>& ev = topo->edge_verts[e];
+                    Slabs d = vslabs[ev[0]];
+                    merge_slabs(d, vslabs[ev[1]]);
+                    return d;
+                  },
+                  slabs, margin, ne, ne ? topo->edges[0].data() : nullptr, 2, key, key_scratch,
+                  build_stack);
 
   // Vertex-face: a vertex and a face meet in one leaf pair of the two trees. The node lanes,
   // then the shared node, then the other lanes: a superset of the double box check
@@ -383,8 +387,8 @@ bool Collider::Impl::feature_pairs(Worker& w) noexcept {
       vertex_tree, face_tree, false, w, [&](const FeatureLeaf& va, const FeatureLeaf& fb, bool) {
         for (int i = 0; i < 4 && (va.bounds.lanes >> i & 1u); ++i) {
           const std::uint32_t p = va.node[0][i];
-          unsigned m = slot_overlap_mask<0, kNodeLanes>(va.bounds, i, fb.bounds) &
-                       ~items_holding(p, fb, 3);
+          unsigned m =
+              slot_overlap_mask<0, kNodeLanes>(va.bounds, i, fb.bounds) & ~items_holding(p, fb, 3);
           if (m != 0) m &= slot_overlap_mask<kNodeLanes, kLeafLanes>(va.bounds, i, fb.bounds);
           for (; m != 0; m &= m - 1)
             process_vertex_face(w, *this, p, *this, fb.item[__builtin_ctz(m)]);

@@ -9,6 +9,9 @@
 #include <cstdint>
 #include <cstdlib>
 #include <memory>
+#include <new>
+#include <type_traits>
+#include <utility>
 #include <vector>
 #if defined(__SSE2__)
 #include <emmintrin.h>
@@ -26,6 +29,30 @@
 namespace tetseg {
 
 inline constexpr std::uint32_t kNone = 0xffffffffu;
+
+/// std::allocator whose value-less construct default-initialises: a vector's resize leaves
+/// trivial elements unwritten, so large scratch written before it is read (per-step caches)
+/// touches no page it does not use.
+template <class T>
+struct DefaultInitAllocator : std::allocator<T> {
+  template <class U>
+  struct rebind {
+    using other = DefaultInitAllocator<U>;
+  };
+  DefaultInitAllocator() = default;
+  template <class U>
+  DefaultInitAllocator(const DefaultInitAllocator<U>&) noexcept {}
+  template <class U>
+  void construct(U* p) noexcept(std::is_nothrow_default_constructible<U>::value) {
+    ::new (static_cast<void*>(p)) U;
+  }
+  template <class U, class... Args>
+  void construct(U* p, Args&&... args) {
+    ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+  }
+};
+template <class T>
+using ScratchVector = std::vector<T, DefaultInitAllocator<T>>;
 
 /// Axis-aligned box.
 struct Box {
@@ -191,9 +218,9 @@ struct WholeSurfaceBvh {
   std::vector<format::BvhNode> nodes;
   std::uint32_t count = 0;          // nodes in use
   std::vector<std::uint32_t> leaf;  // triangle ids in leaf order
-  std::vector<double> centroid;     // scratch for the build
+  ScratchVector<double> centroid;   // scratch for the build
   std::vector<MedianBvhTask> build_stack;
-  std::vector<Box> box;                   // per node, this step
+  ScratchVector<Box> box;                 // per node, this step (written by refit)
   std::vector<std::uint32_t> ntris, mov;  // per node: triangles, moving triangles
 
   /// Allocates everything for `tri_count` triangles (may throw).
@@ -274,7 +301,7 @@ struct alignas(64) Worker {
   // the body's step_serial. Sized at construction (scene: add_body).
   const void* plane_owner = nullptr;
   std::vector<std::uint32_t> plane_base;
-  std::vector<FacePlaneStatic> plane;
+  ScratchVector<FacePlaneStatic> plane;  // an entry is written before it is valid
   std::vector<std::uint64_t> plane_step;
   /// Counts a contact: stops the traversal for kAny, else keeps the earliest and adds it to
   /// `sink`.
@@ -586,7 +613,7 @@ struct Collider::Impl {
   /// rebuilt every step. Sized at construction.
   FeatureTree vertex_tree, face_tree, edge_tree;
   std::vector<std::uint64_t> feature_key, feature_key_scratch;  // the builds' (largest tree)
-  std::vector<Slabs> vslabs;  // per surface vertex
+  std::vector<Slabs> vslabs;                                    // per surface vertex
   std::vector<MedianBvhTask> feature_build_stack;
   /// Every vertex-face and edge-edge pair with four distinct nodes whose swept boxes overlap,
   /// each once, through process_vertex_face / process_edge_edge. False on stack overflow.

@@ -24,9 +24,9 @@
 
 namespace tetseg {
 
-inline constexpr int kSlabs = 10;                 // the directions of Slabs
-inline constexpr int kLeafLanes = 3 + kSlabs;     // a leaf's items: x, y, z, then the slabs
-inline constexpr int kNodeLanes = 7;              // nodes: x, y, z and the first four slabs
+inline constexpr int kSlabs = 10;              // the directions of Slabs
+inline constexpr int kLeafLanes = 3 + kSlabs;  // a leaf's items: x, y, z, then the slabs
+inline constexpr int kNodeLanes = 7;           // nodes: x, y, z and the first four slabs
 
 /// Slabs of a swept feature along the ten directions (1,1,1), (1,1,-1), (1,-1,1), (-1,1,1),
 /// (1,1,0), (1,-1,0), (1,0,1), (1,0,-1), (0,1,1), (0,1,-1) (unnormalised projections, floats
@@ -58,7 +58,9 @@ inline float float_down(double d) noexcept {
 }
 
 /// The smallest float >= d (d not NaN).
-inline float float_up(double d) noexcept { return -float_down(-d); }
+inline float float_up(double d) noexcept {
+  return -float_down(-d);
+}
 
 /// A node of the binary tree a build makes first: the first kNodeLanes lanes of `lo` / `hi`,
 /// then `a` and `b`: a leaf has b = 0 and a = its FeatureLeaf; an inner node b = the items
@@ -138,7 +140,8 @@ inline unsigned items_holding(std::uint32_t node, const FeatureLeaf& b, int rows
   const __m128i n = _mm_set1_epi32(static_cast<int>(node));
   __m128i hit = _mm_setzero_si128();
   for (int r = 0; r < rows; ++r)
-    hit = _mm_or_si128(hit, _mm_cmpeq_epi32(n, _mm_load_si128(reinterpret_cast<const __m128i*>(b.node[r]))));
+    hit = _mm_or_si128(
+        hit, _mm_cmpeq_epi32(n, _mm_load_si128(reinterpret_cast<const __m128i*>(b.node[r]))));
   return static_cast<unsigned>(_mm_movemask_ps(_mm_castsi128_ps(hit)));
 #else
   unsigned mask = 0;
