@@ -4,13 +4,19 @@
 // on random triangle soups (separate triangles and a connected strip, some nodes still) and
 // on a libcgal-demo mesh deformed over steps until it touches itself. Every contact the
 // oracle finds is reported, each once, at the oracle's time, nothing else; with
-// `include_still_pairs` the still pairs too; the brute mode's contacts are the same list.
+// `include_still_pairs` the still pairs too; the brute mode's contacts are the same list. The
+// trees' float bounds (feature_bounds.hpp) are the nearest floats outwards, and contacts
+// exactly at box and slab ends survive them at offsets up to 1e6 and scales 1e-4 .. 1e4.
 
 #include <algorithm>
 #include <catch2/catch.hpp>
+#include <cmath>
+#include <limits>
 #include <memory>
 #include <random>
 #include <vector>
+
+#include "../../runtime/src/feature_bounds.hpp"
 
 #include "runtime/support/compare.hpp"
 #include "runtime/support/motions.hpp"
@@ -142,47 +148,131 @@ TEST_CASE("Features mode: random soups report exactly the brute-force oracle's c
   CHECK(still_only >= 1);      // and some contacts are between still nodes only
 }
 
-TEST_CASE("Features mode: contacts exactly at the ends of the diagonal slabs are found",
-          "[collider][features][oracle]") {
-  // A vertex reaching a face's corner a at t = 1 along a diagonal s, the face stretching away
-  // from a along s: the vertex's slab along s ends exactly where the face's begins (and their
-  // boxes touch too), so slabs that are not closed, or are narrower than the exact
-  // projections, lose the contact. Dyadic coordinates: the oracle decides exactly.
-  const double diagonals[4][3] = {{1, 1, 1}, {1, 1, -1}, {1, -1, 1}, {-1, 1, 1}};
+TEST_CASE("Features mode: float bounds are the nearest floats outwards",
+          "[collider][features][rounding]") {
+  // float_down(d) is the largest float <= d and float_up(d) the smallest >= d, at every scale
+  // and offset (and beyond the float range, and for denormals). The trees' lanes hold them.
+  const float kMax = std::numeric_limits<float>::max();
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::vector<double> values = {0.0,    -0.0,   1e-310, -1e-310,   1e-45,    -1e-45, 1.4e-45,
+                                3e-39,  -3e-39, kMax,   -kMax,     1e39,     -1e39,  1e300,
+                                -1e300, 0.1,    -0.1,   1e6 + 0.1, 1.0 / 3.0};
+  for (double offset : {0.0, 1e6, -1e6, 1e30})
+    for (double scale : {1e-4, 1e-2, 1.0, 1e2, 1e4})
+      for (int i = 0; i < 2000; ++i) values.push_back(offset + scale * u(rng));
+  int inexact = 0;
+  for (const double d : values) {
+    CAPTURE(d);
+    const float lo = float_down(d), hi = float_up(d);
+    REQUIRE(static_cast<double>(lo) <= d);
+    REQUIRE(static_cast<double>(hi) >= d);
+    if (d >= kMax) {
+      CHECK(lo == kMax);
+    } else {
+      REQUIRE(static_cast<double>(std::nextafter(lo, INFINITY)) > d);  // no float between
+    }
+    if (d <= -kMax) {
+      CHECK(hi == -kMax);
+    } else {
+      REQUIRE(static_cast<double>(std::nextafter(hi, -INFINITY)) < d);
+    }
+    inexact += lo != hi ? 1 : 0;
+  }
+  CHECK(inexact > 30000);  // most values are not floats: the rounding is exercised
+}
+
+TEST_CASE("Features mode: contacts exactly at the ends of boxes and slabs are found",
+          "[collider][features][oracle][rounding]") {
+  // A vertex reaching a face's corner a at t = 1 along a direction s, the face stretching away
+  // from a along s: the vertex's box and its slab along s end exactly where the face's begin,
+  // so bounds that are not closed, or narrower than the exact ones (a lo rounded up, a hi
+  // rounded down), lose the contact. Every slab direction (the four diagonals and the six
+  // edge diagonals), at large offsets and at scales 1e-4 .. 1e4, with coordinates that are not
+  // floats; exactly the brute mode's contacts, and the exact oracle's at unit scale.
+  const double directions[10][3] = {{1, 1, 1},  {1, 1, -1}, {1, -1, 1}, {-1, 1, 1}, {1, 1, 0},
+                                    {1, -1, 0}, {1, 0, 1},  {1, 0, -1}, {0, 1, 1},  {0, 1, -1}};
   std::mt19937_64 rng(7);
-  std::uniform_int_distribution<int> grid(-1024, 1024);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
   const std::vector<format::Triangle> tris = {{0, 1, 2}, {3, 4, 5}};
   const auto shape = shape_of(tris, 6);
   int found = 0;
-  for (const auto& s : diagonals) {
-    for (int trial = 0; trial < 8; ++trial) {
-      CAPTURE(s[0], s[1], s[2], trial);
-      double a[3];
-      for (double& c : a) c = std::ldexp(grid(rng), -6) + (trial % 2 ? 1e6 : 0.0);
-      std::vector<double> x0(18), x1(18);
-      auto put = [](std::vector<double>& x, int node, double px, double py, double pz) {
-        x[3 * node] = px, x[3 * node + 1] = py, x[3 * node + 2] = pz;
-      };
-      for (auto* x : {&x0, &x1}) {
-        put(*x, 0, a[0], a[1], a[2]);
-        put(*x, 1, a[0] + s[0] * 0.75, a[1], a[2]);
-        put(*x, 2, a[0], a[1] + s[1] * 0.5, a[2]);
-        put(*x, 4, a[0] + 5, a[1] + 5, a[2] + 5);  // the vertex's triangle, far off
-        put(*x, 5, a[0] + 5, a[1] + 6, a[2] + 5);
+  for (const auto& s : directions) {
+    for (double scale : {1e-4, 1e-2, 1.0, 1e2, 1e4}) {
+      for (double offset : {0.0, 1e6, -3e5}) {
+        CAPTURE(s[0], s[1], s[2], scale, offset);
+        double a[3];
+        for (double& c : a) c = offset + scale * (0.3 + 0.1 * u(rng));
+        // The face spans from a along two axes where s is not zero.
+        int axis[2] = {0, 1};
+        if (s[0] == 0) axis[0] = 2;
+        if (s[1] == 0) axis[1] = 2;
+        std::vector<double> x0(18), x1(18);
+        for (auto* x : {&x0, &x1}) {
+          for (int k = 0; k < 3; ++k) {
+            (*x)[k] = (*x)[3 + k] = (*x)[6 + k] = a[k];
+            (*x)[12 + k] = a[k] + 5 * scale;  // the vertex's triangle, far off
+            (*x)[15 + k] = a[k] + (k == 1 ? 6 : 5) * scale;
+          }
+          (*x)[3 + axis[0]] += s[axis[0]] * 0.75 * scale;
+          (*x)[6 + axis[1]] += s[axis[1]] * 0.5 * scale;
+        }
+        for (int k = 0; k < 3; ++k) {
+          x0[9 + k] = a[k] - 0.25 * scale * s[k];
+          x1[9 + k] = a[k];
+        }
+        ColliderOptions options;
+        options.mode = ColliderMode::kFeatures;
+        const std::vector<Contact> features = contacts_of(shape, options, x0.data(), x1.data());
+        ColliderOptions brute = options;
+        brute.mode = ColliderMode::kBrute;
+        const std::vector<Contact> want = contacts_of(shape, brute, x0.data(), x1.data());
+        REQUIRE_FALSE(want.empty());
+        require_same_list(features, want);
+        if (scale == 1.0 && offset == 0.0) {
+          const OracleBody body{tris.data(), tris.size(), x0.data(), x1.data(), true};
+          Collider collider(shape, options);
+          require_matches_oracle(answer(collider, x0.data(), x1.data()), step_truth(body),
+                                 Expect::kAllContacts);
+        }
+        ++found;
       }
-      put(x0, 3, a[0] - 0.25 * s[0], a[1] - 0.25 * s[1], a[2] - 0.25 * s[2]);
-      put(x1, 3, a[0], a[1], a[2]);
-      const OracleBody body{tris.data(), tris.size(), x0.data(), x1.data(), true};
-      const StepTruth truth = step_truth(body);
-      REQUIRE_FALSE(truth.required.empty());
-      ColliderOptions options;
-      options.mode = ColliderMode::kFeatures;
-      Collider collider(shape, options);
-      require_matches_oracle(answer(collider, x0.data(), x1.data()), truth, Expect::kAllContacts);
-      ++found;
     }
   }
-  CHECK(found == 32);
+  CHECK(found == 150);
+}
+
+TEST_CASE("Features mode: soups at large offsets and scales report the brute mode's contacts",
+          "[collider][features][rounding]") {
+  // The float lanes at every magnitude (1e6 offsets leave floats a step of 0.06 over a soup
+  // of size 1e-4), with and without a minimum separation (the margin added to every hi), and
+  // soups of one to nine triangles (partial leaves, a root that is a leaf).
+  int with_contacts = 0;
+  for (double scale : {1e-4, 1e-2, 1.0, 1e2, 1e4}) {
+    for (double offset : {0.0, 1e6}) {
+      for (int size : {1, 2, 3, 5, 9, 60}) {
+        CAPTURE(scale, offset, size);
+        Soup s = random_soup(static_cast<unsigned>(size * 31 + scale * 7), size, size / 2 + 1, 0.4,
+                             size % 2 ? 0 : 3);
+        for (auto* x : {&s.x0, &s.x1})
+          for (double& c : *x) c = offset + scale * c;
+        const auto shape = shape_of(s.tris, s.x0.size() / 3);
+        for (double separation : {0.0, 0.01}) {
+          CAPTURE(separation);
+          ColliderOptions options;
+          options.mode = ColliderMode::kFeatures;
+          options.ccd.min_separation = separation * scale;
+          const std::vector<Contact> features =
+              contacts_of(shape, options, s.x0.data(), s.x1.data());
+          ColliderOptions brute = options;
+          brute.mode = ColliderMode::kBrute;
+          require_same_list(features, contacts_of(shape, brute, s.x0.data(), s.x1.data()));
+          with_contacts += features.empty() ? 0 : 1;
+        }
+      }
+    }
+  }
+  CHECK(with_contacts >= 60);  // the comparison is not vacuous
 }
 
 TEST_CASE("Features mode: a minimum separation reports what the brute mode reports",
