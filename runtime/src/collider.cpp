@@ -150,17 +150,7 @@ void Collider::Impl::construct(std::shared_ptr<const BodyShape> sh, const Collid
   wmov.assign(nw, 0);
   wsign.assign(nw, 0);
   cluster_err.resize(cluster_count());
-  if (opt.mode == ColliderMode::kFeatures) {
-    const std::size_t ne = topo->edges.size();
-    vertex_tree.reserve(static_cast<std::uint32_t>(nv));
-    face_tree.reserve(tri_count);
-    edge_tree.reserve(static_cast<std::uint32_t>(ne));
-    const std::size_t most = std::max({std::size_t(nv), std::size_t(tri_count), ne});
-    feature_key.resize(most);
-    feature_key_scratch.resize(most);
-    vslabs.resize(nv);
-    feature_build_stack.resize(kMedianBvhStack);
-  }
+  if (opt.mode == ColliderMode::kFeatures) reserve_feature_trees();
   skip_adjacent = uses_global_bvh();
   if (skip_adjacent) build_orphan_sets();
   if (opt.mode == ColliderMode::kRvbc && cluster_count() > 1) build_seam_orphans();

@@ -42,12 +42,28 @@ T* large_array(std::size_t n) {
 
 }  // namespace
 
-void FeatureTree::reserve(std::uint32_t items) {
-  // Every leaf but the last holds four items (build).
-  const std::size_t leaf_cap = std::max<std::size_t>(1, (std::size_t(items) + 3) / 4);
-  nodes.reset(large_array<FeatureNode>(2 * leaf_cap - 1));
-  leaves.reset(large_array<FeatureLeaf>(leaf_cap));
-  wides.reset(large_array<FeatureWide>(leaf_cap));
+void Collider::Impl::reserve_feature_trees() {
+  const std::size_t counts[3] = {topo->surf_nodes.size(), tri_count, topo->edges.size()};
+  FeatureTree* trees[3] = {&vertex_tree, &face_tree, &edge_tree};
+  std::size_t leaves = 0, most = 0;
+  for (const std::size_t n : counts) {
+    leaves += FeatureTree::leaf_capacity(n);
+    most = std::max(most, n);
+  }
+  feature_nodes.reset(large_array<FeatureNode>(2 * FeatureTree::leaf_capacity(most) - 1));
+  feature_leaves.reset(large_array<FeatureLeaf>(leaves));
+  feature_wides.reset(large_array<FeatureWide>(leaves));
+  std::size_t first = 0;
+  for (int t = 0; t < 3; ++t) {
+    trees[t]->nodes = feature_nodes.get();
+    trees[t]->leaves = feature_leaves.get() + first;
+    trees[t]->wides = feature_wides.get() + first;
+    first += FeatureTree::leaf_capacity(counts[t]);
+  }
+  feature_key.resize(most);
+  feature_key_scratch.resize(most);
+  vslabs.resize(counts[0]);
+  feature_build_stack.resize(kMedianBvhStack);
 }
 
 namespace {

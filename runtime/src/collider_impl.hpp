@@ -247,15 +247,18 @@ struct FeatureTree {
   };
   template <class T>
   using Array = std::unique_ptr<T[], Free>;
-  Array<FeatureNode> nodes;   // node 0 the root; children after their parents
-  std::uint32_t count = 0;    // nodes in use
-  Array<FeatureLeaf> leaves;  // by leaf (FeatureNode::a of a leaf node)
+  /// Leaves (and wide nodes) a tree of `items` items needs at most: every leaf but the last
+  /// holds four items.
+  static std::size_t leaf_capacity(std::size_t items) noexcept {
+    return std::max<std::size_t>(1, (items + 3) / 4);
+  }
+  FeatureNode* nodes = nullptr;   // the binary tree (the build's; node 0 the root)
+  std::uint32_t count = 0;        // nodes in use
+  FeatureLeaf* leaves = nullptr;  // leaf_capacity(items) of them
   std::uint32_t leaf_count = 0;
-  Array<FeatureWide> wides;  // inner nodes seen four-wide
+  FeatureWide* wides = nullptr;  // inner nodes seen four-wide (as many as leaves)
   std::uint32_t wide_count = 0;
   std::uint32_t root = 0;  // the root's id: a FeatureWide, or kFeatureLeafBit | its leaf
-  /// Allocates everything for `items` items (may throw; nothing is written until a build).
-  void reserve(std::uint32_t items);
   /// Builds over `items` items without allocating: item i's double box `item_box(i)`, its
   /// slabs `item_slabs(i)` (when `slabs`; else off, with a minimum separation), `margin` (the
   /// minimum separation: added to every hi before rounding up), and its `nodes_per_item`
@@ -612,6 +615,13 @@ struct Collider::Impl {
   /// Morton-order BVHs over the swept boxes of the surface vertices, triangles and edges,
   /// rebuilt every step. Sized at construction.
   FeatureTree vertex_tree, face_tree, edge_tree;
+  // Their storage: the binary nodes shared (one build at a time), the leaves and wide nodes
+  // of the three trees one after the other (reserve_feature_trees).
+  FeatureTree::Array<FeatureNode> feature_nodes;
+  FeatureTree::Array<FeatureLeaf> feature_leaves;
+  FeatureTree::Array<FeatureWide> feature_wides;
+  /// Allocates the trees and their scratch (construction; may throw; nothing is written).
+  void reserve_feature_trees();
   std::vector<std::uint64_t> feature_key, feature_key_scratch;  // the builds' (largest tree)
   std::vector<Slabs> vslabs;                                    // per surface vertex
   std::vector<MedianBvhTask> feature_build_stack;

@@ -75,7 +75,7 @@ struct alignas(64) FeatureNode {
 /// Up to four slots of `Lanes` lanes in structure-of-arrays form (lane k of slot j: lo[k][j],
 /// hi[k][j]); `lanes`: a bit per slot in use (the first n; an unused slot overlaps nothing).
 template <int Lanes>
-struct alignas(64) FeatureSlots {
+struct alignas(16) FeatureSlots {
   float lo[Lanes][4];
   float hi[Lanes][4];
   std::uint32_t lanes;
