@@ -191,6 +191,11 @@ std::vector<Contact> sweep_contacts(const std::vector<std::array<double, 3>>& x0
   return contacts;
 }
 
+// Room for the runtime's contacts: dense contact frames such as cloth-ball have about 1.2 per
+// face; more take a second traversal. A larger buffer costs its first touch (about 6 ms per
+// 15 MB on the benchmark VM), every frame.
+constexpr std::size_t kContactsPerFace = 2;
+
 // The runtime's contacts in the order of `find_contacts`: vertex-face by (vertex, face id), then
 // edge-edge by nodes.
 std::vector<Contact> sorted_contacts(std::vector<tetseg::Contact>& found) {
@@ -253,9 +258,7 @@ std::vector<Contact> scene_contacts(const std::vector<std::array<double, 3>>& x0
   ColliderStatus st = scene.step();
   if (st != ColliderStatus::kOk)
     throw std::runtime_error(std::string("step rejected: ") + tetseg::to_string(st));
-  // Room for a few contacts per face (dense contact frames such as cloth-ball have about 1.2);
-  // more take a second traversal.
-  std::vector<tetseg::Contact> found(4 * faces.size() + 1024);
+  std::vector<tetseg::Contact> found(kContactsPerFace * faces.size() + 1024);
   ContactsResult r;
   st = scene.contacts(found.data(), found.size(), r);
   if (st == ColliderStatus::kOk && r.truncated()) {
@@ -296,9 +299,7 @@ std::vector<Contact> collider_features_contacts(
   ColliderStatus st = collider.step(x0.front().data(), x1.front().data());
   if (st != ColliderStatus::kOk)
     throw std::runtime_error(std::string("step rejected: ") + tetseg::to_string(st));
-  // Room for a few contacts per face (dense contact frames such as cloth-ball have about 1.2);
-  // more take a second pass.
-  std::vector<tetseg::Contact> found(4 * faces.size() + 1024);
+  std::vector<tetseg::Contact> found(kContactsPerFace * faces.size() + 1024);
   ContactsResult r;
   st = collider.contacts(found.data(), found.size(), r);
   if (st == ColliderStatus::kOk && r.truncated()) {
