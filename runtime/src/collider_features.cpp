@@ -1,10 +1,12 @@
 // kFeatures broad phase (docs/runtime.md, "Features mode"): BVHs in the Morton order of the
 // box centres over the swept boxes of the surface vertices, triangles and edges, rebuilt every
-// step; vertex-face candidates from the vertex tree against the triangle tree, edge-edge
-// candidates from the edge tree against itself; each candidate once (a vertex and a face meet
-// in one leaf pair, an edge pair in one leaf or leaf pair, in the leaf order), pairs sharing a
-// node skipped; then the same filters and elementary tests as every mode (process_vertex_face /
-// process_edge_edge). No triangle pairs, no orphan sets, nothing built per shape.
+// step, with float bounds rounded outwards (feature_bounds.hpp: boxes and ten slab directions,
+// a 26-DOP) and traversed four-wide; vertex-face candidates from the vertex tree against the
+// triangle tree, edge-edge candidates from the edge tree against itself; each candidate once (a
+// vertex and a face meet in one leaf pair, an edge pair in one leaf or leaf pair), pairs
+// sharing a node skipped; then the same filters and elementary tests as every mode
+// (process_vertex_face / process_edge_edge). No triangle pairs, no orphan sets, nothing built
+// per shape.
 
 #include <algorithm>
 #include <cmath>

@@ -5,14 +5,17 @@
 //
 // Contract (conservative): a float check may only reject what the exact double check rejects.
 // The double check of two items a, b is `a.lo > fl(b.hi + margin)` or `b.lo > fl(a.hi + margin)`
-// along an axis (boxes_overlap), or their double-derived float slabs apart (the slabs are
-// already floats rounded outwards, add_diagonals). Here lo is rounded down to float and
+// along an axis (boxes_overlap), or their slabs apart (the slabs are already floats that hold
+// the exact projections, add_slabs in collider_features.cpp). Here lo is rounded down to float and
 // hi_m = fl(hi + margin), the very double boxes_overlap compares, is rounded up: then
 // float a.lo <= a.lo and float hi_m >= fl(b.hi + margin), so `float a.lo > float b.hi_m`
 // implies the double rejection. No arithmetic is done in float; comparisons are closed, so
 // items touching exactly at a box or slab end overlap. A node's lanes are the min of its
 // items' lo and the max of their hi_m: a node pair is rejected only when every item pair
-// under it is. With a minimum separation the slabs are off (lanes -inf, +inf).
+// under it is. With a minimum separation the slabs are off (lanes -inf, +inf). (Rounding to
+// nearest is monotone too, so it would also keep every touching pair; the outward rounding
+// keeps the float bounds enclosing the double ones, which the node lanes and any future
+// arithmetic on them rely on. tests/runtime/features_mode_test.cpp fails on inward rounding.)
 
 #include <cmath>
 #include <cstdint>
