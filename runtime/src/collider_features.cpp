@@ -10,11 +10,15 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdlib>
 #include <new>
 #include <type_traits>
 #if defined(__linux__)
 #include <sys/mman.h>
+#endif
+#if defined(TETSEG_HAVE_OPENMP)
+#include <omp.h>
 #endif
 
 #include "collider_impl.hpp"
@@ -66,6 +70,12 @@ void Collider::Impl::reserve_feature_trees() {
   feature_key_scratch.resize(most);
   vslabs.resize(counts[0]);
   feature_build_stack.resize(kMedianBvhStack);
+  // The traversal pushes at most 16 pairs per pair it pops, one level further down one tree
+  // or both; a tree is less than kMedianBvhStack levels deep (build).
+  if (opt.traversal_stack == 0)
+    for (Worker& w : workers) w.stack.resize(std::max(w.stack.size(), 16 * 2 * kMedianBvhStack));
+  // Parallel: 32 tasks per worker, with room for the last expansion.
+  if (workers.size() > 1) feature_frontier.reserve(64 * workers.size() + 16);
 }
 
 namespace {
@@ -284,19 +294,64 @@ inline void merge_slabs(Slabs& a, const Slabs& b) noexcept {
   }
 }
 
-// Every pair of leaves of trees a and b (self: every pair of leaves of one tree, a leaf with
-// itself included) whose lanes overlap, each once: leaves(leaf_a, leaf_b, same_leaf). Nodes
-// are checked four at a time (FeatureWide); an inner node against a leaf, by the leaf's items.
-// False when the worker's stack is too small.
+bool is_leaf(std::uint32_t id) noexcept {
+  return (id & kFeatureLeafBit) != 0;
+}
+
+// One pair `it` of nodes of trees a and b (self: of one tree), each of whose lanes overlap:
+// a pair of leaves goes to leaves(leaf_a, leaf_b, same_leaf); otherwise its overlapping pairs
+// of descendants (at most 16) to push(item), each pair of leaves of the two once in the end.
+// Nodes are checked four at a time (FeatureWide); an inner node against a leaf, by the leaf's
+// items.
+template <class Push, class Leaves>
+void expand_pair(const FeatureTree& a, const FeatureTree& b, bool self, StackItem it, Push&& push,
+                 Leaves&& leaves) noexcept {
+  const bool leaf_a = is_leaf(it.a), leaf_b = is_leaf(it.b);
+  if (leaf_a && leaf_b) {
+    leaves(a.leaves[it.a & ~kFeatureLeafBit], b.leaves[it.b & ~kFeatureLeafBit],
+           self && it.a == it.b);
+  } else if (self && it.a == it.b) {
+    const FeatureWide& wa = a.wides[it.a];
+    for (int i = 0; i < 4 && (wa.bounds.lanes >> i & 1u); ++i) {
+      push(StackItem{wa.child[i], wa.child[i]});
+      for (unsigned m =
+               slot_overlap_mask<0, kNodeLanes>(wa.bounds, i, wa.bounds) & (~0u << (i + 1));
+           m != 0; m &= m - 1)
+        push(StackItem{wa.child[i], wa.child[__builtin_ctz(m)]});
+    }
+  } else if (!leaf_a && !leaf_b) {  // up to four against four
+    const FeatureWide& wa = a.wides[it.a];
+    const FeatureWide& wb = b.wides[it.b];
+    for (int i = 0; i < 4 && (wa.bounds.lanes >> i & 1u); ++i)
+      for (unsigned m = slot_overlap_mask<0, kNodeLanes>(wa.bounds, i, wb.bounds); m != 0;
+           m &= m - 1)
+        push(StackItem{wa.child[i], wb.child[__builtin_ctz(m)]});
+  } else if (!leaf_a) {  // an inner node against the items of a leaf
+    const FeatureWide& wa = a.wides[it.a];
+    const FeatureSlots<kLeafLanes>& lb = b.leaves[it.b & ~kFeatureLeafBit].bounds;
+    unsigned m = 0;
+    for (int i = 0; i < 4 && (lb.lanes >> i & 1u); ++i)
+      m |= slot_overlap_mask<0, kNodeLanes>(lb, i, wa.bounds);
+    for (; m != 0; m &= m - 1) push(StackItem{wa.child[__builtin_ctz(m)], it.b});
+  } else {
+    const FeatureSlots<kLeafLanes>& la = a.leaves[it.a & ~kFeatureLeafBit].bounds;
+    const FeatureWide& wb = b.wides[it.b];
+    unsigned m = 0;
+    for (int i = 0; i < 4 && (la.lanes >> i & 1u); ++i)
+      m |= slot_overlap_mask<0, kNodeLanes>(la, i, wb.bounds);
+    for (; m != 0; m &= m - 1) push(StackItem{it.a, wb.child[__builtin_ctz(m)]});
+  }
+}
+
+// Every pair of leaves under the pair `first` (expand_pair), each once, on w's stack. False
+// when the stack is too small.
 template <class Leaves>
-bool overlapping_leaves(const FeatureTree& a, const FeatureTree& b, bool self, Worker& w,
-                        Leaves&& leaves) noexcept {
-  if (a.count == 0 || b.count == 0) return true;
+bool overlapping_leaves(const FeatureTree& a, const FeatureTree& b, bool self, StackItem first,
+                        Worker& w, Leaves&& leaves) noexcept {
   StackItem* stack = w.stack.data();
   const std::size_t cap = w.stack.size();
   std::size_t top = 0;
-  stack[top++] = {a.root, b.root};
-  auto is_leaf = [](std::uint32_t id) { return (id & kFeatureLeafBit) != 0; };
+  stack[top++] = first;
   auto prefetch = [&](const FeatureTree& t, std::uint32_t id) {
     const void* p = is_leaf(id) ? static_cast<const void*>(&t.leaves[id & ~kFeatureLeafBit])
                                 : static_cast<const void*>(&t.wides[id]);
@@ -313,52 +368,15 @@ bool overlapping_leaves(const FeatureTree& a, const FeatureTree& b, bool self, W
     }
     ++w.stats.node_pairs_visited;
     if (top + 16 > cap) return false;
-    const bool leaf_a = is_leaf(it.a), leaf_b = is_leaf(it.b);
-    if (leaf_a && leaf_b) {
-      leaves(a.leaves[it.a & ~kFeatureLeafBit], b.leaves[it.b & ~kFeatureLeafBit],
-             self && it.a == it.b);
-      continue;
-    }
-    if (self && it.a == it.b) {
-      const FeatureWide& wa = a.wides[it.a];
-      for (int i = 0; i < 4 && (wa.bounds.lanes >> i & 1u); ++i) {
-        stack[top++] = {wa.child[i], wa.child[i]};
-        for (unsigned m =
-                 slot_overlap_mask<0, kNodeLanes>(wa.bounds, i, wa.bounds) & (~0u << (i + 1));
-             m != 0; m &= m - 1)
-          stack[top++] = {wa.child[i], wa.child[__builtin_ctz(m)]};
-      }
-      continue;
-    }
-    if (!leaf_a && !leaf_b) {  // up to four against four
-      const FeatureWide& wa = a.wides[it.a];
-      const FeatureWide& wb = b.wides[it.b];
-      for (int i = 0; i < 4 && (wa.bounds.lanes >> i & 1u); ++i)
-        for (unsigned m = slot_overlap_mask<0, kNodeLanes>(wa.bounds, i, wb.bounds); m != 0;
-             m &= m - 1)
-          stack[top++] = {wa.child[i], wb.child[__builtin_ctz(m)]};
-    } else if (!leaf_a) {  // an inner node against the items of a leaf
-      const FeatureWide& wa = a.wides[it.a];
-      const FeatureSlots<kLeafLanes>& lb = b.leaves[it.b & ~kFeatureLeafBit].bounds;
-      unsigned m = 0;
-      for (int i = 0; i < 4 && (lb.lanes >> i & 1u); ++i)
-        m |= slot_overlap_mask<0, kNodeLanes>(lb, i, wa.bounds);
-      for (; m != 0; m &= m - 1) stack[top++] = {wa.child[__builtin_ctz(m)], it.b};
-    } else {
-      const FeatureSlots<kLeafLanes>& la = a.leaves[it.a & ~kFeatureLeafBit].bounds;
-      const FeatureWide& wb = b.wides[it.b];
-      unsigned m = 0;
-      for (int i = 0; i < 4 && (la.lanes >> i & 1u); ++i)
-        m |= slot_overlap_mask<0, kNodeLanes>(la, i, wb.bounds);
-      for (; m != 0; m &= m - 1) stack[top++] = {it.a, wb.child[__builtin_ctz(m)]};
-    }
+    expand_pair(
+        a, b, self, it, [&](StackItem c) { stack[top++] = c; }, leaves);
   }
   return true;
 }
 
 }  // namespace
 
-bool Collider::Impl::feature_pairs(Worker& w) noexcept {
+bool Collider::Impl::feature_pairs(Worker& w0, bool parallel) noexcept {
   const double margin = opt.ccd.min_separation;
   const std::uint32_t nv = static_cast<std::uint32_t>(topo->surf_nodes.size());
   const std::uint32_t ne = static_cast<std::uint32_t>(topo->edges.size());
@@ -401,37 +419,89 @@ bool Collider::Impl::feature_pairs(Worker& w) noexcept {
   // Vertex-face: a vertex and a face meet in one leaf pair of the two trees. The node lanes,
   // then the shared node, then the other lanes: a superset of the double box check
   // (feature_bounds.hpp), which process_vertex_face repeats.
-  const bool vf_ok = overlapping_leaves(
-      vertex_tree, face_tree, false, w, [&](const FeatureLeaf& va, const FeatureLeaf& fb, bool) {
-        for (int i = 0; i < 4 && (va.bounds.lanes >> i & 1u); ++i) {
-          const std::uint32_t p = va.node[0][i];
-          unsigned m =
-              slot_overlap_mask<0, kNodeLanes>(va.bounds, i, fb.bounds) & ~items_holding(p, fb, 3);
-          if (m != 0) m &= slot_overlap_mask<kNodeLanes, kLeafLanes>(va.bounds, i, fb.bounds);
-          for (; m != 0; m &= m - 1)
-            process_vertex_face(w, *this, p, *this, fb.item[__builtin_ctz(m)]);
-        }
-      });
-  if (!vf_ok) return false;
-
+  auto vertex_faces = [this](Worker& w, const FeatureLeaf& va, const FeatureLeaf& fb, bool) {
+    for (int i = 0; i < 4 && (va.bounds.lanes >> i & 1u); ++i) {
+      const std::uint32_t p = va.node[0][i];
+      unsigned m =
+          slot_overlap_mask<0, kNodeLanes>(va.bounds, i, fb.bounds) & ~items_holding(p, fb, 3);
+      if (m != 0) m &= slot_overlap_mask<kNodeLanes, kLeafLanes>(va.bounds, i, fb.bounds);
+      for (; m != 0; m &= m - 1) process_vertex_face(w, *this, p, *this, fb.item[__builtin_ctz(m)]);
+    }
+  };
   // Edge-edge: a pair of edges meets in one leaf (lanes i < j) or one leaf pair; the still
   // rule and the double box check are process_edge_edge's.
-  return overlapping_leaves(
-      edge_tree, edge_tree, true, w, [&](const FeatureLeaf& ea, const FeatureLeaf& eb, bool same) {
-        for (int i = 0; i < 4 && (ea.bounds.lanes >> i & 1u); ++i) {
-          unsigned m = slot_overlap_mask<0, kNodeLanes>(ea.bounds, i, eb.bounds) &
-                       ~(items_holding(ea.node[0][i], eb, 2) | items_holding(ea.node[1][i], eb, 2));
-          if (same) m &= ~0u << (i + 1);
-          if (m != 0) m &= slot_overlap_mask<kNodeLanes, kLeafLanes>(ea.bounds, i, eb.bounds);
-          if (m == 0) continue;
-          const std::uint32_t e1 = ea.item[i];
-          const Box box1 = edge_box(e1);
-          for (; m != 0; m &= m - 1) {
-            const std::uint32_t e2 = eb.item[__builtin_ctz(m)];
-            process_edge_edge(w, *this, e1, box1, *this, e2, edge_box(e2));
-          }
-        }
-      });
+  auto edge_edges = [this](Worker& w, const FeatureLeaf& ea, const FeatureLeaf& eb, bool same) {
+    for (int i = 0; i < 4 && (ea.bounds.lanes >> i & 1u); ++i) {
+      unsigned m = slot_overlap_mask<0, kNodeLanes>(ea.bounds, i, eb.bounds) &
+                   ~(items_holding(ea.node[0][i], eb, 2) | items_holding(ea.node[1][i], eb, 2));
+      if (same) m &= ~0u << (i + 1);
+      if (m != 0) m &= slot_overlap_mask<kNodeLanes, kLeafLanes>(ea.bounds, i, eb.bounds);
+      if (m == 0) continue;
+      const std::uint32_t e1 = ea.item[i];
+      const Box box1 = edge_box(e1);
+      for (; m != 0; m &= m - 1) {
+        const std::uint32_t e2 = eb.item[__builtin_ctz(m)];
+        process_edge_edge(w, *this, e1, box1, *this, e2, edge_box(e2));
+      }
+    }
+  };
+  // One task: the pairs under one pair of nodes of the vertex and face trees, or of the edge
+  // tree with itself.
+  auto run = [&](Worker& w, const FeatureTask& task) {
+    if (task.edges)
+      return overlapping_leaves(edge_tree, edge_tree, true, task.item, w,
+                                [&](const FeatureLeaf& x, const FeatureLeaf& y, bool same) {
+                                  edge_edges(w, x, y, same);
+                                });
+    return overlapping_leaves(vertex_tree, face_tree, false, task.item, w,
+                              [&](const FeatureLeaf& x, const FeatureLeaf& y, bool same) {
+                                vertex_faces(w, x, y, same);
+                              });
+  };
+  const bool vf = vertex_tree.count > 0 && face_tree.count > 0;
+  const bool ee = edge_tree.count > 0;
+  (void)parallel;  // without OpenMP there is one worker
+#if defined(TETSEG_HAVE_OPENMP)
+  if (parallel && feature_frontier.capacity() > 0) {
+    // The top of both traversals breadth first on this thread, into tasks; the tasks on the
+    // workers (each pair of leaves once, whoever takes it: the serial pairs and counts).
+    std::vector<FeatureTask>& tasks = feature_frontier;
+    tasks.clear();
+    if (vf) tasks.push_back({{vertex_tree.root, face_tree.root}, false});
+    if (ee) tasks.push_back({{edge_tree.root, edge_tree.root}, true});
+    const std::size_t enough = feature_frontier.capacity() - 16;  // room for one expansion
+    std::size_t i = 0;
+    while (i < tasks.size() && tasks.size() < enough / 2) {
+      const FeatureTask task = tasks[i];
+      if (is_leaf(task.item.a) && is_leaf(task.item.b)) {
+        ++i;
+        continue;
+      }
+      tasks[i] = tasks.back();
+      tasks.pop_back();
+      ++w0.stats.node_pairs_visited;
+      auto push = [&](StackItem c) { tasks.push_back({c, task.edges}); };
+      auto none = [](const FeatureLeaf&, const FeatureLeaf&, bool) {};
+      if (task.edges)
+        expand_pair(edge_tree, edge_tree, true, task.item, push, none);
+      else
+        expand_pair(vertex_tree, face_tree, false, task.item, push, none);
+    }
+    const auto count = static_cast<std::int64_t>(tasks.size());
+#pragma omp parallel num_threads(static_cast <int>(workers.size()))
+    {
+      Worker& wt = workers[static_cast<std::size_t>(omp_get_thread_num())];
+      if (omp_get_thread_num() == 0)
+        stats.traversal_threads = static_cast<std::uint32_t>(omp_get_num_threads());
+#pragma omp for schedule(dynamic, 1)
+      for (std::int64_t k = 0; k < count; ++k)
+        if (!wt.stop && !run(wt, tasks[static_cast<std::size_t>(k)])) wt.overflow = true;
+    }
+    return true;
+  }
+#endif
+  if (vf && !run(w0, {{vertex_tree.root, face_tree.root}, false})) return false;
+  return !ee || run(w0, {{edge_tree.root, edge_tree.root}, true});
 }
 
 }  // namespace tetseg

@@ -270,6 +270,13 @@ struct FeatureTree {
              std::uint64_t* key, std::uint64_t* key_scratch, MedianBvhTask* stack) noexcept;
 };
 
+/// A task of the features mode's parallel traversal: a pair of nodes of the vertex and face
+/// trees, or (`edges`) of the edge tree with itself.
+struct FeatureTask {
+  StackItem item;
+  bool edges;
+};
+
 /// A caller's contact buffer, shared by every worker of one query: it keeps the `cap`
 /// smallest contacts in `contact_less` order (a max-heap on that order while filling; the
 /// query sorts it at the end), so its content does not depend on which worker finds what, or
@@ -625,9 +632,14 @@ struct Collider::Impl {
   std::vector<std::uint64_t> feature_key, feature_key_scratch;  // the builds' (largest tree)
   std::vector<Slabs> vslabs;                                    // per surface vertex
   std::vector<MedianBvhTask> feature_build_stack;
+  /// Tasks of the parallel traversal (feature_pairs; reserved at construction with several
+  /// workers).
+  std::vector<FeatureTask> feature_frontier;
   /// Every vertex-face and edge-edge pair with four distinct nodes whose swept boxes overlap,
-  /// each once, through process_vertex_face / process_edge_edge. False on stack overflow.
-  bool feature_pairs(Worker& w) noexcept;
+  /// each once, through process_vertex_face / process_edge_edge: on `w0`, or with `parallel`
+  /// on the OpenMP workers (the top of the traversals expanded on `w0` into tasks; a worker's
+  /// overflow marked in its `overflow`). False on stack overflow.
+  bool feature_pairs(Worker& w0, bool parallel) noexcept;
 
   // --- collider_cone.cpp (kCone; the cone maths: normal_cone.hpp)
   ConeData cone;  // kCone, indexed by global BVH node

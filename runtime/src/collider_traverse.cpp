@@ -569,7 +569,7 @@ bool Collider::Impl::run_query(ContactSink* sink) noexcept {
       }
       if (skip_adjacent && !rest_mode && !w0.overflow) test_orphans(w0);
     } else if (opt.mode == ColliderMode::kFeatures && !rest_mode) {
-      if (!feature_pairs(w0)) w0.overflow = true;
+      if (!feature_pairs(w0, parallel)) w0.overflow = true;
     } else if (opt.mode == ColliderMode::kBrute && !rest_mode) {
 #if defined(TETSEG_HAVE_OPENMP)
       if (parallel) {

@@ -331,6 +331,69 @@ TEST_CASE("Features mode: a deformed real mesh matches the exact oracle up to it
   CHECK(steps >= 2);
 }
 
+#if defined(TETSEG_TEST_OPENMP)
+TEST_CASE("Features mode: two threads report the serial contacts and counts",
+          "[collider][features][openmp]") {
+  // Random soups (a few hundred triangles: tasks of both traversals) and a libcgal-demo mesh
+  // deformed until it touches itself: the same contacts in the same order, the same earliest
+  // contact and counts, and the parallel path did run.
+  auto compare = [](const std::shared_ptr<const BodyShape>& shape, const double* x0,
+                    const double* x1) {
+    ColliderOptions serial_options;
+    serial_options.mode = ColliderMode::kFeatures;
+    ColliderOptions parallel_options = serial_options;
+    parallel_options.use_openmp = true;
+    parallel_options.threads = 2;
+    Collider serial(shape, serial_options), parallel(shape, parallel_options);
+    std::vector<Contact> s(1 << 16), p(1 << 16);
+    for (Collider* c : {&serial, &parallel}) REQUIRE(c->step(x0, x1) == ColliderStatus::kOk);
+    const ContactsResult rs = contacts_ok(serial, s.data(), s.size());
+    const ContactsResult rp = contacts_ok(parallel, p.data(), p.size());
+    REQUIRE(serial.stats().traversal_threads == 1);
+    REQUIRE(parallel.stats().traversal_threads == 2);  // the parallel path ran
+    REQUIRE_FALSE(rs.truncated());
+    REQUIRE(rp.written == rs.written);
+    for (std::size_t i = 0; i < rs.written; ++i) {
+      CAPTURE(i);
+      REQUIRE(same_feature(p[i], s[i]));
+      REQUIRE(p[i].toi == s[i].toi);
+      REQUIRE(p[i].at_start == s[i].at_start);
+    }
+    CHECK(parallel.stats().node_pairs_visited == serial.stats().node_pairs_visited);
+    CHECK(parallel.stats().feature_pairs == serial.stats().feature_pairs);
+    CHECK(parallel.stats().feature_tests == serial.stats().feature_tests);
+    const EarliestContact es = earliest_ok(serial), ep = earliest_ok(parallel);
+    REQUIRE(ep.found == es.found);
+    if (es.found) REQUIRE(same_feature(ep.contact, es.contact));
+    return rs.written;
+  };
+  std::size_t contacts = 0;
+  for (unsigned seed = 40; seed < 46; ++seed) {
+    CAPTURE(seed);
+    const Soup s = random_soup(seed, 300, 200, 0.3, seed % 2 ? 0 : 5);
+    contacts += compare(shape_of(s.tris, s.x0.size() / 3), s.x0.data(), s.x1.data());
+  }
+  CHECK(contacts > 100);  // not vacuous
+  Surface mesh;
+  if (!read_demo_surface("eight", mesh)) return;
+  const auto shape = shape_of(mesh.tris, mesh.verts.size());
+  const double size = bounding_diagonal(mesh);
+  const Waves waves(11, 0.2 * size, 6.0 / size);
+  std::size_t mesh_contacts = 0;
+  for (int f = 0; f < 10; ++f) {
+    CAPTURE(f);
+    std::vector<double> x0, x1;
+    for (const P3& p : mesh.verts) {
+      const P3 a = waves(p, f / 10.0), b = waves(p, (f + 1) / 10.0);
+      x0.insert(x0.end(), a.begin(), a.end());
+      x1.insert(x1.end(), b.begin(), b.end());
+    }
+    mesh_contacts += compare(shape, x0.data(), x1.data());
+  }
+  CHECK(mesh_contacts > 0);
+}
+#endif
+
 TEST_CASE("Features mode: names, scenes and statuses", "[collider][features][api]") {
   ColliderMode parsed = ColliderMode::kRvbc;
   REQUIRE(parse_collider_mode("features", parsed));

@@ -64,8 +64,8 @@ TEST_CASE("Collider contacts into a buffer on two threads equal the serial ones,
   const BentDumbbell db;
   const double* x0 = db.frames[0].data();
   const double* x1 = db.frames[1].data();
-  for (ColliderMode mode :
-       {ColliderMode::kRvbc, ColliderMode::kBvh, ColliderMode::kCone, ColliderMode::kBrute}) {
+  for (ColliderMode mode : {ColliderMode::kRvbc, ColliderMode::kBvh, ColliderMode::kCone,
+                            ColliderMode::kBrute, ColliderMode::kFeatures}) {
     INFO("mode " << tetseg::to_string(mode));
     tetseg::ColliderOptions serial_options;
     serial_options.mode = mode;
