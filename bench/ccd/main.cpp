@@ -238,7 +238,8 @@ tetseg::Asset load_frame_asset(const std::string& path, const io::Mesh& mesh,
 
 int command_frames(const std::string& path0, const std::string& path1, bool json,
                    const tetseg::CcdOptions& options, soup::BroadPhase broad_phase,
-                   soup::StillPairs still_pairs, const std::string& asset_path) {
+                   soup::StillPairs still_pairs, const std::string& asset_path,
+                   std::uint32_t threads) {
   const io::Mesh m0 = load_mesh(path0);
   const io::Mesh m1 = load_mesh(path1);
   if (m0.vertices.size() != m1.vertices.size())
@@ -248,10 +249,13 @@ int command_frames(const std::string& path0, const std::string& path1, bool json
   if (!asset_path.empty()) asset = load_frame_asset(asset_path, m0, path0);
   soup::FrameStats stats;
   const double cpu_start = thread_cpu_seconds();
+  const auto wall_start = std::chrono::steady_clock::now();
   const auto contacts =
       soup::find_contacts(m0.vertices, m1.vertices, m0.faces, options, broad_phase, &stats,
-                          still_pairs, asset_path.empty() ? nullptr : &asset);
+                          still_pairs, asset_path.empty() ? nullptr : &asset, threads);
   const double cpu = thread_cpu_seconds() - cpu_start;
+  const double wall =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   std::ostringstream out;
   char buf[160];
   if (json) {
@@ -287,6 +291,12 @@ int command_frames(const std::string& path0, const std::string& path1, bool json
                  static_cast<unsigned long long>(stats.ee_candidates),
                  static_cast<unsigned long long>(stats.tests), cpu, stats.broad_seconds,
                  stats.test_seconds);
+  } else if (broad_phase == soup::BroadPhase::kFeatures && asset_path.empty() && threads > 1) {
+    std::fprintf(stderr,
+                 "%s: features mode: %llu feature pairs, %llu elementary tests; wall %.3f s on "
+                 "%u threads (PLY reading excluded)\n",
+                 kTool, static_cast<unsigned long long>(stats.feature_pairs),
+                 static_cast<unsigned long long>(stats.tests), wall, threads);
   } else if (broad_phase == soup::BroadPhase::kFeatures && asset_path.empty()) {
     std::fprintf(stderr,
                  "%s: features mode: %llu feature pairs, %llu elementary tests; CPU %.3f s (PLY "
@@ -407,15 +417,27 @@ int main(int argc, char** argv) {
       ->add_option("--min-separation", options.min_separation, "Minimum separation (length units)")
       ->check(CLI::NonNegativeNumber);
   std::string asset_path;
+  auto* asset_option =
+      frames
+          ->add_option(
+              "--asset", asset_path,
+              "Cull with this asset's clusters and detectors (rvbc): its nodes are the "
+              "frame's vertices and its triangles the frame's faces, in order (a surface "
+              "asset built from the first frame). Steps are presumed to start contact-free")
+          ->excludes(brute_flag)
+          ->excludes(sweep_flag)
+          ->excludes(bvh_flag);
+  bool skip_still = false;
+  std::uint32_t threads = 1;
   frames
-      ->add_option("--asset", asset_path,
-                   "Cull with this asset's clusters and detectors (rvbc): its nodes are the "
-                   "frame's vertices and its triangles the frame's faces, in order (a surface "
-                   "asset built from the first frame). Steps are presumed to start contact-free")
+      ->add_option("--threads", threads,
+                   "Threads of the features mode (OpenMP; default 1). With more than one, the "
+                   "time printed is wall time")
+      ->check(CLI::Range(1, 256))
       ->excludes(brute_flag)
       ->excludes(sweep_flag)
-      ->excludes(bvh_flag);
-  bool skip_still = false;
+      ->excludes(bvh_flag)
+      ->excludes(asset_option);
   frames->add_flag("--skip-still", skip_still,
                    "Do not test pairs whose four vertices are still (x0 == x1): the runtime's "
                    "default rule for simulator steps that start contact-free. Default: every "
@@ -439,7 +461,7 @@ int main(int argc, char** argv) {
                             : bvh || !asset_path.empty() ? soup::BroadPhase::kScene
                                                          : soup::BroadPhase::kFeatures,
                             skip_still ? soup::StillPairs::kSkip : soup::StillPairs::kInclude,
-                            asset_path);
+                            asset_path, threads);
     return command_truth(truth_ply, boxes_path, bools_path, kind);
   });
 }

@@ -283,7 +283,7 @@ std::vector<Contact> scene_contacts(const std::vector<std::array<double, 3>>& x0
 std::vector<Contact> collider_features_contacts(
     const std::vector<std::array<double, 3>>& x0, const std::vector<std::array<double, 3>>& x1,
     const std::vector<std::array<std::uint32_t, 3>>& faces, const CcdOptions& options,
-    FrameStats* stats, StillPairs still_pairs) {
+    FrameStats* stats, StillPairs still_pairs, std::uint32_t threads) {
   const auto nodes = static_cast<std::uint32_t>(x0.size());
   std::vector<std::uint32_t> ids;
   ids.reserve(faces.size() * 3);
@@ -295,6 +295,8 @@ std::vector<Contact> collider_features_contacts(
   collider_options.mode = ColliderMode::kFeatures;
   collider_options.ccd = options;
   collider_options.include_still_pairs = still_pairs == StillPairs::kInclude;
+  collider_options.use_openmp = threads > 1;
+  collider_options.threads = threads;
   Collider collider(shape, collider_options);
   ColliderStatus st = collider.step(x0.front().data(), x1.front().data());
   if (st != ColliderStatus::kOk)
@@ -330,10 +332,10 @@ std::vector<Contact> find_contacts(const std::vector<std::array<double, 3>>& x0,
                                    const std::vector<std::array<std::uint32_t, 3>>& faces,
                                    const CcdOptions& options, BroadPhase broad_phase,
                                    FrameStats* stats, StillPairs still_pairs,
-                                   const tetseg::Asset* asset) {
+                                   const tetseg::Asset* asset, std::uint32_t threads) {
   if (broad_phase == BroadPhase::kFeatures && asset == nullptr) {
     if (x0.empty()) return {};
-    return collider_features_contacts(x0, x1, faces, options, stats, still_pairs);
+    return collider_features_contacts(x0, x1, faces, options, stats, still_pairs, threads);
   }
   if (broad_phase == BroadPhase::kScene || broad_phase == BroadPhase::kFeatures)
     return scene_contacts(x0, x1, faces, options, stats, still_pairs, asset);

@@ -61,12 +61,17 @@ struct FrameStats {
 /// the soup is that asset's body (the caller checks that its nodes are the frame's vertices
 /// and its triangles the faces, in order) and is culled with its clusters and detectors
 /// (rvbc; a kBones asset's detectors stay at their rest positions, which is exact and only
-/// culls less); the step is then presumed to start contact-free (docs/runtime.md).
-std::vector<Contact> find_contacts(
-    const std::vector<std::array<double, 3>>& x0, const std::vector<std::array<double, 3>>& x1,
-    const std::vector<std::array<std::uint32_t, 3>>& faces, const CcdOptions& options,
-    BroadPhase broad_phase = BroadPhase::kFeatures, FrameStats* stats = nullptr,
-    StillPairs still_pairs = StillPairs::kInclude, const tetseg::Asset* asset = nullptr);
+/// culls less); the step is then presumed to start contact-free (docs/runtime.md). `threads`
+/// (kFeatures without an asset only): the collider's OpenMP threads (1: serial); the same
+/// contacts.
+std::vector<Contact> find_contacts(const std::vector<std::array<double, 3>>& x0,
+                                   const std::vector<std::array<double, 3>>& x1,
+                                   const std::vector<std::array<std::uint32_t, 3>>& faces,
+                                   const CcdOptions& options,
+                                   BroadPhase broad_phase = BroadPhase::kFeatures,
+                                   FrameStats* stats = nullptr,
+                                   StillPairs still_pairs = StillPairs::kInclude,
+                                   const tetseg::Asset* asset = nullptr, std::uint32_t threads = 1);
 
 /// CPU time of the calling thread, in seconds.
 double thread_cpu_seconds();
