@@ -81,6 +81,9 @@ for sep in 0 0.01; do
   [ "$(wc -l < "$work/brute")" -gt 20 ] || fail "random soup: too few contacts to compare"
   cmp -s "$work/bvh" "$work/brute" || fail "random soup (min separation $sep): BVH and brute force differ"
   cmp -s "$work/features" "$work/brute" || fail "random soup (min separation $sep): features mode and brute force differ"
+  "$tool" frames "$work/r0.ply" "$work/r1.ply" --min-separation $sep --threads 2 2>"$work/err" > "$work/threads"
+  cmp -s "$work/threads" "$work/brute" || fail "random soup (min separation $sep): features mode on two threads and brute force differ"
+  grep -q "on 2 threads" "$work/err" || fail "--threads 2: $(cat "$work/err")"
   echo "random soup, min separation $sep: $(wc -l < "$work/bvh") contacts, features mode = BVH = brute force"
 done
 
@@ -155,6 +158,8 @@ if [ -d "$funnel" ]; then
   "$tool" frames "$funnel/227.ply" "$funnel/228.ply" --brute 2>/dev/null > "$work/brute"
   [ "$(wc -l < "$work/scene")" -eq 134 ] || fail "cloth-funnel: $(wc -l < "$work/scene") contacts, expected 134"
   cmp -s "$work/scene" "$work/brute" || fail "cloth-funnel: features mode and brute force differ"
+  "$tool" frames "$funnel/227.ply" "$funnel/228.ply" --threads 2 2>/dev/null > "$work/threads"
+  cmp -s "$work/scene" "$work/threads" || fail "cloth-funnel: features mode on two threads differs"
   "$tool" frames "$funnel/227.ply" "$funnel/228.ply" --bvh 2>/dev/null > "$work/bvh"
   cmp -s "$work/bvh" "$work/brute" || fail "cloth-funnel: scene body (--bvh) and brute force differ"
   # The sort-and-sweep baseline: the data README's AABB candidate counts, the same contacts.
