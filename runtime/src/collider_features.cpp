@@ -27,6 +27,10 @@ namespace tetseg {
 
 namespace {
 
+// The builds' stack: the binary pass keeps one task per level (depth < kMedianBvhStack), the
+// four-wide pass up to three per level.
+constexpr std::size_t kFeatureBuildStack = 4 * kMedianBvhStack;
+
 // Room for n T (trivial types), not written: only what a build writes is ever touched. A large
 // array is aligned to 2 MiB and, on Linux, asks for transparent huge pages: a build writes tens
 // of MB that are new to the process, and first touches of 4 KiB pages (a fault each) cost more
@@ -69,7 +73,7 @@ void Collider::Impl::reserve_feature_trees() {
   feature_key.resize(most);
   feature_key_scratch.resize(most);
   vslabs.resize(counts[0]);
-  feature_build_stack.resize(kMedianBvhStack);
+  feature_build_stack.resize(kFeatureBuildStack);
   // The traversal pushes at most 16 pairs per pair it pops, one level further down one tree
   // or both; a tree is less than kMedianBvhStack levels deep (build).
   if (opt.traversal_stack == 0)
@@ -182,8 +186,8 @@ void FeatureTree::build(const ItemBox& item_box, const ItemSlabs& item_slabs, bo
   }
   if (from != key) std::copy(from, from + items, key);
   // Top down: a range splits where its highest differing Morton bit turns on (in the middle
-  // when all its codes are equal); at most four items make a leaf. Depth <= 30 + log2(items)
-  // < kMedianBvhStack.
+  // when all its codes are equal); at most four items make a leaf. Depth <= 2 * 30 +
+  // log2(items) + 1 < kMedianBvhStack (two levels per bit at most, below).
   count = 1;
   std::size_t top = 0;
   stack[top++] = {0, 0, items};
@@ -207,8 +211,10 @@ void FeatureTree::build(const ItemBox& item_box, const ItemSlabs& item_slabs, bo
           key + begin, key + end, [&](std::uint64_t k) { return ((k >> 32) & bit) == 0; });
       mid = static_cast<std::uint32_t>(split - key);
     }
-    // Full leaves: the split moved to the nearest multiple of four items from `begin` (all
-    // leaves but the last hold four; at most two levels per Morton bit, within the stack).
+    // Full leaves: the split moved to the nearest multiple of four items from `begin`, so every
+    // leaf but the last holds four. A child then holds at most two items from the other side
+    // of the bit (more only in a leaf of four): its next split, on the same bit, leaves them
+    // in a leaf. So at most two levels per Morton bit.
     mid =
         begin + std::min((mid - begin + 2) / kLeafSize, (end - begin - 1) / kLeafSize) * kLeafSize;
     mid = std::max(mid, begin + kLeafSize);
@@ -231,7 +237,8 @@ void FeatureTree::build(const ItemBox& item_box, const ItemSlabs& item_slabs, bo
   }
   // Four-wide: from the root down, an inner node's slots are its children, the inner slot with
   // most items expanded into its two children while fewer than four; each inner slot in turn
-  // (its FeatureWide numbered when it is queued, in the task's `begin`).
+  // (its FeatureWide numbered when it is queued, in the task's `begin`). Depth first: at most
+  // three slots wait per level, 3 * depth + 1 < kFeatureBuildStack.
   auto id_of = [&](std::uint32_t node, std::uint32_t wide) {
     return nodes[node].b == 0 ? kFeatureLeafBit | nodes[node].a : wide;
   };
