@@ -227,6 +227,15 @@ inline void bernstein_k2(const Ends& u, const MinorTerms<Lanes2>& ma, const Mino
   k03 = det(u, ma);
   k12 = det(swapped(u), ma) + det(u, mb) + det(u, swapped(mb));
 }
+/// The same with mc = swapped(mb) at hand.
+inline void bernstein_k2(const Ends& u, const MinorTerms<Lanes2>& ma, const MinorTerms<Lanes2>& mb,
+                         const MinorTerms<Lanes2>& mc, Lanes2& k03, Lanes2& k12) noexcept {
+  auto det = [](const Ends& w, const MinorTerms<Lanes2>& m) {
+    return w.x * m.m0 - w.y * m.m1 + w.z * m.m2;
+  };
+  k03 = det(u, ma);
+  k12 = det(swapped(u), ma) + det(u, mb) + det(u, mc);
+}
 
 /// The Bernstein coefficients of det[a - o, b - o, c - o] over the step (orientation_k's),
 /// as k03 = (k0, k3) and k12 = (k1, k2): bitwise orientation_k's values.
@@ -360,7 +369,7 @@ struct FacePlaneStatic {
   // Two lanes, each lane bitwise the scalar operations of FacePlaneMinors::of: lane 0 / 1 of
   // `a` hold a0 / a1; of `ma` m00 / m11, of `mb` m10 / m01 (bernstein_k2's).
   orientation_detail::Ends a;
-  orientation_detail::MinorTerms<orientation_detail::Lanes2> ma, mb;
+  orientation_detail::MinorTerms<orientation_detail::Lanes2> ma, mb, mc;
 #else
   double a0[3], a1[3];
   orientation_detail::Minors m00, m10, m01, m11;
@@ -374,6 +383,7 @@ struct FacePlaneStatic {
     const Ends v = sub(ends(b0, b1), f.a), w = sub(ends(c0, c1), f.a);  // (v0, v1), (w0, w1)
     f.ma = minor_terms(v, w);                                           // (m00, m11)
     f.mb = minor_terms(swapped(v), w);                                  // (m10, m01)
+    f.mc = swapped(f.mb);
 #else
     const FacePlaneMinors full = FacePlaneMinors::of(a0, b0, c0, a1, b1, c1);
     for (int k = 0; k < 3; ++k) {
@@ -396,7 +406,7 @@ struct FacePlaneStatic {
     using namespace orientation_detail;
 #if defined(TETSEG_HAVE_LANES2)
     Lanes2 k03, k12;
-    bernstein_k2(sub(ends(p0, p1), a), ma, mb, k03, k12);
+    bernstein_k2(sub(ends(p0, p1), a), ma, mb, mc, k03, k12);
     // The coefficients gathered for the array form: in the plane filters' loops over points
     // this measured fewer instructions than the lanes' form (its bounds are set up once).
     const double k[4] = {k03[0], k12[0], k12[1], k03[1]};
