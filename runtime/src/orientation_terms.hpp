@@ -214,20 +214,11 @@ inline MinorTerms<Lanes2> minor_terms(const Ends& v, const Ends& w) noexcept {
   return {v.y * w.z - v.z * w.y, v.x * w.z - v.z * w.x, v.x * w.y - v.y * w.x};
 }
 
-/// bernstein_k on two lanes: from u = (u0, u1), ma = (m00, m11) and mb = (m10, m01) (lanes of
-/// minor_terms(v, w) and minor_terms(swapped(v), w)), k03 = (k0, k3) and k12 = (k1, k2). Lane
-/// 0 performs bernstein_k's operations for k0 and k1 in their order, lane 1 those of k3 and k2
-/// (the mirror image, the ends swapped; (m01, m10) = swapped(mb) is the same products), so
-/// every coefficient is bitwise the scalar one.
-inline void bernstein_k2(const Ends& u, const MinorTerms<Lanes2>& ma, const MinorTerms<Lanes2>& mb,
-                         Lanes2& k03, Lanes2& k12) noexcept {
-  auto det = [](const Ends& w, const MinorTerms<Lanes2>& m) {
-    return w.x * m.m0 - w.y * m.m1 + w.z * m.m2;
-  };
-  k03 = det(u, ma);
-  k12 = det(swapped(u), ma) + det(u, mb) + det(u, swapped(mb));
-}
-/// The same with mc = swapped(mb) at hand.
+/// bernstein_k on two lanes: from u = (u0, u1), ma = (m00, m11), mb = (m10, m01) and
+/// mc = (m01, m10) (lanes of minor_terms(v, w), minor_terms(swapped(v), w) and its swap: the
+/// same products), k03 = (k0, k3) and k12 = (k1, k2). Lane 0 performs bernstein_k's operations
+/// for k0 and k1 in their order, lane 1 those of k3 and k2 (the mirror image, the ends
+/// swapped), so every coefficient is bitwise the scalar one.
 inline void bernstein_k2(const Ends& u, const MinorTerms<Lanes2>& ma, const MinorTerms<Lanes2>& mb,
                          const MinorTerms<Lanes2>& mc, Lanes2& k03, Lanes2& k12) noexcept {
   auto det = [](const Ends& w, const MinorTerms<Lanes2>& m) {
@@ -244,7 +235,8 @@ inline void orientation_k2(const double* o0, const double* a0, const double* b0,
                            Lanes2& k03, Lanes2& k12) noexcept {
   const Ends o = ends(o0, o1);
   const Ends v = sub(ends(b0, b1), o), w = sub(ends(c0, c1), o);
-  bernstein_k2(sub(ends(a0, a1), o), minor_terms(v, w), minor_terms(swapped(v), w), k03, k12);
+  const MinorTerms<Lanes2> mb = minor_terms(swapped(v), w);
+  bernstein_k2(sub(ends(a0, a1), o), minor_terms(v, w), mb, swapped(mb), k03, k12);
 }
 
 /// static_sign of the coefficients {k03[0], k12[0], k12[1], k03[1]}: the same eight
@@ -397,6 +389,15 @@ struct FacePlaneStatic {
 #endif
     return f;
   }
+#if defined(TETSEG_HAVE_LANES2)
+  /// The cubic's Bernstein coefficients for point p (orientation_k2's layout: k03 = (k0, k3),
+  /// k12 = (k1, k2)), bitwise those of FacePlaneMinors::side's cubic.
+  void coefficients(const double* p0, const double* p1, orientation_detail::Lanes2& k03,
+                    orientation_detail::Lanes2& k12) const noexcept {
+    using namespace orientation_detail;
+    bernstein_k2(sub(ends(p0, p1), a), ma, mb, mc, k03, k12);
+  }
+#endif
   /// FacePlaneMinors::side(a0, a1, p0, p1) of the same triangle when the static bound `e`
   /// decides it (`decided`; e = StaticErr::of the extents of a box holding the triangle and the
   /// point at both ends of the step), found from the coefficients without their error terms;
@@ -406,7 +407,7 @@ struct FacePlaneStatic {
     using namespace orientation_detail;
 #if defined(TETSEG_HAVE_LANES2)
     Lanes2 k03, k12;
-    bernstein_k2(sub(ends(p0, p1), a), ma, mb, mc, k03, k12);
+    coefficients(p0, p1, k03, k12);
     // The coefficients gathered for the array form: in the plane filters' loops over points
     // this measured fewer instructions than the lanes' form (its bounds are set up once).
     const double k[4] = {k03[0], k12[0], k12[1], k03[1]};

@@ -157,6 +157,11 @@ TEST_CASE("The static error bound gives bitwise the orientation cubic's sign", "
       orientation_detail::orientation_k2(p[0], p[3], p[1], p[2], p[4], p[7], p[5], p[6], k03, k12);
       const double k[4] = {k03[0], k12[0], k12[1], k03[1]};
       for (int i = 0; i < 4; ++i) REQUIRE(std::memcmp(&k[i], &ref.k[i], sizeof(double)) == 0);
+      // The plane filters' cached face: the same coefficients.
+      orientation_detail::Lanes2 f03, f12;
+      fast.coefficients(p[3], p[7], f03, f12);
+      const double kf[4] = {f03[0], f12[0], f12[1], f03[1]};
+      for (int i = 0; i < 4; ++i) REQUIRE(std::memcmp(&kf[i], &ref.k[i], sizeof(double)) == 0);
       bool d2 = false;
       const Orientation s2 = orientation_detail::static_sign(k03, k12, err, d2);
       bool d1 = false;
