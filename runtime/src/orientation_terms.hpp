@@ -359,7 +359,8 @@ struct FacePlaneMinors {
 struct FacePlaneStatic {
 #if defined(TETSEG_HAVE_LANES2)
   // Two lanes, each lane bitwise the scalar operations of FacePlaneMinors::of: lane 0 / 1 of
-  // `a` hold a0 / a1; of `ma` m00 / m11, of `mb` m10 / m01 (bernstein_k2's).
+  // `a` hold a0 / a1; of `ma` m00 / m11, of `mb` m10 / m01, of `mc` m01 / m10 (mb's lanes
+  // swapped: the same products; bernstein_k2's).
   orientation_detail::Ends a;
   orientation_detail::MinorTerms<orientation_detail::Lanes2> ma, mb, mc;
 #else
