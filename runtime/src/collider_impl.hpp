@@ -671,9 +671,10 @@ void process_vertex_face(Worker& w, const Collider::Impl& P, std::uint32_t p,
 void process_edge_edge(Worker& w, const Collider::Impl& A, std::uint32_t e1,
                        const Collider::Impl& B, std::uint32_t e2) noexcept;
 /// The same with the edges' swept boxes already at hand (`box1` = A.edge_box(e1), `box2` =
-/// B.edge_box(e2)): the triangle-pair loop computes each edge's box once per pair.
-void process_edge_edge(Worker& w, const Collider::Impl& A, std::uint32_t e1, Box box1,
-                       const Collider::Impl& B, std::uint32_t e2, Box box2) noexcept;
+/// B.edge_box(e2)) and found overlapping by the caller (boxes_overlap with the options'
+/// min_separation): the triangle-pair and feature loops check them before the call.
+void process_edge_edge(Worker& w, const Collider::Impl& A, std::uint32_t e1, const Box& box1,
+                       const Collider::Impl& B, std::uint32_t e2, const Box& box2) noexcept;
 /// Triangle-pair plane filter of triangle t1 of A and t2 of B (plane_filter.hpp): no feature
 /// pair of the two can touch (exact contact only).
 bool plane_separated(Worker& w, const Collider::Impl& A, std::uint32_t t1, const Collider::Impl& B,

@@ -9,6 +9,12 @@
 #include "collider_impl.hpp"
 #include "plane_filter.hpp"
 
+#if defined(__GNUC__)
+#define TETSEG_NOINLINE __attribute__((noinline))
+#else
+#define TETSEG_NOINLINE
+#endif
+
 namespace tetseg {
 namespace {
 
@@ -174,28 +180,19 @@ void test_and_record(Worker& w, const ColliderOptions& opt, Ccd&& ccd, Contact c
   w.record(c);
 }
 
-}  // namespace
-
-void process_vertex_face(Worker& w, const Collider::Impl& P, std::uint32_t p,
-                         const Collider::Impl& F, std::uint32_t face) noexcept {
-  const auto& f = F.tris[face];
-  const std::uint32_t ip = P.topo->surf_index[p];
-  if (!P.vmoved[ip] && !F.tmov[face]) return;  // still feature pair: only t = 0 contact possible
+// What follows a feature pair's coplanarity filter when that did not reject it: the plane
+// filters (exact contact only), then the elementary test. Out of line: inlined, the compiler
+// kept the filter's 24 coordinates for the test and spilled them on every pair, nearly all of
+// which the filter rejects.
+TETSEG_NOINLINE void vertex_face_after_coplanarity(Worker& w, const Collider::Impl& P,
+                                                   std::uint32_t p, const Collider::Impl& F,
+                                                   std::uint32_t face) noexcept {
   const ColliderOptions& opt = P.opt;
-  const double ms = opt.ccd.min_separation;
-  if (!boxes_overlap(P.vbox[ip], F.tbox[face], ms)) return;
-  ++w.stats.feature_pairs;
-  if (ms <= 0) {
-    // Coplanarity cubic det[b-a, c-a, p-a] with a proven strict sign: never coplanar. Its
-    // points lie in the union of the vertex's and the face's swept boxes (static bound).
-    const Orientation o = orientation_of(F.pos0(f[0]), F.pos0(f[1]), F.pos0(f[2]), P.pos0(p),
-                                         F.pos1(f[0]), F.pos1(f[1]), F.pos1(f[2]), P.pos1(p),
-                                         union_static_err(P.vbox[ip], F.tbox[face]));
-    if (o != Orientation::kUncertain || face_off_vertex_planes(w, P, p, F, face)) {
-      ++w.stats.feature_pairs_filtered;
-      return;
-    }
+  if (opt.ccd.min_separation <= 0 && face_off_vertex_planes(w, P, p, F, face)) {
+    ++w.stats.feature_pairs_filtered;
+    return;
   }
+  const auto& f = F.tris[face];
   Contact c;
   c.kind = ContactKind::kVertexFace;
   c.bodies = {P.body_id, F.body_id};
@@ -211,38 +208,20 @@ void process_vertex_face(Worker& w, const Collider::Impl& P, std::uint32_t p,
       c);
 }
 
-void process_edge_edge(Worker& w, const Collider::Impl& A, std::uint32_t e1,
-                       const Collider::Impl& B, std::uint32_t e2) noexcept {
-  if (!A.edge_moving(e1) && !B.edge_moving(e2)) return;  // all four nodes still
-  process_edge_edge(w, A, e1, A.edge_box(e1), B, e2, B.edge_box(e2));
-}
-
-void process_edge_edge(Worker& w, const Collider::Impl& A, std::uint32_t e1, Box box1,
-                       const Collider::Impl& B, std::uint32_t e2, Box box2) noexcept {
-  if (&A == &B && e1 > e2) {
-    std::swap(e1, e2);
-    std::swap(box1, box2);
+// As vertex_face_after_coplanarity: edge e1 of A, e2 of B in the order of the contact, with
+// their swept boxes.
+TETSEG_NOINLINE void edge_edge_after_coplanarity(Worker& w, const Collider::Impl& A,
+                                                 std::uint32_t e1, const Box& box1,
+                                                 const Collider::Impl& B, std::uint32_t e2,
+                                                 const Box& box2) noexcept {
+  const ColliderOptions& opt = A.opt;
+  if (opt.ccd.min_separation <= 0 && (edge_off_face_planes(w, A, e1, B, e2, box2) ||
+                                      edge_off_face_planes(w, B, e2, A, e1, box1))) {
+    ++w.stats.feature_pairs_filtered;
+    return;
   }
   const std::uint32_t a = A.topo->edges[e1][0], b = A.topo->edges[e1][1];
   const std::uint32_t c = B.topo->edges[e2][0], d = B.topo->edges[e2][1];
-  const ColliderOptions& opt = A.opt;
-  const double ms = opt.ccd.min_separation;
-  // As edge_boxes_overlap, from the given boxes.
-  if (!A.edge_moving(e1) && !B.edge_moving(e2)) return;  // all four nodes still
-  if (!boxes_overlap(box1, box2, ms)) return;
-  ++w.stats.feature_pairs;
-  if (ms <= 0) {
-    // det[b-a, d-c, c-a] = det[b-a, d-a, c-a]: orientation of (a; b, d, c), its points in the
-    // union of the two edges' swept boxes (static bound).
-    const Orientation o =
-        orientation_of(A.pos0(a), A.pos0(b), B.pos0(d), B.pos0(c), A.pos1(a), A.pos1(b), B.pos1(d),
-                       B.pos1(c), union_static_err(box1, box2));
-    if (o != Orientation::kUncertain || edge_off_face_planes(w, A, e1, B, e2, box2) ||
-        edge_off_face_planes(w, B, e2, A, e1, box1)) {
-      ++w.stats.feature_pairs_filtered;
-      return;
-    }
-  }
   Contact k;
   k.kind = ContactKind::kEdgeEdge;
   k.bodies = {A.body_id, B.body_id};
@@ -256,6 +235,65 @@ void process_edge_edge(Worker& w, const Collider::Impl& A, std::uint32_t e1, Box
                              v3(A.pos1(a)), v3(A.pos1(b)), v3(B.pos1(c)), v3(B.pos1(d)), opt.ccd);
       },
       k);
+}
+
+}  // namespace
+
+void process_vertex_face(Worker& w, const Collider::Impl& P, std::uint32_t p,
+                         const Collider::Impl& F, std::uint32_t face) noexcept {
+  const auto& f = F.tris[face];
+  const std::uint32_t ip = P.topo->surf_index[p];
+  if (!P.vmoved[ip] && !F.tmov[face]) return;  // still feature pair: only t = 0 contact possible
+  const double ms = P.opt.ccd.min_separation;
+  if (!boxes_overlap(P.vbox[ip], F.tbox[face], ms)) return;
+  ++w.stats.feature_pairs;
+  if (ms <= 0) {
+    // Coplanarity cubic det[b-a, c-a, p-a] with a proven strict sign: never coplanar. Its
+    // points lie in the union of the vertex's and the face's swept boxes (static bound).
+    const Orientation o = orientation_of(F.pos0(f[0]), F.pos0(f[1]), F.pos0(f[2]), P.pos0(p),
+                                         F.pos1(f[0]), F.pos1(f[1]), F.pos1(f[2]), P.pos1(p),
+                                         union_static_err(P.vbox[ip], F.tbox[face]));
+    if (o != Orientation::kUncertain) {
+      ++w.stats.feature_pairs_filtered;
+      return;
+    }
+  }
+  vertex_face_after_coplanarity(w, P, p, F, face);
+}
+
+void process_edge_edge(Worker& w, const Collider::Impl& A, std::uint32_t e1,
+                       const Collider::Impl& B, std::uint32_t e2) noexcept {
+  if (!A.edge_moving(e1) && !B.edge_moving(e2)) return;  // all four nodes still
+  const Box box1 = A.edge_box(e1), box2 = B.edge_box(e2);
+  if (!boxes_overlap(box1, box2, A.opt.ccd.min_separation)) return;
+  process_edge_edge(w, A, e1, box1, B, e2, box2);
+}
+
+void process_edge_edge(Worker& w, const Collider::Impl& A, std::uint32_t e1, const Box& box1_in,
+                       const Collider::Impl& B, std::uint32_t e2, const Box& box2_in) noexcept {
+  const Box* box1 = &box1_in;
+  const Box* box2 = &box2_in;
+  if (&A == &B && e1 > e2) {
+    std::swap(e1, e2);
+    std::swap(box1, box2);
+  }
+  if (!A.edge_moving(e1) && !B.edge_moving(e2)) return;  // all four nodes still
+  const double ms = A.opt.ccd.min_separation;
+  ++w.stats.feature_pairs;
+  if (ms <= 0) {
+    // det[b-a, d-c, c-a] = det[b-a, d-a, c-a]: orientation of (a; b, d, c), its points in the
+    // union of the two edges' swept boxes (static bound).
+    const std::uint32_t a = A.topo->edges[e1][0], b = A.topo->edges[e1][1];
+    const std::uint32_t c = B.topo->edges[e2][0], d = B.topo->edges[e2][1];
+    const Orientation o =
+        orientation_of(A.pos0(a), A.pos0(b), B.pos0(d), B.pos0(c), A.pos1(a), A.pos1(b), B.pos1(d),
+                       B.pos1(c), union_static_err(*box1, *box2));
+    if (o != Orientation::kUncertain) {
+      ++w.stats.feature_pairs_filtered;
+      return;
+    }
+  }
+  edge_edge_after_coplanarity(w, A, e1, *box1, B, e2, *box2);
 }
 
 // Triangle-pair plane filter of triangle t1 of A and t2 of B (plane_filter.hpp; exact

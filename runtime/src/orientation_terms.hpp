@@ -122,10 +122,11 @@ inline BernsteinCubic bernstein(const V3& u0, const V3& u1, const Minors& m00, c
 struct StaticErr {
   double err0, err1;
   static StaticErr of(const double d[3]) noexcept {
-    const V3 dv{d[0], d[1], d[2]};
-    const Minors m = minors(dv, dv);
-    double unused, p;
-    det_perm(dv, m, unused, p);
+    // det_perm(d, minors(d, d)) without the minors: |d.y d.z| + |d.z d.y| = 2 |d.y d.z| (the
+    // two rounded products are equal, |fl(x y)| = fl(|x| |y|)), the same value.
+    const double ax = magnitude(d[0]), ay = magnitude(d[1]), az = magnitude(d[2]);
+    const double yz = ay * az, xz = ax * az, xy = ax * ay;
+    const double p = ax * (yz + yz) + ay * (xz + xz) + az * (xy + xy);
     return {kRelErr * p + kAbsErr, kRelErr * (p + p + p) + kAbsErr};
   }
 };
@@ -193,6 +194,64 @@ inline Orientation static_sign(const double k[4], const StaticErr& e, bool& deci
                        : Orientation::kUncertain;
 }
 
+#if defined(TETSEG_HAVE_LANES2)
+/// A point (or difference) at the start and the end of the step: lane 0 / lane 1.
+using Ends = Vec3T<Lanes2>;
+inline Ends ends(const double* p0, const double* p1) noexcept {
+  return {Lanes2{p0[0], p1[0]}, Lanes2{p0[1], p1[1]}, Lanes2{p0[2], p1[2]}};
+}
+inline Lanes2 swapped(Lanes2 x) noexcept {
+  return Lanes2{x[1], x[0]};
+}
+inline Ends swapped(const Ends& p) noexcept {
+  return {swapped(p.x), swapped(p.y), swapped(p.z)};
+}
+inline MinorTerms<Lanes2> swapped(const MinorTerms<Lanes2>& m) noexcept {
+  return {swapped(m.m0), swapped(m.m1), swapped(m.m2)};
+}
+/// The m terms of `minors`, lane by lane.
+inline MinorTerms<Lanes2> minor_terms(const Ends& v, const Ends& w) noexcept {
+  return {v.y * w.z - v.z * w.y, v.x * w.z - v.z * w.x, v.x * w.y - v.y * w.x};
+}
+
+/// bernstein_k on two lanes: from u = (u0, u1), ma = (m00, m11), mb = (m10, m01) and
+/// mc = (m01, m10) (lanes of minor_terms(v, w), minor_terms(swapped(v), w) and its swap: the
+/// same products), k03 = (k0, k3) and k12 = (k1, k2). Lane 0 performs bernstein_k's operations
+/// for k0 and k1 in their order, lane 1 those of k3 and k2 (the mirror image, the ends
+/// swapped), so every coefficient is bitwise the scalar one.
+inline void bernstein_k2(const Ends& u, const MinorTerms<Lanes2>& ma, const MinorTerms<Lanes2>& mb,
+                         const MinorTerms<Lanes2>& mc, Lanes2& k03, Lanes2& k12) noexcept {
+  auto det = [](const Ends& w, const MinorTerms<Lanes2>& m) {
+    return w.x * m.m0 - w.y * m.m1 + w.z * m.m2;
+  };
+  k03 = det(u, ma);
+  k12 = det(swapped(u), ma) + det(u, mb) + det(u, mc);
+}
+
+/// The Bernstein coefficients of det[a - o, b - o, c - o] over the step (orientation_k's),
+/// as k03 = (k0, k3) and k12 = (k1, k2): bitwise orientation_k's values.
+inline void orientation_k2(const double* o0, const double* a0, const double* b0, const double* c0,
+                           const double* o1, const double* a1, const double* b1, const double* c1,
+                           Lanes2& k03, Lanes2& k12) noexcept {
+  const Ends o = ends(o0, o1);
+  const Ends v = sub(ends(b0, b1), o), w = sub(ends(c0, c1), o);
+  const MinorTerms<Lanes2> mb = minor_terms(swapped(v), w);
+  bernstein_k2(sub(ends(a0, a1), o), minor_terms(v, w), mb, swapped(mb), k03, k12);
+}
+
+/// static_sign of the coefficients {k03[0], k12[0], k12[1], k03[1]}: the same eight
+/// comparisons (NaN failing each), on the lanes.
+inline Orientation static_sign(Lanes2 k03, Lanes2 k12, const StaticErr& e, bool& decided) noexcept {
+  const Lanes2 e0{e.err0, e.err0}, e1{e.err1, e.err1};
+  const int above = sign_bits(k03 > e0) | (sign_bits(k12 > e1) << 2);
+  const int below = sign_bits(k03 < -e0) | (sign_bits(k12 < -e1) << 2);
+  decided = above == 15 || below == 15 || (above != 0 && below != 0);
+  return above == 15   ? Orientation::kPositive
+         : below == 15 ? Orientation::kNegative
+                       : Orientation::kUncertain;
+}
+#endif
+
 /// The sign of a cubic proven by its four Bernstein coefficients (sign_of in classify.cpp).
 inline Orientation sign(const BernsteinCubic& c) noexcept {
   // Written so that NaN coefficients or bounds fail every comparison: uncertain.
@@ -258,12 +317,18 @@ inline Orientation orientation_of(const double* o0, const double* a0, const doub
                                   const double* b1, const double* c1,
                                   const orientation_detail::StaticErr& e) noexcept {
   using namespace orientation_detail;
+  bool decided;
+#if defined(TETSEG_HAVE_LANES2)
+  Lanes2 k03, k12;
+  orientation_k2(o0, a0, b0, c0, o1, a1, b1, c1, k03, k12);
+  const Orientation o = static_sign(k03, k12, e, decided);
+#else
   auto p = [](const double* q) { return Vec3T<double>{q[0], q[1], q[2]}; };
   const Vec3T<double> p0[4] = {p(o0), p(a0), p(b0), p(c0)}, p1[4] = {p(o1), p(a1), p(b1), p(c1)};
   double k[4];
   orientation_k(p0, p1, k);
-  bool decided;
   const Orientation o = static_sign(k, e, decided);
+#endif
   return decided ? o : sign(cubic(o0, a0, b0, c0, o1, a1, b1, c1));
 }
 
@@ -294,8 +359,9 @@ struct FacePlaneMinors {
 struct FacePlaneStatic {
 #if defined(TETSEG_HAVE_LANES2)
   // Two lanes, each lane bitwise the scalar operations of FacePlaneMinors::of: lane 0 / 1 of
-  // `a` hold a0 / a1; of `ma` m00 / m11, of `mb` m10 / m01, of `mc` m01 / m10.
-  orientation_detail::Vec3T<orientation_detail::Lanes2> a;
+  // `a` hold a0 / a1; of `ma` m00 / m11, of `mb` m10 / m01, of `mc` m01 / m10 (mb's lanes
+  // swapped: the same products; bernstein_k2's).
+  orientation_detail::Ends a;
   orientation_detail::MinorTerms<orientation_detail::Lanes2> ma, mb, mc;
 #else
   double a0[3], a1[3];
@@ -306,23 +372,11 @@ struct FacePlaneStatic {
     using namespace orientation_detail;
     FacePlaneStatic f;
 #if defined(TETSEG_HAVE_LANES2)
-    using L = Vec3T<Lanes2>;
-    auto both = [](const double* p, const double* q) {
-      return L{Lanes2{p[0], q[0]}, Lanes2{p[1], q[1]}, Lanes2{p[2], q[2]}};
-    };
-    auto diff = [](const L& p, const L& q) { return L{p.x - q.x, p.y - q.y, p.z - q.z}; };
-    auto swapped = [](const L& p) {
-      return L{Lanes2{p.x[1], p.x[0]}, Lanes2{p.y[1], p.y[0]}, Lanes2{p.z[1], p.z[0]}};
-    };
-    auto m = [](const L& v, const L& w) {
-      return MinorTerms<Lanes2>{v.y * w.z - v.z * w.y, v.x * w.z - v.z * w.x,
-                                v.x * w.y - v.y * w.x};
-    };
-    f.a = both(a0, a1);
-    const L v = diff(both(b0, b1), f.a), w = diff(both(c0, c1), f.a);  // lanes (v0, v1), (w0, w1)
-    f.ma = m(v, w);                                                    // (m00, m11)
-    f.mb = m(swapped(v), w);                                           // (m10, m01)
-    f.mc = m(v, swapped(w));                                           // (m01, m10)
+    f.a = ends(a0, a1);
+    const Ends v = sub(ends(b0, b1), f.a), w = sub(ends(c0, c1), f.a);  // (v0, v1), (w0, w1)
+    f.ma = minor_terms(v, w);                                           // (m00, m11)
+    f.mb = minor_terms(swapped(v), w);                                  // (m10, m01)
+    f.mc = swapped(f.mb);
 #else
     const FacePlaneMinors full = FacePlaneMinors::of(a0, b0, c0, a1, b1, c1);
     for (int k = 0; k < 3; ++k) {
@@ -336,6 +390,15 @@ struct FacePlaneStatic {
 #endif
     return f;
   }
+#if defined(TETSEG_HAVE_LANES2)
+  /// The cubic's Bernstein coefficients for point p (orientation_k2's layout: k03 = (k0, k3),
+  /// k12 = (k1, k2)), bitwise those of FacePlaneMinors::side's cubic.
+  void coefficients(const double* p0, const double* p1, orientation_detail::Lanes2& k03,
+                    orientation_detail::Lanes2& k12) const noexcept {
+    using namespace orientation_detail;
+    bernstein_k2(sub(ends(p0, p1), a), ma, mb, mc, k03, k12);
+  }
+#endif
   /// FacePlaneMinors::side(a0, a1, p0, p1) of the same triangle when the static bound `e`
   /// decides it (`decided`; e = StaticErr::of the extents of a box holding the triangle and the
   /// point at both ends of the step), found from the coefficients without their error terms;
@@ -344,24 +407,17 @@ struct FacePlaneStatic {
                           const orientation_detail::StaticErr& e, bool& decided) const noexcept {
     using namespace orientation_detail;
 #if defined(TETSEG_HAVE_LANES2)
-    // Lane 0 computes k0 and k1, lane 1 k3 and k2, each with bernstein_k's operations in its
-    // order: k0 = det(u0, m00), k1 = det(u1, m00) + det(u0, m10) + det(u0, m01), and the
-    // mirror image with the ends swapped.
-    using L = Vec3T<Lanes2>;
-    const L u{Lanes2{p0[0], p1[0]} - a.x, Lanes2{p0[1], p1[1]} - a.y,
-              Lanes2{p0[2], p1[2]} - a.z};  // (u0, u1)
-    const L us{Lanes2{u.x[1], u.x[0]}, Lanes2{u.y[1], u.y[0]}, Lanes2{u.z[1], u.z[0]}};
-    auto det = [](const L& w, const MinorTerms<Lanes2>& m) {
-      return w.x * m.m0 - w.y * m.m1 + w.z * m.m2;
-    };
-    const Lanes2 k03 = det(u, ma);
-    const Lanes2 k12 = det(us, ma) + det(u, mb) + det(u, mc);
+    Lanes2 k03, k12;
+    coefficients(p0, p1, k03, k12);
+    // The coefficients gathered for the array form: in the plane filters' loops over points
+    // this measured fewer instructions than the lanes' form (its bounds are set up once).
     const double k[4] = {k03[0], k12[0], k12[1], k03[1]};
+    return static_sign(k, e, decided);
 #else
     double k[4];
     bernstein_k(sub(p0, a0), sub(p1, a1), m00, m10, m01, m11, k);
-#endif
     return static_sign(k, e, decided);
+#endif
   }
 };
 

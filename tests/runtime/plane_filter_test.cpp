@@ -6,6 +6,7 @@
 #include <array>
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <cstring>
 #include <random>
 #include <vector>
 
@@ -138,6 +139,37 @@ TEST_CASE("The static error bound gives bitwise the orientation cubic's sign", "
     // Classification's form: detector o = p[3], triangle (p[0], p[1], p[2]).
     REQUIRE(orientation_of(p[3], p[0], p[1], p[2], p[7], p[4], p[5], p[6], err) ==
             classify_orientation(p[3], p[0], p[1], p[2], p[7], p[4], p[5], p[6]));
+    // The static bound is the permanent of the extents' determinant (det_perm of their
+    // minors), found without the minors: bitwise.
+    {
+      using namespace orientation_detail;
+      const V3 ext{extent[0], extent[1], extent[2]};
+      double unused, perm;
+      det_perm(ext, minors(ext, ext), unused, perm);
+      REQUIRE(err.err0 == kRelErr * perm + kAbsErr);
+      REQUIRE(err.err1 == kRelErr * (perm + perm + perm) + kAbsErr);
+    }
+#if defined(TETSEG_HAVE_LANES2)
+    // The feature filters' lanes (orientation_k2): bitwise orientation_bernstein's coefficients
+    // of the same points.
+    {
+      orientation_detail::Lanes2 k03, k12;
+      orientation_detail::orientation_k2(p[0], p[3], p[1], p[2], p[4], p[7], p[5], p[6], k03, k12);
+      const double k[4] = {k03[0], k12[0], k12[1], k03[1]};
+      for (int i = 0; i < 4; ++i) REQUIRE(std::memcmp(&k[i], &ref.k[i], sizeof(double)) == 0);
+      // The plane filters' cached face: the same coefficients.
+      orientation_detail::Lanes2 f03, f12;
+      fast.coefficients(p[3], p[7], f03, f12);
+      const double kf[4] = {f03[0], f12[0], f12[1], f03[1]};
+      for (int i = 0; i < 4; ++i) REQUIRE(std::memcmp(&kf[i], &ref.k[i], sizeof(double)) == 0);
+      bool d2 = false;
+      const Orientation s2 = orientation_detail::static_sign(k03, k12, err, d2);
+      bool d1 = false;
+      const Orientation s1 = orientation_detail::static_sign(ref.k, err, d1);
+      REQUIRE(d2 == d1);
+      REQUIRE(s2 == s1);
+    }
+#endif
   }
   // The shortcut is taken, not bypassed (most random cubics are decided by it).
   CHECK(decided > trials / 2);
