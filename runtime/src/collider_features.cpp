@@ -435,9 +435,10 @@ bool Collider::Impl::feature_pairs(Worker& w0, bool parallel) noexcept {
       for (; m != 0; m &= m - 1) process_vertex_face(w, *this, p, *this, fb.item[__builtin_ctz(m)]);
     }
   };
-  // Edge-edge: a pair of edges meets in one leaf (lanes i < j) or one leaf pair; the still
-  // rule and the double box check are process_edge_edge's.
-  auto edge_edges = [this](Worker& w, const FeatureLeaf& ea, const FeatureLeaf& eb, bool same) {
+  // Edge-edge: a pair of edges meets in one leaf (lanes i < j) or one leaf pair; the double box
+  // check here (process_edge_edge's box overload expects it done), the still rule there.
+  auto edge_edges = [this, margin](Worker& w, const FeatureLeaf& ea, const FeatureLeaf& eb,
+                                   bool same) {
     for (int i = 0; i < 4 && (ea.bounds.lanes >> i & 1u); ++i) {
       unsigned m = slot_overlap_mask<0, kNodeLanes>(ea.bounds, i, eb.bounds) &
                    ~(items_holding(ea.node[0][i], eb, 2) | items_holding(ea.node[1][i], eb, 2));
@@ -448,7 +449,9 @@ bool Collider::Impl::feature_pairs(Worker& w0, bool parallel) noexcept {
       const Box box1 = edge_box(e1);
       for (; m != 0; m &= m - 1) {
         const std::uint32_t e2 = eb.item[__builtin_ctz(m)];
-        process_edge_edge(w, *this, e1, box1, *this, e2, edge_box(e2));
+        const Box box2 = edge_box(e2);
+        if (boxes_overlap(box1, box2, margin))
+          process_edge_edge(w, *this, e1, box1, *this, e2, box2);
       }
     }
   };
