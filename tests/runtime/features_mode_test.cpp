@@ -311,11 +311,7 @@ TEST_CASE("Features mode: a deformed real mesh matches the exact oracle up to it
   for (int f = 0; f < 10 && !touched; ++f) {
     CAPTURE(f);
     std::vector<double> x0, x1;
-    for (const P3& p : mesh.verts) {
-      const P3 a = waves(p, f / 10.0), b = waves(p, (f + 1) / 10.0);
-      x0.insert(x0.end(), a.begin(), a.end());
-      x1.insert(x1.end(), b.begin(), b.end());
-    }
+    motion_step(mesh, waves, f, 10, x0, x1);
     const OracleBody body{mesh.tris.data(), mesh.tris.size(), x0.data(), x1.data(), true};
     const StepTruth truth = step_truth(body);
     const StepAnswer a = answer(features, x0.data(), x1.data());
@@ -383,11 +379,7 @@ TEST_CASE("Features mode: two threads report the serial contacts and counts",
   for (int f = 0; f < 10; ++f) {
     CAPTURE(f);
     std::vector<double> x0, x1;
-    for (const P3& p : mesh.verts) {
-      const P3 a = waves(p, f / 10.0), b = waves(p, (f + 1) / 10.0);
-      x0.insert(x0.end(), a.begin(), a.end());
-      x1.insert(x1.end(), b.begin(), b.end());
-    }
+    motion_step(mesh, waves, f, 10, x0, x1);
     mesh_contacts += compare(shape, x0.data(), x1.data());
   }
   CHECK(mesh_contacts > 0);

@@ -32,6 +32,20 @@ struct Waves {
   }
 };
 
+/// Step f of `steps` of a deformation `motion(p, t)`, t in [0, 1], of the surface's vertices:
+/// their positions at the step's start into `x0` and at its end into `x1` (flat xyz).
+template <class Motion>
+void motion_step(const Surface& s, const Motion& motion, int f, int steps, std::vector<double>& x0,
+                 std::vector<double>& x1) {
+  x0.clear();
+  x1.clear();
+  for (const P3& p : s.verts) {
+    const P3 a = motion(p, double(f) / steps), b = motion(p, double(f + 1) / steps);
+    x0.insert(x0.end(), a.begin(), a.end());
+    x1.insert(x1.end(), b.begin(), b.end());
+  }
+}
+
 /// The mushroom's (synthetic_scenes.hpp) rim droops towards its conical base around the
 /// rim-tip vertex nearest angle 0 (largest radius above the stem), along the cone's normal
 /// turned by `slant` radians about z (a smooth bump, largest at the tip): the tip is the
