@@ -256,7 +256,7 @@ void Collider::Impl::detector_ends(std::uint32_t c, std::array<double, 3>& a,
 // cores a parallel region's fork and join cost about 1 us, a box a few ns, a triangle's
 // classification about 10 ns (docs/benchmarks.md, "Contact-rich steps"). Their results do not
 // depend on the split.
-constexpr std::int64_t kParallelBoxItems = 4096;
+constexpr std::int64_t kParallelBoxItems = 512;
 constexpr std::int64_t kParallelClassifyItems = 1024;
 
 void Collider::Impl::refit_and_classify() noexcept {
