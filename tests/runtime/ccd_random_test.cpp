@@ -15,6 +15,7 @@
 #include <catch2/catch.hpp>
 
 #include "tetseg/runtime/ccd.hpp"
+#include "tetseg/testing/point_triangle.hpp"
 
 namespace {
 
@@ -40,28 +41,6 @@ double norm(const Vec3d& a) {
 }
 Vec3d lerp(const Vec3d& a, const Vec3d& b, double t) {
   return add(a, mul(sub(b, a), t));
-}
-
-/// Distance from p to triangle abc (Ericson, Real-Time Collision Detection 5.1.5).
-double point_triangle_distance(const Vec3d& p, const Vec3d& a, const Vec3d& b, const Vec3d& c) {
-  const Vec3d ab = sub(b, a), ac = sub(c, a), ap = sub(p, a);
-  const double d1 = dot(ab, ap), d2 = dot(ac, ap);
-  if (d1 <= 0 && d2 <= 0) return norm(ap);
-  const Vec3d bp = sub(p, b);
-  const double d3 = dot(ab, bp), d4 = dot(ac, bp);
-  if (d3 >= 0 && d4 <= d3) return norm(bp);
-  const double vc = d1 * d4 - d3 * d2;
-  if (vc <= 0 && d1 >= 0 && d3 <= 0) return norm(sub(p, add(a, mul(ab, d1 / (d1 - d3)))));
-  const Vec3d cp = sub(p, c);
-  const double d5 = dot(ab, cp), d6 = dot(ac, cp);
-  if (d6 >= 0 && d5 <= d6) return norm(cp);
-  const double vb = d5 * d2 - d1 * d6;
-  if (vb <= 0 && d2 >= 0 && d6 <= 0) return norm(sub(p, add(a, mul(ac, d2 / (d2 - d6)))));
-  const double va = d3 * d6 - d5 * d4;
-  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0)
-    return norm(sub(p, add(b, mul(sub(c, b), (d4 - d3) / ((d4 - d3) + (d5 - d6))))));
-  const double denom = 1 / (va + vb + vc);
-  return norm(sub(p, add(a, add(mul(ab, vb * denom), mul(ac, vc * denom)))));
 }
 
 double clamp01(double x) {
@@ -186,7 +165,7 @@ Sample sample(const Case& c, double t) {
     const double wa = dot(cross(sub(b, p), sub(cc, p)), n) / nn;
     const double wb = dot(cross(sub(cc, p), sub(a, p)), n) / nn;
     s.inside = std::min({wa, wb, 1 - wa - wb});
-    s.distance = point_triangle_distance(p, a, b, cc);
+    s.distance = std::sqrt(tetseg::test::squared_distance_to_triangle(p, a, b, cc));
     s.well_shaped = std::sqrt(nn) > 0.1;
   } else {
     const Vec3d &a = x[0], &b = x[1], &cc = x[2], &d = x[3];
