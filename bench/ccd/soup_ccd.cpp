@@ -196,6 +196,24 @@ std::vector<Contact> sweep_contacts(const std::vector<std::array<double, 3>>& x0
 // 15 MB on the benchmark VM), every frame.
 constexpr std::size_t kContactsPerFace = 2;
 
+// Every contact of the step `query` (a Scene or a Collider, stepped) of a soup of `faces`
+// faces: into a buffer of kContactsPerFace per face, once more into one of the count found
+// when that was too small.
+template <class Query>
+std::vector<tetseg::Contact> step_contacts(Query& query, std::size_t faces) {
+  std::vector<tetseg::Contact> found(kContactsPerFace * faces + 1024);
+  ContactsResult r;
+  ColliderStatus st = query.contacts(found.data(), found.size(), r);
+  if (st == ColliderStatus::kOk && r.truncated()) {
+    found.resize(r.found);
+    st = query.contacts(found.data(), found.size(), r);
+  }
+  if (st != ColliderStatus::kOk)
+    throw std::runtime_error(std::string("query failed: ") + tetseg::to_string(st));
+  found.resize(r.written);
+  return found;
+}
+
 // The runtime's contacts in the order of `find_contacts`: vertex-face by (vertex, face id), then
 // edge-edge by nodes.
 std::vector<Contact> sorted_contacts(std::vector<tetseg::Contact>& found) {
@@ -213,6 +231,19 @@ std::vector<Contact> sorted_contacts(std::vector<tetseg::Contact>& found) {
   return contacts;
 }
 
+// The soup's faces over `nodes` vertices as a surface-only body; throws on a face with a
+// repeated or out-of-range vertex.
+std::shared_ptr<const BodyShape> soup_shape(const std::vector<std::array<std::uint32_t, 3>>& faces,
+                                            std::uint32_t nodes) {
+  std::vector<std::uint32_t> ids;
+  ids.reserve(faces.size() * 3);
+  for (const auto& f : faces) ids.insert(ids.end(), f.begin(), f.end());
+  std::shared_ptr<const BodyShape> shape =
+      BodyShape::from_triangles(ids.data(), faces.size(), nodes);
+  if (!shape) throw std::runtime_error("faces with a repeated or out-of-range vertex");
+  return shape;
+}
+
 // The soup as one surface-only body of a runtime scene (one median-split BVH over the swept
 // triangle boxes, self traversal, exact deduplication, the runtime's feature filters and
 // elementary tests). Memory: the mesh, the scene's scratch and the contacts found.
@@ -227,11 +258,7 @@ std::vector<Contact> scene_contacts(const std::vector<std::array<double, 3>>& x0
     shape = BodyShape::from_asset(*asset);
     if (!shape) throw std::runtime_error("cannot set up the asset's body (out of memory)");
   } else {
-    std::vector<std::uint32_t> ids;
-    ids.reserve(faces.size() * 3);
-    for (const auto& f : faces) ids.insert(ids.end(), f.begin(), f.end());
-    shape = BodyShape::from_triangles(ids.data(), faces.size(), nodes);
-    if (!shape) throw std::runtime_error("faces with a repeated or out-of-range vertex");
+    shape = soup_shape(faces, nodes);
   }
   std::vector<double> p0, p1;
   p0.reserve(x0.size() * 3);
@@ -255,19 +282,10 @@ std::vector<Contact> scene_contacts(const std::vector<std::array<double, 3>>& x0
                                      rest_detectors.size()) != ColliderStatus::kOk)
       throw std::runtime_error("cannot set the detector positions");
   }
-  ColliderStatus st = scene.step();
+  const ColliderStatus st = scene.step();
   if (st != ColliderStatus::kOk)
     throw std::runtime_error(std::string("step rejected: ") + tetseg::to_string(st));
-  std::vector<tetseg::Contact> found(kContactsPerFace * faces.size() + 1024);
-  ContactsResult r;
-  st = scene.contacts(found.data(), found.size(), r);
-  if (st == ColliderStatus::kOk && r.truncated()) {
-    found.resize(r.found);
-    st = scene.contacts(found.data(), found.size(), r);
-  }
-  if (st != ColliderStatus::kOk)
-    throw std::runtime_error(std::string("query failed: ") + tetseg::to_string(st));
-  found.resize(r.written);
+  std::vector<tetseg::Contact> found = step_contacts(scene, faces.size());
   if (stats != nullptr) {
     const ColliderStats& body_stats = scene.body_stats(body);
     stats->triangle_pairs = body_stats.triangle_pairs;
@@ -285,12 +303,7 @@ std::vector<Contact> collider_features_contacts(
     const std::vector<std::array<std::uint32_t, 3>>& faces, const CcdOptions& options,
     FrameStats* stats, StillPairs still_pairs, std::uint32_t threads) {
   const auto nodes = static_cast<std::uint32_t>(x0.size());
-  std::vector<std::uint32_t> ids;
-  ids.reserve(faces.size() * 3);
-  for (const auto& f : faces) ids.insert(ids.end(), f.begin(), f.end());
-  std::shared_ptr<const BodyShape> shape =
-      BodyShape::from_triangles(ids.data(), faces.size(), nodes);
-  if (!shape) throw std::runtime_error("faces with a repeated or out-of-range vertex");
+  const std::shared_ptr<const BodyShape> shape = soup_shape(faces, nodes);
   ColliderOptions collider_options;
   collider_options.mode = ColliderMode::kFeatures;
   collider_options.ccd = options;
@@ -298,19 +311,10 @@ std::vector<Contact> collider_features_contacts(
   collider_options.use_openmp = threads > 1;
   collider_options.threads = threads;
   Collider collider(shape, collider_options);
-  ColliderStatus st = collider.step(x0.front().data(), x1.front().data());
+  const ColliderStatus st = collider.step(x0.front().data(), x1.front().data());
   if (st != ColliderStatus::kOk)
     throw std::runtime_error(std::string("step rejected: ") + tetseg::to_string(st));
-  std::vector<tetseg::Contact> found(kContactsPerFace * faces.size() + 1024);
-  ContactsResult r;
-  st = collider.contacts(found.data(), found.size(), r);
-  if (st == ColliderStatus::kOk && r.truncated()) {
-    found.resize(r.found);
-    st = collider.contacts(found.data(), found.size(), r);
-  }
-  if (st != ColliderStatus::kOk)
-    throw std::runtime_error(std::string("query failed: ") + tetseg::to_string(st));
-  found.resize(r.written);
+  std::vector<tetseg::Contact> found = step_contacts(collider, faces.size());
   if (stats != nullptr) {
     const ColliderStats& s = collider.stats();
     stats->feature_pairs = s.feature_pairs;
