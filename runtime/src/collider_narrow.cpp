@@ -9,12 +9,6 @@
 #include "collider_impl.hpp"
 #include "plane_filter.hpp"
 
-#if defined(__GNUC__)
-#define TETSEG_NOINLINE __attribute__((noinline))
-#else
-#define TETSEG_NOINLINE
-#endif
-
 namespace tetseg {
 namespace {
 

@@ -9,6 +9,13 @@
 
 #include "orientation_terms.hpp"
 
+// Keeps a rarely taken path out of its hot caller (a hint; nothing depends on it).
+#if defined(__GNUC__)
+#define TETSEG_NOINLINE __attribute__((noinline))
+#else
+#define TETSEG_NOINLINE
+#endif
+
 namespace tetseg {
 
 /// A triangle moving linearly over a step: node ids and the position arrays they index
@@ -51,11 +58,7 @@ class FaceSides {
 
  private:
   // The full cubic (kept out of line: the static bound usually decides).
-#if defined(__GNUC__)
-  __attribute__((noinline))
-#endif
-  Orientation
-  full_side(const double* p0, const double* p1) noexcept {
+  TETSEG_NOINLINE Orientation full_side(const double* p0, const double* p1) noexcept {
     if (!have_full_) set_full();
     return full_.side(f_.p0(f_.nodes[0]), f_.p1(f_.nodes[0]), p0, p1);
   }
